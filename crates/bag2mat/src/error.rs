@@ -1,0 +1,98 @@
+//! The one error type of the bag2mat library. Binaries add context and print it once.
+
+use std::path::PathBuf;
+
+/// A topic in a bag, as listed when the requested topic is missing.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TopicSummary {
+    /// Topic name.
+    pub topic: String,
+    /// Message type.
+    pub msg_type: String,
+    /// Number of messages (from the index, or counted while scanning).
+    pub count: u64,
+}
+
+/// Everything that can go wrong reading or writing bags and `.mat` files.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// An operating-system error on a path.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file does not start with `#ROSBAG V2.0`.
+    #[error("{path}: not a ROS 1 bag (version 2.0): {what}")]
+    NotABag {
+        /// The file.
+        path: PathBuf,
+        /// What was found instead.
+        what: String,
+    },
+    /// A record or chunk could not be parsed.
+    #[error("{path}: corrupt bag at byte {offset}: {what}")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+        /// File offset of the bad record.
+        offset: u64,
+        /// What is wrong.
+        what: String,
+    },
+    /// No topic of that name (in either slash form).
+    #[error("{}", topic_not_found(.topic, .available))]
+    TopicNotFound {
+        /// The topic asked for.
+        topic: String,
+        /// Every topic in the bag.
+        available: Vec<TopicSummary>,
+    },
+    /// The topic exists but does not carry `sensor_msgs/Imu` with the right md5.
+    #[error("topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}]", crate::imu_msg::MD5)]
+    WrongType {
+        /// The topic.
+        topic: String,
+        /// Its type.
+        msg_type: String,
+        /// Its md5.
+        md5sum: String,
+    },
+    /// A message's bytes do not decode as the expected type.
+    #[error("bad message: {what}")]
+    BadMessage {
+        /// What is wrong.
+        what: String,
+    },
+    /// A `.mat` file could not be read or written as an N×7 `data_imu`.
+    #[error("{path}: {what}")]
+    Mat {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        what: String,
+    },
+}
+
+fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
+    let mut s = format!("no sensor_msgs/Imu topic '{topic}' in the bag");
+    if available.is_empty() {
+        s.push_str(" (the bag has no topics at all)");
+    } else {
+        s.push_str("; topics in the bag:");
+        for t in available {
+            s.push_str(&format!("\n  {:<30} {:>10} msgs : {}", t.topic, t.count, t.msg_type));
+        }
+    }
+    s
+}
+
+impl Error {
+    /// Wraps an I/O error with its path.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Error {
+        Error::Io { path: path.into(), source }
+    }
+}

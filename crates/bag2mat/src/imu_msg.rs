@@ -1,0 +1,231 @@
+//! `sensor_msgs/Imu`: the ROS 1 serialized layout, its md5 and its full message definition.
+//!
+//! The layout is fixed apart from `header.frame_id`, so encoding and decoding are written by
+//! hand (rust_stack.md §5.1): little-endian, no alignment padding, strings as a u32 length
+//! plus bytes, fixed arrays without a length prefix. The definition text is genpy's
+//! `_full_text`, assembled from the four vendored `.msg` files exactly as genpy does (§5.3),
+//! and tested byte for byte against it.
+
+use std::sync::LazyLock;
+
+use crate::bag::RosTime;
+use crate::error::Error;
+
+/// The ROS type name.
+pub const TYPE: &str = "sensor_msgs/Imu";
+/// The ROS 1 md5 of `sensor_msgs/Imu` (genpy's `Imu._md5sum`).
+pub const MD5: &str = "6a62c6daae103f4ff57a132d6f95cec2";
+
+const IMU_MSG: &str = include_str!("../msg/sensor_msgs_Imu.msg");
+/// The dependencies in genpy's order, with the raw text of each `.msg` file.
+const DEPENDENCIES: [(&str, &str); 3] = [
+    ("std_msgs/Header", include_str!("../msg/std_msgs_Header.msg")),
+    ("geometry_msgs/Quaternion", include_str!("../msg/geometry_msgs_Quaternion.msg")),
+    ("geometry_msgs/Vector3", include_str!("../msg/geometry_msgs_Vector3.msg")),
+];
+
+static DEFINITION_TEXT: LazyLock<String> = LazyLock::new(|| {
+    // genpy: the message text, then each dependency after a blank line, a line of 80 '=' and
+    // `MSG: pkg/Type`. Trailing newlines are stripped from every file; nothing else is trimmed
+    // (several lines end in spaces that are part of the text the md5 of readers is built on).
+    let mut text = IMU_MSG.trim_end_matches('\n').to_string();
+    for (name, body) in DEPENDENCIES {
+        text.push_str("\n\n");
+        text.push_str(&"=".repeat(80));
+        text.push_str("\nMSG: ");
+        text.push_str(name);
+        text.push('\n');
+        text.push_str(body.trim_end_matches('\n'));
+    }
+    text
+});
+
+/// The full message definition written into a bag's connection record (2571 bytes).
+pub fn definition() -> &'static str {
+    &DEFINITION_TEXT
+}
+
+/// One `sensor_msgs/Imu` message. Vectors are `[x, y, z]`, the quaternion `[x, y, z, w]`,
+/// covariances row-major 3×3. Units as in ROS: rad/s and m/s².
+#[derive(Debug, Clone, PartialEq)]
+pub struct Imu {
+    /// `header.seq`.
+    pub seq: u32,
+    /// `header.stamp`: the sensor's time of the sample.
+    pub stamp: RosTime,
+    /// `header.frame_id`.
+    pub frame_id: String,
+    /// Orientation quaternion `[x, y, z, w]`.
+    pub orientation: [f64; 4],
+    /// Orientation covariance; `[0] = -1` means "no orientation".
+    pub orientation_covariance: [f64; 9],
+    /// Angular velocity, rad/s.
+    pub angular_velocity: [f64; 3],
+    /// Angular velocity covariance.
+    pub angular_velocity_covariance: [f64; 9],
+    /// Linear acceleration (specific force), m/s².
+    pub linear_acceleration: [f64; 3],
+    /// Linear acceleration covariance.
+    pub linear_acceleration_covariance: [f64; 9],
+}
+
+impl Default for Imu {
+    fn default() -> Self {
+        Imu {
+            seq: 0,
+            stamp: RosTime::default(),
+            frame_id: String::new(),
+            orientation: [0.0; 4],
+            orientation_covariance: [0.0; 9],
+            angular_velocity: [0.0; 3],
+            angular_velocity_covariance: [0.0; 9],
+            linear_acceleration: [0.0; 3],
+            linear_acceleration_covariance: [0.0; 9],
+        }
+    }
+}
+
+/// Serialized size of everything after `frame_id`: 4 + 9 + 3 + 9 + 3 + 9 doubles.
+const BODY_LEN: usize = 37 * 8;
+
+/// The part of a message the analysers need, decoded without allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuSample {
+    /// `header.seq`.
+    pub seq: u32,
+    /// `header.stamp`.
+    pub stamp: RosTime,
+    /// Angular velocity, rad/s.
+    pub gyro: [f64; 3],
+    /// Linear acceleration, m/s².
+    pub acc: [f64; 3],
+}
+
+impl Imu {
+    /// Serialized length in bytes: 312 + the length of `frame_id`.
+    pub fn encoded_len(&self) -> usize {
+        16 + self.frame_id.len() + BODY_LEN
+    }
+
+    /// Appends the ROS 1 serialization of `self` to `out`.
+    pub fn encode(&self, out: &mut Vec<u8>) {
+        out.reserve(self.encoded_len());
+        out.extend_from_slice(&self.seq.to_le_bytes());
+        out.extend_from_slice(&self.stamp.sec.to_le_bytes());
+        out.extend_from_slice(&self.stamp.nsec.to_le_bytes());
+        out.extend_from_slice(&(self.frame_id.len() as u32).to_le_bytes());
+        out.extend_from_slice(self.frame_id.as_bytes());
+        let doubles = self
+            .orientation
+            .iter()
+            .chain(&self.orientation_covariance)
+            .chain(&self.angular_velocity)
+            .chain(&self.angular_velocity_covariance)
+            .chain(&self.linear_acceleration)
+            .chain(&self.linear_acceleration_covariance);
+        for v in doubles {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+
+    /// Decodes a whole message; errors if `data` is not exactly one Imu.
+    pub fn decode(data: &[u8]) -> Result<Imu, Error> {
+        let (head, frame_id, body) = split(data)?;
+        let mut d = [0.0f64; 37];
+        for (i, v) in d.iter_mut().enumerate() {
+            *v = f64_at(body, i);
+        }
+        let mut imu = Imu {
+            seq: head.0,
+            stamp: head.1,
+            frame_id: String::from_utf8_lossy(frame_id).into_owned(),
+            ..Imu::default()
+        };
+        imu.orientation.copy_from_slice(&d[0..4]);
+        imu.orientation_covariance.copy_from_slice(&d[4..13]);
+        imu.angular_velocity.copy_from_slice(&d[13..16]);
+        imu.angular_velocity_covariance.copy_from_slice(&d[16..25]);
+        imu.linear_acceleration.copy_from_slice(&d[25..28]);
+        imu.linear_acceleration_covariance.copy_from_slice(&d[28..37]);
+        Ok(imu)
+    }
+}
+
+impl ImuSample {
+    /// Decodes seq, stamp, gyro and acc from a serialized Imu, skipping the rest.
+    pub fn decode(data: &[u8]) -> Result<ImuSample, Error> {
+        let ((seq, stamp), _, body) = split(data)?;
+        Ok(ImuSample {
+            seq,
+            stamp,
+            gyro: [f64_at(body, 13), f64_at(body, 14), f64_at(body, 15)],
+            acc: [f64_at(body, 25), f64_at(body, 26), f64_at(body, 27)],
+        })
+    }
+}
+
+type Head = (u32, RosTime);
+
+/// Splits a serialized Imu into (seq, stamp), frame_id bytes and the fixed body.
+fn split(data: &[u8]) -> Result<(Head, &[u8], &[u8]), Error> {
+    let bad = |what: String| Error::BadMessage { what };
+    if data.len() < 16 {
+        return Err(bad(format!("Imu message of {} bytes is shorter than its header", data.len())));
+    }
+    let u32_at = |o: usize| u32::from_le_bytes([data[o], data[o + 1], data[o + 2], data[o + 3]]);
+    let seq = u32_at(0);
+    let stamp = RosTime { sec: u32_at(4), nsec: u32_at(8) };
+    let id_len = u32_at(12) as usize;
+    let expected = 16usize.checked_add(id_len).and_then(|n| n.checked_add(BODY_LEN));
+    if expected != Some(data.len()) {
+        return Err(bad(format!(
+            "Imu message of {} bytes does not match its frame_id length {id_len} (expected {} bytes)",
+            data.len(),
+            16u64 + id_len as u64 + BODY_LEN as u64
+        )));
+    }
+    Ok(((seq, stamp), &data[16..16 + id_len], &data[16 + id_len..]))
+}
+
+fn f64_at(body: &[u8], i: usize) -> f64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&body[8 * i..8 * i + 8]);
+    f64::from_le_bytes(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encode_decode_round_trip() {
+        let imu = Imu {
+            seq: 42,
+            stamp: RosTime { sec: 1_600_000_000, nsec: 999_999_999 },
+            frame_id: "base_link".into(),
+            orientation: [0.1, 0.2, 0.3, 0.9],
+            orientation_covariance: [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+            angular_velocity: [1e-300, -0.0, f64::MAX],
+            angular_velocity_covariance: [-1.0; 9],
+            linear_acceleration: [0.5, -9.81, 1e10],
+            linear_acceleration_covariance: [0.25; 9],
+        };
+        let mut buf = Vec::new();
+        imu.encode(&mut buf);
+        assert_eq!(buf.len(), 312 + 9);
+        assert_eq!(Imu::decode(&buf).unwrap(), imu);
+        let s = ImuSample::decode(&buf).unwrap();
+        assert_eq!((s.seq, s.stamp, s.gyro, s.acc), (42, imu.stamp, imu.angular_velocity, imu.linear_acceleration));
+    }
+
+    #[test]
+    fn truncated_message_is_an_error() {
+        let mut buf = Vec::new();
+        Imu::default().encode(&mut buf);
+        for len in [0, 15, 16, buf.len() - 1] {
+            assert!(ImuSample::decode(&buf[..len]).is_err(), "len {len}");
+        }
+        buf.push(0);
+        assert!(Imu::decode(&buf).is_err());
+    }
+}
