@@ -1,0 +1,9 @@
+//! Integration tests of bag2mat: parity with the real bagconvert on the reference bags,
+//! round trips through our writer and reader, the real ROS and MATLAB-format tools reading
+//! what we write, and the command line as a user runs it.
+
+mod cli;
+mod real_tools;
+mod reference;
+mod roundtrip;
+mod util;
