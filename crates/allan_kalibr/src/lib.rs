@@ -1,1 +1,50 @@
-pub fn placeholder() {}
+//! # allan_kalibr
+//!
+//! Reproduces the MATLAB half of rpng/kalibr_allan (`9d38ea9`: `SCRIPT_allan_matparallel.m`,
+//! `allan.m`, `SCRIPT_process_results.m`, `gen_chart.m`) in seconds instead of hours, and adds
+//! what users ask for: Kalibr's `imu.yaml`, the curves as CSV, and readable plots.
+//! The behaviour contract is `shared/specs/kalibr_allan.md`.
+//!
+//! ## Brief overview
+//! * [`tau_grid`]: the 2000-point τ grid exactly as upstream builds it.
+//! * [`estimator`]: the non-overlapping `sig2` per axis (prefix-sum fast path, bit-exact
+//!   replay of upstream's recursion, slow oracle).
+//! * [`fit`]: gen_chart's fixed-slope fits and read-offs.
+//! * [`report`]: the exact printed text; [`yaml`]: Kalibr imu.yaml; [`curves`]: the CSV;
+//!   [`plot`]: the two charts.
+//! * [`input`]: `.mat`/`.bag` loading and the update-rate check; [`run`]: the whole job.
+//!
+//! ## Units and conventions
+//! Accelerometer in m/s², gyroscope in rad/s, as in the bag. The four numbers are
+//! continuous-time Kalibr values: noise densities in m/s²/√Hz and rad/s/√Hz (the −½ line at
+//! τ = 1 s), random walks in m/s³/√Hz and rad/s²/√Hz (the +½ line at τ = 3 s).
+//!
+//! ## Quirks reproduced on purpose (compat)
+//! * The τ grid starts at δ² (issue #25), keeps its m = 0 points (NaN), duplicates, and the
+//!   knife-edge last point (`tau_grid`, `quirk_25_grid_starts_at_delta_squared`,
+//!   `quirk_knife_edge_last_point`).
+//! * `sig2` is the non-overlapping deviation; the overlapping one upstream also computes is
+//!   never used (`estimator`).
+//! * With exactly two clusters Octave squares with `pow(d, 2)` (`estimator`,
+//!   `quirk_two_clusters_square_with_pow`).
+//! * Deviations (not variances) are averaged over axes (issue #27); fit windows are grid
+//!   indices `1:minid-50` and `minid+50:end`; empty windows give NaN (issues #12/#13,
+//!   `quirk_12_13_*` in `fit`).
+//! * The update rate drives the grid; timestamps are only counted (they are checked here
+//!   and a warning printed, which upstream never does).
+
+pub mod cli;
+pub mod curves;
+pub mod error;
+pub mod estimator;
+pub mod fit;
+pub mod input;
+pub mod plot;
+pub mod report;
+pub mod run;
+pub mod tau_grid;
+pub mod yaml;
+
+pub use error::Error;
+pub use estimator::Estimator;
+pub use run::{Analysis, Config, RunOutput, analyse, run, run_on};

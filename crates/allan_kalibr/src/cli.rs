@@ -1,0 +1,104 @@
+//! The command line as the user typed it ([`Args`]) and its resolution into a [`Config`].
+
+use std::path::PathBuf;
+
+use clap::Parser;
+
+use crate::estimator::Estimator;
+use crate::run::Config;
+
+/// kalibr_allan's Allan-deviation results (rpng/kalibr_allan 9d38ea9), in seconds.
+///
+/// Reads IMU samples from a ROS 1 bag or a bagconvert .mat (variable data_imu), computes the
+/// non-overlapping Allan deviation on upstream's 2000-point tau grid, fits the -1/2 and +1/2
+/// lines as gen_chart.m does, prints upstream's lines and writes imu.yaml,
+/// allan_curves.csv, allan_accel.{png,svg} and allan_gyro.{png,svg}.
+#[derive(Debug, Clone, Parser, PartialEq)]
+#[command(name = "allan_kalibr", version)]
+pub struct Args {
+    /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
+    pub input: PathBuf,
+    /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml).
+    #[arg(long, default_value = "imu")]
+    pub topic: String,
+    /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
+    /// from the timestamps.
+    #[arg(long, value_name = "HZ")]
+    pub update_rate: Option<f64>,
+    /// Chart title prefix (upstream's titlestr).
+    #[arg(long, value_name = "TEXT", default_value = "")]
+    pub title: String,
+    /// Replay upstream's running-mean recursion: curves bit-identical to kalibr_allan (slower).
+    #[arg(long)]
+    pub bit_exact: bool,
+    /// Output directory (default: the input's directory).
+    #[arg(short = 'o', long, value_name = "OUTDIR")]
+    pub outdir: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl From<Args> for Config {
+    fn from(a: Args) -> Config {
+        let outdir = a.outdir.unwrap_or_else(|| match a.input.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        });
+        Config {
+            input: a.input,
+            topic: a.topic,
+            update_rate: a.update_rate,
+            title: a.title,
+            estimator: if a.bit_exact {
+                Estimator::BitExact
+            } else {
+                Estimator::PrefixSum
+            },
+            outdir,
+            quiet: a.quiet,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(v: &[&str]) -> Config {
+        Args::try_parse_from(std::iter::once("allan_kalibr").chain(v.iter().copied()))
+            .unwrap()
+            .into()
+    }
+
+    #[test]
+    fn defaults() {
+        let c = parse(&["data/x.bag"]);
+        assert_eq!(c.outdir, PathBuf::from("data"));
+        assert_eq!(c.topic, "imu");
+        assert_eq!(c.update_rate, None);
+        assert_eq!(c.estimator, Estimator::PrefixSum);
+        assert_eq!(parse(&["x.mat"]).outdir, PathBuf::from("."));
+    }
+
+    #[test]
+    fn flags() {
+        let c = parse(&[
+            "x.bag",
+            "--topic",
+            "/imu0",
+            "--update-rate",
+            "200",
+            "--bit-exact",
+            "-o",
+            "out",
+            "--title",
+            "ADIS",
+        ]);
+        assert_eq!(c.topic, "/imu0");
+        assert_eq!(c.update_rate, Some(200.0));
+        assert_eq!(c.estimator, Estimator::BitExact);
+        assert_eq!(c.outdir, PathBuf::from("out"));
+        assert_eq!(c.title, "ADIS");
+    }
+}

@@ -1,0 +1,50 @@
+//! The error type of the allan_kalibr library; the binary prints it once with anyhow.
+
+use std::path::PathBuf;
+
+/// Everything that can stop a run. No output file is written when any of these occurs.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The update rate is not a finite positive number of Hz.
+    #[error("update rate must be a finite positive number of Hz, got {0}")]
+    BadRate(f64),
+    /// Fewer than 3 samples: taumax = floor((N-1)/2) < 1, where upstream takes log10(0)
+    /// or the log of a negative number and produces garbage or crashes.
+    #[error(
+        "too few samples for an Allan deviation: {n} (need at least 3, so that taumax = floor((N-1)/2) >= 1)"
+    )]
+    TooShort {
+        /// Number of samples found.
+        n: usize,
+    },
+    /// The timestamps cannot give a rate (no --update-rate and no positive time span).
+    #[error("cannot estimate the update rate from the timestamps ({what}); pass --update-rate HZ")]
+    NoRate {
+        /// Why.
+        what: String,
+    },
+    /// Input file extension is neither .bag nor .mat.
+    #[error("{path}: unknown input type (expected a .bag or a .mat file)")]
+    UnknownInput {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Data contains NaN or infinite samples (upstream would silently produce NaN curves).
+    #[error("{what}")]
+    BadData {
+        /// What is wrong.
+        what: String,
+    },
+    /// Reading the bag or .mat, or writing an output file, failed.
+    #[error(transparent)]
+    Io(#[from] bag2mat::Error),
+    /// Drawing a plot failed.
+    #[error("plot {path}: {what}")]
+    Plot {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        what: String,
+    },
+}

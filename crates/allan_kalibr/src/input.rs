@@ -1,0 +1,223 @@
+//! Loading the samples (a `.mat` with `data_imu`, or a `.bag` read through bag2mat exactly
+//! as bagconvert does) and choosing the update rate that drives the τ grid.
+//!
+//! Upstream never looks at the timestamps except to count them (kalibr_allan.md §2): the
+//! user types the rate into the script. Here the rate is estimated from the timestamps when
+//! not given, and a given rate that disagrees with them by more than 1 % gets a warning.
+
+use std::path::Path;
+
+use crate::error::Error;
+
+/// A relative disagreement between the given and the measured rate above which we warn.
+pub const RATE_WARN_REL: f64 = 0.01;
+/// An estimated rate within this relative distance of an integer is rounded to it
+/// (timestamps of a 200 Hz IMU give 199.99…, and the grid wants the nominal rate).
+pub const RATE_SNAP_REL: f64 = 0.005;
+
+/// The samples as bagconvert's `data_imu` columns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuData {
+    /// Column 1: time in seconds (bag record time, `sec + 1e-9*nsec`, for bags).
+    pub t: Vec<f64>,
+    /// Columns 2–7: ax ay az (m/s²), wx wy wz (rad/s).
+    pub axes: [Vec<f64>; 6],
+    /// The topic the samples came from (the bag's own spelling), if known.
+    pub topic: Option<String>,
+    /// Messages for the user (bag2mat's notes).
+    pub notes: Vec<String>,
+}
+
+impl ImuData {
+    /// Number of samples N.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// Builds the columns from a bag2mat series (t = record time `to_sec()`, as bagconvert).
+    pub fn from_series(s: bag2mat::ImuSeries) -> Self {
+        let t = s.record_time.iter().map(|r| r.to_sec()).collect();
+        let axes = std::array::from_fn(|c| {
+            if c < 3 {
+                s.acc.iter().map(|v| v[c]).collect()
+            } else {
+                s.gyro.iter().map(|v| v[c - 3]).collect()
+            }
+        });
+        ImuData {
+            t,
+            axes,
+            topic: Some(s.topic),
+            notes: s.notes,
+        }
+    }
+
+    /// Checks that every sample is finite (a NaN would silently turn whole curves into NaN).
+    pub fn check_finite(&self) -> Result<(), Error> {
+        const NAMES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
+        for (a, col) in self.axes.iter().enumerate() {
+            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+                return Err(Error::BadData {
+                    what: format!(
+                        "sample {} of {} is {} (every sample must be finite)",
+                        i + 1,
+                        NAMES[a],
+                        col[i]
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Reads a `.bag` (topic `topic`) or a `.mat` (variable `data_imu`), by extension.
+pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "bag" => {
+            let opts = bag2mat::ReadOptions { quiet };
+            Ok(ImuData::from_series(bag2mat::read_imu_series(
+                path, topic, &opts,
+            )?))
+        }
+        "mat" => load_mat(path),
+        _ => Err(Error::UnknownInput {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+fn load_mat(path: &Path) -> Result<ImuData, Error> {
+    let d = bag2mat::mat::read_data_imu(path)?;
+    let [t, ax, ay, az, wx, wy, wz] = d.columns;
+    Ok(ImuData {
+        t,
+        axes: [ax, ay, az, wx, wy, wz],
+        topic: None,
+        notes: Vec::new(),
+    })
+}
+
+/// The rate used for the grid and what to tell the user about it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RateChoice {
+    /// Hz, drives the τ grid.
+    pub used: f64,
+    /// `(N-1)/(t_N - t_1)` when the timestamps allow it.
+    pub measured: Option<f64>,
+    /// An info line (estimated) or a warning (disagreement), for stderr.
+    pub message: Option<String>,
+}
+
+/// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span.
+pub fn measured_rate(t: &[f64]) -> Option<f64> {
+    let (first, last) = (t.first()?, t.last()?);
+    let span = last - first;
+    (t.len() >= 2 && span.is_finite() && span > 0.0).then(|| (t.len() - 1) as f64 / span)
+}
+
+/// Chooses the update rate: the given one (warning if the timestamps disagree by more than
+/// [`RATE_WARN_REL`]) or the measured one, snapped to an integer within [`RATE_SNAP_REL`].
+pub fn choose_rate(given: Option<f64>, t: &[f64]) -> Result<RateChoice, Error> {
+    let measured = measured_rate(t);
+    match given {
+        Some(rate) => {
+            if !(rate.is_finite() && rate > 0.0) {
+                return Err(Error::BadRate(rate));
+            }
+            let message = measured
+                .filter(|m| ((m - rate) / rate).abs() > RATE_WARN_REL)
+                .map(|m| {
+                    format!(
+                        "warning: --update-rate {rate} Hz but the timestamps give {m:.4} Hz \
+                     ({:+.2} %); the grid uses {rate} Hz as upstream would",
+                        (m - rate) / rate * 100.0
+                    )
+                });
+            Ok(RateChoice {
+                used: rate,
+                measured,
+                message,
+            })
+        }
+        None => {
+            let m = measured.ok_or_else(|| Error::NoRate {
+                what: format!("{} samples, no positive time span", t.len()),
+            })?;
+            let r = m.round();
+            let used = if r >= 1.0 && ((m - r) / r).abs() <= RATE_SNAP_REL {
+                r
+            } else {
+                m
+            };
+            let message = Some(format!(
+                "update rate: {used} Hz (estimated from the timestamps: {m:.4} Hz; pass --update-rate to override)"
+            ));
+            Ok(RateChoice {
+                used,
+                measured,
+                message,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn times(n: usize, rate: f64) -> Vec<f64> {
+        (0..n).map(|i| 1.6e9 + i as f64 / rate).collect()
+    }
+
+    #[test]
+    fn estimated_rate_snaps_to_integer() {
+        let c = choose_rate(None, &times(1000, 200.0)).unwrap();
+        assert_eq!(c.used, 200.0);
+        assert!(c.message.unwrap().contains("estimated"));
+        let c = choose_rate(None, &times(1000, 12.34)).unwrap();
+        // Absolute times near 1.6e9 s carry ~2.4e-7 s of rounding each.
+        const ABS_TIME_REL_TOL: f64 = 1e-7;
+        assert!(
+            ((c.used - 12.34) / 12.34).abs() < ABS_TIME_REL_TOL,
+            "{}",
+            c.used
+        );
+    }
+
+    #[test]
+    fn given_rate_warns_only_beyond_one_percent() {
+        let t = times(1000, 200.0);
+        assert!(choose_rate(Some(200.0), &t).unwrap().message.is_none());
+        assert!(choose_rate(Some(201.0), &t).unwrap().message.is_none());
+        let c = choose_rate(Some(100.0), &t).unwrap();
+        assert_eq!(c.used, 100.0);
+        assert!(c.message.unwrap().starts_with("warning"));
+    }
+
+    #[test]
+    fn no_rate_without_span() {
+        assert!(matches!(
+            choose_rate(None, &[1.0]),
+            Err(Error::NoRate { .. })
+        ));
+        assert!(matches!(
+            choose_rate(None, &[1.0, 1.0]),
+            Err(Error::NoRate { .. })
+        ));
+        assert!(matches!(
+            choose_rate(Some(-1.0), &[]),
+            Err(Error::BadRate(_))
+        ));
+        assert_eq!(choose_rate(Some(50.0), &[]).unwrap().used, 50.0);
+    }
+}

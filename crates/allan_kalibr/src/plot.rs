@@ -1,0 +1,253 @@
+//! The two charts of `gen_chart.m` (kalibr_allan.md §3.3), drawn with plotters and the
+//! workspace's embedded font: log-log Allan deviation of x, y, z and their average against
+//! `tau1`, the −½ (red) and +½ (blue) fitted lines, the τ≈1 and τ≈3 read-off points, and
+//! the two values in the legend. PNG and SVG, both written atomically.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::error::Error;
+use crate::fit::ChartFit;
+
+/// MATLAB's default colour order (lines 1–4: x, y, z, average).
+const MATLAB_COLORS: [RGBColor; 4] = [
+    RGBColor(0, 114, 189),
+    RGBColor(217, 83, 25),
+    RGBColor(237, 177, 32),
+    RGBColor(126, 47, 142),
+];
+/// PNG size in pixels.
+const PNG_SIZE: (u32, u32) = (1400, 1000);
+/// SVG size in user units.
+const SVG_SIZE: (u32, u32) = (1000, 720);
+/// Points on each fitted line (log-spaced over the τ range).
+const FIT_LINE_POINTS: usize = 400;
+
+/// What one chart shows.
+pub struct Chart<'a> {
+    /// Title: `<title> <sensor name>` as upstream (`[titlestr ' ' name]`).
+    pub title: String,
+    /// `acceleration` or `gyroscope` (legend: `x-acceleration`, …).
+    pub name: &'a str,
+    /// Unit of the deviation (`m/s^2`, `rad/s`).
+    pub unit: &'a str,
+    /// Units of the white-noise and random-walk values.
+    pub unit_white: &'a str,
+    pub unit_bias: &'a str,
+    /// `tau1` of the grid.
+    pub tau: &'a [f64],
+    /// The three per-axis curves.
+    pub axes: [&'a [f64]; 3],
+    /// The fit (holds the average curve and both lines).
+    pub fit: &'a ChartFit,
+}
+
+/// Draws `chart` into `<stem>.png` and `<stem>.svg` under `dir`; returns the two paths.
+pub fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2], Error> {
+    bag2mat::plot::register_font();
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+
+    // SVG: drawn into a string, then written atomically.
+    let mut svg_text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg_text, SVG_SIZE).into_drawing_area();
+        draw(chart, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
+        root.present().map_err(|e| plot_err(&svg, e))?;
+    }
+    bag2mat::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
+
+    // PNG: plotters encodes by extension, so the temporary name keeps `.png`; it is
+    // renamed into place only after a successful encode.
+    let tmp = dir.join(format!(".{stem}.{}.tmp.png", std::process::id()));
+    let result = (|| {
+        let root = BitMapBackend::new(&tmp, PNG_SIZE).into_drawing_area();
+        draw(chart, &root, PNG_SIZE.0 as f64 / SVG_SIZE.0 as f64)?;
+        root.present()?;
+        Ok::<(), Box<dyn std::error::Error>>(())
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::Plot {
+            path: png,
+            what: e.to_string(),
+        });
+    }
+    std::fs::rename(&tmp, &png).map_err(|e| bag2mat::Error::io(&png, e))?;
+    Ok([png, svg])
+}
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Plot {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    }
+}
+
+/// Finite, positive (plottable on log axes) points of a curve.
+fn positive_points(tau: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    tau.iter()
+        .zip(y)
+        .filter(|(t, v)| **t > 0.0 && v.is_finite() && **v > 0.0)
+        .map(|(&t, &v)| (t, v))
+        .collect()
+}
+
+fn draw<DB: DrawingBackend>(
+    chart: &Chart,
+    root: &DrawingArea<DB, Shift>,
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    root.fill(&WHITE)?;
+    let curves: Vec<Vec<(f64, f64)>> = chart
+        .axes
+        .iter()
+        .map(|y| positive_points(chart.tau, y))
+        .chain([positive_points(chart.tau, &chart.fit.sigavg)])
+        .collect();
+    let all = curves.iter().flatten();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 >= x1 || y0 > y1 {
+        // Nothing plottable (cannot happen after the input checks); draw an empty frame.
+        (x0, x1, y0, y1) = (1e-3, 1.0, 1e-3, 1.0);
+    }
+    // Pad a bit in log space; make sure the read-off points are inside.
+    for v in [chart.fit.white, chart.fit.bias] {
+        if v.is_finite() && v > 0.0 {
+            y0 = y0.min(v);
+            y1 = y1.max(v);
+        }
+    }
+    let (y0, y1) = (y0 / 1.6, y1 * 1.6);
+    let (x0, x1) = (x0 / 1.3, x1 * 1.3);
+
+    let mut ctx = ChartBuilder::on(root)
+        .caption(&chart.title, ("sans-serif", px(26.0)))
+        .margin(px(16.0))
+        .x_label_area_size(px(60.0))
+        .y_label_area_size(px(95.0))
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    ctx.configure_mesh()
+        .x_desc("τ [sec]")
+        .y_desc(format!("Normal Allan Deviation [{}]", chart.unit))
+        .label_style(("sans-serif", px(16.0)))
+        .axis_desc_style(("sans-serif", px(20.0)))
+        .x_label_formatter(&|v| format_tick(*v))
+        .y_label_formatter(&|v| format_tick(*v))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .draw()?;
+
+    let labels = ["x", "y", "z"].map(|a| format!("{a}-{}", chart.name));
+    for (i, pts) in curves.iter().enumerate() {
+        let color = MATLAB_COLORS[i];
+        let label = if i < 3 {
+            labels[i].clone()
+        } else {
+            "average".to_owned()
+        };
+        ctx.draw_series(LineSeries::new(
+            pts.iter().copied(),
+            color.stroke_width(px(1.5).max(1)),
+        ))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+    }
+
+    // Fitted lines over the whole τ range, clipped to the y range (log-spaced samples).
+    let fit = chart.fit;
+    let line = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+        (0..FIT_LINE_POINTS)
+            .map(|k| {
+                let t = x0 * (x1 / x0).powf(k as f64 / (FIT_LINE_POINTS - 1) as f64);
+                (t, f(t))
+            })
+            .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
+            .collect()
+    };
+    let red = RED.mix(0.5);
+    let blue = BLUE.mix(0.5);
+    let white_label = format!("−½ fit: σ = {} {}", value6(fit.white), chart.unit_white);
+    let bias_label = format!("+½ fit: σ_b = {} {}", value6(fit.bias), chart.unit_bias);
+    ctx.draw_series(LineSeries::new(
+        line(&|t| fit.h_fit1(t)),
+        red.stroke_width(px(3.0)),
+    ))?
+    .label(white_label)
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red.stroke_width(4)));
+    ctx.draw_series(LineSeries::new(
+        line(&|t| fit.h_fit2(t)),
+        blue.stroke_width(px(3.0)),
+    ))?
+    .label(bias_label)
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(4)));
+
+    // Read-off points: σ at τ≈1 on the red line, σ_b at τ≈3 on the blue line.
+    let marks = [(fit.tau_at1, fit.white, RED), (fit.tau_at2, fit.bias, BLUE)];
+    for (t, v, c) in marks {
+        if t > 0.0 && v.is_finite() && v >= y0 && v <= y1 {
+            ctx.draw_series(std::iter::once(Circle::new((t, v), px(7.0), c.filled())))?;
+            ctx.draw_series(std::iter::once(Circle::new(
+                (t, v),
+                px(9.0),
+                BLACK.stroke_width(1),
+            )))?;
+        }
+    }
+
+    ctx.configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", px(17.0)))
+        .draw()?;
+    Ok(())
+}
+
+/// `%.6f` as upstream's text box, but NaN spelled out.
+fn value6(v: f64) -> String {
+    crate::report::matlab_fixed(v, 6)
+}
+
+/// Tick labels on log axes: powers of ten as `1e-3`, others compactly.
+fn format_tick(v: f64) -> String {
+    let l = v.log10();
+    if (l - l.round()).abs() < 1e-9 {
+        let e = l.round() as i32;
+        return match e {
+            -2..=3 => format!("{}", 10f64.powi(e)),
+            _ => format!("1e{e}"),
+        };
+    }
+    format!("{v:.2e}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels() {
+        assert_eq!(format_tick(1000.0), "1000");
+        assert_eq!(format_tick(0.01), "0.01");
+        assert_eq!(format_tick(1e-5), "1e-5");
+    }
+
+    #[test]
+    fn non_positive_points_are_dropped() {
+        let p = positive_points(&[0.0, 1.0, 2.0, 3.0], &[f64::NAN, 1.0, f64::NAN, 0.0]);
+        assert_eq!(p, vec![(1.0, 1.0)]);
+    }
+}

@@ -1,0 +1,185 @@
+//! The whole job: load → choose rate → grid → sig2 → gen_chart ×2 → text, yaml, CSV, plots.
+//!
+//! Everything is computed before the first file is written, so a bad input leaves no output
+//! behind; each file is written atomically.
+
+use std::path::{Path, PathBuf};
+
+use crate::curves;
+use crate::error::Error;
+use crate::estimator::{Estimator, sig2_curves};
+use crate::fit::{ChartFit, gen_chart};
+use crate::input::{self, ImuData, RateChoice};
+use crate::plot::{self, Chart};
+use crate::report;
+use crate::tau_grid::TauGrid;
+use crate::yaml::ImuYaml;
+
+/// What the program runs with (resolved from the command line in `cli`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    /// `.bag` or `.mat`.
+    pub input: PathBuf,
+    /// Bag topic (bag2mat's topic rules).
+    pub topic: String,
+    /// Hz; None = estimate from the timestamps.
+    pub update_rate: Option<f64>,
+    /// Chart title prefix (upstream's hard-coded `titlestr`).
+    pub title: String,
+    /// Fast prefix sums or the bit-exact recursion.
+    pub estimator: Estimator,
+    /// Output directory (created if missing).
+    pub outdir: PathBuf,
+    /// No progress bars.
+    pub quiet: bool,
+}
+
+/// The numbers of one run.
+#[derive(Debug, Clone)]
+pub struct Analysis {
+    /// The τ grid.
+    pub grid: TauGrid,
+    /// sig2 curves ax ay az wx wy wz over the grid.
+    pub sig2: [Vec<f64>; 6],
+    /// gen_chart on the accelerometer curves.
+    pub accel: ChartFit,
+    /// gen_chart on the gyroscope curves.
+    pub gyro: ChartFit,
+}
+
+/// Computes grid, curves and both fits for `axes` (each N samples) at `rate` Hz.
+pub fn analyse(
+    axes: &[Vec<f64>; 6],
+    rate: f64,
+    estimator: Estimator,
+    quiet: bool,
+) -> Result<Analysis, Error> {
+    let grid = TauGrid::new(axes[0].len(), rate)?;
+    let jobs = 6 * grid.distinct_m().len() as u64;
+    let bar = bag2mat::progress::bar(jobs, quiet || estimator == Estimator::PrefixSum, "taus");
+    bar.set_message("allan");
+    let sig2 = sig2_curves(axes, &grid, estimator, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let accel = gen_chart(&grid.tau1, &sig2[0], &sig2[1], &sig2[2]);
+    let gyro = gen_chart(&grid.tau1, &sig2[3], &sig2[4], &sig2[5]);
+    Ok(Analysis {
+        grid,
+        sig2,
+        accel,
+        gyro,
+    })
+}
+
+/// Result of [`run`]: the printed text, the messages for stderr and the files written.
+#[derive(Debug)]
+pub struct RunOutput {
+    /// The numbers.
+    pub analysis: Analysis,
+    /// How the update rate was chosen.
+    pub rate: RateChoice,
+    /// Upstream's printed text (stdout).
+    pub text: String,
+    /// Notes and warnings (stderr), in order.
+    pub notes: Vec<String>,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// Runs the whole job for `config`.
+pub fn run(config: &Config) -> Result<RunOutput, Error> {
+    let data = input::load(&config.input, &config.topic, config.quiet)?;
+    run_on(config, data)
+}
+
+/// [`run`] on samples already in memory.
+pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
+    let mut notes = data.notes.clone();
+    if data.len() < 3 {
+        return Err(Error::TooShort { n: data.len() });
+    }
+    data.check_finite()?;
+    let rate = input::choose_rate(config.update_rate, &data.t)?;
+    notes.extend(rate.message.clone());
+    let topic = data.topic.clone().unwrap_or_else(|| config.topic.clone());
+    let analysis = analyse(&data.axes, rate.used, config.estimator, config.quiet)?;
+    drop(data);
+    let text = report::full_text(&analysis.accel, &analysis.gyro);
+
+    // Render the text outputs before touching the output directory.
+    let source = config
+        .input
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let yaml = ImuYaml {
+        accelerometer_noise_density: analysis.accel.white,
+        accelerometer_random_walk: analysis.accel.bias,
+        gyroscope_noise_density: analysis.gyro.white,
+        gyroscope_random_walk: analysis.gyro.bias,
+        rostopic: topic,
+        update_rate: rate.used,
+    }
+    .render(&source);
+    let mut csv = Vec::new();
+    curves::write_csv(
+        &mut csv,
+        &analysis.grid.tau1,
+        &analysis.sig2,
+        &analysis.accel.sigavg,
+        &analysis.gyro.sigavg,
+    )
+    .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
+
+    let dir = &config.outdir;
+    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    let mut written = Vec::new();
+    let yaml_path = dir.join("imu.yaml");
+    bag2mat::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
+    written.push(yaml_path);
+    let csv_path = dir.join("allan_curves.csv");
+    bag2mat::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
+    written.push(csv_path);
+    written.extend(write_plots(&analysis, &config.title, dir)?);
+    Ok(RunOutput {
+        analysis,
+        rate,
+        text,
+        notes,
+        written,
+    })
+}
+
+/// Writes `allan_accel.{png,svg}` and `allan_gyro.{png,svg}` into `dir`.
+pub fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let join = |name: &str| {
+        if title.is_empty() {
+            name.to_owned()
+        } else {
+            format!("{title} {name}")
+        }
+    };
+    let accel = Chart {
+        title: join("acceleration"),
+        name: "acceleration",
+        unit: "m/s^2",
+        unit_white: "m/s^2/sqrt(Hz)",
+        unit_bias: "m/s^3/sqrt(Hz)",
+        tau: &a.grid.tau1,
+        axes: [&a.sig2[0], &a.sig2[1], &a.sig2[2]],
+        fit: &a.accel,
+    };
+    let gyro = Chart {
+        title: join("gyroscope"),
+        name: "gyroscope",
+        unit: "rad/s",
+        unit_white: "rad/s/sqrt(Hz)",
+        unit_bias: "rad/s^2/sqrt(Hz)",
+        tau: &a.grid.tau1,
+        axes: [&a.sig2[3], &a.sig2[4], &a.sig2[5]],
+        fit: &a.gyro,
+    };
+    let mut out = Vec::new();
+    out.extend(plot::write_chart(&accel, dir, "allan_accel")?);
+    out.extend(plot::write_chart(&gyro, dir, "allan_gyro")?);
+    Ok(out)
+}
