@@ -1,0 +1,203 @@
+//! The overlapping Allan variance exactly as imu_utils computes it (imu_utils.md §3.2–3.6):
+//! mean-period frequency, integrated signal θ, then for each cluster size m
+//! σ²(m) = Σ ((θ[k+2m] − 2θ[k+m]) + θ[k])² / ((2 (period·m)²) (N − 2m)).
+//!
+//! The fast path ([`allan_variance`]) runs the O(N) pass of every factor in parallel (rayon)
+//! and sums with eight independent accumulators so the compiler vectorises it (AVX-512/AVX2
+//! chosen at run time). Each squared term is bit-identical to upstream's; only the summation
+//! order differs, which moves the result by ~1e-13 relative, far inside the 1e-9 parity
+//! tolerance. One axis is processed at a time so its θ (23 MB for a 4 h 200 Hz bag) stays in
+//! the shared L3 cache while both cores sweep it. The naive sequential oracle lives in the
+//! tests.
+
+use rayon::prelude::*;
+
+/// Mean sample period: sequential sum of stamp differences over N−1 (`getAvgDt`).
+/// Jitter and gaps are ignored (quirk 8, imu_utils.md §6).
+pub fn mean_period(t: &[f64]) -> f64 {
+    let mut sum_dt = 0.0;
+    for w in t.windows(2) {
+        sum_dt += w[1] - w[0];
+    }
+    sum_dt / (t.len() as f64 - 1.0)
+}
+
+/// Integrated signal `θ[k] = (x[0] + … + x[k]) / freq` (`calcThetas`: a division by the
+/// frequency, not a product with the period).
+pub fn thetas(x: &[f64], freq: f64) -> Vec<f64> {
+    let mut sum = 0.0;
+    x.iter()
+        .map(|&v| {
+            sum += v;
+            sum / freq
+        })
+        .collect()
+}
+
+/// Plain mean (`getAvgValue`): sequential sum over N.
+pub fn mean(x: &[f64]) -> f64 {
+    let mut sum = 0.0;
+    for &v in x {
+        sum += v;
+    }
+    sum / x.len() as f64
+}
+
+/// `tau[i] = period * m[i]`.
+pub fn taus(period: f64, factors: &[usize]) -> Vec<f64> {
+    factors.iter().map(|&m| period * m as f64).collect()
+}
+
+/// The divisor `(2 (period·m)²) (N − 2m)`; N − 2m may be zero or negative (imu_utils.md §3.4
+/// edge cases: 0/0 → NaN, 0/negative → −0.0).
+pub fn divisor(n: usize, m: usize, period: f64) -> f64 {
+    let cluster_period2 = (period * m as f64) * (period * m as f64);
+    2.0 * cluster_period2 * (n as i64 - 2 * m as i64) as f64
+}
+
+const LANES: usize = 8;
+
+#[inline(always)]
+fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    let mut acc = [0.0f64; LANES];
+    let (a8, ar) = a.as_chunks::<LANES>();
+    let (b8, br) = b.as_chunks::<LANES>();
+    let (c8, cr) = c.as_chunks::<LANES>();
+    for ((a, b), c) in a8.iter().zip(b8).zip(c8) {
+        for l in 0..LANES {
+            // Upstream's expression order: (θ[k+2m] − 2θ[k+m]) + θ[k].
+            let d = (c[l] - 2.0 * b[l]) + a[l];
+            acc[l] += d * d;
+        }
+    }
+    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for ((a, b), c) in ar.iter().zip(br).zip(cr) {
+        let d = (c - 2.0 * b) + a;
+        s += d * d;
+    }
+    s
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn second_diff_sum_avx512(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    second_diff_sum_body(a, b, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn second_diff_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    second_diff_sum_body(a, b, c)
+}
+
+/// Σ over k of ((θ[k+2m] − 2θ[k+m]) + θ[k])², 0 when N − 2m ≤ 0.
+pub fn second_diff_sum(theta: &[f64], m: usize) -> f64 {
+    let n = theta.len();
+    if n <= 2 * m {
+        return 0.0;
+    }
+    let cnt = n - 2 * m;
+    let (a, b, c) = (
+        &theta[..cnt],
+        &theta[m..m + cnt],
+        &theta[2 * m..2 * m + cnt],
+    );
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F (checked just above).
+            return unsafe { second_diff_sum_avx512(a, b, c) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { second_diff_sum_avx2(a, b, c) };
+        }
+    }
+    second_diff_sum_body(a, b, c)
+}
+
+/// Overlapping Allan variances of one axis for every factor, in factor order
+/// (`calcVariance`), computed in parallel over the factors.
+pub fn allan_variance(theta: &[f64], factors: &[usize], period: f64) -> Vec<f64> {
+    let n = theta.len();
+    factors
+        .par_iter()
+        .with_max_len(1)
+        .map(|&m| second_diff_sum(theta, m) / divisor(n, m, period))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Seed of the test signal generator (a fixed LCG, no external RNG needed).
+    const SEED: u64 = 0x5EED_1234_ABCD_0001;
+    /// Different summation order only: a few hundred ulps at most for these lengths.
+    const FAST_VS_NAIVE_REL_TOL: f64 = 1e-11;
+
+    /// Upstream's loop as written: one sequential sum per factor.
+    fn naive_allan_variance(theta: &[f64], factors: &[usize], period: f64) -> Vec<f64> {
+        let n = theta.len() as i64;
+        factors
+            .iter()
+            .map(|&m| {
+                let m = m as i64;
+                let mut s = 0.0;
+                let mut k = 0;
+                while k < n - 2 * m {
+                    let i = k as usize;
+                    let mu = m as usize;
+                    let d = theta[i + 2 * mu] - 2.0 * theta[i + mu] + theta[i];
+                    s += d * d;
+                    k += 1;
+                }
+                s / divisor(n as usize, m as usize, period)
+            })
+            .collect()
+    }
+
+    fn noise(n: usize) -> Vec<f64> {
+        let mut state = SEED;
+        (0..n)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1000.0 + 200.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fast_matches_naive_oracle() {
+        for &n in &[12_203usize, 40_001] {
+            let x = noise(n);
+            let t: Vec<f64> = (0..n).map(|i| 1.6e9 + i as f64 * 0.005).collect();
+            let period = mean_period(&t);
+            let theta = thetas(&x, 1.0 / period);
+            let f = crate::factors::factors(n, 100);
+            let fast = allan_variance(&theta, &f, period);
+            let slow = naive_allan_variance(&theta, &f, period);
+            for (i, (a, b)) in fast.iter().zip(&slow).enumerate() {
+                let rel = ((a - b) / b).abs();
+                assert!(
+                    rel <= FAST_VS_NAIVE_REL_TOL,
+                    "n {n} factor index {i} (m {}): expected {b:e}, actual {a:e}, rel {rel:e}, tol {FAST_VS_NAIVE_REL_TOL:e}",
+                    f[i]
+                );
+            }
+        }
+    }
+
+    /// imu_utils.md §3.4/§3.7: N − 2m = 0 gives 0/0 = NaN, N − 2m < 0 gives −0.0.
+    #[test]
+    fn quirk_degenerate_last_factor_nan_and_negative_zero() {
+        let theta = thetas(&[1.0, 2.0], 100.0);
+        let v = allan_variance(&theta, &[1], 0.01);
+        assert!(v[0].is_nan());
+        let theta = thetas(&[1.0, 2.0, 3.0], 100.0);
+        let v = allan_variance(&theta, &[2], 0.01);
+        assert!(v[0] == 0.0 && v[0].is_sign_negative(), "got {:e}", v[0]);
+    }
+}
