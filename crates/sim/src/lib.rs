@@ -1,1 +1,47 @@
-pub fn placeholder() {}
+//! `sim`: an IMU data simulator after HeYijia/vio_data_simulation
+//! (`../shared/specs/vio_data_simulation.md`), plus Spline-Fusion IMU synthesis from poses.
+//!
+//! * [`noise`]: continuous ↔ discrete noise parameters (THE place for these conversions in
+//!   the workspace) and the seeded `addIMUnoise` generator.
+//! * [`motion`]: the analytic models (static level IMU, 20 s ellipse).
+//! * [`grid`]: upstream's accumulated time grids.
+//! * [`bag_sim`]: `sim bag` — the `ros_version` static (or ellipse) IMU bag via bag2mat.
+//! * [`traj`]: `sim traj` — the `master` text files (IMU poses, camera poses, landmarks,
+//!   observations).
+//! * [`integrate`]: `sim integrate` — upstream Euler vs midpoint dead reckoning, error table,
+//!   plots.
+//! * [`spline`]: `sim spline` — uniform cumulative cubic B-spline on ℝ³ × SO(3) and its IMU.
+//!
+//! Units: s, m, rad; gravity g_w = (0, 0, −9.81) (ENU, z up), so a level IMU at rest reads
+//! acc = (0, 0, +9.81).
+//!
+//! # Quirks reproduced on purpose
+//! * `quirk_01_ros_version_double_accumulation_counts_2880001` ([`grid::Grid::AccumulatedF64`]):
+//!   `for (double t = 0; t < 14400; t += 1.0/200)` gives 2 880 001 samples (spec §4).
+//! * `quirk_02_master_float_grid` ([`grid::Grid::AccumulatedF32`]): the `master` loops
+//!   accumulate in `float`: 4001 IMU samples, 600 camera frames (spec §8 item 1).
+//! * `quirk_03_topic_imu_without_slash`, seq 0, zero covariances, frame `base_link`
+//!   ([`bag_sim`], spec §4).
+//! * `quirk_04_euler_uses_right_sample` ([`integrate`]): upstream `testImu` integrates
+//!   interval i with sample i (spec §6).
+//! * `quirk_05_eigen_quaternion_sign` ([`rotation::quat_from_matrix`]): w may be negative.
+//!
+//! Not reproduced: upstream noise (a fresh `std::random_device` per sample; spec §8 item 6)
+//! and the `float` constants of `MotionModel` (f64 here; spec §8 item 2).
+
+#![deny(missing_docs)]
+
+pub mod bag_sim;
+pub mod cppfmt;
+pub mod error;
+pub mod grid;
+pub mod integrate;
+pub mod motion;
+pub mod noise;
+pub mod plot;
+pub mod rotation;
+pub mod spline;
+pub mod textio;
+pub mod traj;
+
+pub use error::{Result, SimError};

@@ -1,0 +1,54 @@
+//! The library's error type.
+
+use std::path::PathBuf;
+
+/// Everything `sim` can fail with; the binary reports it once and exits non-zero.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// A value given on the command line is out of range or inconsistent.
+    #[error("invalid argument: {0}")]
+    InvalidArgument(String),
+    /// An input text file could not be parsed.
+    #[error("{path}: line {line}: {msg}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        msg: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The spline cannot be built from the given poses.
+    #[error("spline: {0}")]
+    Spline(String),
+    /// Drawing a plot failed.
+    #[error("plot {path}: {msg}")]
+    Plot {
+        /// The output file.
+        path: PathBuf,
+        /// The backend's message.
+        msg: String,
+    },
+    /// Writing the bag failed (bag2mat's error).
+    #[error(transparent)]
+    Bag(#[from] bag2mat::Error),
+}
+
+/// Shorthand.
+pub type Result<T> = std::result::Result<T, SimError>;
+
+impl SimError {
+    /// An I/O error with its path.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        SimError::Io { path: path.into(), source }
+    }
+}

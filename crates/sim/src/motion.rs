@@ -1,0 +1,171 @@
+//! The analytic motion models of vio_data_simulation (spec §2): the `master` ellipse
+//! trajectory and the `ros_version` static level IMU, with ground-truth pose, velocity,
+//! body-frame gyro and specific force.
+//!
+//! Differences from upstream: upstream's `MotionModel` keeps its constants in `float`
+//! (K = f32(π/10), f32 products such as `K1*K`); here every constant is an exact `f64`
+//! (spec §8 item 2: with f64 constants 2843 of the 4001 `imu_pose.txt` lines differ in some
+//! printed 6-digit value). The model itself (formulas, ZYX Euler convention, gravity sign)
+//! is the same.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// World gravity, ENU z up, hard-coded in upstream `MotionModel`/`testImu`: a level IMU at
+/// rest therefore reads +9.81 on acc z.
+pub const GRAVITY_W: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
+
+/// Ellipse semi-axes (m), z amplitude (m), z frequency factor and angular rate K = π/10
+/// (one lap in 20 s) of the `master` model.
+const ELLIPSE_X: f64 = 15.0;
+const ELLIPSE_Y: f64 = 20.0;
+const Z_AMP: f64 = 1.0;
+const K1: f64 = 10.0;
+const K: f64 = std::f64::consts::PI / 10.0;
+/// Roll and pitch amplitudes (rad).
+const K_ROLL: f64 = 0.1;
+const K_PITCH: f64 = 0.2;
+
+/// Which motion to simulate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    /// `ros_version`: `MotionModel(0)` for every sample ⇒ R = I, gyro 0, acc (0, 0, 9.81).
+    Static,
+    /// `master`: the 20 s ellipse with sinusoidal z, roll and pitch.
+    Ellipse,
+}
+
+/// Ground truth at one instant (upstream `MotionData`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionSample {
+    /// Time, s.
+    pub t: f64,
+    /// Body → world rotation.
+    pub r_wb: Matrix3<f64>,
+    /// Body origin in world, m.
+    pub p: Vector3<f64>,
+    /// World velocity, m/s.
+    pub v: Vector3<f64>,
+    /// World acceleration, m/s².
+    pub a: Vector3<f64>,
+    /// Body angular velocity, rad/s.
+    pub gyro: Vector3<f64>,
+    /// Body specific force R_wbᵀ (a − g_w), m/s².
+    pub acc: Vector3<f64>,
+}
+
+impl Motion {
+    /// Sample the model at time `t` (s).
+    pub fn sample(self, t: f64) -> MotionSample {
+        match self {
+            Motion::Static => static_level(t),
+            Motion::Ellipse => ellipse(t),
+        }
+    }
+}
+
+/// R_wb = Rz(yaw)·Ry(pitch)·Rx(roll) (upstream `euler2Rotation`, ZYX, body → world);
+/// `rpy` = (roll, pitch, yaw).
+pub fn euler_to_rotation(rpy: Vector3<f64>) -> Matrix3<f64> {
+    let (sr, cr) = rpy.x.sin_cos();
+    let (sp, cp) = rpy.y.sin_cos();
+    let (sy, cy) = rpy.z.sin_cos();
+    Matrix3::new(
+        cy * cp,
+        cy * sp * sr - sy * cr,
+        sy * sr + cy * cr * sp,
+        sy * cp,
+        cy * cr + sy * sr * sp,
+        sp * sy * cr - cy * sr,
+        -sp,
+        cp * sr,
+        cp * cr,
+    )
+}
+
+/// E(roll, pitch) mapping ZYX Euler-angle rates to body rates (upstream
+/// `eulerRates2bodyRates`): [[1, 0, −sθ], [0, cφ, sφcθ], [0, −sφ, cφcθ]].
+pub fn euler_rates_to_body_rates(rpy: Vector3<f64>) -> Matrix3<f64> {
+    let (sr, cr) = rpy.x.sin_cos();
+    let (sp, cp) = rpy.y.sin_cos();
+    Matrix3::new(1.0, 0.0, -sp, 0.0, cr, sr * cp, 0.0, -sr, cr * cp)
+}
+
+/// The `master` ellipse model at time `t` (spec §2.1).
+pub fn ellipse(t: f64) -> MotionSample {
+    let (s, c) = (K * t).sin_cos();
+    let (sz, cz) = (K1 * K * t).sin_cos();
+    let p = Vector3::new(ELLIPSE_X * c + 5.0, ELLIPSE_Y * s + 5.0, Z_AMP * sz + 5.0);
+    let v = Vector3::new(-K * ELLIPSE_X * s, K * ELLIPSE_Y * c, Z_AMP * K1 * K * cz);
+    let k2 = K * K;
+    let a = Vector3::new(-k2 * ELLIPSE_X * c, -k2 * ELLIPSE_Y * s, -Z_AMP * K1 * K1 * k2 * sz);
+    let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), K * t);
+    let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), K);
+    let r_wb = euler_to_rotation(rpy);
+    let gyro = euler_rates_to_body_rates(rpy) * rates;
+    let acc = r_wb.transpose() * (a - GRAVITY_W);
+    MotionSample { t, r_wb, p, v, a, gyro, acc }
+}
+
+/// The `ros_version` model as its `main` uses it: `MotionModel(0)` for every sample
+/// (spec §2.2) — identity attitude at the origin, gyro 0, acc (0, 0, 9.81). `t` is only
+/// stored.
+pub fn static_level(t: f64) -> MotionSample {
+    let z = Vector3::zeros();
+    MotionSample { t, r_wb: Matrix3::identity(), p: z, v: z, a: z, gyro: z, acc: -GRAVITY_W }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rotation::quat_from_matrix;
+
+    /// The spec's sanity values are printed with 5–6 significant digits.
+    const SPEC_DIGITS_TOL: f64 = 1e-5;
+    /// Finite-difference step and the resulting O(h²) central-difference error bound.
+    const FD_H: f64 = 1e-5;
+    const FD_TOL: f64 = 1e-6;
+
+    fn close(case: &str, got: &[f64], exp: &[f64], tol: f64) {
+        for (i, (g, e)) in got.iter().zip(exp).enumerate() {
+            assert!((g - e).abs() <= tol, "{case} [{i}]: expected {e}, actual {g}, tol {tol}");
+        }
+    }
+
+    #[test]
+    fn sanity_values_at_t0() {
+        // Spec §2.1: p = (20, 5, 5), v = (0, 2π, π), q_wb = (w 0.99875, x 0.04998, 0, 0),
+        // gyro = (0, 0.230364, 0.292623), acc = (−1.48044, 0.979366, 9.76099).
+        let m = ellipse(0.0);
+        close("p", m.p.as_slice(), &[20.0, 5.0, 5.0], 1e-12);
+        let pi = std::f64::consts::PI;
+        close("v", m.v.as_slice(), &[0.0, 2.0 * pi, pi], 1e-12);
+        let q = quat_from_matrix(&m.r_wb);
+        close("q (w x y z)", &q, &[0.99875, 0.04998, 0.0, 0.0], SPEC_DIGITS_TOL * 2.0);
+        close("gyro", m.gyro.as_slice(), &[0.0, 0.230364, 0.292623], SPEC_DIGITS_TOL);
+        close("acc", m.acc.as_slice(), &[-1.48044, 0.979366, 9.76099], SPEC_DIGITS_TOL);
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        // Naive oracle: central differences of p, v and R.
+        for &t in &[0.0, 1.3, 7.77, 13.365, 19.9] {
+            let (m0, m1, m) = (ellipse(t - FD_H), ellipse(t + FD_H), ellipse(t));
+            let v_fd = (m1.p - m0.p) / (2.0 * FD_H);
+            let a_fd = (m1.v - m0.v) / (2.0 * FD_H);
+            close(&format!("v t={t}"), v_fd.as_slice(), m.v.as_slice(), FD_TOL * 10.0);
+            close(&format!("a t={t}"), a_fd.as_slice(), m.a.as_slice(), FD_TOL * 10.0);
+            // ω̂ = Rᵀ Ṙ.
+            let rdot = (m1.r_wb - m0.r_wb) / (2.0 * FD_H);
+            let w = m.r_wb.transpose() * rdot;
+            close(&format!("gyro t={t}"), &[w[(2, 1)], w[(0, 2)], w[(1, 0)]], m.gyro.as_slice(), FD_TOL);
+        }
+    }
+
+    #[test]
+    fn static_reads_plus_g_on_z() {
+        let m = Motion::Static.sample(123.0);
+        assert_eq!(m.acc, Vector3::new(0.0, 0.0, 9.81));
+        assert_eq!(m.gyro, Vector3::zeros());
+        assert_eq!(quat_from_matrix(&m.r_wb), [1.0, 0.0, 0.0, 0.0]);
+    }
+}
