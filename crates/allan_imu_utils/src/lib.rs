@@ -28,7 +28,18 @@
 //! The corrected reading is written beside the compat one, never instead of it
 //! ([`opencv_yaml::YamlMode`]).
 
+pub mod analysis;
 pub mod cfmt;
+pub mod cli;
+pub mod collect;
+pub mod error;
 pub mod estimator;
 pub mod factors;
 pub mod fit;
+pub mod launch;
+pub mod opencv_yaml;
+pub mod plot;
+pub mod report;
+pub mod run;
+
+pub use error::Error;

@@ -1,1 +1,41 @@
-fn main() {}
+//! `allan_imu_utils BAG [--topic imu] [--name imu] [--data-save-path DIR] [--max-time-min 120]
+//! [--max-cluster 100] [--launch FILE.launch]`: imu_utils without ROS.
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::Parser;
+
+use allan_imu_utils::cli::{Args, Config};
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("allan_imu_utils: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> anyhow::Result<()> {
+    let t = std::time::Instant::now();
+    let config = Config::try_from(Args::parse()).context("bad arguments")?;
+    let outcome = allan_imu_utils::run::run(&config)
+        .with_context(|| format!("analysing {}", config.bag.display()))?;
+    for note in &outcome.notes {
+        eprintln!("{note}");
+    }
+    std::io::stdout()
+        .lock()
+        .write_all(outcome.stdout.as_bytes())
+        .context("writing stdout")?;
+    if config.timings {
+        for (phase, d) in &outcome.timings {
+            eprintln!("timing {phase} {:.3} s", d.as_secs_f64());
+        }
+        eprintln!("timing total {:.3} s", t.elapsed().as_secs_f64());
+    }
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! The command line (what the user typed, [`Args`]) and the resolved settings ([`Config`]):
+//! explicit flags, then the `--launch` file's parameters, then upstream-like defaults.
+
+use std::path::PathBuf;
+
+use clap::Parser;
+
+use crate::error::Error;
+use crate::launch::{self, LaunchParams, LaunchValue};
+
+/// Default topic, name, limit and cluster count (imu_utils' shipped launch files).
+pub const DEFAULT_TOPIC: &str = "imu";
+/// Default IMU name.
+pub const DEFAULT_NAME: &str = "imu";
+/// Default `max_time_min` of the shipped launch files.
+pub const DEFAULT_MAX_TIME_MIN: u32 = 120;
+/// Default `max_cluster` of the shipped launch files.
+pub const DEFAULT_MAX_CLUSTER: usize = 100;
+
+/// imu_utils' Allan variance and noise fit, read straight from a ROS 1 bag (no roscore, no
+/// replay). Prints upstream's report and writes `<name>_imu_param.yaml`, a continuous-time
+/// `<name>_imu_param_continuous.yaml`, the 16 `data_<name>_*.txt` curves and plots.
+#[derive(Debug, Clone, Parser)]
+#[command(name = "allan_imu_utils", version)]
+pub struct Args {
+    /// The ROS 1 bag (uncompressed, bz2 or lz4 chunks).
+    pub bag: PathBuf,
+    /// sensor_msgs/Imu topic (`imu` and `/imu` are the same) [default: imu]
+    #[arg(long)]
+    pub topic: Option<String>,
+    /// IMU name used in output file names and the yaml [default: imu]
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Output directory (created if missing) [default: .]
+    #[arg(long)]
+    pub data_save_path: Option<PathBuf>,
+    /// Stop after this many minutes of header time; the message crossing it is kept [default: 120]
+    #[arg(long)]
+    pub max_time_min: Option<u32>,
+    /// Number of log-spaced cluster sizes requested [default: 100]
+    #[arg(long)]
+    pub max_cluster: Option<usize>,
+    /// Take the settings from an imu_utils roslaunch file; explicit flags override it
+    #[arg(long, value_name = "FILE.launch")]
+    pub launch: Option<PathBuf>,
+    /// No progress bar
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Do not draw allan_gyr/allan_acc plots
+    #[arg(long)]
+    pub no_plots: bool,
+    /// Print the time of each phase on stderr (for benchmarks)
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// What a run uses.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Config {
+    /// Input bag.
+    pub bag: PathBuf,
+    /// Topic.
+    pub topic: String,
+    /// IMU name.
+    pub name: String,
+    /// Output directory.
+    pub out_dir: PathBuf,
+    /// Stop rule, minutes.
+    pub max_time_min: u32,
+    /// Cluster count M.
+    pub max_cluster: usize,
+    /// No progress bar.
+    pub quiet: bool,
+    /// Draw plots.
+    pub plots: bool,
+    /// Report phase times.
+    pub timings: bool,
+}
+
+fn from_launch(lp: Option<&LaunchParams>, param: &str) -> Result<Option<String>, Error> {
+    match lp.and_then(|l| l.get(param)) {
+        None => Ok(None),
+        Some(LaunchValue::Value(v)) => Ok(Some(v.clone())),
+        Some(LaunchValue::Unresolved(v)) => Err(Error::Config(format!(
+            "launch parameter {param} = \"{v}\" needs ROS to resolve the $(…) substitution; give {} instead",
+            launch::flag_for(param)
+        ))),
+    }
+}
+
+fn parse_launch_int<T: std::str::FromStr>(
+    v: Option<String>,
+    param: &str,
+) -> Result<Option<T>, Error> {
+    v.map(|s| {
+        s.parse::<T>().map_err(|_| {
+            Error::Config(format!(
+                "launch parameter {param} = \"{s}\" is not a non-negative integer"
+            ))
+        })
+    })
+    .transpose()
+}
+
+impl TryFrom<Args> for Config {
+    type Error = Error;
+
+    fn try_from(a: Args) -> Result<Config, Error> {
+        let lp = a.launch.as_deref().map(launch::read).transpose()?;
+        let lp = lp.as_ref();
+        let topic = match a.topic {
+            Some(t) => t,
+            None => from_launch(lp, "imu_topic")?.unwrap_or_else(|| DEFAULT_TOPIC.into()),
+        };
+        let name = match a.name {
+            Some(n) => n,
+            None => from_launch(lp, "imu_name")?.unwrap_or_else(|| DEFAULT_NAME.into()),
+        };
+        let out_dir = match a.data_save_path {
+            Some(p) => p,
+            None => from_launch(lp, "data_save_path")?
+                .map(PathBuf::from)
+                .unwrap_or_else(|| PathBuf::from(".")),
+        };
+        let max_time_min = match a.max_time_min {
+            Some(v) => v,
+            None => parse_launch_int(from_launch(lp, "max_time_min")?, "max_time_min")?
+                .unwrap_or(DEFAULT_MAX_TIME_MIN),
+        };
+        let max_cluster = match a.max_cluster {
+            Some(v) => v,
+            None => parse_launch_int(from_launch(lp, "max_cluster")?, "max_cluster")?
+                .unwrap_or(DEFAULT_MAX_CLUSTER),
+        };
+        if max_cluster < 2 {
+            return Err(Error::Config(format!(
+                "max_cluster must be at least 2 (got {max_cluster})"
+            )));
+        }
+        if topic.trim().is_empty() {
+            return Err(Error::Config("the topic is empty".into()));
+        }
+        if name.is_empty() || name.contains('/') {
+            return Err(Error::Config(format!(
+                "the IMU name '{name}' must be non-empty and contain no '/'"
+            )));
+        }
+        Ok(Config {
+            bag: a.bag,
+            topic,
+            name,
+            out_dir,
+            max_time_min,
+            max_cluster,
+            quiet: a.quiet,
+            plots: !a.no_plots,
+            timings: a.timings,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(extra: &[&str]) -> Args {
+        let mut v = vec!["allan_imu_utils", "x.bag"];
+        v.extend_from_slice(extra);
+        Args::parse_from(v)
+    }
+
+    #[test]
+    fn defaults() {
+        let c = Config::try_from(args(&[])).unwrap();
+        assert_eq!(
+            (
+                c.topic.as_str(),
+                c.name.as_str(),
+                c.max_time_min,
+                c.max_cluster
+            ),
+            ("imu", "imu", 120, 100)
+        );
+        assert_eq!(c.out_dir, PathBuf::from("."));
+    }
+
+    #[test]
+    fn launch_file_then_flags_override() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("a.launch");
+        std::fs::write(
+            &f,
+            r#"<launch><node pkg="imu_utils" type="imu_an" name="imu_an">
+            <param name="imu_topic" type="string" value="/imu/data"/>
+            <param name="imu_name" type="string" value="xsens"/>
+            <param name="data_save_path" type="string" value="$(find imu_utils)/data/"/>
+            <param name="max_time_min" type="int" value="200"/>
+            <param name="max_cluster" type="int" value="50"/></node></launch>"#,
+        )
+        .unwrap();
+        let fs = f.to_str().unwrap();
+        let e = Config::try_from(args(&["--launch", fs]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--data-save-path") && e.contains("$(find imu_utils)"),
+            "{e}"
+        );
+        let c = Config::try_from(args(&[
+            "--launch",
+            fs,
+            "--data-save-path",
+            "/tmp/o",
+            "--max-cluster",
+            "100",
+        ]))
+        .unwrap();
+        assert_eq!(c.topic, "/imu/data");
+        assert_eq!(c.name, "xsens");
+        assert_eq!(c.max_time_min, 200);
+        assert_eq!(c.max_cluster, 100);
+        assert_eq!(c.out_dir, PathBuf::from("/tmp/o"));
+    }
+
+    #[test]
+    fn bad_values() {
+        assert!(Config::try_from(args(&["--max-cluster", "1"])).is_err());
+        assert!(Config::try_from(args(&["--name", "a/b"])).is_err());
+    }
+}

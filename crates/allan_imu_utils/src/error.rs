@@ -1,0 +1,65 @@
+//! The error type of the allan_imu_utils library; the binary reports it once.
+
+use std::path::PathBuf;
+
+/// Everything that stops an analysis.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading the bag failed (includes "no such topic", whose message lists the bag's topics).
+    #[error(transparent)]
+    Bag(#[from] bag2mat::Error),
+    /// Too few samples for a 5-parameter fit.
+    #[error(
+        "too few samples on topic '{topic}': {n} messages give {valid} Allan points with data, the 5-term fit needs at least {needed} (record longer)"
+    )]
+    TooFewSamples {
+        /// Topic.
+        topic: String,
+        /// Samples used.
+        n: usize,
+        /// Factors with N − 2m > 0.
+        valid: usize,
+        /// Minimum.
+        needed: usize,
+    },
+    /// A NaN or infinite value in the input.
+    #[error(
+        "non-finite {what} in message {index} (0-based) of topic '{topic}': the Allan variance would be NaN"
+    )]
+    NonFinite {
+        /// Topic.
+        topic: String,
+        /// Which field.
+        what: String,
+        /// Message index.
+        index: usize,
+    },
+    /// A roslaunch file could not be used.
+    #[error("{path}: {what}")]
+    Launch {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        what: String,
+    },
+    /// A setting is missing or invalid.
+    #[error("{0}")]
+    Config(String),
+    /// Writing outputs failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Drawing a plot failed.
+    #[error("plot {path}: {what}")]
+    Plot {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        what: String,
+    },
+}

@@ -1,0 +1,174 @@
+//! `allan_gyr.{png,svg}` and `allan_acc.{png,svg}`: per-axis Allan deviation points and the
+//! fitted model curves on log-log axes, as imu_utils' MATLAB scripts (`draw_allan.m`) draw
+//! the `data_*` and `data_*_sim_*` files. Gyro values stay in imu_utils' pseudo-deg/h
+//! (57.3-based) like the files they mirror; acc in m/s².
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::analysis::Analysis;
+use crate::error::Error;
+
+const COLORS: [RGBColor; 3] = [
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(31, 119, 180),
+];
+const SIZE: (u32, u32) = (1000, 700);
+
+struct Curves<'a> {
+    title: String,
+    y_label: &'a str,
+    taus: &'a [f64],
+    data: [Vec<f64>; 3],
+    fit: [Vec<f64>; 3],
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let finite_pos = |v: &f64| v.is_finite() && *v > 0.0;
+    let all: Vec<f64> = c
+        .data
+        .iter()
+        .chain(c.fit.iter())
+        .flatten()
+        .copied()
+        .filter(finite_pos)
+        .collect();
+    let (mut lo, mut hi) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    if all.is_empty() {
+        (lo, hi) = (1e-3, 1.0);
+    }
+    let taus: Vec<f64> = c.taus.iter().copied().filter(finite_pos).collect();
+    let (tlo, thi) = taus
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    let (tlo, thi) = if taus.is_empty() {
+        (1e-3, 1.0)
+    } else {
+        (tlo / 1.3, thi * 1.3)
+    };
+    let mut chart = ChartBuilder::on(root)
+        .caption(&c.title, ("sans-serif", 26))
+        .margin(20)
+        .x_label_area_size(55)
+        .y_label_area_size(90)
+        .build_cartesian_2d((tlo..thi).log_scale(), (lo / 1.5..hi * 1.5).log_scale())
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc("cluster time τ (s)")
+        .y_desc(c.y_label)
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .label_style(("sans-serif", 16))
+        .axis_desc_style(("sans-serif", 18))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let col = COLORS[k];
+        let pts: Vec<(f64, f64)> = c
+            .taus
+            .iter()
+            .zip(&c.data[k])
+            .filter(|(t, v)| finite_pos(t) && finite_pos(v))
+            .map(|(t, v)| (*t, *v))
+            .collect();
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.stroke_width(1))))
+            .map_err(|e| e.to_string())?
+            .label(format!("{axis} data"))
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
+        let line: Vec<(f64, f64)> = c
+            .taus
+            .iter()
+            .zip(&c.fit[k])
+            .filter(|(t, v)| finite_pos(t) && finite_pos(v))
+            .map(|(t, v)| (*t, *v))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(line, col.stroke_width(2)))
+            .map_err(|e| e.to_string())?
+            .label(format!("{axis} fit"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 16))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}
+
+fn curves<'a>(an: &'a Analysis, name: &str, base: usize) -> Curves<'a> {
+    let taus = &an.axes[base].taus;
+    let gyro = base == 0;
+    Curves {
+        title: format!(
+            "{name}: {} Allan deviation and imu_utils fit",
+            if gyro { "gyroscope" } else { "accelerometer" }
+        ),
+        y_label: if gyro {
+            "Allan deviation (deg/h, imu_utils 57.3 units)"
+        } else {
+            "Allan deviation (m/s²)"
+        },
+        taus,
+        data: [0, 1, 2].map(|k| an.axes[base + k].deviation()),
+        fit: [0, 1, 2].map(|k| an.fits[base + k].sim(taus)),
+    }
+}
+
+fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
+    let err = |what: String| Error::Plot {
+        path: path.to_path_buf(),
+        what,
+    };
+    // Draw to a temporary name in the same directory, then rename (atomic output).
+    let tmp = path.with_file_name(format!(
+        ".{}.{}.tmp.{}",
+        path.file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        std::process::id(),
+        if svg { "svg" } else { "png" }
+    ));
+    let result = if svg {
+        let root = SVGBackend::new(&tmp, SIZE).into_drawing_area();
+        draw(&root, c)
+    } else {
+        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
+        draw(&root, c)
+    };
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(err(e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })
+}
+
+/// Writes the four plot files into `dir`; returns their paths.
+pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    bag2mat::plot::register_font();
+    let mut out = Vec::new();
+    for (stem, base) in [("allan_gyr", 0), ("allan_acc", 3)] {
+        let c = curves(an, name, base);
+        for (ext, svg) in [("png", false), ("svg", true)] {
+            let p = dir.join(format!("{stem}.{ext}"));
+            render(&p, &c, svg)?;
+            out.push(p);
+        }
+    }
+    Ok(out)
+}

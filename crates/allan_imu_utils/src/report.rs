@@ -1,0 +1,154 @@
+//! Upstream's terminal output and curve files (imu_utils.md §5.1–5.2).
+//!
+//! The stdout text is rebuilt line by line in upstream's order and iostream formats (`%g`,
+//! precision 6), including its typos and spacing: the double space after the axis name,
+//! the trailing space in `dt ` and in the fit headers, `Gyro X` vs `Gyro y`, the mislabeled
+//! rad/h line (quirk 5) and the `bias … degree/s` line with 57.3 (quirk 4).
+//! The 16 `data_<name>_*.txt` files hold one `%.10g` number per line; all of them use the
+//! x-axis taus and the acc `sim` curves are evaluated at all taus (quirk 11).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::analysis::{AXIS_NAMES, Analysis};
+use crate::cfmt::{g, g6};
+use crate::error::Error;
+use crate::fit::{SECONDS_PER_HOUR, find_min_index};
+
+/// Upstream's fit headers (capital X only; trailing space).
+const FIT_HEADERS: [&str; 6] = [
+    "Gyro X ", "Gyro y ", "Gyro z ", "acc X ", "acc y ", "acc z ",
+];
+
+/// Upstream's numData warning threshold and short-time threshold (minutes), quirk 14.
+const TOO_FEW_NUMBER: usize = 10_000;
+const TOO_SHORT_MIN: f64 = 10.0;
+
+fn calc_block(out: &mut String, a: &crate::analysis::AxisAllan) {
+    let name = a.name;
+    let _ = writeln!(out, "{name}  numData {}", a.n);
+    if a.n < TOO_FEW_NUMBER {
+        let _ = writeln!(out, "{name}  Too few number");
+    }
+    let dt = a.end_t - a.start_t;
+    let _ = writeln!(out, "{name}  start_t {}", g6(a.start_t));
+    let _ = writeln!(out, "{name}  end_t {}", g6(a.end_t));
+    let _ = writeln!(out, "{name} dt ");
+    let _ = writeln!(out, "-------------{} s", g6(dt));
+    let _ = writeln!(out, "-------------{} min", g6(dt / 60.0));
+    let _ = writeln!(out, "-------------{} h", g6(dt / 3600.0));
+    if dt / 60.0 < TOO_SHORT_MIN {
+        let _ = writeln!(out, "{name}  Too short time!!!!");
+    }
+    let _ = writeln!(out, "{name}  freq {}", g6(a.freq));
+    let _ = writeln!(out, "{name}  period {}", g6(a.period));
+}
+
+/// The whole stdout of an upstream run, from the `num of Cluster` lines on.
+pub fn stdout_text(an: &Analysis) -> String {
+    let mut out = String::new();
+    for name in AXIS_NAMES {
+        let _ = writeln!(out, "{name}  num of Cluster {}", an.max_cluster);
+    }
+    out.push_str("wait for imu data.\n");
+    for i in 0..3 {
+        calc_block(&mut out, &an.axes[i]);
+    }
+    for i in 0..3 {
+        let fit = &an.fits[i];
+        let a = &an.axes[i];
+        let _ = writeln!(out, "{}", FIT_HEADERS[i]);
+        let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
+        let _ = writeln!(
+            out,
+            " Bias Instability {} rad/s",
+            g6(fit.gyro_b_line_value())
+        );
+        let at = a.taus[find_min_index(&fit.sim(&a.taus))];
+        let _ = writeln!(
+            out,
+            " Bias Instability {} rad/s, at {} s",
+            g6(fit.bias_instability()),
+            g6(at)
+        );
+        let _ = writeln!(out, " White Noise {} rad/s", g6(fit.gyro_n_line_value()));
+        let _ = writeln!(out, " White Noise {} rad/s", g6(fit.white_noise()));
+        let _ = writeln!(
+            out,
+            "  bias {} degree/s",
+            g6(an.gyro_mean[i] / SECONDS_PER_HOUR)
+        );
+        out.push_str("-------------------\n");
+    }
+    out.push_str("==============================================\n");
+    out.push_str("==============================================\n");
+    for i in 3..6 {
+        calc_block(&mut out, &an.axes[i]);
+    }
+    for i in 3..6 {
+        let fit = &an.fits[i];
+        let _ = writeln!(out, "{}", FIT_HEADERS[i]);
+        let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
+        let _ = writeln!(
+            out,
+            " Bias Instability {} m/s^2",
+            g6(fit.bias_instability())
+        );
+        let _ = writeln!(out, " White Noise {} m/s^2", g6(fit.white_noise()));
+        out.push_str("-------------------\n");
+    }
+    out
+}
+
+/// One curve file's content: `%.10g` per line.
+pub fn curve_text(values: &[f64]) -> String {
+    let mut s = String::with_capacity(values.len() * 16);
+    for &v in values {
+        s.push_str(&g(v, 10));
+        s.push('\n');
+    }
+    s
+}
+
+/// The 16 curve files (file name, content) in upstream's write order: sim_gyr, gyr,
+/// sim_acc, acc.
+pub fn curve_files(an: &Analysis, name: &str) -> Vec<(String, String)> {
+    let mut files = Vec::with_capacity(16);
+    for (sensor, base) in [("gyr", 0usize), ("acc", 3usize)] {
+        let taus = &an.axes[base].taus;
+        // sim: fitted deviation of each axis at the x-axis taus (all of them).
+        files.push((format!("data_{name}_sim_{sensor}_t.txt"), curve_text(taus)));
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let sim = an.fits[base + k].sim(taus);
+            files.push((
+                format!("data_{name}_sim_{sensor}_{axis}.txt"),
+                curve_text(&sim),
+            ));
+        }
+        files.push((format!("data_{name}_{sensor}_t.txt"), curve_text(taus)));
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            files.push((
+                format!("data_{name}_{sensor}_{axis}.txt"),
+                curve_text(&an.axes[base + k].deviation()),
+            ));
+        }
+    }
+    // Upstream order: sim_gyr, gyr, sim_acc, acc — the loop above produces exactly that.
+    files
+}
+
+/// Writes one text file atomically.
+pub fn write_text(path: &Path, text: &str) -> Result<(), Error> {
+    bag2mat::output::write_atomic(path, |w| w.write_all(text.as_bytes())).map_err(Error::from)
+}
+
+/// Writes the curve files into `dir`; returns their paths.
+pub fn write_curve_files(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut paths = Vec::new();
+    for (file, text) in curve_files(an, name) {
+        let p = dir.join(file);
+        write_text(&p, &text)?;
+        paths.push(p);
+    }
+    Ok(paths)
+}
