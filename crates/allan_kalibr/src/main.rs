@@ -10,7 +10,12 @@ use allan_kalibr::{Config, run};
 
 fn main() -> ExitCode {
     let config: Config = Args::parse().into();
-    match run(&config).with_context(|| format!("allan_kalibr {}", config.input.display())) {
+    // The library's messages already carry their causes inline, so the error is flattened to
+    // its text before the context is added (printing the cause chain would repeat them).
+    let result = run(&config)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .with_context(|| format!("allan_kalibr {}", config.input.display()));
+    match result {
         Ok(out) => {
             for n in &out.notes {
                 eprintln!("{n}");

@@ -179,8 +179,22 @@ where
     };
     let red = RED.mix(0.5);
     let blue = BLUE.mix(0.5);
-    let white_label = format!("−½ fit: σ = {} {}", value6(fit.white), chart.unit_white);
-    let bias_label = format!("+½ fit: σ_b = {} {}", value6(fit.bias), chart.unit_bias);
+    let white_label = format!(
+        "−½ fit: σ = {} {} (τ = {} s)",
+        value6(fit.white),
+        chart.unit_white,
+        crate::report::matlab_fixed(fit.tau_at1, 2)
+    );
+    let bias_label = if fit.bias.is_nan() {
+        "+½ fit: σ_b = NaN (no finite point 50 past the minimum)".to_owned()
+    } else {
+        format!(
+            "+½ fit: σ_b = {} {} (τ = {} s)",
+            value6(fit.bias),
+            chart.unit_bias,
+            crate::report::matlab_fixed(fit.tau_at2, 2)
+        )
+    };
     ctx.draw_series(LineSeries::new(
         line(&|t| fit.h_fit1(t)),
         red.stroke_width(px(3.0)),
@@ -207,8 +221,49 @@ where
         }
     }
 
+    // Legend in the corner that hides the fewest curve points and neither read-off point
+    // (upstream uses "southeast", which often covers the +1/2 read-off).
+    let font = px(17.0) as i32;
+    let longest = [labels[0].len(), 16, 60].into_iter().max().unwrap_or(60) as i32;
+    let legend_w = longest * font * 55 / 100 + 50;
+    let legend_h = 6 * (font + 10) + 16;
+    let (xr, yr) = ctx.plotting_area().get_pixel_range();
+    let mut weighted: Vec<((i32, i32), usize)> = curves
+        .iter()
+        .flatten()
+        .map(|p| (ctx.backend_coord(p), 1))
+        .collect();
+    for (t, v, _) in marks {
+        if t > 0.0 && v.is_finite() {
+            weighted.push((ctx.backend_coord(&(t, v)), 100_000));
+        }
+    }
+    let corners = [
+        (
+            SeriesLabelPosition::LowerRight,
+            xr.end - legend_w,
+            yr.end - legend_h,
+        ),
+        (SeriesLabelPosition::UpperRight, xr.end - legend_w, yr.start),
+        (SeriesLabelPosition::LowerLeft, xr.start, yr.end - legend_h),
+        (SeriesLabelPosition::UpperLeft, xr.start, yr.start),
+    ];
+    let cost = |bx: i32, by: i32| -> usize {
+        weighted
+            .iter()
+            .filter(|((x, y), _)| {
+                *x >= bx && *x <= bx + legend_w && *y >= by && *y <= by + legend_h
+            })
+            .map(|(_, w)| w)
+            .sum()
+    };
+    let position = corners
+        .into_iter()
+        .min_by_key(|(_, bx, by)| cost(*bx, *by))
+        .map(|(p, _, _)| p)
+        .unwrap_or(SeriesLabelPosition::LowerRight);
     ctx.configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(position)
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .label_font(("sans-serif", px(17.0)))

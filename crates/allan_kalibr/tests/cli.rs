@@ -1,1 +1,306 @@
-//! CLI tests (filled below).
+//! The `allan_kalibr` binary run as a user would: on a bag, on a .mat, and on bad inputs
+//! (clear error, non-zero exit, no output file left behind).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use allan_kalibr::input;
+use bag2mat::mat::{DataImu, write_data_imu};
+
+use crate::common::{CASES, final_full, process_lines, rel_err};
+
+/// The four numbers read back from imu.yaml: they are written in shortest round-trip form,
+/// so they carry the run's value exactly; vs the reference the spec's 1e-9 applies.
+const NUMBERS_REL_TOL: f64 = 1e-9;
+/// The outputs a successful run writes.
+const OUTPUTS: [&str; 6] = [
+    "imu.yaml",
+    "allan_curves.csv",
+    "allan_accel.png",
+    "allan_accel.svg",
+    "allan_gyro.png",
+    "allan_gyro.svg",
+];
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .args(args)
+        .output()
+        .expect("run allan_kalibr")
+}
+
+fn s(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn yaml_value(text: &str, key: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(&format!("{key}:")))
+        .unwrap_or_else(|| panic!("no {key} in imu.yaml:\n{text}"));
+    let v = line.split_whitespace().nth(1).unwrap();
+    if v == ".nan" {
+        f64::NAN
+    } else {
+        v.parse().unwrap()
+    }
+}
+
+fn assert_no_outputs(dir: &Path) {
+    if dir.exists() {
+        let left: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert!(
+            left.is_empty(),
+            "outputs left behind in {}: {left:?}",
+            dir.display()
+        );
+    }
+}
+
+/// p3 (uncompressed, 61 s): stdout is upstream's text, imu.yaml holds the four numbers.
+#[test]
+fn bag_input_prints_upstream_text_and_writes_outputs() {
+    let case = &CASES[2];
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = run(&[
+        case.bag().to_str().unwrap(),
+        "--topic",
+        case.topic,
+        "-o",
+        out.to_str().unwrap(),
+        "--title",
+        "p3",
+    ]);
+    assert!(o.status.success(), "stderr: {}", s(&o.stderr));
+    let stdout = s(&o.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines[0], "=> opening the mat file.");
+    assert_eq!(lines[1], "=> plotting accelerometer.");
+    assert_eq!(lines[6], "=> plotting gyroscope.");
+    assert_eq!(lines[11], "=> final results");
+    let chart: Vec<String> = lines[2..6]
+        .iter()
+        .chain(&lines[7..11])
+        .map(|l| l.to_string())
+        .collect();
+    assert_eq!(chart, process_lines(case));
+    let fin: Vec<&str> = lines[12..].to_vec();
+    assert_eq!(fin.join("\n"), case.kalibr("final.txt").trim_end());
+    // The estimated rate is announced on stderr.
+    assert!(
+        s(&o.stderr).contains("update rate: 200 Hz"),
+        "stderr: {}",
+        s(&o.stderr)
+    );
+    for f in OUTPUTS {
+        let p = out.join(f);
+        let len = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 0, "{} missing or empty", p.display());
+    }
+    let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+    let want = final_full(case).values;
+    let keys = [
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+    ];
+    for (k, key) in keys.iter().enumerate() {
+        let got = yaml_value(&yaml, key);
+        let e = rel_err(got, want[k]);
+        assert!(
+            e <= NUMBERS_REL_TOL,
+            "{}: {key} expected {:e} actual {got:e} rel {e:e} tol {NUMBERS_REL_TOL:e}",
+            case.name,
+            want[k]
+        );
+    }
+    assert!(yaml.contains("rostopic:                    imu "), "{yaml}");
+    assert!(
+        yaml.contains("update_rate:                 200.0"),
+        "{yaml}"
+    );
+    let csv = std::fs::read_to_string(out.join("allan_curves.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 2001);
+    // No temporary files remain.
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), OUTPUTS.len(), "{names:?}");
+}
+
+/// The same samples as a .mat (written through bag2mat) give the same text; `--bit-exact`
+/// runs; a wrong `--update-rate` is used but warned about.
+#[test]
+fn mat_input_matches_bag_input() {
+    let case = &CASES[2];
+    let d = input::load(&case.bag(), case.topic, true).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let mat = tmp.path().join("p3.mat");
+    let mut m = DataImu::with_capacity(d.len());
+    for i in 0..d.len() {
+        m.push([
+            d.t[i],
+            d.axes[0][i],
+            d.axes[1][i],
+            d.axes[2][i],
+            d.axes[3][i],
+            d.axes[4][i],
+            d.axes[5][i],
+        ]);
+    }
+    write_data_imu(&mat, &m).unwrap();
+    // Default OUTDIR: beside the input.
+    let o = run(&[
+        mat.to_str().unwrap(),
+        "--update-rate",
+        "200",
+        "--bit-exact",
+        "-q",
+    ]);
+    assert!(o.status.success(), "stderr: {}", s(&o.stderr));
+    let chart: Vec<String> = s(&o.stdout)
+        .lines()
+        .filter(|l| l.starts_with("tau = ") || l.starts_with("h_fit"))
+        .map(str::to_owned)
+        .collect();
+    assert_eq!(chart, process_lines(case));
+    assert!(s(&o.stdout).ends_with(&case.kalibr("final.txt")));
+    for f in OUTPUTS {
+        assert!(tmp.path().join(f).exists(), "{f} not beside the input");
+    }
+    let warn = run(&[
+        mat.to_str().unwrap(),
+        "--update-rate",
+        "100",
+        "-o",
+        tmp.path().join("w").to_str().unwrap(),
+    ]);
+    assert!(warn.status.success(), "stderr: {}", s(&warn.stderr));
+    assert!(
+        s(&warn.stderr).contains("warning: --update-rate 100 Hz but the timestamps give 200"),
+        "stderr: {}",
+        s(&warn.stderr)
+    );
+}
+
+#[test]
+fn missing_file_is_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    for input in ["nope.bag", "nope.mat"] {
+        let p = tmp.path().join(input);
+        let o = run(&[p.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert!(!o.status.success());
+        let err = s(&o.stderr);
+        assert!(
+            err.contains(input) && err.contains("error"),
+            "{input}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+        assert_no_outputs(&out);
+    }
+}
+
+#[test]
+fn unknown_extension_and_wrong_topic_are_clear_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let txt = tmp.path().join("data.txt");
+    std::fs::write(&txt, "1 2 3\n").unwrap();
+    let o = run(&[txt.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        s(&o.stderr).contains("expected a .bag or a .mat"),
+        "{}",
+        s(&o.stderr)
+    );
+    // p2's bag holds /imu/data and /status: asking for `imu0` lists both.
+    let bag = CASES[1].bag();
+    let o = run(&[
+        bag.to_str().unwrap(),
+        "--topic",
+        "imu0",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = s(&o.stderr);
+    assert!(
+        err.contains("imu0") && err.contains("/imu/data") && err.contains("/status"),
+        "{err}"
+    );
+    assert_no_outputs(&out);
+}
+
+/// Upstream crashes (log10 of 0 or of a negative taumax) on 0, 1 or 2 samples; we say why.
+#[test]
+fn empty_and_too_short_inputs_are_clear_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    for n in [0usize, 1, 2] {
+        let mat = tmp.path().join(format!("n{n}.mat"));
+        let mut m = DataImu::with_capacity(n);
+        for i in 0..n {
+            m.push([i as f64 * 0.005, 0.1, 0.2, 9.8, 0.01, 0.02, 0.03]);
+        }
+        write_data_imu(&mat, &m).unwrap();
+        let o = run(&[
+            mat.to_str().unwrap(),
+            "--update-rate",
+            "200",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "n={n}");
+        let err = s(&o.stderr);
+        assert!(
+            err.contains("too few samples") && err.contains(&format!(": {n} ")),
+            "n={n}: {err}"
+        );
+        assert_no_outputs(&out);
+    }
+    // Three samples are enough for a (useless but defined) run.
+    let mat = tmp.path().join("n3.mat");
+    let mut m = DataImu::with_capacity(3);
+    for i in 0..3 {
+        m.push([
+            i as f64 * 0.005,
+            0.1 * i as f64,
+            0.2,
+            9.8,
+            0.01,
+            0.02,
+            0.03 * i as f64,
+        ]);
+    }
+    write_data_imu(&mat, &m).unwrap();
+    let o = run(&[mat.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "n=3: {}", s(&o.stderr));
+}
+
+#[test]
+fn non_finite_samples_are_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mat = tmp.path().join("nan.mat");
+    let mut m = DataImu::with_capacity(100);
+    for i in 0..100 {
+        let wy = if i == 41 { f64::NAN } else { 0.02 };
+        m.push([i as f64 * 0.01, 0.1, 0.2, 9.8, 0.01, wy, 0.03]);
+    }
+    write_data_imu(&mat, &m).unwrap();
+    let o = run(&[mat.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        s(&o.stderr).contains("sample 42 of wy is NaN"),
+        "{}",
+        s(&o.stderr)
+    );
+    assert_no_outputs(&out);
+}
