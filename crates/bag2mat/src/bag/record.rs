@@ -78,6 +78,25 @@ pub fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, String> {
     Ok(out)
 }
 
+/// The `op`, `conn` and `time` fields of a record header, found without allocating: the hot
+/// path of reading, run once per message. Fields missing from the header stay `None`.
+pub fn op_conn_time(header: &[u8]) -> Result<(Option<u8>, Option<u32>, Option<RosTime>), String> {
+    let (mut op, mut conn, mut time) = (None, None, None);
+    let mut pos = 0usize;
+    while pos < header.len() {
+        let len = read_u32(header, pos).ok_or("header field length overruns the header")? as usize;
+        let field = header.get(pos + 4..pos + 4 + len).ok_or("header field overruns the header")?;
+        match field {
+            [b'o', b'p', b'=', v] => op = Some(*v),
+            [b'c', b'o', b'n', b'n', b'=', v @ ..] if v.len() == 4 => conn = Some(u32::from_le_bytes([v[0], v[1], v[2], v[3]])),
+            [b't', b'i', b'm', b'e', b'=', v @ ..] => time = RosTime::from_bytes(v),
+            _ => {}
+        }
+        pos += 4 + len;
+    }
+    Ok((op, conn, time))
+}
+
 /// A parsed record header, fields looked up by name.
 pub struct Header<'a> {
     fields: Vec<(&'a str, &'a [u8])>,
