@@ -3,3 +3,4 @@
 
 mod common;
 mod fit_reference;
+mod reference;
