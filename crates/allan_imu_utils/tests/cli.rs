@@ -1,0 +1,254 @@
+//! The binary as a user runs it: the launch file of `launch_equivalents/`, bad inputs with
+//! clear errors, and the yaml files read back by OpenCV's own `cv2.FileStorage`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use bag2mat::RosTime;
+use bag2mat::bag::BagWriter;
+use bag2mat::imu_msg::Imu;
+
+use crate::common::CASES;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_allan_imu_utils"))
+}
+
+fn launch_file() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../launch_equivalents/my_imu.launch")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn run(cmd: &mut Command) -> Output {
+    cmd.output().expect("binary runs")
+}
+
+/// Seed of the synthetic bags' noise (a fixed LCG).
+const SEED: u64 = 0xB0A7_5EED;
+
+/// A 200 Hz bag of `n` messages of white noise; `nan_at` puts a NaN into acc y there.
+fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
+    let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
+    let conn = w.add_imu_connection("/imu");
+    let mut state = SEED;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for i in 0..n {
+        let stamp = RosTime::from_nanos(1_600_000_000_000_000_000 + i as u64 * 5_000_000);
+        let mut m = Imu {
+            seq: i as u32,
+            stamp,
+            ..Imu::default()
+        };
+        m.angular_velocity = [next() * 0.1, next() * 0.1, next() * 0.1];
+        m.linear_acceleration = [next(), next(), 9.81 + next()];
+        if nan_at == Some(i) {
+            m.linear_acceleration[1] = f64::NAN;
+        }
+        w.write_imu(conn, stamp, &m).unwrap();
+    }
+    w.finish().unwrap();
+}
+
+#[test]
+fn launch_file_with_overrides_reproduces_p3() {
+    let case = &CASES[2];
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(bin()
+        .arg(case.bag())
+        .arg("--launch")
+        .arg(launch_file())
+        .args(["--name", "p3", "--quiet", "--data-save-path"])
+        .arg(dir.path()));
+    let stderr = text(&out.stderr);
+    assert!(
+        out.status.success(),
+        "exit {:?}, stderr:\n{stderr}",
+        out.status
+    );
+    assert!(
+        stderr.contains("bag ended after 12200 messages before max_time_min (120)"),
+        "stderr:\n{stderr}"
+    );
+    let ours = text(&out.stdout);
+    let theirs = case.read("stdout.txt");
+    assert_eq!(
+        ours.lines().count(),
+        theirs.lines().count(),
+        "stdout line count"
+    );
+    for (i, (a, b)) in ours.lines().zip(theirs.lines()).enumerate() {
+        let fitted = b.starts_with("C ") || b.starts_with(" Bias") || b.starts_with(" White");
+        assert!(
+            fitted || a == b,
+            "stdout line {}: expected {b:?}, actual {a:?}",
+            i + 1
+        );
+    }
+    for f in [
+        "p3_imu_param.yaml",
+        "p3_imu_param_continuous.yaml",
+        "allan_gyr.png",
+        "allan_acc.svg",
+        "data_p3_sim_acc_z.txt",
+    ] {
+        assert!(dir.path().join(f).is_file(), "{f} not written");
+    }
+}
+
+#[test]
+fn launch_substitution_without_flag_names_the_flag() {
+    let out = run(bin()
+        .arg(CASES[2].bag())
+        .arg("--launch")
+        .arg(launch_file())
+        .arg("--quiet"));
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("--data-save-path") && stderr.contains("$(find imu_utils)"),
+        "stderr:\n{stderr}"
+    );
+}
+
+#[test]
+fn missing_topic_lists_the_bag_topics() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(bin()
+        .arg(CASES[1].bag())
+        .args(["--topic", "/nope", "--quiet", "--data-save-path"])
+        .arg(dir.path()));
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("/nope") && stderr.contains("/imu/data") && stderr.contains("/status"),
+        "stderr:\n{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing written on error"
+    );
+}
+
+#[test]
+fn too_few_samples_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("tiny.bag");
+    write_bag(&bag, 9, None);
+    let out = run(bin()
+        .arg(&bag)
+        .args(["--quiet", "--data-save-path"])
+        .arg(dir.path()));
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("too few samples") && stderr.contains("9 messages"),
+        "stderr:\n{stderr}"
+    );
+}
+
+#[test]
+fn nan_in_the_data_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("nan.bag");
+    write_bag(&bag, 3000, Some(1234));
+    let out = run(bin()
+        .arg(&bag)
+        .args(["--quiet", "--data-save-path"])
+        .arg(dir.path()));
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("linear_acceleration.y") && stderr.contains("message 1234"),
+        "stderr:\n{stderr}"
+    );
+}
+
+/// Reads every real of a FileStorage yaml with OpenCV (Debian python3-opencv, the system
+/// python) and prints `path value` lines.
+const CV2_DUMP: &str = r#"
+import sys, cv2
+fs = cv2.FileStorage(sys.argv[1], cv2.FILE_STORAGE_READ)
+assert fs.isOpened(), "OpenCV could not open " + sys.argv[1]
+print("name", fs.getNode("name").string())
+for s in ("Gyr", "Acc"):
+    n = fs.getNode(s)
+    print(s + "/unit", repr(n.getNode("unit").string()))
+    for ax in ("avg-axis", "x-axis", "y-axis", "z-axis"):
+        a = n.getNode(ax)
+        for k in a.keys():
+            print("%s/%s/%s %.17g" % (s, ax, k, a.getNode(k).real()))
+"#;
+
+#[test]
+fn opencv_reads_both_yaml_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(bin()
+        .arg(CASES[2].bag())
+        .args([
+            "--topic",
+            "imu",
+            "--name",
+            "16448",
+            "--quiet",
+            "--no-plots",
+            "--data-save-path",
+        ])
+        .arg(dir.path()));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for (file, unit) in [
+        ("16448_imu_param.yaml", "' rad/s'"),
+        (
+            "16448_imu_param_continuous.yaml",
+            "'gyr_n: rad / s / sqrt(Hz)",
+        ),
+    ] {
+        let path = dir.path().join(file);
+        let py = run(Command::new("/usr/bin/python3")
+            .args(["-c", CV2_DUMP])
+            .arg(&path));
+        let dump = text(&py.stdout);
+        assert!(
+            py.status.success(),
+            "cv2 failed on {file}: {}",
+            text(&py.stderr)
+        );
+        assert!(
+            dump.contains("name 16448\n"),
+            "{file}: name not read back:\n{dump}"
+        );
+        assert!(
+            dump.lines()
+                .any(|l| l.starts_with("Gyr/unit ") && l.contains(unit)),
+            "{file}: unit:\n{dump}"
+        );
+        // Every value OpenCV reads equals the one we wrote.
+        let ours = std::fs::read_to_string(&path).unwrap();
+        let mut n = 0;
+        for line in dump.lines().filter(|l| l.contains("-axis/")) {
+            let (key, v) = line.split_once(' ').unwrap();
+            let cv: f64 = v.parse().unwrap();
+            let leaf = key.rsplit('/').next().unwrap();
+            let written: Vec<f64> = ours
+                .lines()
+                .filter_map(|l| l.trim().strip_prefix(&format!("{leaf}: ")))
+                .map(|s| s.parse().unwrap())
+                .collect();
+            assert!(
+                written.contains(&cv),
+                "{file}: OpenCV read {key} = {cv:e}, not among the written {written:?}"
+            );
+            n += 1;
+        }
+        let expected = if file.contains("continuous") { 24 } else { 16 };
+        assert_eq!(n, expected, "{file}: values read by OpenCV:\n{dump}");
+    }
+}
