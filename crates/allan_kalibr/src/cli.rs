@@ -37,6 +37,9 @@ pub struct Args {
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
+    #[arg(long)]
+    pub timings: bool,
 }
 
 impl From<Args> for Config {
@@ -57,6 +60,7 @@ impl From<Args> for Config {
             },
             outdir,
             quiet: a.quiet,
+            timings: a.timings,
         }
     }
 }

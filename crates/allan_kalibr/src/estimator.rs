@@ -27,10 +27,11 @@ pub enum Estimator {
 
 /// `sig2` for all six axes on every grid point (NaN at m = 0, duplicates copied).
 ///
-/// `axes` are the six sample columns ax ay az wx wy wz, each of length `grid.n`.
+/// `axes` are the six sample columns ax ay az wx wy wz, each of length `grid.n`; the fast
+/// path turns each column into its prefix sums in place (no second copy of the samples).
 /// `on_progress` is called once per finished (axis, m) job.
 pub fn sig2_curves(
-    axes: &[Vec<f64>; 6],
+    mut axes: [Vec<f64>; 6],
     grid: &TauGrid,
     estimator: Estimator,
     on_progress: &(dyn Fn() + Sync),
@@ -38,13 +39,10 @@ pub fn sig2_curves(
     let ms = grid.distinct_m();
     let per_m: Vec<Vec<f64>> = match estimator {
         Estimator::PrefixSum => axes
-            .par_iter()
+            .par_iter_mut()
             .map(|x| {
-                let prefix = compensated_prefix(x);
-                let v = ms
-                    .iter()
-                    .map(|&m| sig2_from_prefix(&prefix, m as usize))
-                    .collect();
+                prefix_in_place(x);
+                let v = sig2_tiled(x, &ms);
                 for _ in 0..ms.len() {
                     on_progress();
                 }
@@ -52,7 +50,7 @@ pub fn sig2_curves(
             })
             .collect(),
         Estimator::BitExact => {
-            // Parallel over axes and m; largest m first is irrelevant (each job is O(n)).
+            // Parallel over axes and m; each job is one O(n) replay of the recursion.
             let jobs: Vec<(usize, usize)> = (0..6)
                 .flat_map(|a| (0..ms.len()).map(move |j| (a, j)))
                 .collect();
@@ -87,32 +85,36 @@ fn expand(grid_m: &[u64], ms: &[u64], values: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Prefix sums `P[i] = Σ_{k<i} (x[k] − c)` with `P[0] = 0`, where `c` is the first sample.
+/// Turns `x` into its prefix sums in place: afterwards `x[i] = P[i+1] = Σ_{k≤i} (x[k] − c)`
+/// (`P[0] = 0` is implicit), where `c` is the first sample.
 ///
 /// Subtracting `c` keeps a constant offset (gravity on acc z) out of the sums, and the
-/// running sum is Neumaier-compensated so each stored `P[i]` is within half an ulp of the
-/// exact value: a block sum `P[j] − P[i]` then carries no error accumulated along the way.
-/// The offset cancels in the difference of two block means.
-pub fn compensated_prefix(x: &[f64]) -> Vec<f64> {
+/// running sum is Kahan-compensated so each stored `P[i]` is within about an ulp of the exact
+/// value: a block sum `P[j] − P[i]` then carries no error accumulated along the way. The
+/// offset cancels in the difference of two block means.
+pub fn prefix_in_place(x: &mut [f64]) {
     let c = x.first().copied().unwrap_or(0.0);
+    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
+    for xi in x.iter_mut() {
+        let y = (*xi - c) - comp;
+        let t = sum + y;
+        comp = (t - sum) - y;
+        sum = t;
+        *xi = sum;
+    }
+}
+
+/// Prefix sums with `P[0] = 0` (length n + 1), for [`sig2_from_prefix`].
+pub fn compensated_prefix(x: &[f64]) -> Vec<f64> {
     let mut p = Vec::with_capacity(x.len() + 1);
     p.push(0.0);
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
-    for &xi in x {
-        let v = xi - c;
-        let t = sum + v;
-        if sum.abs() >= v.abs() {
-            comp += (sum - t) + v;
-        } else {
-            comp += (v - t) + sum;
-        }
-        sum = t;
-        p.push(sum + comp);
-    }
+    p.extend_from_slice(x);
+    prefix_in_place(&mut p[1..]);
     p
 }
 
-/// `sig2` for cluster size `m ≥ 1` from [`compensated_prefix`] output (length n + 1).
+/// `sig2` for cluster size `m ≥ 1` from [`compensated_prefix`] output (length n + 1); one m
+/// at a time (the reference for [`sig2_tiled`]).
 pub fn sig2_from_prefix(prefix: &[f64], m: usize) -> f64 {
     let n = prefix.len() - 1;
     if m == 0 || m > n {
@@ -129,6 +131,72 @@ pub fn sig2_from_prefix(prefix: &[f64], m: usize) -> f64 {
         prev = mean;
     }
     (0.5 * (acc / (k - 1) as f64)).sqrt()
+}
+
+/// Prefix entries per tile of [`sig2_tiled`] (128 KiB: stays in L2 while every m walks it).
+const TILE: usize = 16 * 1024;
+
+/// `sig2` for every m in `ms` (ascending, ≥ 1) from in-place prefix sums `p[i] = P[i+1]`.
+///
+/// Cache-blocked: the prefix array is walked tile by tile and every m takes its cluster
+/// boundaries (multiples of m) inside the tile, so each tile comes from memory once instead
+/// of once per m. Squared differences of block sums are accumulated and divided by m² at the
+/// end. Matches [`sig2_from_prefix`] to rounding.
+pub fn sig2_tiled(p: &[f64], ms: &[u64]) -> Vec<f64> {
+    struct State {
+        m: usize,
+        next: usize, // next boundary, in P numbering (P[next] = p[next-1])
+        end: usize,  // last boundary K*m
+        last_p: f64,
+        last_b: f64,
+        have_b: bool,
+        acc: f64,
+    }
+    let n = p.len();
+    let mut st: Vec<State> = ms
+        .iter()
+        .map(|&m| {
+            let m = m as usize;
+            State {
+                m,
+                next: m.max(1),
+                end: if m == 0 { 0 } else { (n / m) * m },
+                last_p: 0.0, // P[0]
+                last_b: 0.0,
+                have_b: false,
+                acc: 0.0,
+            }
+        })
+        .collect();
+    let mut tile_start = 1;
+    while tile_start <= n {
+        let tile_end = (tile_start + TILE).min(n + 1);
+        for s in st.iter_mut() {
+            while s.next < tile_end && s.next <= s.end {
+                let pv = p[s.next - 1];
+                let b = pv - s.last_p;
+                if s.have_b {
+                    let d = b - s.last_b;
+                    s.acc += d * d;
+                }
+                s.have_b = true;
+                s.last_b = b;
+                s.last_p = pv;
+                s.next += s.m;
+            }
+        }
+        tile_start = tile_end;
+    }
+    st.iter()
+        .map(|s| {
+            let k = n.checked_div(s.m).unwrap_or(0);
+            if k < 2 {
+                return f64::NAN;
+            }
+            let mf = s.m as f64;
+            (0.5 * (s.acc / (k - 1) as f64)).sqrt() / mf
+        })
+        .collect()
 }
 
 /// `sig2` for cluster size `m` exactly as `allan.m` computes it (kalibr_allan.md §2.1):
@@ -229,12 +297,40 @@ mod tests {
     }
 
     #[test]
+    fn tiled_matches_single_m_over_tile_boundaries() {
+        // Longer than several tiles, with m values that straddle tile edges.
+        let x = signal(3 * TILE + 777, 9.81, 0.01);
+        let prefix = compensated_prefix(&x);
+        let ms: Vec<u64> = vec![1, 2, 3, 5, 8, 13, 999, 4096, 16_385, 20_000, 24_000];
+        let mut p = x.clone();
+        prefix_in_place(&mut p);
+        let tiled = sig2_tiled(&p, &ms);
+        for (j, &m) in ms.iter().enumerate() {
+            let single = sig2_from_prefix(&prefix, m as usize);
+            let o = sig2_oracle(&x, m as usize);
+            assert!(
+                rel(tiled[j], single) < ORACLE_REL_TOL,
+                "m={m}: tiled {} single {single}",
+                tiled[j]
+            );
+            assert!(
+                rel(tiled[j], o) < ORACLE_REL_TOL,
+                "m={m}: tiled {} oracle {o}",
+                tiled[j]
+            );
+        }
+    }
+
+    #[test]
     fn oracle_matches_hand_computed_value() {
         // Blocks of m=2: means 1.5, 3.5, 5.5 → diffs 2, 2 → sqrt(0.5*4) = sqrt(2).
         let x = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 100.0];
         assert_eq!(sig2_oracle(&x, 2), 2.0_f64.sqrt());
         assert_eq!(sig2_recursive(&x, 2), 2.0_f64.sqrt());
         assert_eq!(sig2_from_prefix(&compensated_prefix(&x), 2), 2.0_f64.sqrt());
+        let mut p = x.to_vec();
+        prefix_in_place(&mut p);
+        assert_eq!(sig2_tiled(&p, &[2]), vec![2.0_f64.sqrt()]);
     }
 
     #[test]
@@ -263,7 +359,7 @@ mod tests {
         let axes: [Vec<f64>; 6] = std::array::from_fn(|a| axes[a][..2000].to_vec());
         let grid = TauGrid::new(2000, 100.0).unwrap();
         for est in [Estimator::PrefixSum, Estimator::BitExact] {
-            let c = sig2_curves(&axes, &grid, est, &|| {});
+            let c = sig2_curves(axes.clone(), &grid, est, &|| {});
             for a in 0..6 {
                 for (i, &m) in grid.m.iter().enumerate() {
                     let o = sig2_oracle(&axes[a], m as usize);

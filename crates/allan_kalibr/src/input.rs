@@ -41,19 +41,28 @@ impl ImuData {
 
     /// Builds the columns from a bag2mat series (t = record time `to_sec()`, as bagconvert).
     pub fn from_series(s: bag2mat::ImuSeries) -> Self {
-        let t = s.record_time.iter().map(|r| r.to_sec()).collect();
-        let axes = std::array::from_fn(|c| {
-            if c < 3 {
-                s.acc.iter().map(|v| v[c]).collect()
-            } else {
-                s.gyro.iter().map(|v| v[c - 3]).collect()
-            }
-        });
+        // Consumes the series part by part so that at most one 3-column block is held twice
+        // (peak memory stays near the size of the samples).
+        let bag2mat::ImuSeries {
+            topic,
+            record_time,
+            acc,
+            gyro,
+            notes,
+            ..
+        } = s;
+        let t = record_time.iter().map(|r| r.to_sec()).collect();
+        drop(record_time);
+        let split = |v: Vec<[f64; 3]>| -> [Vec<f64>; 3] {
+            std::array::from_fn(|c| v.iter().map(|x| x[c]).collect())
+        };
+        let [ax, ay, az] = split(acc);
+        let [wx, wy, wz] = split(gyro);
         ImuData {
             t,
-            axes,
-            topic: Some(s.topic),
-            notes: s.notes,
+            axes: [ax, ay, az, wx, wy, wz],
+            topic: Some(topic),
+            notes,
         }
     }
 

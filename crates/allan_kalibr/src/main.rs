@@ -24,6 +24,9 @@ fn main() -> ExitCode {
             for p in &out.written {
                 eprintln!("wrote {}", p.display());
             }
+            if config.timings {
+                eprintln!("{}", out.timings);
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

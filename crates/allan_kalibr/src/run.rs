@@ -4,6 +4,7 @@
 //! behind; each file is written atomically.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use crate::curves;
 use crate::error::Error;
@@ -32,6 +33,8 @@ pub struct Config {
     pub outdir: PathBuf,
     /// No progress bars.
     pub quiet: bool,
+    /// Print phase timings on stderr (for the benchmark).
+    pub timings: bool,
 }
 
 /// The numbers of one run.
@@ -47,9 +50,10 @@ pub struct Analysis {
     pub gyro: ChartFit,
 }
 
-/// Computes grid, curves and both fits for `axes` (each N samples) at `rate` Hz.
+/// Computes grid, curves and both fits for `axes` (each N samples) at `rate` Hz. The
+/// columns are consumed: the fast path turns them into prefix sums in place.
 pub fn analyse(
-    axes: &[Vec<f64>; 6],
+    axes: [Vec<f64>; 6],
     rate: f64,
     estimator: Estimator,
     quiet: bool,
@@ -83,12 +87,39 @@ pub struct RunOutput {
     pub notes: Vec<String>,
     /// Files written.
     pub written: Vec<PathBuf>,
+    /// Wall time of each phase.
+    pub timings: Timings,
+}
+
+/// Wall-clock seconds per phase of [`run`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Timings {
+    /// Reading the bag or .mat.
+    pub load: f64,
+    /// τ grid, sig2 curves and both fits.
+    pub analyse: f64,
+    /// Rendering and writing yaml, CSV and plots.
+    pub output: f64,
+}
+
+impl std::fmt::Display for Timings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "timings: load {:.3} s, allan+fit {:.3} s, outputs {:.3} s",
+            self.load, self.analyse, self.output
+        )
+    }
 }
 
 /// Runs the whole job for `config`.
 pub fn run(config: &Config) -> Result<RunOutput, Error> {
+    let start = Instant::now();
     let data = input::load(&config.input, &config.topic, config.quiet)?;
-    run_on(config, data)
+    let load = start.elapsed().as_secs_f64();
+    let mut out = run_on(config, data)?;
+    out.timings.load = load;
+    Ok(out)
 }
 
 /// [`run`] on samples already in memory.
@@ -101,8 +132,11 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     let rate = input::choose_rate(config.update_rate, &data.t)?;
     notes.extend(rate.message.clone());
     let topic = data.topic.clone().unwrap_or_else(|| config.topic.clone());
-    let analysis = analyse(&data.axes, rate.used, config.estimator, config.quiet)?;
-    drop(data);
+    let start = Instant::now();
+    let ImuData { axes, .. } = data;
+    let analysis = analyse(axes, rate.used, config.estimator, config.quiet)?;
+    let analyse_s = start.elapsed().as_secs_f64();
+    let start = Instant::now();
     let text = report::full_text(&analysis.accel, &analysis.gyro);
 
     // Render the text outputs before touching the output directory.
@@ -140,12 +174,18 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     bag2mat::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
     written.extend(write_plots(&analysis, &config.title, dir)?);
+    let timings = Timings {
+        load: 0.0,
+        analyse: analyse_s,
+        output: start.elapsed().as_secs_f64(),
+    };
     Ok(RunOutput {
         analysis,
         rate,
         text,
         notes,
         written,
+        timings,
     })
 }
 

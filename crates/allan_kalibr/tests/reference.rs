@@ -138,7 +138,7 @@ fn parity(case: &Case) {
     let r = ref_curves(case);
     let f = final_full(case);
     for est in [Estimator::PrefixSum, Estimator::BitExact] {
-        let a = allan_kalibr::analyse(&data.axes, case.rate, est, true).unwrap();
+        let a = allan_kalibr::analyse(data.axes.clone(), case.rate, est, true).unwrap();
         let (worst, axis, idx, diff_count) = curve_errors(case, &a.sig2, &r.sig2);
         let got = [a.accel.white, a.accel.bias, a.gyro.white, a.gyro.bias];
         let num_worst = (0..4)
