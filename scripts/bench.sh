@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Speed and memory benchmarks (never run by the tests). Usage: scripts/bench.sh [WORKDIR]
+#
+# On a 4 h, 200 Hz static bag written by `sim` (2,880,001 messages, ~1.09 GB uncompressed):
+#   * sim writing it (none, lz4) vs Debian's python rosbag writing the same number of Imu
+#     messages (target: sim >= 50x faster on the uncompressed bag);
+#   * bag2mat (read + .mat) vs `cat bag > /dev/null` (target: < 3x) and its peak memory vs the
+#     output matrix size (target: < 2x); python rosbag reading the same rows, extrapolated
+#     from BENCH_PY_READ_MSGS messages (python reads ~4k msgs/s: a full read takes ~12 min);
+#   * then each analyser's own benchmark script, on the same bag.
+# Environment: BENCH_PY_WRITE_MSGS (default: all 2,880,001), BENCH_PY_READ_MSGS (200000).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+work=${1:-$(mktemp -d /tmp/imu-bench.XXXXXX)}
+mkdir -p "$work"
+echo "work dir: $work"
+cargo build --release --quiet -p sim -p bag2mat -p allan_kalibr -p allan_imu_utils
+bin="$root/target/release"
+N=2880001
+py_write=${BENCH_PY_WRITE_MSGS:-$N}
+py_read=${BENCH_PY_READ_MSGS:-200000}
+
+# seconds and peak KB of a command, on stdout as "SECONDS KB"
+measure() { /usr/bin/time -f "%e %M" -o "$work/.time" "$@" >/dev/null 2>&1; cat "$work/.time"; }
+ratio() { /usr/bin/python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print('%.1f' % (a / b if b > 0 else float('inf')))" "$1" "$2"; }
+
+echo
+echo "== writing the 4 h bag ($N messages)"
+read -r t_none _ < <(measure "$bin/sim" bag -o "$work/imu.bag" --start-time 1700000000 --compression none --quiet)
+read -r t_lz4 _ < <(measure "$bin/sim" bag -o "$work/imu_lz4.bag" --start-time 1700000000 --compression lz4 --quiet)
+t_py=$(/usr/bin/python3 scripts/bench_py_rosbag.py write "$work/py.bag" "$py_write" none)
+t_py_full=$(/usr/bin/python3 -c "print($t_py * $N / $py_write)")
+rm -f "$work/py.bag"
+echo "sim none: ${t_none} s   sim lz4: ${t_lz4} s   python rosbag none: ${t_py} s for $py_write msgs (${t_py_full} s for $N)"
+echo "ratio python/sim (none): $(ratio "$t_py_full" "$t_none")x   [target >= 50x]"
+
+echo
+echo "== reading: bag2mat vs cat vs python rosbag"
+cat "$work/imu.bag" > /dev/null # warm the page cache
+read -r t_cat _ < <(measure cat "$work/imu.bag")
+best=""
+for _ in 1 2 3; do
+  read -r t kb < <(measure "$bin/bag2mat" "$work/imu.bag" imu -o "$work/imu.mat" --quiet)
+  if [ -z "$best" ] || /usr/bin/python3 -c "import sys; sys.exit(0 if $t < $best else 1)"; then best=$t; best_kb=$kb; fi
+done
+mat_kb=$(( $(stat -c %s "$work/imu.mat") / 1024 ))
+read -r t_lz4r _ < <(measure "$bin/bag2mat" "$work/imu_lz4.bag" imu -o "$work/imu_lz4.mat" --quiet)
+t_pyr=$(/usr/bin/python3 scripts/bench_py_rosbag.py read "$work/imu.bag" "$py_read")
+t_pyr_full=$(/usr/bin/python3 -c "print($t_pyr * $N / $py_read)")
+echo "cat: ${t_cat} s   bag2mat (none, best of 3): ${best} s   bag2mat (lz4): ${t_lz4r} s   python read: ${t_pyr} s for $py_read msgs (~${t_pyr_full} s for $N)"
+echo "ratio bag2mat/cat: $(ratio "$best" "$t_cat")x   [target < 3x]   python/bag2mat: $(ratio "$t_pyr_full" "$best")x"
+echo "bag2mat peak RSS: ${best_kb} KB   output matrix: ${mat_kb} KB   ratio: $(ratio "$best_kb" "$mat_kb")x   [target < 2x]"
+
+for s in scripts/bench_allan_kalibr.sh scripts/bench_allan_imu_utils.sh; do
+  if [ -x "$s" ]; then
+    echo
+    echo "== $s"
+    "$s" "$work/imu.bag" "$work/imu.mat"
+  fi
+done
