@@ -172,18 +172,47 @@ pub fn sig2_tiled(p: &[f64], ms: &[u64]) -> Vec<f64> {
     while tile_start <= n {
         let tile_end = (tile_start + TILE).min(n + 1);
         for s in st.iter_mut() {
-            while s.next < tile_end && s.next <= s.end {
-                let pv = p[s.next - 1];
-                let b = pv - s.last_p;
-                if s.have_b {
-                    let d = b - s.last_b;
-                    s.acc += d * d;
-                }
-                s.have_b = true;
-                s.last_b = b;
-                s.last_p = pv;
-                s.next += s.m;
+            let stop = (tile_end - 1).min(s.end);
+            if s.next > stop {
+                continue;
             }
+            let m = s.m;
+            // Locals (registers) for the walk; two accumulators break the add chain.
+            let (mut next, mut lp, mut lb, mut acc0, mut acc1) =
+                (s.next, s.last_p, s.last_b, s.acc, 0.0);
+            if !s.have_b {
+                let pv = p[next - 1];
+                lb = pv - lp;
+                lp = pv;
+                next += m;
+                s.have_b = true;
+            }
+            while next + m <= stop {
+                let p1 = p[next - 1];
+                let p2 = p[next + m - 1];
+                let b1 = p1 - lp;
+                let b2 = p2 - p1;
+                let d1 = b1 - lb;
+                let d2 = b2 - b1;
+                acc0 += d1 * d1;
+                acc1 += d2 * d2;
+                lb = b2;
+                lp = p2;
+                next += 2 * m;
+            }
+            if next <= stop {
+                let pv = p[next - 1];
+                let b = pv - lp;
+                let d = b - lb;
+                acc0 += d * d;
+                lb = b;
+                lp = pv;
+                next += m;
+            }
+            s.next = next;
+            s.last_p = lp;
+            s.last_b = lb;
+            s.acc = acc0 + acc1;
         }
         tile_start = tile_end;
     }
