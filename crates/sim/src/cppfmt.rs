@@ -27,7 +27,9 @@ pub fn push_g_prec(out: &mut String, x: f64, prec: usize) {
     }
     // Scientific rendering with prec significant digits gives the (rounded) exponent.
     let sci = format!("{:.*e}", prec - 1, x);
-    let (mant, exp) = sci.split_once('e').expect("Rust's {:e} always has an exponent");
+    let (mant, exp) = sci
+        .split_once('e')
+        .expect("Rust's {:e} always has an exponent");
     let exp: i32 = exp.parse().expect("Rust's exponent is an integer");
     if exp < -4 || exp >= prec as i32 {
         out.push_str(strip_zeros(mant));
@@ -42,7 +44,11 @@ pub fn push_g_prec(out: &mut String, x: f64, prec: usize) {
 }
 
 fn strip_zeros(s: &str) -> &str {
-    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { s }
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
 }
 
 /// `%g` (6 significant digits) as a new string.

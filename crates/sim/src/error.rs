@@ -49,6 +49,9 @@ pub type Result<T> = std::result::Result<T, SimError>;
 impl SimError {
     /// An I/O error with its path.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        SimError::Io { path: path.into(), source }
+        SimError::Io {
+            path: path.into(),
+            source,
+        }
     }
 }

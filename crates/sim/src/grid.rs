@@ -32,7 +32,15 @@ pub struct GridIter {
 impl Grid {
     /// Times of this grid from 0 to `end` (s) at `rate` (Hz).
     pub fn times(self, end: f64, rate: f64) -> GridIter {
-        GridIter { grid: self, rate, end, i: 0, n_exact: (end * rate).round() as u64, t64: 0.0, t32: 0.0 }
+        GridIter {
+            grid: self,
+            rate,
+            end,
+            i: 0,
+            n_exact: (end * rate).round() as u64,
+            t64: 0.0,
+            t32: 0.0,
+        }
     }
 }
 

@@ -19,6 +19,7 @@ use crate::noise::NoiseGenerator;
 use crate::rotation::{quat_from_matrix, unit_quat};
 use crate::textio::PoseRow;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use std::path::PathBuf;
 
 /// Integration scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,7 +55,11 @@ impl State {
     /// The state of a truth sample (quaternion by Eigen's rule, as upstream
     /// `Quaterniond(init_Rwb_)`).
     pub fn from_motion(m: &MotionSample) -> Self {
-        State { q: unit_quat(quat_from_matrix(&m.r_wb)), p: m.p, v: m.v }
+        State {
+            q: unit_quat(quat_from_matrix(&m.r_wb)),
+            p: m.p,
+            v: m.v,
+        }
     }
 }
 
@@ -130,12 +135,21 @@ pub fn errors(truth: &[PoseRow], states: &[State]) -> Errors {
 
 /// The rows written to `imu_int_pose*.txt`: (t, [w x y z], p) for samples 1..N−1.
 pub fn int_rows(rows: &[PoseRow], states: &[State]) -> Vec<(f64, [f64; 4], Vector3<f64>)> {
-    rows.iter().zip(states).skip(1).map(|(r, s)| (r.t, [s.q.w, s.q.i, s.q.j, s.q.k], s.p)).collect()
+    rows.iter()
+        .zip(states)
+        .skip(1)
+        .map(|(r, s)| (r.t, [s.q.w, s.q.i, s.q.j, s.q.k], s.p))
+        .collect()
 }
 
 /// Truth rows of the ellipse model on a grid, optionally with the `addIMUnoise` model applied
 /// (pose columns stay true, as upstream `imu_pose_noise.txt`).
-pub fn model_rows(grid: Grid, duration: f64, rate: f64, noise: Option<&mut NoiseGenerator>) -> Vec<PoseRow> {
+pub fn model_rows(
+    grid: Grid,
+    duration: f64,
+    rate: f64,
+    noise: Option<&mut NoiseGenerator>,
+) -> Vec<PoseRow> {
     let mut noise = noise;
     grid.times(duration, rate)
         .map(|t| {
@@ -144,9 +158,197 @@ pub fn model_rows(grid: Grid, duration: f64, rate: f64, noise: Option<&mut Noise
             if let Some(n) = noise.as_deref_mut() {
                 n.apply(&mut g, &mut a);
             }
-            PoseRow { t, q: quat_from_matrix(&m.r_wb), p: m.p, gyro: g.into(), acc: a.into() }
+            PoseRow {
+                t,
+                q: quat_from_matrix(&m.r_wb),
+                p: m.p,
+                gyro: g.into(),
+                acc: a.into(),
+            }
         })
         .collect()
+}
+
+/// Where `sim integrate` takes its input from.
+#[derive(Debug, Clone)]
+pub enum IntegrateInput {
+    /// 14-column files (`imu_pose.txt`, optional `imu_pose_noise.txt`), as upstream
+    /// `testImu` reads them.
+    Files {
+        /// Clean file.
+        clean: PathBuf,
+        /// Noisy file, if any.
+        noisy: Option<PathBuf>,
+    },
+    /// The ellipse model in memory (full precision), clean and with the noise model.
+    Model {
+        /// Grid.
+        grid: Grid,
+        /// Seconds.
+        duration: f64,
+        /// Hz.
+        rate: f64,
+        /// Noise parameters.
+        noise: crate::noise::ContinuousNoise,
+        /// Seed.
+        seed: u64,
+    },
+}
+
+/// How the initial state is obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InitState {
+    /// The analytic ellipse model at the first timestamp (upstream uses the in-memory
+    /// truth; velocity is not in the file).
+    Model,
+    /// The first row's pose, velocity by a second-order one-sided difference of the
+    /// first three positions (for files not produced from the ellipse model).
+    File,
+}
+
+/// Settings of `sim integrate`.
+#[derive(Debug, Clone)]
+pub struct IntegrateConfig {
+    /// Input.
+    pub input: IntegrateInput,
+    /// Methods to run.
+    pub methods: Vec<Method>,
+    /// Initial state.
+    pub init: InitState,
+    /// Step, s (upstream: `imu_timestep`, not the timestamps).
+    pub dt: f64,
+    /// Output directory.
+    pub out_dir: PathBuf,
+    /// Draw the plots.
+    pub plots: bool,
+}
+
+/// One line of the error table.
+#[derive(Debug, Clone)]
+pub struct TableRow {
+    /// `clean` or `noisy`.
+    pub input: &'static str,
+    /// Method.
+    pub method: Method,
+    /// Errors.
+    pub errors: Errors,
+}
+
+/// Run `sim integrate`: integrate, write `imu_int_pose*.txt`, plot. Returns the table rows
+/// and the files written.
+pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)> {
+    use crate::textio::{NumFormat, format_int_rows, read_pose_rows, write_string};
+    if !(cfg.dt.is_finite() && cfg.dt > 0.0) {
+        return Err(crate::SimError::InvalidArgument(format!(
+            "the integration step must be positive, got {}",
+            cfg.dt
+        )));
+    }
+    let inputs: Vec<(&'static str, Vec<PoseRow>)> = match &cfg.input {
+        IntegrateInput::Files { clean, noisy } => {
+            let mut v = vec![("clean", read_pose_rows(clean)?)];
+            if let Some(n) = noisy {
+                v.push(("noisy", read_pose_rows(n)?));
+            }
+            v
+        }
+        IntegrateInput::Model {
+            grid,
+            duration,
+            rate,
+            noise,
+            seed,
+        } => {
+            let mut g = NoiseGenerator::new(noise.discretize(1.0 / rate), *seed);
+            vec![
+                ("clean", model_rows(*grid, *duration, *rate, None)),
+                ("noisy", model_rows(*grid, *duration, *rate, Some(&mut g))),
+            ]
+        }
+    };
+    std::fs::create_dir_all(&cfg.out_dir).map_err(|e| crate::SimError::io(&cfg.out_dir, e))?;
+    let mut table = Vec::new();
+    let mut files = Vec::new();
+    for (name, rows) in &inputs {
+        let init = match cfg.init {
+            InitState::Model => State::from_motion(&crate::motion::ellipse(rows[0].t)),
+            InitState::File => {
+                if rows.len() < 3 {
+                    return Err(crate::SimError::InvalidArgument(
+                        "--init file needs at least 3 rows".into(),
+                    ));
+                }
+                let v = (rows[1].p * 4.0 - rows[0].p * 3.0 - rows[2].p) / (2.0 * cfg.dt);
+                State {
+                    q: unit_quat(rows[0].q),
+                    p: rows[0].p,
+                    v,
+                }
+            }
+        };
+        let mut tracks = Vec::new();
+        for &m in &cfg.methods {
+            let states = integrate(rows, init, cfg.dt, m);
+            table.push(TableRow {
+                input: name,
+                method: m,
+                errors: errors(rows, &states),
+            });
+            let suffix = match (*name, m) {
+                ("clean", Method::Euler) => String::new(),
+                ("clean", _) => format!("_{}", m.name()),
+                (_, Method::Euler) => "_noise".to_string(),
+                (_, _) => format!("_noise_{}", m.name()),
+            };
+            let path = cfg.out_dir.join(format!("imu_int_pose{suffix}.txt"));
+            write_string(
+                &path,
+                &format_int_rows(&int_rows(rows, &states), NumFormat::CppG),
+            )?;
+            files.push(path);
+            tracks.push((m, states));
+        }
+        if cfg.plots {
+            let t: Vec<crate::plot::Track> = tracks
+                .iter()
+                .map(|(m, s)| crate::plot::Track {
+                    label: m.name(),
+                    states: s,
+                })
+                .collect();
+            let stem = cfg.out_dir.join(format!("integrate_{name}"));
+            let title = format!(
+                "IMU dead reckoning, {name} input ({} samples, dt = {} s)",
+                rows.len(),
+                cfg.dt
+            );
+            crate::plot::plot_integration(&stem, &title, rows, &t)?;
+            files.push(stem.with_extension("png"));
+            files.push(stem.with_extension("svg"));
+        }
+    }
+    Ok((table, files))
+}
+
+/// The error table as printed by `sim integrate`.
+pub fn format_table(rows: &[TableRow]) -> String {
+    let mut s = format!(
+        "{:<6} {:<9} {:>14} {:>14} {:>14} {:>16}\n",
+        "input", "method", "final |dp| [m]", "RMS |dp| [m]", "max |dp| [m]", "final rot [deg]"
+    );
+    for r in rows {
+        let e = &r.errors;
+        s += &format!(
+            "{:<6} {:<9} {:>14.6} {:>14.6} {:>14.6} {:>16.6}\n",
+            r.input,
+            r.method.name(),
+            e.final_pos,
+            e.rms_pos,
+            e.max_pos,
+            e.final_rot_deg
+        );
+    }
+    s
 }
 
 #[cfg(test)]
@@ -166,13 +368,37 @@ mod tests {
     fn quirk_04_euler_uses_right_sample_default_run_errors() {
         let e = run(Grid::AccumulatedF32, 200.0, Method::Euler);
         let m = run(Grid::AccumulatedF32, 200.0, Method::Midpoint);
-        assert!((0.9..=1.1).contains(&e.final_pos), "euler final {:.4} m, expected 0.9–1.1 (spec 1.038)", e.final_pos);
-        assert!(m.final_pos <= 0.02, "midpoint final {:.4} m, expected ≤ 0.02 (spec 0.0093)", m.final_pos);
+        assert!(
+            (0.9..=1.1).contains(&e.final_pos),
+            "euler final {:.4} m, expected 0.9–1.1 (spec 1.038)",
+            e.final_pos
+        );
+        assert!(
+            m.final_pos <= 0.02,
+            "midpoint final {:.4} m, expected ≤ 0.02 (spec 0.0093)",
+            m.final_pos
+        );
         // Spec table: 1.038 m / 0.0215° and 0.0093 m / 0.0066°, quoted to 2–4 digits.
-        assert!((e.final_pos - 1.038).abs() < 0.002, "euler final {:.5}", e.final_pos);
-        assert!((e.final_rot_deg - 0.0215).abs() < 0.0005, "euler rot {:.5}°", e.final_rot_deg);
-        assert!((m.final_pos - 0.0093).abs() < 0.0005, "midpoint final {:.5}", m.final_pos);
-        assert!((m.final_rot_deg - 0.0066).abs() < 0.0005, "midpoint rot {:.5}°", m.final_rot_deg);
+        assert!(
+            (e.final_pos - 1.038).abs() < 0.002,
+            "euler final {:.5}",
+            e.final_pos
+        );
+        assert!(
+            (e.final_rot_deg - 0.0215).abs() < 0.0005,
+            "euler rot {:.5}°",
+            e.final_rot_deg
+        );
+        assert!(
+            (m.final_pos - 0.0093).abs() < 0.0005,
+            "midpoint final {:.5}",
+            m.final_pos
+        );
+        assert!(
+            (m.final_rot_deg - 0.0066).abs() < 0.0005,
+            "midpoint rot {:.5}°",
+            m.final_rot_deg
+        );
     }
 
     /// Issue 5: midpoint's final error on clean data ≥ 50× smaller than Euler's over 20 s.
@@ -181,7 +407,11 @@ mod tests {
         for grid in [Grid::AccumulatedF32, Grid::Exact] {
             let e = run(grid, 200.0, Method::Euler).final_pos;
             let m = run(grid, 200.0, Method::Midpoint).final_pos;
-            assert!(m * 50.0 <= e, "{grid:?}: euler {e:.5} m, midpoint {m:.5} m, ratio {:.1} < 50", e / m);
+            assert!(
+                m * 50.0 <= e,
+                "{grid:?}: euler {e:.5} m, midpoint {m:.5} m, ratio {:.1} < 50",
+                e / m
+            );
         }
     }
 
@@ -193,7 +423,10 @@ mod tests {
     #[test]
     fn convergence_orders_one_and_two() {
         for (method, expected) in [(Method::Euler, 2.0), (Method::Midpoint, 4.0)] {
-            let errs: Vec<f64> = [100.0, 200.0, 400.0].iter().map(|&r| run(Grid::Exact, r, method).final_pos).collect();
+            let errs: Vec<f64> = [100.0, 200.0, 400.0]
+                .iter()
+                .map(|&r| run(Grid::Exact, r, method).final_pos)
+                .collect();
             for k in 0..2 {
                 let ratio = errs[k] / errs[k + 1];
                 assert!(
@@ -209,7 +442,10 @@ mod tests {
         // Spec §6 figures on the exact grid at 200 Hz: Euler 1.042 m, midpoint 1.3 mm.
         let e = run(Grid::Exact, 200.0, Method::Euler).final_pos;
         let m = run(Grid::Exact, 200.0, Method::Midpoint).final_pos;
-        assert!((e - 1.042).abs() < 0.002 && (m - 0.0013).abs() < 0.0002, "euler {e:.5}, midpoint {m:.6}");
+        assert!(
+            (e - 1.042).abs() < 0.002 && (m - 0.0013).abs() < 0.0002,
+            "euler {e:.5}, midpoint {m:.6}"
+        );
     }
 
     #[test]
@@ -218,13 +454,28 @@ mod tests {
         // normalised half-angle increment has angle 2·atan(ω dt / 2).
         let w = 0.3;
         let dt = 0.005;
-        let rows: Vec<PoseRow> = (0..=200).map(|i| PoseRow { t: i as f64 * dt, q: [1.0, 0.0, 0.0, 0.0], p: Vector3::zeros(), gyro: Vector3::new(0.0, 0.0, w), acc: Vector3::new(0.0, 0.0, 9.81) }).collect();
-        let init = State { q: UnitQuaternion::identity(), p: Vector3::zeros(), v: Vector3::zeros() };
+        let rows: Vec<PoseRow> = (0..=200)
+            .map(|i| PoseRow {
+                t: i as f64 * dt,
+                q: [1.0, 0.0, 0.0, 0.0],
+                p: Vector3::zeros(),
+                gyro: Vector3::new(0.0, 0.0, w),
+                acc: Vector3::new(0.0, 0.0, 9.81),
+            })
+            .collect();
+        let init = State {
+            q: UnitQuaternion::identity(),
+            p: Vector3::zeros(),
+            v: Vector3::zeros(),
+        };
         for m in [Method::Euler, Method::Midpoint] {
             let s = integrate(&rows, init, dt, m);
             let expected = 200.0 * 2.0 * (w * dt / 2.0).atan();
             let got = s[200].q.angle();
-            assert!((got - expected).abs() < 1e-12, "{m:?}: angle {got}, expected {expected}");
+            assert!(
+                (got - expected).abs() < 1e-12,
+                "{m:?}: angle {got}, expected {expected}"
+            );
             assert!(s[200].p.norm() < 1e-9, "{m:?}: drift {:?}", s[200].p);
         }
     }

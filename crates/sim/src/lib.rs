@@ -10,7 +10,8 @@
 //!   observations).
 //! * [`integrate`]: `sim integrate` — upstream Euler vs midpoint dead reckoning, error table,
 //!   plots.
-//! * [`spline`]: `sim spline` — uniform cumulative cubic B-spline on ℝ³ × SO(3) and its IMU.
+//! * [`spline`]: uniform cumulative cubic B-spline on ℝ³ × SO(3) and its IMU;
+//!   [`spline_sim`]: the `sim spline` command around it.
 //!
 //! Units: s, m, rad; gravity g_w = (0, 0, −9.81) (ENU, z up), so a level IMU at rest reads
 //! acc = (0, 0, +9.81).
@@ -32,6 +33,7 @@
 #![deny(missing_docs)]
 
 pub mod bag_sim;
+pub mod cli;
 pub mod cppfmt;
 pub mod error;
 pub mod grid;
@@ -39,8 +41,10 @@ pub mod integrate;
 pub mod motion;
 pub mod noise;
 pub mod plot;
+pub mod report;
 pub mod rotation;
 pub mod spline;
+pub mod spline_sim;
 pub mod textio;
 pub mod traj;
 

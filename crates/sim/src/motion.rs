@@ -97,13 +97,25 @@ pub fn ellipse(t: f64) -> MotionSample {
     let p = Vector3::new(ELLIPSE_X * c + 5.0, ELLIPSE_Y * s + 5.0, Z_AMP * sz + 5.0);
     let v = Vector3::new(-K * ELLIPSE_X * s, K * ELLIPSE_Y * c, Z_AMP * K1 * K * cz);
     let k2 = K * K;
-    let a = Vector3::new(-k2 * ELLIPSE_X * c, -k2 * ELLIPSE_Y * s, -Z_AMP * K1 * K1 * k2 * sz);
+    let a = Vector3::new(
+        -k2 * ELLIPSE_X * c,
+        -k2 * ELLIPSE_Y * s,
+        -Z_AMP * K1 * K1 * k2 * sz,
+    );
     let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), K * t);
     let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), K);
     let r_wb = euler_to_rotation(rpy);
     let gyro = euler_rates_to_body_rates(rpy) * rates;
     let acc = r_wb.transpose() * (a - GRAVITY_W);
-    MotionSample { t, r_wb, p, v, a, gyro, acc }
+    MotionSample {
+        t,
+        r_wb,
+        p,
+        v,
+        a,
+        gyro,
+        acc,
+    }
 }
 
 /// The `ros_version` model as its `main` uses it: `MotionModel(0)` for every sample
@@ -111,7 +123,15 @@ pub fn ellipse(t: f64) -> MotionSample {
 /// stored.
 pub fn static_level(t: f64) -> MotionSample {
     let z = Vector3::zeros();
-    MotionSample { t, r_wb: Matrix3::identity(), p: z, v: z, a: z, gyro: z, acc: -GRAVITY_W }
+    MotionSample {
+        t,
+        r_wb: Matrix3::identity(),
+        p: z,
+        v: z,
+        a: z,
+        gyro: z,
+        acc: -GRAVITY_W,
+    }
 }
 
 #[cfg(test)]
@@ -127,7 +147,10 @@ mod tests {
 
     fn close(case: &str, got: &[f64], exp: &[f64], tol: f64) {
         for (i, (g, e)) in got.iter().zip(exp).enumerate() {
-            assert!((g - e).abs() <= tol, "{case} [{i}]: expected {e}, actual {g}, tol {tol}");
+            assert!(
+                (g - e).abs() <= tol,
+                "{case} [{i}]: expected {e}, actual {g}, tol {tol}"
+            );
         }
     }
 
@@ -140,9 +163,24 @@ mod tests {
         let pi = std::f64::consts::PI;
         close("v", m.v.as_slice(), &[0.0, 2.0 * pi, pi], 1e-12);
         let q = quat_from_matrix(&m.r_wb);
-        close("q (w x y z)", &q, &[0.99875, 0.04998, 0.0, 0.0], SPEC_DIGITS_TOL * 2.0);
-        close("gyro", m.gyro.as_slice(), &[0.0, 0.230364, 0.292623], SPEC_DIGITS_TOL);
-        close("acc", m.acc.as_slice(), &[-1.48044, 0.979366, 9.76099], SPEC_DIGITS_TOL);
+        close(
+            "q (w x y z)",
+            &q,
+            &[0.99875, 0.04998, 0.0, 0.0],
+            SPEC_DIGITS_TOL * 2.0,
+        );
+        close(
+            "gyro",
+            m.gyro.as_slice(),
+            &[0.0, 0.230364, 0.292623],
+            SPEC_DIGITS_TOL,
+        );
+        close(
+            "acc",
+            m.acc.as_slice(),
+            &[-1.48044, 0.979366, 9.76099],
+            SPEC_DIGITS_TOL,
+        );
     }
 
     #[test]
@@ -152,12 +190,27 @@ mod tests {
             let (m0, m1, m) = (ellipse(t - FD_H), ellipse(t + FD_H), ellipse(t));
             let v_fd = (m1.p - m0.p) / (2.0 * FD_H);
             let a_fd = (m1.v - m0.v) / (2.0 * FD_H);
-            close(&format!("v t={t}"), v_fd.as_slice(), m.v.as_slice(), FD_TOL * 10.0);
-            close(&format!("a t={t}"), a_fd.as_slice(), m.a.as_slice(), FD_TOL * 10.0);
+            close(
+                &format!("v t={t}"),
+                v_fd.as_slice(),
+                m.v.as_slice(),
+                FD_TOL * 10.0,
+            );
+            close(
+                &format!("a t={t}"),
+                a_fd.as_slice(),
+                m.a.as_slice(),
+                FD_TOL * 10.0,
+            );
             // ω̂ = Rᵀ Ṙ.
             let rdot = (m1.r_wb - m0.r_wb) / (2.0 * FD_H);
             let w = m.r_wb.transpose() * rdot;
-            close(&format!("gyro t={t}"), &[w[(2, 1)], w[(0, 2)], w[(1, 0)]], m.gyro.as_slice(), FD_TOL);
+            close(
+                &format!("gyro t={t}"),
+                &[w[(2, 1)], w[(0, 2)], w[(1, 0)]],
+                m.gyro.as_slice(),
+                FD_TOL,
+            );
         }
     }
 

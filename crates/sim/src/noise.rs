@@ -84,7 +84,12 @@ pub struct DiscreteNoise {
 
 impl ContinuousNoise {
     /// No noise at all.
-    pub const ZERO: Self = Self { gyro_noise: 0.0, gyro_bias_rw: 0.0, acc_noise: 0.0, acc_bias_rw: 0.0 };
+    pub const ZERO: Self = Self {
+        gyro_noise: 0.0,
+        gyro_bias_rw: 0.0,
+        acc_noise: 0.0,
+        acc_bias_rw: 0.0,
+    };
 
     /// Discretise at sample period `dt` (s).
     pub fn discretize(&self, dt: f64) -> DiscreteNoise {
@@ -147,17 +152,42 @@ impl Preset {
     /// The preset's continuous-time parameters.
     pub fn params(self) -> ContinuousNoise {
         match self {
-            Preset::Low => ContinuousNoise { gyro_noise: 0.01, gyro_bias_rw: 1e-5, acc_noise: 0.01, acc_bias_rw: 1e-4 },
-            Preset::Medium => ContinuousNoise { gyro_noise: 0.015, gyro_bias_rw: 5e-5, acc_noise: 0.019, acc_bias_rw: 5e-4 },
-            Preset::High => ContinuousNoise { gyro_noise: 0.03, gyro_bias_rw: 1e-4, acc_noise: 0.03, acc_bias_rw: 1e-3 },
+            Preset::Low => ContinuousNoise {
+                gyro_noise: 0.01,
+                gyro_bias_rw: 1e-5,
+                acc_noise: 0.01,
+                acc_bias_rw: 1e-4,
+            },
+            Preset::Medium => ContinuousNoise {
+                gyro_noise: 0.015,
+                gyro_bias_rw: 5e-5,
+                acc_noise: 0.019,
+                acc_bias_rw: 5e-4,
+            },
+            Preset::High => ContinuousNoise {
+                gyro_noise: 0.03,
+                gyro_bias_rw: 1e-4,
+                acc_noise: 0.03,
+                acc_bias_rw: 1e-3,
+            },
         }
     }
 }
 
 /// vio_data_simulation `master` `param.h` (20 s trajectory run): gyro 0.015, 1e-5; acc 0.019,
 /// 1e-4 (vio_data_simulation.md §1). Used by `sim traj`/`sim spline` when no preset is given.
-pub const MASTER_PARAMS: ContinuousNoise =
-    ContinuousNoise { gyro_noise: 0.015, gyro_bias_rw: 1e-5, acc_noise: 0.019, acc_bias_rw: 1e-4 };
+pub const MASTER_PARAMS: ContinuousNoise = ContinuousNoise {
+    gyro_noise: 0.015,
+    gyro_bias_rw: 1e-5,
+    acc_noise: 0.019,
+    acc_bias_rw: 1e-4,
+};
+
+/// One standard normal draw (ziggurat, rand_distr).
+#[inline(always)]
+fn normal(rng: &mut StdRng) -> f64 {
+    StandardNormal.sample(rng)
+}
 
 /// Seeded noise source applying the `addIMUnoise` model (module doc) sample by sample.
 pub struct NoiseGenerator {
@@ -170,7 +200,12 @@ pub struct NoiseGenerator {
 impl NoiseGenerator {
     /// A generator for the given per-sample stds, seeded with `seed`, biases zero.
     pub fn new(d: DiscreteNoise, seed: u64) -> Self {
-        Self { rng: StdRng::seed_from_u64(seed), d, gyro_bias: [0.0; 3], acc_bias: [0.0; 3] }
+        Self {
+            rng: StdRng::seed_from_u64(seed),
+            d,
+            gyro_bias: [0.0; 3],
+            acc_bias: [0.0; 3],
+        }
     }
 
     /// Current biases (gyro, acc) — after the last update, like upstream's stored
@@ -181,7 +216,7 @@ impl NoiseGenerator {
 
     #[inline(always)]
     fn n(&mut self) -> f64 {
-        StandardNormal.sample(&mut self.rng)
+        normal(&mut self.rng)
     }
 
     /// Add noise to one sample in place. Mirrors vio_data_simulation `addIMUnoise`
@@ -190,17 +225,19 @@ impl NoiseGenerator {
     #[inline]
     pub fn apply(&mut self, gyro: &mut [f64; 3], acc: &mut [f64; 3]) {
         let d = self.d;
-        for k in 0..3 {
-            gyro[k] += d.gyro_noise * self.n() + self.gyro_bias[k];
+        // Draw order n1 (gyro white), n2 (acc white), n3, n4 — keep it: it defines the data.
+        for (g, b) in gyro.iter_mut().zip(self.gyro_bias) {
+            *g += d.gyro_noise * self.n() + b;
         }
-        for k in 0..3 {
-            acc[k] += d.acc_noise * self.n() + self.acc_bias[k];
+        for (a, b) in acc.iter_mut().zip(self.acc_bias) {
+            *a += d.acc_noise * self.n() + b;
         }
-        for k in 0..3 {
-            self.gyro_bias[k] += d.gyro_bias_step * self.n();
+        let rng = &mut self.rng;
+        for b in self.gyro_bias.iter_mut() {
+            *b += d.gyro_bias_step * normal(rng);
         }
-        for k in 0..3 {
-            self.acc_bias[k] += d.acc_bias_step * self.n();
+        for b in self.acc_bias.iter_mut() {
+            *b += d.acc_bias_step * normal(rng);
         }
     }
 }
@@ -222,12 +259,16 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::excessive_precision)] // the seed's number exactly as printed
     fn worked_number_from_the_seed() {
         // The seed's worked example: a per-sample std 0.20988682986301069 at 200 Hz is the
         // continuous density 0.01484124... rad/s/√Hz.
         let c = white_to_continuous(0.20988682986301069, 0.005);
         let expected = 0.014841240067788202;
-        assert!(rel(c, expected) < ROUND_TRIP_REL_TOL, "expected {expected}, actual {c}");
+        assert!(
+            rel(c, expected) < ROUND_TRIP_REL_TOL,
+            "expected {expected}, actual {c}"
+        );
         assert!((c - 0.01484124).abs() < 1e-8, "leading digits: actual {c}");
     }
 
@@ -235,10 +276,22 @@ mod tests {
     fn field_md_examples() {
         // field.md §3: σ = 0.03 at 200 Hz → 0.4243; σ_b = 1e-4 at 200 Hz → 7.07e-6;
         // at 100 Hz → 0.3 and 1e-5.
-        let cases = [(0.03, 0.005, 0.42426406871192857, true), (1e-4, 0.005, 7.0710678118654756e-6, false), (0.03, 0.01, 0.3, true), (1e-4, 0.01, 1e-5, false)];
+        let cases = [
+            (0.03, 0.005, 0.42426406871192857, true),
+            (1e-4, 0.005, 7.0710678118654756e-6, false),
+            (0.03, 0.01, 0.3, true),
+            (1e-4, 0.01, 1e-5, false),
+        ];
         for (i, (s, dt, exp, white)) in cases.into_iter().enumerate() {
-            let got = if white { white_to_discrete(s, dt) } else { random_walk_to_discrete(s, dt) };
-            assert!(rel(got, exp) < 1e-12, "case {i}: expected {exp}, actual {got}, tol 1e-12");
+            let got = if white {
+                white_to_discrete(s, dt)
+            } else {
+                random_walk_to_discrete(s, dt)
+            };
+            assert!(
+                rel(got, exp) < 1e-12,
+                "case {i}: expected {exp}, actual {got}, tol 1e-12"
+            );
         }
     }
 
@@ -248,9 +301,19 @@ mod tests {
         // 7.07e-6; ros_version bias steps 3.54e-6 and 3.54e-5 (4 significant digits).
         let m = MASTER_PARAMS.discretize(0.005);
         let r = Preset::Medium.params().discretize(0.005);
-        let cases = [(m.gyro_noise, 0.2121), (m.acc_noise, 0.2687), (m.gyro_bias_step, 7.07e-7), (m.acc_bias_step, 7.07e-6), (r.gyro_bias_step, 3.54e-6), (r.acc_bias_step, 3.54e-5)];
+        let cases = [
+            (m.gyro_noise, 0.2121),
+            (m.acc_noise, 0.2687),
+            (m.gyro_bias_step, 7.07e-7),
+            (m.acc_bias_step, 7.07e-6),
+            (r.gyro_bias_step, 3.54e-6),
+            (r.acc_bias_step, 3.54e-5),
+        ];
         for (i, (got, exp)) in cases.into_iter().enumerate() {
-            assert!(rel(got, exp) < SPEC_3_DIGITS_REL_TOL, "case {i}: expected {exp}, actual {got}, tol {SPEC_3_DIGITS_REL_TOL} rel");
+            assert!(
+                rel(got, exp) < SPEC_3_DIGITS_REL_TOL,
+                "case {i}: expected {exp}, actual {got}, tol {SPEC_3_DIGITS_REL_TOL} rel"
+            );
         }
     }
 
@@ -260,13 +323,29 @@ mod tests {
             for p in [Preset::Low, Preset::Medium, Preset::High] {
                 let c = p.params();
                 let back = c.discretize(dt).to_continuous();
-                for (i, (a, b)) in [(back.gyro_noise, c.gyro_noise), (back.gyro_bias_rw, c.gyro_bias_rw), (back.acc_noise, c.acc_noise), (back.acc_bias_rw, c.acc_bias_rw)].into_iter().enumerate() {
-                    assert!(rel(a, b) < ROUND_TRIP_REL_TOL, "{p:?} dt {dt} field {i}: expected {b}, actual {a}");
+                for (i, (a, b)) in [
+                    (back.gyro_noise, c.gyro_noise),
+                    (back.gyro_bias_rw, c.gyro_bias_rw),
+                    (back.acc_noise, c.acc_noise),
+                    (back.acc_bias_rw, c.acc_bias_rw),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    assert!(
+                        rel(a, b) < ROUND_TRIP_REL_TOL,
+                        "{p:?} dt {dt} field {i}: expected {b}, actual {a}"
+                    );
                 }
             }
             let x = 0.123;
             assert!(rel(white_to_discrete(white_to_continuous(x, dt), dt), x) < ROUND_TRIP_REL_TOL);
-            assert!(rel(random_walk_to_discrete(random_walk_to_continuous(x, dt), dt), x) < ROUND_TRIP_REL_TOL);
+            assert!(
+                rel(
+                    random_walk_to_discrete(random_walk_to_continuous(x, dt), dt),
+                    x
+                ) < ROUND_TRIP_REL_TOL
+            );
         }
     }
 
@@ -284,7 +363,11 @@ mod tests {
             let (mut g2, mut a2) = (g1, a1);
             a.apply(&mut g1, &mut a1);
             b.apply(&mut g2, &mut a2);
-            assert_eq!((g1, a1), (g2, a2), "sample {i}: same seed must give the same noise");
+            assert_eq!(
+                (g1, a1),
+                (g2, a2),
+                "sample {i}: same seed must give the same noise"
+            );
             // Remove the (known) bias before its update to isolate the white part.
             s_g += (g1[0] - prev_bias.0[0]).powi(2);
             s_a += (a1[2] - 9.81 - prev_bias.1[2]).powi(2);
@@ -294,9 +377,17 @@ mod tests {
             prev_bias = now;
         }
         let n = N as f64;
-        let cases = [("gyro white", (s_g / n).sqrt(), d.gyro_noise), ("acc white", (s_a / n).sqrt(), d.acc_noise), ("gyro bias step", (s_bg / n).sqrt(), d.gyro_bias_step), ("acc bias step", (s_ba / n).sqrt(), d.acc_bias_step)];
+        let cases = [
+            ("gyro white", (s_g / n).sqrt(), d.gyro_noise),
+            ("acc white", (s_a / n).sqrt(), d.acc_noise),
+            ("gyro bias step", (s_bg / n).sqrt(), d.gyro_bias_step),
+            ("acc bias step", (s_ba / n).sqrt(), d.acc_bias_step),
+        ];
         for (name, got, exp) in cases {
-            assert!(rel(got, exp) < STAT_REL_TOL, "{name}: expected {exp}, actual {got}, tol {STAT_REL_TOL} rel");
+            assert!(
+                rel(got, exp) < STAT_REL_TOL,
+                "{name}: expected {exp}, actual {got}, tol {STAT_REL_TOL} rel"
+            );
         }
     }
 
@@ -304,7 +395,13 @@ mod tests {
     fn first_sample_carries_no_bias_and_bias_updates_after() {
         // Spec §3: initial biases are zero, so sample 0 is pure white noise; the bias applied
         // to sample k is the one accumulated from steps 0..k-1.
-        let d = DiscreteNoise { dt: 0.005, gyro_noise: 0.0, gyro_bias_step: 1.0, acc_noise: 0.0, acc_bias_step: 1.0 };
+        let d = DiscreteNoise {
+            dt: 0.005,
+            gyro_noise: 0.0,
+            gyro_bias_step: 1.0,
+            acc_noise: 0.0,
+            acc_bias_step: 1.0,
+        };
         let mut g = NoiseGenerator::new(d, SEED);
         let (mut w, mut f) = ([0.0; 3], [0.0; 3]);
         g.apply(&mut w, &mut f);
@@ -313,6 +410,10 @@ mod tests {
         assert!(bg.iter().chain(ba.iter()).all(|&b| b != 0.0));
         let (mut w, mut f) = ([0.0; 3], [0.0; 3]);
         g.apply(&mut w, &mut f);
-        assert_eq!((w, f), (bg, ba), "sample 1 carries the bias after the first update");
+        assert_eq!(
+            (w, f),
+            (bg, ba),
+            "sample 1 carries the bias after the first update"
+        );
     }
 }

@@ -1,1 +1,256 @@
-//! placeholder
+//! Plots of `sim integrate`: ground truth and the integrated trajectories (top view, z over
+//! time, position error over time), PNG and SVG, with bag2mat's embedded font.
+
+use crate::error::{Result, SimError};
+use crate::integrate::State;
+use crate::textio::PoseRow;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One integrated trajectory to draw.
+pub struct Track<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// States, one per truth row.
+    pub states: &'a [State],
+}
+
+const SIZE: (u32, u32) = (1800, 600);
+const COLORS: [RGBColor; 3] = [
+    RGBColor(0, 0, 0),
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+];
+
+fn range(it: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in it {
+        if v.is_finite() {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+        lo -= 1.0;
+        hi += 1.0;
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    truth: &[PoseRow],
+    tracks: &[Track],
+) -> std::result::Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let root = root.titled(title, ("sans-serif", 28)).map_err(|x| e(&x))?;
+    let panels = root.split_evenly((1, 3));
+    let label_font = ("sans-serif", 20);
+
+    // Top view.
+    let xs = truth
+        .iter()
+        .map(|r| r.p.x)
+        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.x)));
+    let ys = truth
+        .iter()
+        .map(|r| r.p.y)
+        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.y)));
+    let (x0, x1) = range(xs);
+    let (y0, y1) = range(ys);
+    let mut c = ChartBuilder::on(&panels[0])
+        .caption("top view", ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|x| e(&x))?;
+    c.configure_mesh()
+        .x_desc("x [m]")
+        .y_desc("y [m]")
+        .label_style(label_font)
+        .draw()
+        .map_err(|x| e(&x))?;
+    let series = |i: usize| -> Vec<(f64, f64)> {
+        if i == 0 {
+            truth.iter().map(|r| (r.p.x, r.p.y)).collect()
+        } else {
+            tracks[i - 1]
+                .states
+                .iter()
+                .map(|s| (s.p.x, s.p.y))
+                .collect()
+        }
+    };
+    for i in 0..=tracks.len() {
+        let col = COLORS[i % COLORS.len()];
+        let label = if i == 0 {
+            "ground truth"
+        } else {
+            tracks[i - 1].label
+        };
+        let width = if i == 0 { 3 } else { 2 };
+        c.draw_series(LineSeries::new(series(i), col.stroke_width(width)))
+            .map_err(|x| e(&x))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 25, y)], col.stroke_width(3)));
+    }
+    c.draw_series(std::iter::once(Circle::new(
+        (truth[0].p.x, truth[0].p.y),
+        6,
+        RED.filled(),
+    )))
+    .map_err(|x| e(&x))?;
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::MiddleMiddle)
+        .label_font(label_font)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|x| e(&x))?;
+
+    // z over time.
+    let (t0, t1) = range(truth.iter().map(|r| r.t));
+    let (z0, z1) = range(
+        truth
+            .iter()
+            .map(|r| r.p.z)
+            .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.z))),
+    );
+    let mut c = ChartBuilder::on(&panels[1])
+        .caption("z over time", ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(t0..t1, z0..z1)
+        .map_err(|x| e(&x))?;
+    c.configure_mesh()
+        .x_desc("t [s]")
+        .y_desc("z [m]")
+        .label_style(label_font)
+        .draw()
+        .map_err(|x| e(&x))?;
+    c.draw_series(LineSeries::new(
+        truth.iter().map(|r| (r.t, r.p.z)),
+        COLORS[0].stroke_width(4),
+    ))
+    .map_err(|x| e(&x))?;
+    for (i, tr) in tracks.iter().enumerate() {
+        c.draw_series(LineSeries::new(
+            truth.iter().zip(tr.states).map(|(r, s)| (r.t, s.p.z)),
+            COLORS[(i + 1) % 3].stroke_width(2),
+        ))
+        .map_err(|x| e(&x))?;
+    }
+
+    // Position error over time.
+    let errs: Vec<Vec<(f64, f64)>> = tracks
+        .iter()
+        .map(|tr| {
+            truth
+                .iter()
+                .zip(tr.states)
+                .map(|(r, s)| (r.t, (s.p - r.p).norm()))
+                .collect()
+        })
+        .collect();
+    // Log scale so that errors orders of magnitude apart (Euler vs midpoint) are both visible.
+    let emax = errs
+        .iter()
+        .flatten()
+        .map(|p| p.1)
+        .fold(0.0f64, f64::max)
+        .max(1e-9)
+        * 1.5;
+    let emin = errs
+        .iter()
+        .flatten()
+        .map(|p| p.1)
+        .filter(|&v| v > 0.0)
+        .fold(f64::INFINITY, f64::min)
+        .max(emax * 1e-7);
+    let errs: Vec<Vec<(f64, f64)>> = errs
+        .into_iter()
+        .map(|v| v.into_iter().map(|(t, e)| (t, e.max(emin))).collect())
+        .collect();
+    let mut c = ChartBuilder::on(&panels[2])
+        .caption("position error |p - p_true|", ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t0..t1, (emin..emax).log_scale())
+        .map_err(|x| e(&x))?;
+    c.configure_mesh()
+        .x_desc("t [s]")
+        .y_desc("error [m] (log)")
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .label_style(label_font)
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (i, (tr, pts)) in tracks.iter().zip(errs).enumerate() {
+        let col = COLORS[(i + 1) % 3];
+        c.draw_series(LineSeries::new(pts, col.stroke_width(2)))
+            .map_err(|x| e(&x))?
+            .label(tr.label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 25, y)], col.stroke_width(3)));
+    }
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .label_font(label_font)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))?;
+    Ok(())
+}
+
+/// Draw `stem.png` and `stem.svg` (written atomically).
+pub fn plot_integration(
+    stem: &Path,
+    title: &str,
+    truth: &[PoseRow],
+    tracks: &[Track],
+) -> Result<()> {
+    bag2mat::plot::register_font();
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    let perr = |p: &Path, msg: String| SimError::Plot {
+        path: p.into(),
+        msg,
+    };
+    // PNG: plotters picks the encoder from the extension, so the temp file keeps ".png";
+    // it is renamed into place once complete (atomic output).
+    let name = png
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = png.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
+    let r = draw(
+        BitMapBackend::new(&tmp, SIZE).into_drawing_area(),
+        title,
+        truth,
+        tracks,
+    );
+    if let Err(m) = r {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(perr(&png, m));
+    }
+    std::fs::rename(&tmp, &png).map_err(|e| SimError::io(&png, e))?;
+    let mut s = String::new();
+    draw(
+        SVGBackend::with_string(&mut s, SIZE).into_drawing_area(),
+        title,
+        truth,
+        tracks,
+    )
+    .map_err(|m| perr(&svg, m))?;
+    crate::textio::write_string(&svg, &s)
+}

@@ -13,7 +13,12 @@ pub fn quat_from_matrix(m: &Matrix3<f64>) -> [f64; 4] {
         let s = (trace + 1.0).sqrt();
         let w = 0.5 * s;
         let s = 0.5 / s;
-        [w, (m[(2, 1)] - m[(1, 2)]) * s, (m[(0, 2)] - m[(2, 0)]) * s, (m[(1, 0)] - m[(0, 1)]) * s]
+        [
+            w,
+            (m[(2, 1)] - m[(1, 2)]) * s,
+            (m[(0, 2)] - m[(2, 0)]) * s,
+            (m[(1, 0)] - m[(0, 1)]) * s,
+        ]
     } else {
         let mut i = 0;
         if m[(1, 1)] > m[(0, 0)] {
@@ -62,18 +67,27 @@ mod tests {
             let q = quat_from_matrix(&m);
             let back = matrix_from_quat(q);
             let err = (back - m).abs().max();
-            assert!(err < ROUND_TRIP_TOL, "sample {i}: |R(q(R)) − R| = {err}, tol {ROUND_TRIP_TOL}");
+            assert!(
+                err < ROUND_TRIP_TOL,
+                "sample {i}: |R(q(R)) − R| = {err}, tol {ROUND_TRIP_TOL}"
+            );
             if q[0] < 0.0 {
                 negative_w += 1;
             }
             // Same rotation as nalgebra's conversion, up to the overall sign.
             let n = UnitQuaternion::from_matrix(&m);
             let d = (n.w * q[0] + n.i * q[1] + n.j * q[2] + n.k * q[3]).abs();
-            assert!((d - 1.0).abs() < 1e-12, "sample {i}: |<q_eigen, q_nalgebra>| = {d}");
+            assert!(
+                (d - 1.0).abs() < 1e-12,
+                "sample {i}: |<q_eigen, q_nalgebra>| = {d}"
+            );
         }
         // Spec §5: along the 20 s run w < 0 for samples 2003–2672 (upstream float grid; on
         // the exact grid the run is within a sample of that).
-        assert!((668..=672).contains(&negative_w), "negative-w samples: {negative_w}, expected ≈ 670");
+        assert!(
+            (668..=672).contains(&negative_w),
+            "negative-w samples: {negative_w}, expected ≈ 670"
+        );
     }
 
     #[test]
@@ -81,6 +95,9 @@ mod tests {
         // Rotation by π about x: trace = −1, x is made positive.
         let m = euler_to_rotation(Vector3::new(std::f64::consts::PI, 0.0, 0.0));
         let q = quat_from_matrix(&m);
-        assert!((q[1] - 1.0).abs() < 1e-15 && q[0].abs() < 1e-15, "q = {q:?}");
+        assert!(
+            (q[1] - 1.0).abs() < 1e-15 && q[0].abs() < 1e-15,
+            "q = {q:?}"
+        );
     }
 }

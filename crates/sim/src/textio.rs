@@ -61,7 +61,10 @@ pub fn write_string(path: &Path, s: &str) -> Result<()> {
 pub fn format_pose_rows(rows: &[PoseRow], f: NumFormat) -> String {
     let mut s = String::with_capacity(rows.len() * 160);
     for r in rows {
-        let vals = [r.t, r.q[0], r.q[1], r.q[2], r.q[3], r.p.x, r.p.y, r.p.z, r.gyro.x, r.gyro.y, r.gyro.z, r.acc.x, r.acc.y, r.acc.z];
+        let vals = [
+            r.t, r.q[0], r.q[1], r.q[2], r.q[3], r.p.x, r.p.y, r.p.z, r.gyro.x, r.gyro.y, r.gyro.z,
+            r.acc.x, r.acc.y, r.acc.z,
+        ];
         for v in vals {
             push(&mut s, v, f);
             s.push(' ');
@@ -91,7 +94,11 @@ pub fn format_int_rows(rows: &[(f64, [f64; 4], Vector3<f64>)], f: NumFormat) -> 
 
 /// TUM layout `t tx ty tz qx qy qz qw`, fixed decimals, no trailing space (upstream
 /// `save_Pose_asTUM` uses 9 and 5 decimals).
-pub fn format_tum(rows: &[(f64, Vector3<f64>, [f64; 4])], t_decimals: usize, decimals: usize) -> String {
+pub fn format_tum(
+    rows: &[(f64, Vector3<f64>, [f64; 4])],
+    t_decimals: usize,
+    decimals: usize,
+) -> String {
     let mut s = String::with_capacity(rows.len() * 100);
     for (t, p, q) in rows {
         let _ = writeln!(
@@ -116,10 +123,19 @@ fn read_to_string(path: &Path) -> Result<String> {
 }
 
 fn parse_fields(path: &Path, line_no: usize, line: &str, n: usize) -> Result<Vec<f64>> {
-    let v: std::result::Result<Vec<f64>, _> = line.split_whitespace().map(str::parse::<f64>).collect();
-    let v = v.map_err(|e| SimError::Parse { path: path.into(), line: line_no, msg: format!("not a number ({e})") })?;
+    let v: std::result::Result<Vec<f64>, _> =
+        line.split_whitespace().map(str::parse::<f64>).collect();
+    let v = v.map_err(|e| SimError::Parse {
+        path: path.into(),
+        line: line_no,
+        msg: format!("not a number ({e})"),
+    })?;
     if v.len() < n {
-        return Err(SimError::Parse { path: path.into(), line: line_no, msg: format!("expected {n} columns, found {}", v.len()) });
+        return Err(SimError::Parse {
+            path: path.into(),
+            line: line_no,
+            msg: format!("expected {n} columns, found {}", v.len()),
+        });
     }
     Ok(v)
 }
@@ -133,10 +149,20 @@ pub fn read_pose_rows(path: &Path) -> Result<Vec<PoseRow>> {
             continue;
         }
         let v = parse_fields(path, i + 1, line, 14)?;
-        rows.push(PoseRow { t: v[0], q: [v[1], v[2], v[3], v[4]], p: Vector3::new(v[5], v[6], v[7]), gyro: Vector3::new(v[8], v[9], v[10]), acc: Vector3::new(v[11], v[12], v[13]) });
+        rows.push(PoseRow {
+            t: v[0],
+            q: [v[1], v[2], v[3], v[4]],
+            p: Vector3::new(v[5], v[6], v[7]),
+            gyro: Vector3::new(v[8], v[9], v[10]),
+            acc: Vector3::new(v[11], v[12], v[13]),
+        });
     }
     if rows.len() < 2 {
-        return Err(SimError::Parse { path: path.into(), line: 0, msg: format!("need at least 2 rows, found {}", rows.len()) });
+        return Err(SimError::Parse {
+            path: path.into(),
+            line: 0,
+            msg: format!("need at least 2 rows, found {}", rows.len()),
+        });
     }
     Ok(rows)
 }
@@ -154,7 +180,10 @@ pub fn parse_time_ns(s: &str) -> Option<i64> {
         None => (false, s.strip_prefix('+').unwrap_or(s)),
     };
     let (int, frac) = body.split_once('.').unwrap_or((body, ""));
-    if (int.is_empty() && frac.is_empty()) || !int.bytes().all(|b| b.is_ascii_digit()) || !frac.bytes().all(|b| b.is_ascii_digit()) {
+    if (int.is_empty() && frac.is_empty())
+        || !int.bytes().all(|b| b.is_ascii_digit())
+        || !frac.bytes().all(|b| b.is_ascii_digit())
+    {
         return None;
     }
     let whole: i64 = if int.is_empty() { 0 } else { int.parse().ok()? };
@@ -183,7 +212,11 @@ pub fn read_tum(path: &Path) -> Result<Vec<Pose>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let err = |msg: String| SimError::Parse { path: path.into(), line: i + 1, msg };
+        let err = |msg: String| SimError::Parse {
+            path: path.into(),
+            line: i + 1,
+            msg,
+        };
         let mut it = line.split_whitespace();
         let t = it.next().ok_or_else(|| err("empty line".into()))?;
         let t_ns = parse_time_ns(t).ok_or_else(|| err(format!("bad time {t:?}")))?;
@@ -192,9 +225,15 @@ pub fn read_tum(path: &Path) -> Result<Vec<Pose>> {
         let q = [v[6], v[3], v[4], v[5]];
         let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
         if (n - 1.0).abs() > TUM_QUAT_NORM_TOL {
-            return Err(err(format!("quaternion norm {n} is not 1 (±{TUM_QUAT_NORM_TOL})")));
+            return Err(err(format!(
+                "quaternion norm {n} is not 1 (±{TUM_QUAT_NORM_TOL})"
+            )));
         }
-        out.push(Pose { t_ns, p: Vector3::new(v[0], v[1], v[2]), r: matrix_from_quat(q) });
+        out.push(Pose {
+            t_ns,
+            p: Vector3::new(v[0], v[1], v[2]),
+            r: matrix_from_quat(q),
+        });
     }
     Ok(out)
 }
@@ -205,7 +244,10 @@ mod tests {
 
     #[test]
     fn time_parsing_is_exact() {
-        assert_eq!(parse_time_ns("1700000000.123456789"), Some(1_700_000_000_123_456_789));
+        assert_eq!(
+            parse_time_ns("1700000000.123456789"),
+            Some(1_700_000_000_123_456_789)
+        );
         assert_eq!(parse_time_ns("0.033333335"), Some(33_333_335));
         assert_eq!(parse_time_ns("12"), Some(12_000_000_000));
         assert_eq!(parse_time_ns(".5"), Some(500_000_000));
@@ -219,12 +261,24 @@ mod tests {
 
     #[test]
     fn pose_rows_round_trip_full_precision() {
-        let rows = vec![PoseRow { t: 0.005, q: [0.9, 0.1, -0.2, 0.3], p: Vector3::new(20.0, 5.0, 5.0), gyro: Vector3::new(1e-9, 0.0, -0.0), acc: Vector3::new(-1.48, 0.97, 9.76) }; 3];
+        let rows = vec![
+            PoseRow {
+                t: 0.005,
+                q: [0.9, 0.1, -0.2, 0.3],
+                p: Vector3::new(20.0, 5.0, 5.0),
+                gyro: Vector3::new(1e-9, 0.0, -0.0),
+                acc: Vector3::new(-1.48, 0.97, 9.76)
+            };
+            3
+        ];
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("x.txt");
         write_string(&p, &format_pose_rows(&rows, NumFormat::Full)).unwrap();
         assert_eq!(read_pose_rows(&p).unwrap(), rows);
         let g = format_pose_rows(&rows[..1], NumFormat::CppG);
-        assert_eq!(g, "0.005 0.9 0.1 -0.2 0.3 20 5 5 1e-09 0 -0 -1.48 0.97 9.76 \n");
+        assert_eq!(
+            g,
+            "0.005 0.9 0.1 -0.2 0.3 20 5 5 1e-09 0 -0 -1.48 0.97 9.76 \n"
+        );
     }
 }

@@ -11,7 +11,7 @@
 
 /// The cumulative blending matrix C (row-major, rows j = 0..3).
 pub const C: [[f64; 4]; 4] = [
-    [6.0 / 6.0, 0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0, 0.0],
     [5.0 / 6.0, 3.0 / 6.0, -3.0 / 6.0, 1.0 / 6.0],
     [1.0 / 6.0, 3.0 / 6.0, 3.0 / 6.0, -2.0 / 6.0],
     [0.0, 0.0, 0.0, 1.0 / 6.0],
@@ -51,7 +51,12 @@ mod tests {
     /// Naive oracle: the textbook uniform cubic B-spline weights.
     fn standard_weights(u: f64) -> [f64; 4] {
         let v = 1.0 - u;
-        [v * v * v / 6.0, (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0, (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0, u * u * u / 6.0]
+        [
+            v * v * v / 6.0,
+            (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0,
+            (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
+            u * u * u / 6.0,
+        ]
     }
 
     #[test]
@@ -62,7 +67,11 @@ mod tests {
             let bt = b(u);
             for j in 0..4 {
                 let tail: f64 = w[j..].iter().sum();
-                assert!((bt[j] - tail).abs() < 1e-15, "u {u} j {j}: expected {tail}, actual {}", bt[j]);
+                assert!(
+                    (bt[j] - tail).abs() < 1e-15,
+                    "u {u} j {j}: expected {tail}, actual {}",
+                    bt[j]
+                );
             }
         }
         assert_eq!(b(0.0), [1.0, 5.0 / 6.0, 1.0 / 6.0, 0.0]);
@@ -79,8 +88,16 @@ mod tests {
             for j in 0..4 {
                 let fd1 = (bp[j] - bm[j]) / (2.0 * h);
                 let fd2 = (dp[j] - dm[j]) / (2.0 * h);
-                assert!((fd1 - d1[j]).abs() < FD_TOL, "du_b u {u} j {j}: fd {fd1}, analytic {}", d1[j]);
-                assert!((fd2 - d2[j]).abs() < FD_TOL, "du2_b u {u} j {j}: fd {fd2}, analytic {}", d2[j]);
+                assert!(
+                    (fd1 - d1[j]).abs() < FD_TOL,
+                    "du_b u {u} j {j}: fd {fd1}, analytic {}",
+                    d1[j]
+                );
+                assert!(
+                    (fd2 - d2[j]).abs() < FD_TOL,
+                    "du2_b u {u} j {j}: fd {fd2}, analytic {}",
+                    d2[j]
+                );
             }
         }
     }

@@ -21,7 +21,11 @@ use super::{basis, so3};
 use nalgebra::{Matrix3, Vector3};
 
 /// Position, velocity and acceleration of an R³ segment at u (Δt = knot spacing, s).
-pub fn r3_eval(c: &[Vector3<f64>; 4], u: f64, dt: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+pub fn r3_eval(
+    c: &[Vector3<f64>; 4],
+    u: f64,
+    dt: f64,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     let (b, db, d2b) = (basis::b(u), basis::du_b(u), basis::du2_b(u));
     let mut p = c[0];
     let mut v = Vector3::zeros();
@@ -61,7 +65,11 @@ pub fn so3_value(c: &[Matrix3<f64>; 4], u: f64) -> Matrix3<f64> {
 }
 
 /// R, Ṙ, R̈ by Lovegrove's product rule (module doc) — the slow, obviously-correct oracle.
-pub fn so3_product_rule(c: &[Matrix3<f64>; 4], u: f64, dt: f64) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>) {
+pub fn so3_product_rule(
+    c: &[Matrix3<f64>; 4],
+    u: f64,
+    dt: f64,
+) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>) {
     let (b, db, d2b) = (basis::b(u), basis::du_b(u), basis::du2_b(u));
     let mut a = [Matrix3::identity(); 3];
     let mut ad = [Matrix3::zeros(); 3];
@@ -118,10 +126,16 @@ mod tests {
                 let u = k as f64 / 10.0;
                 let (r, w) = so3_eval(&c, u, dt);
                 let (r2, rd, _) = so3_product_rule(&c, u, dt);
-                assert!((r - r2).abs().max() < SAME_QUANTITY_TOL, "case {case} u {u}: R differs");
+                assert!(
+                    (r - r2).abs().max() < SAME_QUANTITY_TOL,
+                    "case {case} u {u}: R differs"
+                );
                 let w2 = so3::vee(&(r.transpose() * rd));
                 let err = (w - w2).norm();
-                assert!(err < SAME_QUANTITY_TOL, "case {case} u {u}: ω {w:?} vs product rule {w2:?}, err {err}");
+                assert!(
+                    err < SAME_QUANTITY_TOL,
+                    "case {case} u {u}: ω {w:?} vs product rule {w2:?}, err {err}"
+                );
                 let h = 1e-6;
                 let fd = (so3_value(&c, u + h) - so3_value(&c, u - h)) / (2.0 * h * dt);
                 let err = (fd - rd).abs().max();
@@ -150,12 +164,25 @@ mod tests {
 
     #[test]
     fn r3_is_the_standard_blend() {
-        let c = [Vector3::new(1.0, 2.0, 3.0), Vector3::new(-1.0, 0.5, 2.0), Vector3::new(4.0, -2.0, 0.0), Vector3::new(0.0, 1.0, 1.0)];
+        let c = [
+            Vector3::new(1.0, 2.0, 3.0),
+            Vector3::new(-1.0, 0.5, 2.0),
+            Vector3::new(4.0, -2.0, 0.0),
+            Vector3::new(0.0, 1.0, 1.0),
+        ];
         let u: f64 = 0.37;
         let v = 1.0 - u;
-        let w = [v * v * v / 6.0, (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0, (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0, u * u * u / 6.0];
+        let w = [
+            v * v * v / 6.0,
+            (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0,
+            (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
+            u * u * u / 6.0,
+        ];
         let expected = c[0] * w[0] + c[1] * w[1] + c[2] * w[2] + c[3] * w[3];
         let (p, _, _) = r3_eval(&c, u, 1.0);
-        assert!((p - expected).norm() < 1e-14, "expected {expected:?}, actual {p:?}");
+        assert!(
+            (p - expected).norm() < 1e-14,
+            "expected {expected:?}, actual {p:?}"
+        );
     }
 }

@@ -15,7 +15,11 @@ pub fn hat(w: &Vector3<f64>) -> Matrix3<f64> {
 
 /// Inverse of [`hat`] (reads the antisymmetric part, so a slightly non-skew input is fine).
 pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
-    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+    Vector3::new(
+        m[(2, 1)] - m[(1, 2)],
+        m[(0, 2)] - m[(2, 0)],
+        m[(1, 0)] - m[(0, 1)],
+    ) * 0.5
 }
 
 /// exp(ω̂) = I + sinθ/θ ω̂ + (1 − cosθ)/θ² ω̂², θ = ‖ω‖.
@@ -106,7 +110,10 @@ mod tests {
             let back = log(&r);
             let err = (back - w).norm();
             let tol = if w.norm() > 3.0 { 1e-6 } else { ROUND_TRIP_TOL };
-            assert!(err < tol, "case {i}: w = {w:?}, log(exp(w)) = {back:?}, err {err}, tol {tol}");
+            assert!(
+                err < tol,
+                "case {i}: w = {w:?}, log(exp(w)) = {back:?}, err {err}, tol {tol}"
+            );
         }
     }
 

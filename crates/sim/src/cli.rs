@@ -1,0 +1,570 @@
+//! Command-line arguments (what the user typed, clap derive) and their resolution into the
+//! library's configurations (`TryFrom`), kept out of `main.rs` so they can be unit-tested.
+
+use crate::bag_sim::{BagConfig, now_ns, parse_start_time};
+use crate::error::{Result, SimError};
+use crate::grid::Grid;
+use crate::integrate::{InitState, IntegrateConfig, IntegrateInput, Method};
+use crate::motion::Motion;
+use crate::noise::{ContinuousNoise, DEFAULT_SEED, MASTER_PARAMS, Preset};
+use crate::spline::Fit;
+use crate::spline_sim::{PoseSource, SplineConfig};
+use crate::traj::TrajConfig;
+use bag2mat::Compression;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+/// IMU data simulator (after HeYijia/vio_data_simulation) and Spline-Fusion IMU synthesis.
+#[derive(Debug, Parser)]
+#[command(name = "sim", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Write a simulated IMU bag (default: vio_data_simulation ros_version's 4 h static bag).
+    Bag(BagArgs),
+    /// Write the upstream text files of the 20 s ellipse trajectory.
+    Traj(TrajArgs),
+    /// Integrate IMU samples (Euler vs midpoint) and report the errors.
+    Integrate(IntegrateArgs),
+    /// Fit a cubic B-spline to poses and emit IMU data from its derivatives.
+    Spline(SplineArgs),
+}
+
+/// Noise parameter presets (continuous time).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// gyro 0.01 rad/s/√Hz, 1e-5 rad/s²/√Hz; acc 0.01 m/s²/√Hz, 1e-4 m/s³/√Hz.
+    Low,
+    /// gyro 0.015, 5e-5; acc 0.019, 5e-4 (ros_version param.h).
+    Medium,
+    /// gyro 0.03, 1e-4; acc 0.03, 1e-3.
+    High,
+    /// gyro 0.015, 1e-5; acc 0.019, 1e-4 (master param.h, the 20 s trajectory run).
+    Master,
+}
+
+impl PresetArg {
+    fn params(self) -> ContinuousNoise {
+        match self {
+            PresetArg::Low => Preset::Low.params(),
+            PresetArg::Medium => Preset::Medium.params(),
+            PresetArg::High => Preset::High.params(),
+            PresetArg::Master => MASTER_PARAMS,
+        }
+    }
+}
+
+/// Noise flags shared by the subcommands: a preset plus explicit overrides.
+#[derive(Debug, Clone, Args)]
+pub struct NoiseArgs {
+    /// Noise preset (continuous-time parameters); explicit flags below override it.
+    #[arg(long, value_enum)]
+    pub preset: Option<PresetArg>,
+    /// Gyro white-noise density σ_g [rad/s/√Hz].
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub gyro_noise: Option<f64>,
+    /// Gyro bias random walk σ_bg [rad/s²/√Hz].
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub gyro_bias_rw: Option<f64>,
+    /// Accelerometer white-noise density σ_a [m/s²/√Hz].
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub acc_noise: Option<f64>,
+    /// Accelerometer bias random walk σ_ba [m/s³/√Hz].
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub acc_bias_rw: Option<f64>,
+    /// RNG seed (the same flags and seed give identical output).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SEED)]
+    pub seed: u64,
+}
+
+impl NoiseArgs {
+    /// Resolve against a default preset; rejects negative or non-finite values.
+    pub fn resolve(&self, default: PresetArg) -> Result<ContinuousNoise> {
+        let mut c = self.preset.unwrap_or(default).params();
+        for (name, v, slot) in [
+            ("--gyro-noise", self.gyro_noise, &mut c.gyro_noise),
+            ("--gyro-bias-rw", self.gyro_bias_rw, &mut c.gyro_bias_rw),
+            ("--acc-noise", self.acc_noise, &mut c.acc_noise),
+            ("--acc-bias-rw", self.acc_bias_rw, &mut c.acc_bias_rw),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(SimError::InvalidArgument(format!(
+                        "{name} must be a non-negative number, got {v}"
+                    )));
+                }
+                *slot = v;
+            }
+        }
+        Ok(c)
+    }
+}
+
+/// Motion models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MotionArg {
+    /// Level IMU at rest (ros_version).
+    Static,
+    /// The 20 s ellipse (master), repeated.
+    Ellipse,
+}
+
+/// Bag chunk compression.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompressionArg {
+    /// Uncompressed (upstream default).
+    None,
+    /// bzip2.
+    Bz2,
+    /// LZ4 frames.
+    Lz4,
+}
+
+impl From<CompressionArg> for Compression {
+    fn from(c: CompressionArg) -> Self {
+        match c {
+            CompressionArg::None => Compression::None,
+            CompressionArg::Bz2 => Compression::Bz2,
+            CompressionArg::Lz4 => Compression::Lz4,
+        }
+    }
+}
+
+/// Time grids.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GridArg {
+    /// Upstream master's float-accumulated times (4001 samples, t₄₀₀₀ = 19.99965).
+    Upstream,
+    /// t = i/rate, end point included.
+    Exact,
+}
+
+impl From<GridArg> for Grid {
+    fn from(g: GridArg) -> Self {
+        match g {
+            GridArg::Upstream => Grid::AccumulatedF32,
+            GridArg::Exact => Grid::Exact,
+        }
+    }
+}
+
+/// `sim bag`.
+#[derive(Debug, Clone, Args)]
+pub struct BagArgs {
+    /// Output bag.
+    #[arg(short, long, default_value = "imu.bag")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub noise: NoiseArgs,
+    /// Sample rate [Hz].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Duration [s]; samples at t = 0, 1/rate, … while t < duration, accumulated in double as
+    /// upstream (14400 s at 200 Hz → 2 880 001 messages).
+    #[arg(allow_negative_numbers = true, long, default_value_t = 14400.0)]
+    pub duration: f64,
+    /// Time of the first message [UNIX seconds, decimal]; default now.
+    #[arg(allow_negative_numbers = true, long, value_name = "UNIX_SECONDS")]
+    pub start_time: Option<String>,
+    /// Topic name.
+    #[arg(long, default_value = "imu")]
+    pub topic: String,
+    /// header.frame_id.
+    #[arg(long, default_value = "base_link")]
+    pub frame_id: String,
+    /// Motion model.
+    #[arg(long, value_enum, default_value_t = MotionArg::Static)]
+    pub motion: MotionArg,
+    /// Chunk compression.
+    #[arg(long, value_enum, default_value_t = CompressionArg::None)]
+    pub compression: CompressionArg,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl TryFrom<BagArgs> for BagConfig {
+    type Error = SimError;
+    fn try_from(a: BagArgs) -> Result<Self> {
+        let start_ns = match &a.start_time {
+            Some(s) => parse_start_time(s)?,
+            None => now_ns(),
+        };
+        let cfg = BagConfig {
+            out: a.output,
+            noise: a.noise.resolve(PresetArg::Medium)?,
+            rate: a.rate,
+            duration: a.duration,
+            seed: a.noise.seed,
+            start_ns,
+            topic: a.topic,
+            frame_id: a.frame_id,
+            motion: match a.motion {
+                MotionArg::Static => Motion::Static,
+                MotionArg::Ellipse => Motion::Ellipse,
+            },
+            compression: a.compression.into(),
+            quiet: a.quiet,
+        };
+        crate::bag_sim::validate(&cfg)?;
+        Ok(cfg)
+    }
+}
+
+/// `sim traj`.
+#[derive(Debug, Clone, Args)]
+pub struct TrajArgs {
+    /// Output directory.
+    #[arg(short, long, default_value = ".")]
+    pub output: PathBuf,
+    /// Duration [s].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 20.0)]
+    pub duration: f64,
+    /// IMU rate [Hz].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Camera rate [Hz].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 30.0)]
+    pub cam_rate: f64,
+    /// Time grid.
+    #[arg(long, value_enum, default_value_t = GridArg::Upstream)]
+    pub grid: GridArg,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub noise: NoiseArgs,
+}
+
+fn positive(name: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(SimError::InvalidArgument(format!(
+            "{name} must be a positive number, got {v}"
+        )))
+    }
+}
+
+impl TryFrom<TrajArgs> for TrajConfig {
+    type Error = SimError;
+    fn try_from(a: TrajArgs) -> Result<Self> {
+        Ok(TrajConfig {
+            out_dir: a.output,
+            duration: positive("--duration", a.duration)?,
+            rate: positive("--rate", a.rate)?,
+            cam_rate: positive("--cam-rate", a.cam_rate)?,
+            noise: a.noise.resolve(PresetArg::Master)?,
+            seed: a.noise.seed,
+            grid: a.grid.into(),
+        })
+    }
+}
+
+/// Integration methods to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Upstream Euler.
+    Euler,
+    /// Midpoint.
+    Midpoint,
+    /// Both.
+    Both,
+}
+
+/// Initial-state source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum InitArg {
+    /// The analytic ellipse model at the first timestamp (as upstream).
+    Model,
+    /// The first row's pose, velocity from the first three positions.
+    File,
+}
+
+/// `sim integrate`.
+#[derive(Debug, Clone, Args)]
+pub struct IntegrateArgs {
+    /// Integration scheme.
+    #[arg(long, value_enum, default_value_t = MethodArg::Both)]
+    pub method: MethodArg,
+    /// 14-column IMU pose file (imu_pose.txt); default: simulate the model in memory.
+    #[arg(long, value_name = "FILE")]
+    pub input: Option<PathBuf>,
+    /// Noisy file; default: imu_pose_noise.txt next to --input, if present.
+    #[arg(long, value_name = "FILE")]
+    pub noisy: Option<PathBuf>,
+    /// Output directory (imu_int_pose*.txt, integrate_*.png/svg).
+    #[arg(short, long, default_value = ".")]
+    pub output: PathBuf,
+    /// Initial state.
+    #[arg(long, value_enum, default_value_t = InitArg::Model)]
+    pub init: InitArg,
+    /// Sample rate [Hz] (the integration step is 1/rate, as upstream's imu_timestep).
+    #[arg(allow_negative_numbers = true, long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Duration [s] when simulating in memory.
+    #[arg(allow_negative_numbers = true, long, default_value_t = 20.0)]
+    pub duration: f64,
+    /// Time grid when simulating in memory.
+    #[arg(long, value_enum, default_value_t = GridArg::Upstream)]
+    pub grid: GridArg,
+    /// Skip the plots.
+    #[arg(long)]
+    pub no_plot: bool,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub noise: NoiseArgs,
+}
+
+impl TryFrom<IntegrateArgs> for IntegrateConfig {
+    type Error = SimError;
+    fn try_from(a: IntegrateArgs) -> Result<Self> {
+        let rate = positive("--rate", a.rate)?;
+        let input = match a.input {
+            Some(clean) => {
+                let noisy = a.noisy.or_else(|| {
+                    let n = clean.with_file_name("imu_pose_noise.txt");
+                    (n.exists() && n != clean).then_some(n)
+                });
+                IntegrateInput::Files { clean, noisy }
+            }
+            None => {
+                if a.noisy.is_some() {
+                    return Err(SimError::InvalidArgument("--noisy needs --input".into()));
+                }
+                IntegrateInput::Model {
+                    grid: a.grid.into(),
+                    duration: positive("--duration", a.duration)?,
+                    rate,
+                    noise: a.noise.resolve(PresetArg::Master)?,
+                    seed: a.noise.seed,
+                }
+            }
+        };
+        Ok(IntegrateConfig {
+            input,
+            methods: match a.method {
+                MethodArg::Euler => vec![Method::Euler],
+                MethodArg::Midpoint => vec![Method::Midpoint],
+                MethodArg::Both => vec![Method::Euler, Method::Midpoint],
+            },
+            init: match a.init {
+                InitArg::Model => InitState::Model,
+                InitArg::File => InitState::File,
+            },
+            dt: 1.0 / rate,
+            out_dir: a.output,
+            plots: !a.no_plot,
+        })
+    }
+}
+
+/// Spline fit kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FitArg {
+    /// The spline passes through the poses.
+    Interp,
+    /// Poses are the control points (smoothing).
+    Approx,
+}
+
+/// `sim spline`.
+#[derive(Debug, Clone, Args)]
+pub struct SplineArgs {
+    /// TUM pose file `t tx ty tz qx qy qz qw`.
+    #[arg(long, value_name = "POSES.tum", required_unless_present_any = ["from_model", "self_check"], conflicts_with = "from_model")]
+    pub poses: Option<PathBuf>,
+    /// Use the analytic ellipse model's poses (at --pose-rate over --duration) as input.
+    #[arg(long)]
+    pub from_model: bool,
+    /// Only run the self-check (model poses → spline → IMU vs analytic IMU) and exit non-zero
+    /// if it fails.
+    #[arg(long)]
+    pub self_check: bool,
+    /// Pose rate for --from-model / --self-check [Hz].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 200.0)]
+    pub pose_rate: f64,
+    /// Duration for --from-model [s].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 20.0)]
+    pub duration: f64,
+    /// Knot spacing [s]; default the median pose spacing.
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub knot_dt: Option<f64>,
+    /// Fit kind.
+    #[arg(long, value_enum, default_value_t = FitArg::Interp)]
+    pub fit: FitArg,
+    /// IMU rate [Hz].
+    #[arg(allow_negative_numbers = true, long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Write the noisy file and bag without noise.
+    #[arg(long)]
+    pub no_noise: bool,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub noise: NoiseArgs,
+    /// Output directory, or a path ending in .bag (text files then go beside it).
+    #[arg(short, long, default_value = ".")]
+    pub output: PathBuf,
+    /// First emitted time [s, same clock as the poses]; default the spline start.
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub t_start: Option<String>,
+    /// Last emitted time [s]; default the spline end.
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    pub t_end: Option<String>,
+    /// Bag time of the first sample [UNIX seconds]; default the pose times if absolute, else now.
+    #[arg(allow_negative_numbers = true, long, value_name = "UNIX_SECONDS")]
+    pub start_time: Option<String>,
+    /// Bag topic.
+    #[arg(long, default_value = "imu")]
+    pub topic: String,
+    /// Bag header.frame_id.
+    #[arg(long, default_value = "base_link")]
+    pub frame_id: String,
+    /// Bag chunk compression.
+    #[arg(long, value_enum, default_value_t = CompressionArg::None)]
+    pub compression: CompressionArg,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn time_arg(name: &str, s: &Option<String>) -> Result<Option<i64>> {
+    s.as_ref()
+        .map(|s| {
+            crate::textio::parse_time_ns(s).ok_or_else(|| {
+                SimError::InvalidArgument(format!("{name} {s:?} is not a number of seconds"))
+            })
+        })
+        .transpose()
+}
+
+impl TryFrom<SplineArgs> for SplineConfig {
+    type Error = SimError;
+    fn try_from(a: SplineArgs) -> Result<Self> {
+        let source = match (a.poses, a.from_model) {
+            (Some(p), false) => PoseSource::Tum(p),
+            (None, true) => PoseSource::Model {
+                duration: positive("--duration", a.duration)?,
+                rate: positive("--pose-rate", a.pose_rate)?,
+            },
+            _ => {
+                return Err(SimError::InvalidArgument(
+                    "give exactly one of --poses FILE and --from-model".into(),
+                ));
+            }
+        };
+        let knot_dt_ns = match a.knot_dt {
+            Some(k) => Some((positive("--knot-dt", k)? * 1e9).round() as i64),
+            None => None,
+        };
+        Ok(SplineConfig {
+            source,
+            knot_dt_ns,
+            fit: match a.fit {
+                FitArg::Interp => Fit::Interp,
+                FitArg::Approx => Fit::Approx,
+            },
+            rate: positive("--rate", a.rate)?,
+            noise: if a.no_noise {
+                None
+            } else {
+                Some(a.noise.resolve(PresetArg::Master)?)
+            },
+            seed: a.noise.seed,
+            out: a.output,
+            topic: a.topic,
+            frame_id: a.frame_id,
+            start_ns: a.start_time.as_deref().map(parse_start_time).transpose()?,
+            compression: a.compression.into(),
+            t_start_ns: time_arg("--t-start", &a.t_start)?,
+            t_end_ns: time_arg("--t-end", &a.t_end)?,
+            quiet: a.quiet,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(args: &[&str]) -> std::result::Result<Cli, clap::Error> {
+        Cli::try_parse_from(std::iter::once("sim").chain(args.iter().copied()))
+    }
+
+    #[test]
+    fn bag_defaults_are_the_seed_run() {
+        let Command::Bag(a) = parse(&["bag", "--start-time", "1700000000"])
+            .unwrap()
+            .command
+        else {
+            panic!("not bag")
+        };
+        let c = BagConfig::try_from(a).unwrap();
+        assert_eq!(
+            (c.rate, c.duration, c.topic.as_str(), c.frame_id.as_str()),
+            (200.0, 14400.0, "imu", "base_link")
+        );
+        assert_eq!(c.noise, Preset::Medium.params());
+        assert_eq!(c.motion, Motion::Static);
+        assert_eq!(c.compression, Compression::None);
+        assert_eq!(c.start_ns, 1_700_000_000_000_000_000);
+        assert_eq!(c.out, PathBuf::from("imu.bag"));
+    }
+
+    #[test]
+    fn explicit_flags_override_the_preset() {
+        let Command::Bag(a) = parse(&["bag", "--preset", "high", "--acc-noise", "0.5"])
+            .unwrap()
+            .command
+        else {
+            panic!()
+        };
+        let c = BagConfig::try_from(a).unwrap();
+        assert_eq!(c.noise.acc_noise, 0.5);
+        assert_eq!(c.noise.gyro_noise, 0.03);
+    }
+
+    #[test]
+    fn bad_values_are_rejected() {
+        for args in [
+            &["bag", "--rate", "0"][..],
+            &["bag", "--duration", "-1"],
+            &["bag", "--gyro-noise", "-0.1"],
+            &["bag", "--start-time", "yesterday"],
+            &["bag", "--topic", ""],
+        ] {
+            let Command::Bag(a) = parse(args).unwrap().command else {
+                panic!()
+            };
+            assert!(
+                BagConfig::try_from(a).is_err(),
+                "{args:?} should be rejected"
+            );
+        }
+        assert!(parse(&["bag", "--compression", "zip"]).is_err());
+        assert!(parse(&["bag", "--motion", "circle"]).is_err());
+        assert!(
+            parse(&["spline"]).is_err(),
+            "spline needs --poses or --from-model"
+        );
+    }
+
+    #[test]
+    fn spline_sources() {
+        let Command::Spline(a) = parse(&["spline", "--from-model", "--knot-dt", "0.01"])
+            .unwrap()
+            .command
+        else {
+            panic!()
+        };
+        let c = SplineConfig::try_from(a).unwrap();
+        assert!(matches!(c.source, PoseSource::Model { .. }));
+        assert_eq!(c.knot_dt_ns, Some(10_000_000));
+        assert!(parse(&["spline", "--from-model", "--poses", "x.tum"]).is_err());
+    }
+}

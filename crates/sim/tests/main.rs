@@ -1,0 +1,7 @@
+//! Integration tests of `sim`: the built binary run as a user would (cli), and its bags read
+//! by Debian's real rosbag tools (real_tools). Tools are never skipped: a missing tool fails
+//! (scripts/test.sh installs them).
+
+mod cli;
+mod real_tools;
+mod util;
