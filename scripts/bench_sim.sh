@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Benchmark of `sim` (figures only, no pass/fail): writing the default 4 h, 200 Hz static bag
+# (2,880,001 messages) with each compression, best of BENCH_RUNS, split into user time (RNG,
+# normal sampling, message encoding) and system time (writing ~1.09 GB); then the 20 s
+# trajectory, integration and spline commands.
+#
+# usage: scripts/bench_sim.sh [WORKDIR]
+# env:   CARGO_TARGET_DIR (default <repo>/target), BENCH_RUNS (default 3)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+WORK="${1:-$(mktemp -d /tmp/sim-bench.XXXXXX)}"
+mkdir -p "$WORK"
+TARGET="${CARGO_TARGET_DIR:-$ROOT/target}"
+RUNS="${BENCH_RUNS:-3}"
+(cd "$ROOT" && cargo build --release --quiet -p sim)
+SIM="$TARGET/release/sim"
+echo "work dir: $WORK"
+
+# "wall user sys peakKB" of a command
+measure() { /usr/bin/time -f "%e %U %S %M" -o "$WORK/.time" "$@" >/dev/null 2>&1; cat "$WORK/.time"; }
+
+echo "== sim bag, 4 h default (2,880,001 msgs), best of $RUNS"
+printf "%-12s %8s %8s %8s %10s %12s\n" compression wall_s user_s sys_s peak_KB size_B
+for c in none lz4 bz2; do
+  best=""
+  for _ in $(seq "$RUNS"); do
+    read -r w u s kb < <(measure "$SIM" bag -o "$WORK/imu_$c.bag" --start-time 1700000000 --compression "$c" --quiet)
+    if [ -z "$best" ] || /usr/bin/python3 -c "import sys; sys.exit(0 if $w < $best else 1)"; then best=$w; bu=$u; bs=$s; bkb=$kb; fi
+  done
+  printf "%-12s %8s %8s %8s %10s %12s\n" "$c" "$best" "$bu" "$bs" "$bkb" "$(stat -c %s "$WORK/imu_$c.bag")"
+  [ "$c" = none ] || rm -f "$WORK/imu_$c.bag"
+done
+
+echo
+echo "== 20 s trajectory commands (wall user sys peakKB)"
+echo "traj:             $(measure "$SIM" traj -o "$WORK/traj")"
+echo "integrate:        $(measure "$SIM" integrate -o "$WORK/int")"
+echo "spline self-check: $(measure "$SIM" spline --self-check)"
+echo "spline from-model: $(measure "$SIM" spline --from-model -o "$WORK/spline" --start-time 1700000000 --quiet)"
