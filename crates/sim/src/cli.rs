@@ -5,7 +5,7 @@ use crate::bag_sim::{BagConfig, now_ns, parse_start_time};
 use crate::error::{Result, SimError};
 use crate::grid::Grid;
 use crate::integrate::{InitState, IntegrateConfig, IntegrateInput, Method};
-use crate::motion::Motion;
+use crate::motion::{Mode, Motion};
 use crate::noise::{ContinuousNoise, DEFAULT_SEED, MASTER_PARAMS, Preset};
 use crate::spline::Fit;
 use crate::spline_sim::{PoseSource, SplineConfig};
@@ -236,6 +236,10 @@ pub struct TrajArgs {
     /// Time grid.
     #[arg(long, value_enum, default_value_t = GridArg::Upstream)]
     pub grid: GridArg,
+    /// Upstream's float model constants on the upstream grid: the clean outputs then match
+    /// vio_data_simulation master digit for digit.
+    #[arg(long, conflicts_with = "grid")]
+    pub compat: bool,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub noise: NoiseArgs,
@@ -261,7 +265,16 @@ impl TryFrom<TrajArgs> for TrajConfig {
             cam_rate: positive("--cam-rate", a.cam_rate)?,
             noise: a.noise.resolve(PresetArg::Master)?,
             seed: a.noise.seed,
-            grid: a.grid.into(),
+            grid: if a.compat {
+                Grid::AccumulatedF32
+            } else {
+                a.grid.into()
+            },
+            mode: if a.compat {
+                Mode::CompatF32
+            } else {
+                Mode::Double
+            },
         })
     }
 }
@@ -313,6 +326,10 @@ pub struct IntegrateArgs {
     /// Time grid when simulating in memory.
     #[arg(long, value_enum, default_value_t = GridArg::Upstream)]
     pub grid: GridArg,
+    /// Upstream's float model constants on the upstream grid: the clean outputs then match
+    /// vio_data_simulation master digit for digit.
+    #[arg(long, conflicts_with = "grid")]
+    pub compat: bool,
     /// Skip the plots.
     #[arg(long)]
     pub no_plot: bool,
@@ -325,6 +342,11 @@ impl TryFrom<IntegrateArgs> for IntegrateConfig {
     type Error = SimError;
     fn try_from(a: IntegrateArgs) -> Result<Self> {
         let rate = positive("--rate", a.rate)?;
+        let mode = if a.compat {
+            Mode::CompatF32
+        } else {
+            Mode::Double
+        };
         let input = match a.input {
             Some(clean) => {
                 let noisy = a.noisy.or_else(|| {
@@ -338,7 +360,12 @@ impl TryFrom<IntegrateArgs> for IntegrateConfig {
                     return Err(SimError::InvalidArgument("--noisy needs --input".into()));
                 }
                 IntegrateInput::Model {
-                    grid: a.grid.into(),
+                    grid: if a.compat {
+                        Grid::AccumulatedF32
+                    } else {
+                        a.grid.into()
+                    },
+                    mode,
                     duration: positive("--duration", a.duration)?,
                     rate,
                     noise: a.noise.resolve(PresetArg::Master)?,
@@ -353,6 +380,7 @@ impl TryFrom<IntegrateArgs> for IntegrateConfig {
                 MethodArg::Midpoint => vec![Method::Midpoint],
                 MethodArg::Both => vec![Method::Euler, Method::Midpoint],
             },
+            mode,
             init: match a.init {
                 InitArg::Model => InitState::Model,
                 InitArg::File => InitState::File,
@@ -497,7 +525,7 @@ mod tests {
     }
 
     #[test]
-    fn bag_defaults_are_the_seed_run() {
+    fn quirk_03_topic_imu_without_slash_and_seed_defaults() {
         let Command::Bag(a) = parse(&["bag", "--start-time", "1700000000"])
             .unwrap()
             .command

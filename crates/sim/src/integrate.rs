@@ -14,7 +14,7 @@
 //! Euler is first order in dt, midpoint second order (the tests check both rates).
 
 use crate::grid::Grid;
-use crate::motion::{GRAVITY_W, MotionSample};
+use crate::motion::{GRAVITY_W, Mode, MotionSample};
 use crate::noise::NoiseGenerator;
 use crate::rotation::{quat_from_matrix, unit_quat};
 use crate::textio::PoseRow;
@@ -146,6 +146,7 @@ pub fn int_rows(rows: &[PoseRow], states: &[State]) -> Vec<(f64, [f64; 4], Vecto
 /// (pose columns stay true, as upstream `imu_pose_noise.txt`).
 pub fn model_rows(
     grid: Grid,
+    mode: Mode,
     duration: f64,
     rate: f64,
     noise: Option<&mut NoiseGenerator>,
@@ -153,7 +154,7 @@ pub fn model_rows(
     let mut noise = noise;
     grid.times(duration, rate)
         .map(|t| {
-            let m = crate::motion::ellipse(t);
+            let m = crate::motion::ellipse_with(t, mode);
             let (mut g, mut a): ([f64; 3], [f64; 3]) = (m.gyro.into(), m.acc.into());
             if let Some(n) = noise.as_deref_mut() {
                 n.apply(&mut g, &mut a);
@@ -184,6 +185,8 @@ pub enum IntegrateInput {
     Model {
         /// Grid.
         grid: Grid,
+        /// Model constants.
+        mode: Mode,
         /// Seconds.
         duration: f64,
         /// Hz.
@@ -215,6 +218,8 @@ pub struct IntegrateConfig {
     pub methods: Vec<Method>,
     /// Initial state.
     pub init: InitState,
+    /// Model constants for `InitState::Model`.
+    pub mode: Mode,
     /// Step, s (upstream: `imu_timestep`, not the timestamps).
     pub dt: f64,
     /// Output directory.
@@ -254,6 +259,7 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
         }
         IntegrateInput::Model {
             grid,
+            mode,
             duration,
             rate,
             noise,
@@ -261,8 +267,11 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
         } => {
             let mut g = NoiseGenerator::new(noise.discretize(1.0 / rate), *seed);
             vec![
-                ("clean", model_rows(*grid, *duration, *rate, None)),
-                ("noisy", model_rows(*grid, *duration, *rate, Some(&mut g))),
+                ("clean", model_rows(*grid, *mode, *duration, *rate, None)),
+                (
+                    "noisy",
+                    model_rows(*grid, *mode, *duration, *rate, Some(&mut g)),
+                ),
             ]
         }
     };
@@ -271,7 +280,9 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
     let mut files = Vec::new();
     for (name, rows) in &inputs {
         let init = match cfg.init {
-            InitState::Model => State::from_motion(&crate::motion::ellipse(rows[0].t)),
+            InitState::Model => {
+                State::from_motion(&crate::motion::ellipse_with(rows[0].t, cfg.mode))
+            }
             InitState::File => {
                 if rows.len() < 3 {
                     return Err(crate::SimError::InvalidArgument(
@@ -357,7 +368,7 @@ mod tests {
     use crate::motion::ellipse;
 
     fn run(grid: Grid, rate: f64, method: Method) -> Errors {
-        let rows = model_rows(grid, 20.0, rate, None);
+        let rows = model_rows(grid, Mode::Double, 20.0, rate, None);
         let states = integrate(&rows, State::from_motion(&ellipse(0.0)), 1.0 / rate, method);
         errors(&rows, &states)
     }

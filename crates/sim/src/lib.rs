@@ -26,9 +26,13 @@
 //! * `quirk_04_euler_uses_right_sample` ([`integrate`]): upstream `testImu` integrates
 //!   interval i with sample i (spec §6).
 //! * `quirk_05_eigen_quaternion_sign` ([`rotation::quat_from_matrix`]): w may be negative.
+//! * `quirk_06_motion_model_float_locals` ([`motion::Mode::CompatF32`], `--compat`): the
+//!   `float` constants of `MotionModel` (spec §8 item 2). Off by default (exact f64); with it,
+//!   `sim traj --compat` and `sim integrate --compat` reproduce upstream master's clean files
+//!   byte for byte (tests/upstream.rs, against the real program's output).
 //!
-//! Not reproduced: upstream noise (a fresh `std::random_device` per sample; spec §8 item 6)
-//! and the `float` constants of `MotionModel` (f64 here; spec §8 item 2).
+//! Not reproduced: upstream noise (a fresh `std::random_device` per sample; spec §8 item 6);
+//! the uninitialised gyro/acc columns of `cam_pose.txt` (written as 0).
 
 #![deny(missing_docs)]
 

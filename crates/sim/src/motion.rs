@@ -90,8 +90,29 @@ pub fn euler_rates_to_body_rates(rpy: Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(1.0, 0.0, -sp, 0.0, cr, sr * cp, 0.0, -sr, cr * cp)
 }
 
-/// The `master` ellipse model at time `t` (spec §2.1).
+/// How the ellipse model's constants are evaluated — chosen once, here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// Exact f64 constants (K = π/10 in double). The default.
+    #[default]
+    Double,
+    /// Upstream's `float` locals: K = f32(π/10) and the f32 products `K1*K`, `K*K`,
+    /// `-K*ellipse_x`, `K*ellipse_y`, `-z*K1*K1` (vio_data_simulation `master` 660dc72
+    /// `IMU::MotionModel`, spec §8 item 2). With the upstream float time grid this reproduces
+    /// upstream's clean text files digit for digit (`quirk_06_motion_model_float_locals`).
+    CompatF32,
+}
+
+/// The `master` ellipse model at time `t` with exact f64 constants (spec §2.1).
 pub fn ellipse(t: f64) -> MotionSample {
+    ellipse_with(t, Mode::Double)
+}
+
+/// The `master` ellipse model at time `t`, constants evaluated per `mode`.
+pub fn ellipse_with(t: f64, mode: Mode) -> MotionSample {
+    if mode == Mode::CompatF32 {
+        return ellipse_compat_f32(t);
+    }
     let (s, c) = (K * t).sin_cos();
     let (sz, cz) = (K1 * K * t).sin_cos();
     let p = Vector3::new(ELLIPSE_X * c + 5.0, ELLIPSE_Y * s + 5.0, Z_AMP * sz + 5.0);
@@ -104,6 +125,42 @@ pub fn ellipse(t: f64) -> MotionSample {
     );
     let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), K * t);
     let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), K);
+    let r_wb = euler_to_rotation(rpy);
+    let gyro = euler_rates_to_body_rates(rpy) * rates;
+    let acc = r_wb.transpose() * (a - GRAVITY_W);
+    MotionSample {
+        t,
+        r_wb,
+        p,
+        v,
+        a,
+        gyro,
+        acc,
+    }
+}
+
+/// Upstream's arithmetic, C++ promotion rules spelled out: float × float products are
+/// rounded to f32, float × double promote to double.
+fn ellipse_compat_f32(t: f64) -> MotionSample {
+    let kf = (std::f64::consts::PI / 10.0) as f32; // float K = M_PI/10
+    let k = kf as f64;
+    let k1k = (10.0f32 * kf) as f64; // K1*K (float)
+    let (s, c) = ((k * t).sin(), (k * t).cos());
+    let (sz, cz) = ((k1k * t).sin(), (k1k * t).cos());
+    let p = Vector3::new(15.0 * c + 5.0, 20.0 * s + 5.0, 1.0 * sz + 5.0);
+    let v = Vector3::new(
+        (-kf * 15.0f32) as f64 * s,
+        (kf * 20.0f32) as f64 * c,
+        (1.0f32 * 10.0f32 * kf) as f64 * cz,
+    );
+    let k2 = (kf * kf) as f64; // double K2 = K*K (float product)
+    let a = Vector3::new(
+        -k2 * 15.0 * c,
+        -k2 * 20.0 * s,
+        (-1.0f32 * 10.0f32 * 10.0f32) as f64 * k2 * sz,
+    );
+    let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), k * t);
+    let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), k);
     let r_wb = euler_to_rotation(rpy);
     let gyro = euler_rates_to_body_rates(rpy) * rates;
     let acc = r_wb.transpose() * (a - GRAVITY_W);
@@ -212,6 +269,17 @@ mod tests {
                 FD_TOL,
             );
         }
+    }
+
+    #[test]
+    fn quirk_06_motion_model_float_locals() {
+        // Upstream `MotionModel` keeps K = M_PI/10 in a float: v_y(0) = f32(K·20), not 2π;
+        // the exact-f64 model gives 2π. (Byte parity of the text files: tests/upstream.rs.)
+        let kf = (std::f64::consts::PI / 10.0) as f32;
+        let c = ellipse_with(0.0, Mode::CompatF32);
+        assert_eq!(c.v.y, (kf * 20.0f32) as f64);
+        assert_eq!(ellipse(0.0).v.y, 2.0 * std::f64::consts::PI);
+        assert!((c.v.y - ellipse(0.0).v.y).abs() > 1e-7 && (c.v.y - ellipse(0.0).v.y).abs() < 1e-5);
     }
 
     #[test]

@@ -60,7 +60,7 @@ mod tests {
     const ROUND_TRIP_TOL: f64 = 1e-14;
 
     #[test]
-    fn round_trip_and_sign_rule() {
+    fn quirk_05_eigen_quaternion_sign() {
         let mut negative_w = 0;
         for i in 0..4001 {
             let m = ellipse(i as f64 / 200.0).r_wb;

@@ -2,7 +2,9 @@
 //! ellipse model — IMU poses (clean and noisy), camera poses (14-column and TUM), the house
 //! landmarks and the per-frame observations in normalised image coordinates.
 //!
-//! Differences from upstream: f64 model constants (see [`crate::motion`]); the unused gyro/acc
+//! Differences from upstream: f64 model constants by default (see [`crate::motion`]; with
+//! `--compat` the float constants are emulated and the clean files match upstream byte for
+//! byte); the unused gyro/acc
 //! columns of `cam_pose.txt` (uninitialised memory upstream) are written as 0; the noise
 //! comes from a seeded generator. Additional file: `imu_pose_tum.txt` (IMU poses, TUM layout
 //! with 9 decimals — a suitable `sim spline --poses` input, unlike the 5-decimal camera file).
@@ -11,7 +13,7 @@ use crate::cppfmt::push_g;
 use crate::error::{Result, SimError};
 use crate::grid::Grid;
 use crate::integrate::model_rows;
-use crate::motion::ellipse;
+use crate::motion::{Mode, ellipse_with};
 use crate::noise::{ContinuousNoise, NoiseGenerator};
 use crate::rotation::quat_from_matrix;
 use crate::textio::{NumFormat, PoseRow, format_pose_rows, format_tum, write_string};
@@ -35,6 +37,8 @@ pub struct TrajConfig {
     pub seed: u64,
     /// Time grid (upstream: `float` accumulation).
     pub grid: Grid,
+    /// Model constants.
+    pub mode: Mode,
 }
 
 /// The house model of upstream `bin/house_model/house.txt`: 23 segments (x0 y0 z0 x1 y1 z1,
@@ -111,11 +115,11 @@ pub struct CamFrame {
 }
 
 /// Camera frames: R_wc = R_wb·R_bc, t_wc = t_wb + R_wb·t_bc.
-pub fn cam_frames(grid: Grid, duration: f64, cam_rate: f64) -> Vec<CamFrame> {
+pub fn cam_frames(grid: Grid, mode: Mode, duration: f64, cam_rate: f64) -> Vec<CamFrame> {
     let rbc = r_bc();
     grid.times(duration, cam_rate)
         .map(|t| {
-            let m = ellipse(t);
+            let m = ellipse_with(t, mode);
             CamFrame {
                 t,
                 r_wc: m.r_wb * rbc,
@@ -182,9 +186,15 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
     write(&dir.join("all_points.txt"), &s)?;
 
     // IMU.
-    let truth = model_rows(cfg.grid, cfg.duration, cfg.rate, None);
+    let truth = model_rows(cfg.grid, cfg.mode, cfg.duration, cfg.rate, None);
     let mut noise_gen = NoiseGenerator::new(cfg.noise.discretize(1.0 / cfg.rate), cfg.seed);
-    let noisy = model_rows(cfg.grid, cfg.duration, cfg.rate, Some(&mut noise_gen));
+    let noisy = model_rows(
+        cfg.grid,
+        cfg.mode,
+        cfg.duration,
+        cfg.rate,
+        Some(&mut noise_gen),
+    );
     write(
         &dir.join("imu_pose.txt"),
         &format_pose_rows(&truth, NumFormat::CppG),
@@ -197,7 +207,7 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
     write(&dir.join("imu_pose_tum.txt"), &format_tum(&tum, 9, 9))?;
 
     // Cameras.
-    let frames = cam_frames(cfg.grid, cfg.duration, cfg.cam_rate);
+    let frames = cam_frames(cfg.grid, cfg.mode, cfg.duration, cfg.cam_rate);
     let cam_rows: Vec<PoseRow> = frames
         .iter()
         .map(|f| PoseRow {
@@ -259,10 +269,13 @@ mod tests {
     fn camera_looks_inward_and_sees_the_house() {
         // Cam-z = −body-x; at t = 0 the body x axis points away from the ellipse centre, so
         // the house (centred near (5, 5)) is in front of the camera.
-        let f = &cam_frames(Grid::AccumulatedF32, 20.0, 30.0)[0];
+        let f = &cam_frames(Grid::AccumulatedF32, Mode::Double, 20.0, 30.0)[0];
         let (points, _) = landmarks();
         let visible = points.iter().filter(|p| to_cam(f, p).is_some()).count();
         assert_eq!(visible, points.len(), "all landmarks in front at t = 0");
-        assert_eq!(cam_frames(Grid::AccumulatedF32, 20.0, 30.0).len(), 600);
+        assert_eq!(
+            cam_frames(Grid::AccumulatedF32, Mode::Double, 20.0, 30.0).len(),
+            600
+        );
     }
 }

@@ -4,4 +4,5 @@
 
 mod cli;
 mod real_tools;
+mod upstream;
 mod util;
