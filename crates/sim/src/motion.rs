@@ -157,7 +157,7 @@ fn ellipse_compat_f32(t: f64) -> MotionSample {
     let a = Vector3::new(
         -k2 * 15.0 * c,
         -k2 * 20.0 * s,
-        (-1.0f32 * 10.0f32 * 10.0f32) as f64 * k2 * sz,
+        (-10.0f32 * 10.0f32) as f64 * k2 * sz, // -z*K1*K1 in float (z = 1)
     );
     let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), k * t);
     let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), k);
