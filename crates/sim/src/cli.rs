@@ -456,6 +456,9 @@ pub struct SplineArgs {
     /// Bag chunk compression.
     #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     pub compression: CompressionArg,
+    /// Gravity magnitude [m/s²], world z up: a level IMU at rest reads +g on z.
+    #[arg(long, allow_negative_numbers = true, default_value_t = crate::spline::GRAVITY)]
+    pub gravity: f64,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -511,6 +514,7 @@ impl TryFrom<SplineArgs> for SplineConfig {
             compression: a.compression.into(),
             t_start_ns: time_arg("--t-start", &a.t_start)?,
             t_end_ns: time_arg("--t-end", &a.t_end)?,
+            gravity: a.gravity,
             quiet: a.quiet,
         })
     }

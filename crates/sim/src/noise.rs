@@ -54,6 +54,18 @@ pub fn random_walk_to_continuous(sigma_bd: f64, dt: f64) -> f64 {
     sigma_bd / dt.sqrt()
 }
 
+/// Allan deviation of white noise of density `sigma` (unit/√Hz) at averaging time `tau` (s):
+/// σ_A(τ) = σ/√τ — the −½ slope line, which reads σ at τ = 1 s (IEEE 952 Annex C).
+pub fn adev_white(sigma: f64, tau: f64) -> f64 {
+    sigma / tau.sqrt()
+}
+
+/// Allan deviation of a random walk of strength `sigma_b` (unit/s/√Hz) at `tau` (s):
+/// σ_A(τ) = σ_b·√(τ/3) — the +½ slope line, which reads σ_b at τ = 3 s.
+pub fn adev_random_walk(sigma_b: f64, tau: f64) -> f64 {
+    sigma_b * (tau / 3.0).sqrt()
+}
+
 /// Continuous-time noise parameters of a 6-axis IMU (units in the module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContinuousNoise {
@@ -315,6 +327,16 @@ mod tests {
                 "case {i}: expected {exp}, actual {got}, tol {SPEC_3_DIGITS_REL_TOL} rel"
             );
         }
+    }
+
+    #[test]
+    fn allan_lines_read_off_at_1_and_3_seconds() {
+        // field.md §2: the white line read at τ = 1 s gives σ, the random-walk line at τ = 3 s
+        // gives σ_b; spec §3's check for the static bag: ADEV(1 s) ≈ 0.015 rad/s.
+        assert_eq!(adev_white(0.015, 1.0), 0.015);
+        assert!(rel(adev_random_walk(5e-5, 3.0), 5e-5) < ROUND_TRIP_REL_TOL);
+        assert!(rel(adev_white(0.02, 100.0), 0.002) < ROUND_TRIP_REL_TOL);
+        assert!(rel(adev_random_walk(1e-4, 300.0), 1e-3) < ROUND_TRIP_REL_TOL);
     }
 
     #[test]
