@@ -339,6 +339,74 @@ mod tests {
         assert!(rel(adev_random_walk(1e-4, 300.0), 1e-3) < ROUND_TRIP_REL_TOL);
     }
 
+    /// Naive non-overlapping Allan deviation of rate samples `x` at cluster size `m`.
+    fn adev_naive(x: &[f64], m: usize) -> f64 {
+        let means: Vec<f64> = x
+            .chunks_exact(m)
+            .map(|c| c.iter().sum::<f64>() / m as f64)
+            .collect();
+        let s: f64 = means.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+        (s / (2.0 * (means.len() - 1) as f64)).sqrt()
+    }
+
+    /// ADEV estimate with K clusters has relative std ≈ 1/√(2(K−1)); 4 std.
+    fn adev_tol(clusters: usize) -> f64 {
+        4.0 / (2.0 * (clusters - 1) as f64).sqrt()
+    }
+
+    #[test]
+    fn allan_deviation_of_generated_noise_matches_the_continuous_parameters() {
+        // Spec §3 "Allan check for the port": ADEV(1 s) = σ for the white part and
+        // ADEV(τ) = σ_b·√(τ/3) for the bias walk, when the generator discretises correctly.
+        let rate = 200.0;
+        let dt = 1.0 / rate;
+        let white = ContinuousNoise {
+            gyro_noise: 0.015,
+            gyro_bias_rw: 0.0,
+            acc_noise: 0.019,
+            acc_bias_rw: 0.0,
+        };
+        let mut g = NoiseGenerator::new(white.discretize(dt), SEED);
+        let n = 2000 * 200; // 2000 s
+        let (mut gx, mut az) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for _ in 0..n {
+            let (mut w, mut a) = ([0.0; 3], [0.0; 3]);
+            g.apply(&mut w, &mut a);
+            gx.push(w[0]);
+            az.push(a[2]);
+        }
+        let tol = adev_tol(2000);
+        for (name, x, sigma) in [("gyro", &gx, 0.015), ("acc", &az, 0.019)] {
+            let got = adev_naive(x, 200);
+            let exp = adev_white(sigma, 1.0);
+            assert!(
+                rel(got, exp) < tol,
+                "{name} white ADEV(1 s): expected {exp}, actual {got}, tol {tol} rel"
+            );
+        }
+        let walk = ContinuousNoise {
+            gyro_noise: 0.0,
+            gyro_bias_rw: 5e-5,
+            acc_noise: 0.0,
+            acc_bias_rw: 5e-4,
+        };
+        let mut g = NoiseGenerator::new(walk.discretize(dt), SEED + 1);
+        let n = 8000 * 200; // 8000 s, τ = 20 s ⇒ 400 clusters
+        let mut gy = Vec::with_capacity(n);
+        for _ in 0..n {
+            let (mut w, mut a) = ([0.0; 3], [0.0; 3]);
+            g.apply(&mut w, &mut a);
+            gy.push(w[1]);
+        }
+        let tol = adev_tol(400);
+        let got = adev_naive(&gy, 20 * 200);
+        let exp = adev_random_walk(5e-5, 20.0);
+        assert!(
+            rel(got, exp) < tol,
+            "gyro bias walk ADEV(20 s): expected {exp}, actual {got}, tol {tol} rel"
+        );
+    }
+
     #[test]
     fn round_trips() {
         for &dt in &[1.0 / 100.0, 1.0 / 200.0, 1.0 / 400.0, 1e-3, 0.1] {
