@@ -12,7 +12,7 @@ use std::fmt::Write;
 pub fn bag_header(c: &BagConfig) -> String {
     let n = crate::bag_sim::message_count(c.rate, c.duration);
     format!(
-        "sim bag: {} motion, {} Hz, {} s -> {} messages on topic '{}' (frame_id '{}'), start {:.9}, compression {}, seed {}\n{}",
+        "sim bag: {} motion, {} Hz, {} s -> {} messages on topic '{}' (frame_id '{}'), start {}.{:09}, compression {}, seed {}\n{}",
         match c.motion {
             crate::motion::Motion::Static => "static",
             crate::motion::Motion::Ellipse => "ellipse",
@@ -22,7 +22,8 @@ pub fn bag_header(c: &BagConfig) -> String {
         n,
         c.topic,
         c.frame_id,
-        c.start_ns as f64 * 1e-9,
+        c.start_ns / 1_000_000_000,
+        c.start_ns % 1_000_000_000,
         c.compression.name(),
         c.seed,
         c.noise.describe(c.rate)
@@ -31,12 +32,13 @@ pub fn bag_header(c: &BagConfig) -> String {
 
 /// Printed when `sim bag` is done.
 pub fn bag_done(c: &BagConfig, s: &BagSummary) -> String {
+    let t = |r: bag2mat::RosTime| format!("{}.{:09}", r.sec, r.nsec);
     format!(
-        "wrote {} ({} messages, {:.9} .. {:.9})",
+        "wrote {} ({} messages, {} .. {})",
         c.out.display(),
         s.messages,
-        s.first.to_sec(),
-        s.last.to_sec()
+        t(s.first),
+        t(s.last)
     )
 }
 
