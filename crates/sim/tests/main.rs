@@ -4,5 +4,4 @@
 
 mod cli;
 mod real_tools;
-mod upstream;
 mod util;
