@@ -195,7 +195,7 @@ fn walk_tiles(p: &mut [f64], ms: &[u64], mut prepare: impl FnMut(&mut [f64])) ->
             State {
                 m,
                 next: m.max(1),
-                end: if m == 0 { 0 } else { (n / m) * m },
+                end: n.checked_div(m).unwrap_or(0) * m,
                 last_p: 0.0, // P[0]
                 last_b: 0.0,
                 have_b: false,
@@ -280,21 +280,25 @@ pub fn sig2_recursive(x: &[f64], m: usize) -> f64 {
     let mf = m as f64;
     let k = n / m;
     let mut d = x[..m].iter().fold(0.0, |s, &v| s + v) / mf;
-    // The kept means D(1), D(1+m), …: D(i) with 1-based i ≡ 1 (mod m).
+    // The kept means are D(1), D(1+m), …: after D(1), every run of m recursion steps ends
+    // on the next kept D. Steps i = 2 … n−m+1 (1-based) are replayed in full; the last
+    // n − K·m steps only feed D values that are never kept, so they are skipped (they cannot
+    // change any kept value).
     let mut prev = d;
     let mut acc = 0.0;
     let two = black_box(2.0_f64);
     let mut kept = 1;
-    let mut next_keep = 1 + m; // 1-based index of the next kept D
-    for i in 2..=(n - m + 1) {
-        d += (x[i + m - 2] - x[i - 2]) / mf;
-        if i == next_keep {
-            let diff = d - prev;
-            acc += if k == 2 { diff.powf(two) } else { diff * diff };
-            prev = d;
-            kept += 1;
-            next_keep += m;
+    for c in 1..k {
+        // Steps i = 2+(c−1)m … 1+cm use x(i+m−1) − x(i−1), i.e. 0-based x[i+m−2] − x[i−2].
+        let lo = &x[(c - 1) * m..c * m];
+        let hi = &x[c * m..(c + 1) * m];
+        for (&h, &l) in hi.iter().zip(lo) {
+            d += (h - l) / mf;
         }
+        let diff = d - prev;
+        acc += if k == 2 { diff.powf(two) } else { diff * diff };
+        prev = d;
+        kept += 1;
     }
     debug_assert_eq!(kept, k);
     (0.5 * (acc / (k - 1) as f64)).sqrt()
