@@ -25,8 +25,13 @@ pub struct Args {
     /// from the timestamps.
     #[arg(long, value_name = "HZ")]
     pub update_rate: Option<f64>,
-    /// Chart title prefix (upstream's titlestr).
-    #[arg(long, value_name = "TEXT", default_value = "")]
+    /// Chart title prefix (upstream's titlestr) [default: the input's file stem].
+    #[arg(
+        long,
+        value_name = "TEXT",
+        default_value = "",
+        hide_default_value = true
+    )]
     pub title: String,
     /// Replay upstream's running-mean recursion: curves bit-identical to kalibr_allan (slower).
     #[arg(long)]

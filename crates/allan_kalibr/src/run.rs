@@ -173,7 +173,17 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     let csv_path = dir.join("allan_curves.csv");
     bag2mat::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
-    written.extend(write_plots(&analysis, &config.title, dir)?);
+    // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
+    let title = if config.title.is_empty() {
+        config
+            .input
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    } else {
+        config.title.clone()
+    };
+    written.extend(write_plots(&analysis, &title, dir)?);
     let timings = Timings {
         load: 0.0,
         analyse: analyse_s,
