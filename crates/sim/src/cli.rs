@@ -34,6 +34,53 @@ pub enum Command {
     Integrate(IntegrateArgs),
     /// Fit a cubic B-spline to poses and emit IMU data from its derivatives.
     Spline(SplineArgs),
+    /// Tabulate the analysers' figures (written by scripts/compare.sh) against the truth.
+    Compare(CompareArgs),
+}
+
+/// `sim compare` arguments.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// Folder with `<preset>/imu_utils/<preset>_imu_param.yaml`, `<preset>/kalibr/imu.yaml`
+    /// and `<preset>/kalibr/ieee952_terms.csv`.
+    #[arg(long)]
+    pub root: PathBuf,
+    /// Presets to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values = ["low", "medium", "high"])]
+    pub presets: Vec<PresetArg>,
+    /// Sample rate of the simulated bags [Hz].
+    #[arg(long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Duration of the simulated bags [s].
+    #[arg(long, default_value_t = 14400.0)]
+    pub duration: f64,
+    /// Write the Markdown tables here as well [default: ROOT/compare.md].
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Fail (exit 1) when a figure is outside the tolerances stated for this data length.
+    #[arg(long)]
+    pub check: bool,
+}
+
+impl TryFrom<CompareArgs> for crate::compare::CompareConfig {
+    type Error = SimError;
+    fn try_from(a: CompareArgs) -> Result<Self> {
+        if !(a.rate > 0.0 && a.duration > 0.0) {
+            return Err(SimError::InvalidArgument("--rate and --duration must be positive".into()));
+        }
+        let presets = a
+            .presets
+            .iter()
+            .map(|p| match p {
+                PresetArg::Low => Ok(Preset::Low),
+                PresetArg::Medium => Ok(Preset::Medium),
+                PresetArg::High => Ok(Preset::High),
+                PresetArg::Master => Err(SimError::InvalidArgument("compare takes low, medium or high".into())),
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let output = a.output.unwrap_or_else(|| a.root.join("compare.md"));
+        Ok(crate::compare::CompareConfig { root: a.root, presets, rate: a.rate, duration: a.duration, output, check: a.check })
+    }
 }
 
 /// Noise parameter presets (continuous time).

@@ -38,6 +38,9 @@ pub enum SimError {
         /// The backend's message.
         msg: String,
     },
+    /// A tool output read by `sim compare` is missing or malformed.
+    #[error("comparison input: {0}")]
+    Input(String),
     /// Writing the bag failed (bag2mat's error).
     #[error(transparent)]
     Bag(#[from] bag2mat::Error),

@@ -10,6 +10,7 @@
 //!   observations).
 //! * [`integrate`]: `sim integrate` — upstream Euler vs midpoint dead reckoning, error table,
 //!   plots.
+//! * [`compare`]: `sim compare` — the tools' figures against the simulated truth.
 //! * [`spline`]: uniform cumulative cubic B-spline on ℝ³ × SO(3) and its IMU;
 //!   [`spline_sim`]: the `sim spline` command around it.
 //!
@@ -28,8 +29,9 @@
 //! * `quirk_05_eigen_quaternion_sign` ([`rotation::quat_from_matrix`]): w may be negative.
 //! * `quirk_06_motion_model_float_locals` ([`motion::Mode::CompatF32`], `--compat`): the
 //!   `float` constants of `MotionModel` (spec §8 item 2). Off by default (exact f64); with it,
-//!   `sim traj --compat` and `sim integrate --compat` reproduce upstream master's clean files
-//!   byte for byte (tests/upstream.rs, against the real program's output).
+//!   `sim traj --compat` and `sim integrate --compat` reproduced upstream master's clean files
+//!   byte for byte when checked once against the real program's output (those outputs are
+//!   not committed: nothing built from fetched code is).
 //!
 //! Not reproduced: upstream noise (a fresh `std::random_device` per sample; spec §8 item 6);
 //! the uninitialised gyro/acc columns of `cam_pose.txt` (written as 0).
@@ -38,6 +40,7 @@
 
 pub mod bag_sim;
 pub mod cli;
+pub mod compare;
 pub mod cppfmt;
 pub mod error;
 pub mod grid;

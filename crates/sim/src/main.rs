@@ -46,6 +46,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 eprintln!("wrote {}", f.display());
             }
         }
+        Command::Compare(a) => {
+            let cfg = sim::compare::CompareConfig::try_from(a)?;
+            if !sim::compare::run(&cfg)? {
+                return Ok(ExitCode::FAILURE);
+            }
+        }
         Command::Spline(a) => {
             if a.self_check {
                 let (text, pass) = sim::report::spline_self_check(a.pose_rate)?;

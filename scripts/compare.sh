@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# The seed's comparison: for each preset (low, medium, high) simulate a static IMU bag, convert
+# it (bag2mat), run both analysers on it, and tabulate what each found against the truth, in
+# continuous time and in discrete time at the sample rate (compare.md), with plots.
+#
+# usage: scripts/compare.sh [--duration S] [--rate HZ] [--out DIR] [--seed N] [--check]
+#   defaults: 14400 s (4 h), 200 Hz, out/compare, seed 1. --check fails on figures outside the
+#   tolerances `sim compare` states for the data length (used by scripts/test.sh).
+# env: BIN_DIR: use these binaries instead of building target/release.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+duration=14400 rate=200 out=out/compare seed=1 check=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --duration) duration=$2; shift 2 ;;
+    --rate) rate=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --seed) seed=$2; shift 2 ;;
+    --check) check=(--check); shift ;;
+    *) echo "compare.sh: unknown argument $1 (see the header of this script)" >&2; exit 2 ;;
+  esac
+done
+if [ -z "${BIN_DIR:-}" ]; then
+  cargo build --release --quiet -p sim -p bag2mat -p allan_imu_utils -p allan_kalibr
+  BIN_DIR=target/release
+fi
+minutes=$(( (${duration%.*} + 59) / 60 + 1 ))
+start=$(date +%s)
+for preset in low medium high; do
+  d="$out/$preset"
+  rm -rf "$d"; mkdir -p "$d"
+  echo "== $preset: sim bag ($duration s at $rate Hz)" >&2
+  "$BIN_DIR/sim" bag -o "$d/imu.bag" --preset "$preset" --duration "$duration" --rate "$rate" \
+    --seed "$seed" --start-time 1700000000 --quiet 2>"$d/sim.log"
+  "$BIN_DIR/bag2mat" "$d/imu.bag" imu --quiet
+  "$BIN_DIR/allan_imu_utils" "$d/imu.bag" --topic imu --name "$preset" --max-time-min "$minutes" \
+    --data-save-path "$d/imu_utils" --quiet >"$d/imu_utils.txt" 2>"$d/imu_utils.err"
+  "$BIN_DIR/allan_kalibr" "$d/imu.mat" --update-rate "$rate" --title "$preset" -o "$d/kalibr" --quiet \
+    >"$d/kalibr.txt" 2>"$d/kalibr.err"
+  rm -f "$d/imu.bag" "$d/imu.mat" # 1 GB each at 4 h; the tables keep what matters
+done
+"$BIN_DIR/sim" compare --root "$out" --rate "$rate" --duration "$duration" "${check[@]}"
+echo "compare.sh: done in $(( $(date +%s) - start )) s; tables in $out/compare.md" >&2
