@@ -90,8 +90,9 @@ pub struct Analysis {
     pub fits: Vec<AxisFit>,
 }
 
-/// Checks there is enough data, runs the Allan step and the fits.
-pub fn analyse(samples: &Samples, max_cluster: usize) -> Result<Analysis, Error> {
+/// Fails with [`Error::TooFewSamples`] unless the grid has [`MIN_VALID_POINTS`] factors with
+/// N − 2m > 0.
+pub fn check_enough(samples: &Samples, max_cluster: usize) -> Result<(), Error> {
     let n = samples.len();
     let valid = if n < 2 {
         0
@@ -109,16 +110,26 @@ pub fn analyse(samples: &Samples, max_cluster: usize) -> Result<Analysis, Error>
             needed: MIN_VALID_POINTS,
         });
     }
-    let axes = allan_step(samples, max_cluster);
-    let gyro_mean = [0, 1, 2].map(|k| estimator::mean(&samples.gyro[k]));
-    let fits: Vec<AxisFit> = axes
-        .par_iter()
+    Ok(())
+}
+
+/// The six fits (gyro classes for the first three axes, acc for the rest), in parallel.
+pub fn fit_all(axes: &[AxisAllan]) -> Vec<AxisFit> {
+    axes.par_iter()
         .enumerate()
         .map(|(i, a)| {
             let sensor = if i < 3 { Sensor::Gyro } else { Sensor::Acc };
             AxisFit::fit(sensor, &a.taus, &a.variance, a.freq)
         })
-        .collect();
+        .collect()
+}
+
+/// Checks there is enough data, runs the Allan step and the fits.
+pub fn analyse(samples: &Samples, max_cluster: usize) -> Result<Analysis, Error> {
+    check_enough(samples, max_cluster)?;
+    let axes = allan_step(samples, max_cluster);
+    let gyro_mean = [0, 1, 2].map(|k| estimator::mean(&samples.gyro[k]));
+    let fits = fit_all(&axes);
     Ok(Analysis {
         max_cluster,
         axes,

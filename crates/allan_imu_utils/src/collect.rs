@@ -6,6 +6,8 @@
 //! kept (quirk 10). Where the node waits forever because the bag ended first (issues #15,
 //! #25), we stop at the end and report it.
 
+use rayon::prelude::*;
+
 use crate::error::Error;
 use crate::fit::{IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR};
 
@@ -66,47 +68,58 @@ pub fn collect(series: &bag2mat::ImuSeries, max_time_min: u32) -> Result<Samples
             break;
         }
     }
-    let mut s = Samples {
+    // Seven independent column conversions, in parallel.
+    let col = |k: usize| -> Vec<f64> {
+        match k {
+            0 => series.stamp[..n].iter().map(|st| st.to_sec()).collect(),
+            1..=3 => series.gyro[..n]
+                .iter()
+                .map(|w| w[k - 1] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
+                .collect(),
+            _ => series.acc[..n].iter().map(|a| a[k - 4]).collect(),
+        }
+    };
+    let mut cols: Vec<Vec<f64>> = (0..7usize).into_par_iter().map(col).collect();
+    // The first non-finite value (lowest message index; gyro before acc, x before y before z).
+    const FIELDS: [&str; 6] = [
+        "angular_velocity.x",
+        "angular_velocity.y",
+        "angular_velocity.z",
+        "linear_acceleration.x",
+        "linear_acceleration.y",
+        "linear_acceleration.z",
+    ];
+    let first_bad: Vec<Option<usize>> = cols[1..]
+        .par_iter()
+        .map(|c| c.iter().position(|v| !v.is_finite()))
+        .collect();
+    if let Some((field, index)) = first_bad
+        .iter()
+        .enumerate()
+        .filter_map(|(f, i)| i.map(|i| (f, i)))
+        .min_by_key(|&(f, i)| (i, f))
+    {
+        return Err(non_finite(series, FIELDS[field].to_string(), index));
+    }
+    let acc = [
+        cols.pop().unwrap_or_default(),
+        cols.pop().unwrap_or_default(),
+        cols.pop().unwrap_or_default(),
+    ];
+    let acc = {
+        let [z, y, x] = acc;
+        [x, y, z]
+    };
+    let gyro = [cols.remove(1), cols.remove(1), cols.remove(1)];
+    let t = cols.remove(0);
+    Ok(Samples {
         topic: series.topic.clone(),
-        t: Vec::with_capacity(n),
-        gyro: [
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        ],
-        acc: [
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        ],
+        t,
+        gyro,
+        acc,
         stop,
         available: series.len(),
-    };
-    const AXIS: [&str; 3] = ["x", "y", "z"];
-    for i in 0..n {
-        let w = series.gyro[i];
-        let a = series.acc[i];
-        for k in 0..3 {
-            if !w[k].is_finite() {
-                return Err(non_finite(
-                    series,
-                    format!("angular_velocity.{}", AXIS[k]),
-                    i,
-                ));
-            }
-            if !a[k].is_finite() {
-                return Err(non_finite(
-                    series,
-                    format!("linear_acceleration.{}", AXIS[k]),
-                    i,
-                ));
-            }
-            s.gyro[k].push(w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR);
-            s.acc[k].push(a[k]);
-        }
-        s.t.push(series.stamp[i].to_sec());
-    }
-    Ok(s)
+    })
 }
 
 fn non_finite(series: &bag2mat::ImuSeries, what: String, index: usize) -> Error {

@@ -38,8 +38,10 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     )?;
     timings.push(("read_bag", t0.elapsed()));
     let mut notes = series.notes.clone();
+    let t0 = Instant::now();
     let samples = collect::collect(&series, config.max_time_min)?;
     drop(series);
+    timings.push(("collect", t0.elapsed()));
     if samples.stop == Stop::EndOfBag {
         notes.push(format!(
             "WARNING: bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
@@ -47,9 +49,20 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
             config.max_time_min
         ));
     }
+    analysis::check_enough(&samples, config.max_cluster)?;
     let t1 = Instant::now();
-    let analysis = analysis::analyse(&samples, config.max_cluster)?;
-    timings.push(("allan_and_fit", t1.elapsed()));
+    let axes = analysis::allan_step(&samples, config.max_cluster);
+    timings.push(("allan", t1.elapsed()));
+    let t1 = Instant::now();
+    let gyro_mean = [0, 1, 2].map(|k| crate::estimator::mean(&samples.gyro[k]));
+    let fits = analysis::fit_all(&axes);
+    let analysis = Analysis {
+        max_cluster: config.max_cluster,
+        axes,
+        gyro_mean,
+        fits,
+    };
+    timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
     std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
         path: config.out_dir.clone(),

@@ -64,7 +64,7 @@ impl Case {
         let mut t = Vec::new();
         let mut v = Vec::new();
         for line in text.lines().filter(|l| !l.trim().is_empty()) {
-            let mut it = line.split_whitespace().map(|s| parse_c_float(s));
+            let mut it = line.split_whitespace().map(parse_c_float);
             t.push(it.next().unwrap());
             v.push(it.next().unwrap());
         }

@@ -2,6 +2,10 @@
 //! `testdata/` (reference.rs) and the command line as a user runs it (cli.rs).
 
 mod cli;
+// `!(err <= tol)` is deliberate: it also fails on NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 mod fit_reference;
 mod reference;

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Benchmark of allan_imu_utils (called by scripts/bench.sh): end-to-end wall time of the
+# binary on a bag, and the time of the Allan step alone (θ + overlapping AVAR over all
+# factors and six axes), reported by the binary's --timings.
+#
+# Usage: scripts/bench_allan_imu_utils.sh [BAG] [RUNS]
+#   BAG   default: a 4 h 200 Hz uncompressed simulated bag (made once with `sim bag`,
+#         kept in ${BENCH_DIR:-target/bench}/imu_4h_200hz.bag)
+#   RUNS  default 5; the minimum and median of the runs are printed.
+# The whole bag is used (--max-time-min 100000: the stop rule never fires). Target on the
+# 2-core machine: < 0.6 s end to end for the 4 h bag.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs="${2:-5}"
+target="${CARGO_TARGET_DIR:-target}"
+cargo build --release -q -p allan_imu_utils
+bin="$target/release/allan_imu_utils"
+bag="${1:-}"
+if [ -z "$bag" ]; then
+  dir="${BENCH_DIR:-$target/bench}"
+  bag="$dir/imu_4h_200hz.bag"
+  if [ ! -f "$bag" ]; then
+    mkdir -p "$dir"
+    cargo build --release -q -p sim
+    "$target/release/sim" bag --output "$bag" --rate 200 --duration 14400 --start-time 1600000000 --compression none --quiet >/dev/null
+  fi
+fi
+out="$(mktemp -d)"
+trap 'rm -rf "$out"' EXIT
+cat "$bag" >/dev/null # warm the page cache, as the other tools' benchmarks do
+echo "allan_imu_utils on $bag ($(du -h "$bag" | cut -f1)), $runs runs"
+totals=(); allans=(); reads=(); fits=()
+for _ in $(seq "$runs"); do
+  start=$(date +%s.%N)
+  "$bin" "$bag" --max-time-min 100000 --data-save-path "$out" --quiet --no-plots --timings >/dev/null 2>"$out/stderr"
+  end=$(date +%s.%N)
+  totals+=("$(echo "$end - $start" | bc -l)")
+  allans+=("$(awk '$1=="timing" && $2=="allan" {print $3}' "$out/stderr")")
+  reads+=("$(awk '$1=="timing" && $2=="read_bag" {print $3}' "$out/stderr")")
+  fits+=("$(awk '$1=="timing" && $2=="fit" {print $3}' "$out/stderr")")
+done
+stats() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {printf "min %.3f s  median %.3f s", a[1], a[int((NR+1)/2)]}'; }
+echo "  end to end : $(stats "${totals[@]}")"
+echo "  read bag   : $(stats "${reads[@]}")"
+echo "  Allan step : $(stats "${allans[@]}")"
+echo "  fits       : $(stats "${fits[@]}")"
+grep -m1 "messages" "$out/stderr" || true
