@@ -1,11 +1,12 @@
 //! Integration tests of allan_imu_utils: parity with the upstream reference outputs in
-//! `testdata/` (reference.rs) and the command line as a user runs it (cli.rs).
+//! `testdata/` (fit_reference.rs: the fit alone on upstream's variances; reference.rs: whole
+//! runs on the four bags) and the command line as a user runs it (cli.rs).
 
-mod cli;
 // `!(err <= tol)` is deliberate: it also fails on NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![allow(clippy::needless_range_loop)]
 
+mod cli;
 mod common;
 mod fit_reference;
 mod reference;
