@@ -46,28 +46,28 @@ impl AxisAllan {
     }
 }
 
-/// The Allan step alone, all six axes (the part the benchmark times).
-pub fn allan_step(samples: &Samples, max_cluster: usize) -> Vec<AxisAllan> {
+/// The Allan step alone, all six axes (the part the benchmark times). Consumes the samples:
+/// each axis' column becomes its θ in place.
+pub fn allan_step(samples: Samples, max_cluster: usize) -> Vec<AxisAllan> {
     let n = samples.len();
     let period = estimator::mean_period(&samples.t);
     let freq = 1.0 / period;
     let f = factors::factors(n, max_cluster);
     let taus = estimator::taus(period, &f);
-    let series: Vec<&Vec<f64>> = samples.gyro.iter().chain(samples.acc.iter()).collect();
+    let (start_t, end_t) = (samples.t[0], samples.t[n - 1]);
+    let Samples { gyro, acc, .. } = samples;
+    let mut thetas: Vec<Vec<f64>> = gyro.into_iter().chain(acc).collect();
     // θ for all axes at once (one sequential cumulative sum each), then one axis at a time so
     // its θ stays in cache while the factors run in parallel.
-    let thetas: Vec<Vec<f64>> = series
-        .par_iter()
-        .map(|x| estimator::thetas(x, freq))
-        .collect();
+    thetas.par_iter_mut().for_each(|x| estimator::thetas_in_place(x, freq));
     thetas
         .iter()
         .zip(AXIS_NAMES)
         .map(|(theta, name)| AxisAllan {
             name,
             n,
-            start_t: samples.t[0],
-            end_t: samples.t[n - 1],
+            start_t,
+            end_t,
             freq,
             period,
             factors: f.clone(),
@@ -75,6 +75,11 @@ pub fn allan_step(samples: &Samples, max_cluster: usize) -> Vec<AxisAllan> {
             variance: estimator::allan_variance(theta, &f, period),
         })
         .collect()
+}
+
+/// Gyro means in pseudo-deg/h (`getAvgValue`).
+pub fn gyro_means(samples: &Samples) -> [f64; 3] {
+    [0, 1, 2].map(|k| estimator::mean(&samples.gyro[k]))
 }
 
 /// Everything the outputs are made of.
@@ -127,8 +132,8 @@ pub fn fit_all(axes: &[AxisAllan]) -> Vec<AxisFit> {
 /// Checks there is enough data, runs the Allan step and the fits.
 pub fn analyse(samples: &Samples, max_cluster: usize) -> Result<Analysis, Error> {
     check_enough(samples, max_cluster)?;
-    let axes = allan_step(samples, max_cluster);
-    let gyro_mean = [0, 1, 2].map(|k| estimator::mean(&samples.gyro[k]));
+    let gyro_mean = gyro_means(samples);
+    let axes = allan_step(samples.clone(), max_cluster);
     let fits = fit_all(&axes);
     Ok(Analysis {
         max_cluster,

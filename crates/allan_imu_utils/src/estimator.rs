@@ -34,6 +34,16 @@ pub fn thetas(x: &[f64], freq: f64) -> Vec<f64> {
         .collect()
 }
 
+/// [`thetas`] computed in place (the samples are not needed afterwards; saves the page
+/// faults of a fresh 23 MB buffer per axis on a 4 h bag).
+pub fn thetas_in_place(x: &mut [f64], freq: f64) {
+    let mut sum = 0.0;
+    for v in x.iter_mut() {
+        sum += *v;
+        *v = sum / freq;
+    }
+}
+
 /// Plain mean (`getAvgValue`): sequential sum over N.
 pub fn mean(x: &[f64]) -> f64 {
     let mut sum = 0.0;
@@ -196,6 +206,14 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn thetas_in_place_equals_thetas() {
+        let x = noise(1000);
+        let mut y = x.clone();
+        thetas_in_place(&mut y, 199.99999997275231);
+        assert_eq!(y, thetas(&x, 199.99999997275231));
     }
 
     /// imu_utils.md §3.4/§3.7: N − 2m = 0 gives 0/0 = NaN, N − 2m < 0 gives −0.0.

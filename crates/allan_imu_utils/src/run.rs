@@ -50,11 +50,11 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
         ));
     }
     analysis::check_enough(&samples, config.max_cluster)?;
+    let gyro_mean = analysis::gyro_means(&samples);
     let t1 = Instant::now();
-    let axes = analysis::allan_step(&samples, config.max_cluster);
+    let axes = analysis::allan_step(samples, config.max_cluster);
     timings.push(("allan", t1.elapsed()));
     let t1 = Instant::now();
-    let gyro_mean = [0, 1, 2].map(|k| crate::estimator::mean(&samples.gyro[k]));
     let fits = analysis::fit_all(&axes);
     let analysis = Analysis {
         max_cluster: config.max_cluster,
