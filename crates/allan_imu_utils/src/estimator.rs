@@ -212,8 +212,8 @@ mod tests {
     fn thetas_in_place_equals_thetas() {
         let x = noise(1000);
         let mut y = x.clone();
-        thetas_in_place(&mut y, 199.99999997275231);
-        assert_eq!(y, thetas(&x, 199.99999997275231));
+        thetas_in_place(&mut y, 199.999_999_972_752_3);
+        assert_eq!(y, thetas(&x, 199.999_999_972_752_3));
     }
 
     /// imu_utils.md §3.4/§3.7: N − 2m = 0 gives 0/0 = NaN, N − 2m < 0 gives −0.0.
