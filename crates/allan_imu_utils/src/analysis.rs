@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use crate::collect::Samples;
+use crate::collect::Collected;
 use crate::error::Error;
 use crate::estimator;
 use crate::factors;
@@ -46,40 +46,50 @@ impl AxisAllan {
     }
 }
 
-/// The Allan step alone, all six axes (the part the benchmark times). Consumes the samples:
-/// each axis' column becomes its θ in place.
-pub fn allan_step(samples: Samples, max_cluster: usize) -> Vec<AxisAllan> {
-    let n = samples.len();
-    let period = estimator::mean_period(&samples.t);
+/// The Allan step alone, all six axes (the part the benchmark times), plus the gyro means
+/// (`getAvgValue`: the same sequential sum θ is built from, over N). Fails on the first
+/// non-finite value.
+pub fn allan_step(
+    c: &Collected<'_>,
+    max_cluster: usize,
+) -> Result<(Vec<AxisAllan>, [f64; 3]), Error> {
+    let n = c.len();
+    let period = estimator::mean_period(&c.t);
     let freq = 1.0 / period;
     let f = factors::factors(n, max_cluster);
     let taus = estimator::taus(period, &f);
-    let (start_t, end_t) = (samples.t[0], samples.t[n - 1]);
-    let Samples { gyro, acc, .. } = samples;
-    let mut thetas: Vec<Vec<f64>> = gyro.into_iter().chain(acc).collect();
-    // θ for all axes at once (one sequential cumulative sum each), then one axis at a time so
-    // its θ stays in cache while the factors run in parallel.
-    thetas.par_iter_mut().for_each(|x| estimator::thetas_in_place(x, freq));
-    thetas
+    // θ for all axes at once, straight from the bag rows (one sequential cumulative sum
+    // each), then one axis at a time so its θ stays in cache while the factors run in
+    // parallel.
+    let integrated: Vec<(Vec<f64>, f64, Option<usize>)> = (0..6usize)
+        .into_par_iter()
+        .map(|axis| estimator::thetas_checked(c.values(axis), n, freq))
+        .collect();
+    if let Some((axis, index)) = integrated
+        .iter()
+        .enumerate()
+        .filter_map(|(a, (_, _, bad))| bad.map(|i| (a, i)))
+        .min_by_key(|&(a, i)| (i, a))
+    {
+        return Err(c.non_finite(axis, index));
+    }
+    let gyro_mean = [0, 1, 2].map(|k| integrated[k].1 / n as f64);
+    let axes = integrated
         .iter()
         .zip(AXIS_NAMES)
-        .map(|(theta, name)| AxisAllan {
+        .map(|((theta, _, _), name)| AxisAllan {
             name,
             n,
-            start_t,
-            end_t,
+            start_t: c.t[0],
+            end_t: c.t[n - 1],
             freq,
             period,
             factors: f.clone(),
             taus: taus.clone(),
             variance: estimator::allan_variance(theta, &f, period),
         })
-        .collect()
-}
-
-/// Gyro means in pseudo-deg/h (`getAvgValue`).
-pub fn gyro_means(samples: &Samples) -> [f64; 3] {
-    [0, 1, 2].map(|k| estimator::mean(&samples.gyro[k]))
+        .collect();
+    Ok((axes, gyro_mean))
 }
 
 /// Everything the outputs are made of.
@@ -97,8 +107,8 @@ pub struct Analysis {
 
 /// Fails with [`Error::TooFewSamples`] unless the grid has [`MIN_VALID_POINTS`] factors with
 /// N − 2m > 0.
-pub fn check_enough(samples: &Samples, max_cluster: usize) -> Result<(), Error> {
-    let n = samples.len();
+pub fn check_enough(c: &Collected<'_>, max_cluster: usize) -> Result<(), Error> {
+    let n = c.len();
     let valid = if n < 2 {
         0
     } else {
@@ -109,7 +119,7 @@ pub fn check_enough(samples: &Samples, max_cluster: usize) -> Result<(), Error> 
     };
     if valid < MIN_VALID_POINTS {
         return Err(Error::TooFewSamples {
-            topic: samples.topic.clone(),
+            topic: c.topic().to_string(),
             n,
             valid,
             needed: MIN_VALID_POINTS,
@@ -130,10 +140,9 @@ pub fn fit_all(axes: &[AxisAllan]) -> Vec<AxisFit> {
 }
 
 /// Checks there is enough data, runs the Allan step and the fits.
-pub fn analyse(samples: &Samples, max_cluster: usize) -> Result<Analysis, Error> {
-    check_enough(samples, max_cluster)?;
-    let gyro_mean = gyro_means(samples);
-    let axes = allan_step(samples.clone(), max_cluster);
+pub fn analyse(c: &Collected<'_>, max_cluster: usize) -> Result<Analysis, Error> {
+    check_enough(c, max_cluster)?;
+    let (axes, gyro_mean) = allan_step(c, max_cluster)?;
     let fits = fit_all(&axes);
     Ok(Analysis {
         max_cluster,

@@ -38,22 +38,20 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     )?;
     timings.push(("read_bag", t0.elapsed()));
     let mut notes = series.notes.clone();
-    let t0 = Instant::now();
-    let samples = collect::collect(&series, config.max_time_min)?;
-    drop(series);
-    timings.push(("collect", t0.elapsed()));
-    if samples.stop == Stop::EndOfBag {
+    let collected = collect::collect(&series, config.max_time_min);
+    if collected.stop == Stop::EndOfBag {
         notes.push(format!(
             "WARNING: bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
-            samples.len(),
+            collected.len(),
             config.max_time_min
         ));
     }
-    analysis::check_enough(&samples, config.max_cluster)?;
-    let gyro_mean = analysis::gyro_means(&samples);
+    analysis::check_enough(&collected, config.max_cluster)?;
     let t1 = Instant::now();
-    let axes = analysis::allan_step(samples, config.max_cluster);
+    let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster)?;
     timings.push(("allan", t1.elapsed()));
+    drop(collected);
+    drop(series);
     let t1 = Instant::now();
     let fits = analysis::fit_all(&axes);
     let analysis = Analysis {
