@@ -1,6 +1,6 @@
 //! The overlapping Allan variance exactly as imu_utils computes it (imu_utils.md §3.2–3.6):
 //! mean-period frequency, integrated signal θ, then for each cluster size m
-//! σ²(m) = Σ ((θ[k+2m] − 2θ[k+m]) + θ[k])² / ((2 (period·m)²) (N − 2m)).
+//! `σ²(m) = Σ ((θ[k+2m] − 2θ[k+m]) + θ[k])² / ((2 (period·m)²) (N − 2m))`.
 //!
 //! The fast path ([`allan_variance`]) runs the O(N) pass of every factor in parallel (rayon)
 //! and sums with 32 independent accumulators so the compiler vectorises it (AVX-512/AVX2
@@ -118,7 +118,7 @@ fn second_diff_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
     second_diff_sum_body(a, b, c)
 }
 
-/// Σ over k of ((θ[k+2m] − 2θ[k+m]) + θ[k])², 0 when N − 2m ≤ 0.
+/// `Σ_k ((θ[k+2m] − 2θ[k+m]) + θ[k])²`, 0 when N − 2m ≤ 0.
 pub fn second_diff_sum(theta: &[f64], m: usize) -> f64 {
     let n = theta.len();
     if n <= 2 * m {

@@ -6,8 +6,8 @@
 //! Specification: `imu_utils.md` (project specs). Modules, in pipeline order:
 //! [`collect`] (stop rule), [`factors`] (cluster grid), [`estimator`] (Allan variance),
 //! [`fit`] (start point, dogleg, derived values), [`report`] (stdout and curve files),
-//! [`opencv_yaml`] (both yaml files), [`plot`]; [`launch`] and [`config`] turn the user's
-//! flags or roslaunch file into a [`config::Config`]; [`run`] ties them together.
+//! [`opencv_yaml`] (both yaml files), [`plot`]; [`launch`] and [`cli`] turn the user's
+//! flags or roslaunch file into a [`cli::Config`]; [`run`] ties them together.
 //!
 //! # Quirks reproduced on purpose (imu_utils.md §6)
 //! 1. `*_n` is the fitted ADEV at 1 s times √freq (discrete), not a density.
