@@ -18,12 +18,14 @@ pub struct TopicSummary {
 #[non_exhaustive]
 pub enum Error {
     /// An operating-system error on a path.
-    #[error("{path}: {source}")]
+    // The cause is part of the message and deliberately not a `source`: anyhow's chained
+    // output would print it twice.
+    #[error("{path}: {cause}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file does not start with `#ROSBAG V2.0`.
     #[error("{path}: not a ROS 1 bag (version 2.0): {what}")]
@@ -92,7 +94,7 @@ fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
 
 impl Error {
     /// Wraps an I/O error with its path.
-    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Error {
-        Error::Io { path: path.into(), source }
+    pub fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Error {
+        Error::Io { path: path.into(), cause }
     }
 }
