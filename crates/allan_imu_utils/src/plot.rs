@@ -161,14 +161,17 @@ fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
 /// Writes the four plot files into `dir`; returns their paths.
 pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     bag2mat::plot::register_font();
-    let mut out = Vec::new();
-    for (stem, base) in [("allan_gyr", 0), ("allan_acc", 3)] {
-        let c = curves(an, name, base);
-        for (ext, svg) in [("png", false), ("svg", true)] {
+    use rayon::prelude::*;
+    let jobs = [
+        ("allan_gyr", 0, "png"),
+        ("allan_gyr", 0, "svg"),
+        ("allan_acc", 3, "png"),
+        ("allan_acc", 3, "svg"),
+    ];
+    jobs.par_iter()
+        .map(|&(stem, base, ext)| {
             let p = dir.join(format!("{stem}.{ext}"));
-            render(&p, &c, svg)?;
-            out.push(p);
-        }
-    }
-    Ok(out)
+            render(&p, &curves(an, name, base), ext == "svg").map(|()| p)
+        })
+        .collect()
 }

@@ -144,11 +144,12 @@ pub fn write_text(path: &Path, text: &str) -> Result<(), Error> {
 
 /// Writes the curve files into `dir`; returns their paths.
 pub fn write_curve_files(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    let mut paths = Vec::new();
-    for (file, text) in curve_files(an, name) {
-        let p = dir.join(file);
-        write_text(&p, &text)?;
-        paths.push(p);
-    }
-    Ok(paths)
+    use rayon::prelude::*;
+    curve_files(an, name)
+        .into_par_iter()
+        .map(|(file, text)| {
+            let p = dir.join(file);
+            write_text(&p, &text).map(|()| p)
+        })
+        .collect()
 }
