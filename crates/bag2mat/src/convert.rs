@@ -39,7 +39,10 @@ impl Format {
 /// bagconvert's output path: the bag's directory, its stem (the last extension removed, as
 /// boost::filesystem's `stem`) and the format's extension.
 pub fn default_output(bag: &Path, format: Format) -> PathBuf {
-    let stem = bag.file_stem().map(|s| s.to_os_string()).unwrap_or_else(|| "out".into());
+    let stem = bag
+        .file_stem()
+        .map(|s| s.to_os_string())
+        .unwrap_or_else(|| "out".into());
     let mut name = stem;
     name.push(".");
     name.push(format.extension());
@@ -54,7 +57,15 @@ pub fn data_imu_from_series(s: &ImuSeries) -> DataImu {
     let mut d = DataImu::with_capacity(s.len());
     for i in 0..s.len() {
         let (a, g) = (s.acc[i], s.gyro[i]);
-        d.push([s.record_time[i].to_sec(), a[0], a[1], a[2], g[0], g[1], g[2]]);
+        d.push([
+            s.record_time[i].to_sec(),
+            a[0],
+            a[1],
+            a[2],
+            g[0],
+            g[1],
+            g[2],
+        ]);
     }
     d
 }
@@ -76,14 +87,26 @@ pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Conv
     let sel = bag.select_imu_topic(topic)?;
     let mut data = DataImu::with_capacity(sel.expected as usize);
     let report = bag.stream_imu(&sel, quiet, &mut |t, m| {
-        data.push([t.to_sec(), m.acc[0], m.acc[1], m.acc[2], m.gyro[0], m.gyro[1], m.gyro[2]]);
+        data.push([
+            t.to_sec(),
+            m.acc[0],
+            m.acc[1],
+            m.acc[2],
+            m.gyro[0],
+            m.gyro[1],
+            m.gyro[2],
+        ]);
     })?;
     if let Some(order) = &report.order {
         for c in data.columns.iter_mut() {
             *c = permute(c, order);
         }
     }
-    Ok(Converted { data, topic: sel.topic, notes: report.notes })
+    Ok(Converted {
+        data,
+        topic: sel.topic,
+        notes: report.notes,
+    })
 }
 
 /// Writes the matrix in `format` to `out`, atomically.
@@ -94,12 +117,19 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
             writeln!(w, "t,ax,ay,az,wx,wy,wz")?;
             for i in 0..data.rows() {
                 let r = data.row(i);
-                writeln!(w, "{},{},{},{},{},{},{}", r[0], r[1], r[2], r[3], r[4], r[5], r[6])?;
+                writeln!(
+                    w,
+                    "{},{},{},{},{},{},{}",
+                    r[0], r[1], r[2], r[3], r[4], r[5], r[6]
+                )?;
             }
             Ok(())
         }),
         Format::Npy => write_atomic(out, |w| {
-            let dict = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {COLS}), }}", data.rows());
+            let dict = format!(
+                "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {COLS}), }}",
+                data.rows()
+            );
             // NPY v1.0: magic, version, u16 header length; header padded with spaces and a
             // final newline so that the data starts on a 64-byte boundary.
             let unpadded = 10 + dict.len() + 1;
@@ -130,9 +160,18 @@ mod tests {
 
     #[test]
     fn default_output_follows_boost_stem() {
-        assert_eq!(default_output(Path::new("/a/b/foo.bag"), Format::Mat), PathBuf::from("/a/b/foo.mat"));
-        assert_eq!(default_output(Path::new("a.b.bag"), Format::Mat), PathBuf::from("a.b.mat"));
-        assert_eq!(default_output(Path::new("dir/x.bag"), Format::Csv), PathBuf::from("dir/x.csv"));
+        assert_eq!(
+            default_output(Path::new("/a/b/foo.bag"), Format::Mat),
+            PathBuf::from("/a/b/foo.mat")
+        );
+        assert_eq!(
+            default_output(Path::new("a.b.bag"), Format::Mat),
+            PathBuf::from("a.b.mat")
+        );
+        assert_eq!(
+            default_output(Path::new("dir/x.bag"), Format::Csv),
+            PathBuf::from("dir/x.csv")
+        );
     }
 }
 
@@ -154,20 +193,31 @@ pub struct Config {
 /// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet. Returns the
 /// output path and the number of rows written.
 pub fn run(cfg: &Config) -> Result<(PathBuf, usize), Error> {
-    let out = cfg.output.clone().unwrap_or_else(|| default_output(&cfg.bag, cfg.format));
+    let out = cfg
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&cfg.bag, cfg.format));
     let log = |s: &str| {
         if !cfg.quiet {
             eprintln!("{s}");
         }
     };
     log(&format!("BAG Path is: {}", cfg.bag.display()));
-    log(&format!("{} Path is: {}", cfg.format.extension().to_uppercase(), out.display()));
+    log(&format!(
+        "{} Path is: {}",
+        cfg.format.extension().to_uppercase(),
+        out.display()
+    ));
     log("Reading in rosbag file...");
     let conv = bag_to_data_imu(&cfg.bag, &cfg.topic, cfg.quiet)?;
     for n in &conv.notes {
         eprintln!("warning: {n}");
     }
-    log(&format!("Done processing bag: {} messages on '{}'", conv.data.rows(), conv.topic));
+    log(&format!(
+        "Done processing bag: {} messages on '{}'",
+        conv.data.rows(),
+        conv.topic
+    ));
     write(&out, &conv.data, cfg.format)?;
     log("Done processing IMU data");
     Ok((out, conv.data.rows()))

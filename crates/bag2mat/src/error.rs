@@ -54,7 +54,10 @@ pub enum Error {
         available: Vec<TopicSummary>,
     },
     /// The topic exists but does not carry `sensor_msgs/Imu` with the right md5.
-    #[error("topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}]", crate::imu_msg::MD5)]
+    #[error(
+        "topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}]",
+        crate::imu_msg::MD5
+    )]
     WrongType {
         /// The topic.
         topic: String,
@@ -86,7 +89,10 @@ fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
     } else {
         s.push_str("; topics in the bag:");
         for t in available {
-            s.push_str(&format!("\n  {:<30} {:>10} msgs : {}", t.topic, t.count, t.msg_type));
+            s.push_str(&format!(
+                "\n  {:<30} {:>10} msgs : {}",
+                t.topic, t.count, t.msg_type
+            ));
         }
     }
     s
@@ -95,6 +101,9 @@ fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
 impl Error {
     /// Wraps an I/O error with its path.
     pub fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Error {
-        Error::Io { path: path.into(), cause }
+        Error::Io {
+            path: path.into(),
+            cause,
+        }
     }
 }

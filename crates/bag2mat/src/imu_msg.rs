@@ -19,9 +19,18 @@ pub const MD5: &str = "6a62c6daae103f4ff57a132d6f95cec2";
 const IMU_MSG: &str = include_str!("../msg/sensor_msgs_Imu.msg");
 /// The dependencies in genpy's order, with the raw text of each `.msg` file.
 const DEPENDENCIES: [(&str, &str); 3] = [
-    ("std_msgs/Header", include_str!("../msg/std_msgs_Header.msg")),
-    ("geometry_msgs/Quaternion", include_str!("../msg/geometry_msgs_Quaternion.msg")),
-    ("geometry_msgs/Vector3", include_str!("../msg/geometry_msgs_Vector3.msg")),
+    (
+        "std_msgs/Header",
+        include_str!("../msg/std_msgs_Header.msg"),
+    ),
+    (
+        "geometry_msgs/Quaternion",
+        include_str!("../msg/geometry_msgs_Quaternion.msg"),
+    ),
+    (
+        "geometry_msgs/Vector3",
+        include_str!("../msg/geometry_msgs_Vector3.msg"),
+    ),
 ];
 
 static DEFINITION_TEXT: LazyLock<String> = LazyLock::new(|| {
@@ -146,7 +155,8 @@ impl Imu {
         imu.angular_velocity.copy_from_slice(&d[13..16]);
         imu.angular_velocity_covariance.copy_from_slice(&d[16..25]);
         imu.linear_acceleration.copy_from_slice(&d[25..28]);
-        imu.linear_acceleration_covariance.copy_from_slice(&d[28..37]);
+        imu.linear_acceleration_covariance
+            .copy_from_slice(&d[28..37]);
         Ok(imu)
     }
 }
@@ -170,13 +180,21 @@ type Head = (u32, RosTime);
 fn split(data: &[u8]) -> Result<(Head, &[u8], &[u8]), Error> {
     let bad = |what: String| Error::BadMessage { what };
     if data.len() < 16 {
-        return Err(bad(format!("Imu message of {} bytes is shorter than its header", data.len())));
+        return Err(bad(format!(
+            "Imu message of {} bytes is shorter than its header",
+            data.len()
+        )));
     }
     let u32_at = |o: usize| u32::from_le_bytes([data[o], data[o + 1], data[o + 2], data[o + 3]]);
     let seq = u32_at(0);
-    let stamp = RosTime { sec: u32_at(4), nsec: u32_at(8) };
+    let stamp = RosTime {
+        sec: u32_at(4),
+        nsec: u32_at(8),
+    };
     let id_len = u32_at(12) as usize;
-    let expected = 16usize.checked_add(id_len).and_then(|n| n.checked_add(BODY_LEN));
+    let expected = 16usize
+        .checked_add(id_len)
+        .and_then(|n| n.checked_add(BODY_LEN));
     if expected != Some(data.len()) {
         return Err(bad(format!(
             "Imu message of {} bytes does not match its frame_id length {id_len} (expected {} bytes)",
@@ -201,7 +219,10 @@ mod tests {
     fn encode_decode_round_trip() {
         let imu = Imu {
             seq: 42,
-            stamp: RosTime { sec: 1_600_000_000, nsec: 999_999_999 },
+            stamp: RosTime {
+                sec: 1_600_000_000,
+                nsec: 999_999_999,
+            },
             frame_id: "base_link".into(),
             orientation: [0.1, 0.2, 0.3, 0.9],
             orientation_covariance: [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
@@ -215,7 +236,10 @@ mod tests {
         assert_eq!(buf.len(), 312 + 9);
         assert_eq!(Imu::decode(&buf).unwrap(), imu);
         let s = ImuSample::decode(&buf).unwrap();
-        assert_eq!((s.seq, s.stamp, s.gyro, s.acc), (42, imu.stamp, imu.angular_velocity, imu.linear_acceleration));
+        assert_eq!(
+            (s.seq, s.stamp, s.gyro, s.acc),
+            (42, imu.stamp, imu.angular_velocity, imu.linear_acceleration)
+        );
     }
 
     #[test]

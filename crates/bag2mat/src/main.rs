@@ -29,7 +29,13 @@ struct Args {
 
 fn main() -> ExitCode {
     let a = Args::parse();
-    let cfg = Config { bag: a.bag, topic: a.topic, output: a.output, format: a.format, quiet: a.quiet };
+    let cfg = Config {
+        bag: a.bag,
+        topic: a.topic,
+        output: a.output,
+        format: a.format,
+        quiet: a.quiet,
+    };
     match run(&cfg) {
         Ok(_) => ExitCode::SUCCESS,
         Err(e) => {

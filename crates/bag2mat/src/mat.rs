@@ -38,7 +38,9 @@ pub struct DataImu {
 impl DataImu {
     /// An empty matrix with room for `n` rows.
     pub fn with_capacity(n: usize) -> DataImu {
-        DataImu { columns: std::array::from_fn(|_| Vec::with_capacity(n)) }
+        DataImu {
+            columns: std::array::from_fn(|_| Vec::with_capacity(n)),
+        }
     }
 
     /// Number of rows.
@@ -112,140 +114,232 @@ pub fn write_data_imu(path: &Path, data: &DataImu) -> Result<(), Error> {
     })
 }
 
-/// Reads the variable `data_imu` (N×7) from a Level-5 MAT file.
+/// Reads the variable `data_imu` (N×7) from a Level-5 MAT file. The file is streamed: the
+/// values go straight from the (possibly zlib-compressed) element into the columns, so the
+/// peak memory is the matrix itself, not the file plus the matrix.
 pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let err = |what: String| Error::Mat { path: path.to_path_buf(), what };
-    if bytes.len() >= 8 && &bytes[..8] == b"\x89HDF\r\n\x1a\n" || bytes.starts_with(b"MATLAB 7.3") {
-        return Err(err("MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')".into()));
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    let mut r = std::io::BufReader::with_capacity(1 << 20, file);
+    let err = |what: String| Error::Mat {
+        path: path.to_path_buf(),
+        what,
+    };
+    let mut header = [0u8; 128];
+    let got = read_full(&mut r, &mut header).map_err(|e| Error::io(path, e))?;
+    if got >= 8 && &header[..8] == b"\x89HDF\r\n\x1a\n" || header.starts_with(b"MATLAB 7.3") {
+        return Err(err(
+            "MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')".into(),
+        ));
     }
-    if bytes.len() < 128 || bytes[..4].contains(&0) {
+    if got < 128 || header[..4].contains(&0) {
         return Err(err("not a MATLAB Level-5 MAT file (header missing)".into()));
     }
-    match &bytes[126..128] {
+    match &header[126..128] {
         b"IM" => {}
         b"MI" => return Err(err("big-endian MAT files are not supported".into())),
-        _ => return Err(err("not a MATLAB Level-5 MAT file (no endian indicator)".into())),
-    }
-    let mut pos = 128;
-    let mut names = Vec::new();
-    while pos < bytes.len() {
-        let (ty, data, next) = element(&bytes, pos).map_err(|w| err(format!("byte {pos}: {w}")))?;
-        let inflated;
-        let (ty, data) = if ty == MI_COMPRESSED {
-            let mut out = Vec::new();
-            flate2::read::ZlibDecoder::new(data).read_to_end(&mut out).map_err(|e| err(format!("byte {pos}: zlib: {e}")))?;
-            inflated = out;
-            let (ity, idata, _) = element(&inflated, 0).map_err(|w| err(format!("compressed element at byte {pos}: {w}")))?;
-            (ity, idata)
-        } else {
-            (ty, data)
-        };
-        if ty == MI_MATRIX {
-            match matrix(data).map_err(|w| err(format!("variable at byte {pos}: {w}")))? {
-                Matrix { name, .. } if name != VAR_NAME => names.push(name),
-                Matrix { rows, cols, values, .. } => {
-                    if cols != COLS {
-                        return Err(err(format!("data_imu is {rows}×{cols}; expected N×7 [t ax ay az wx wy wz]")));
-                    }
-                    let columns = std::array::from_fn(|c| values[c * rows..(c + 1) * rows].to_vec());
-                    return Ok(DataImu { columns });
-                }
-            }
+        _ => {
+            return Err(err(
+                "not a MATLAB Level-5 MAT file (no endian indicator)".into()
+            ));
         }
-        pos = next;
+    }
+    let mut pos = 128u64;
+    let mut names = Vec::new();
+    while pos < len {
+        let at = |w: String| err(format!("byte {pos}: {w}"));
+        let (ty, n, small) = read_tag(&mut r).map_err(|e| at(e.to_string()))?;
+        if small {
+            pos += 8;
+            continue;
+        }
+        let found = match ty {
+            MI_COMPRESSED => {
+                let mut z = flate2::read::ZlibDecoder::new((&mut r).take(n as u64));
+                let (ity, _, _) = read_tag(&mut z).map_err(|e| at(format!("zlib: {e}")))?;
+                let found = if ity == MI_MATRIX {
+                    Some(matrix(&mut z).map_err(at)?)
+                } else {
+                    None
+                };
+                std::io::copy(z.get_mut(), &mut std::io::sink()).map_err(|e| at(e.to_string()))?;
+                pos += 8 + n as u64;
+                found
+            }
+            _ => {
+                let padded = (n as u64).div_ceil(8) * 8;
+                let mut body = (&mut r).take(padded);
+                let found = if ty == MI_MATRIX {
+                    Some(matrix(&mut body).map_err(at)?)
+                } else {
+                    None
+                };
+                std::io::copy(&mut body, &mut std::io::sink()).map_err(|e| at(e.to_string()))?;
+                pos += 8 + padded;
+                found
+            }
+        };
+        match found {
+            Some(Parsed::DataImu(d)) => return Ok(d),
+            Some(Parsed::Other(name)) => names.push(name),
+            None => {}
+        }
     }
     Err(err(if names.is_empty() {
         "no variable 'data_imu' in the file (it holds no variables)".to_string()
     } else {
-        format!("no variable 'data_imu' in the file; it holds: {}", names.join(", "))
+        format!(
+            "no variable 'data_imu' in the file; it holds: {}",
+            names.join(", ")
+        )
     }))
 }
 
-/// Splits the data element at `pos`: (type, data, offset of the next element). Handles the
-/// "small data element" form (type and size packed in the first 4 bytes).
-fn element(buf: &[u8], pos: usize) -> Result<(u32, &[u8], usize), String> {
-    let word = |p: usize| -> Result<u32, String> {
-        buf.get(p..p + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).ok_or_else(|| "truncated element tag".to_string())
-    };
-    let first = word(pos)?;
-    if first >> 16 != 0 {
-        let (ty, n) = (first & 0xffff, (first >> 16) as usize);
-        if n > 4 {
-            return Err("small data element longer than 4 bytes".into());
+/// Reads until `buf` is full or the input ends; returns the bytes read.
+fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match r.read(&mut buf[got..])? {
+            0 => break,
+            k => got += k,
         }
-        let data = buf.get(pos + 4..pos + 4 + n).ok_or("truncated small element")?;
-        return Ok((ty, data, pos + 8));
     }
-    let n = word(pos + 4)? as usize;
-    let data = buf.get(pos + 8..pos + 8 + n).ok_or_else(|| format!("element of {n} bytes runs past the end of the file"))?;
-    // Compressed elements are not padded; all others are padded to 8 bytes.
-    let padded = if first == MI_COMPRESSED { n } else { n.div_ceil(8) * 8 };
-    Ok((first, data, pos + 8 + padded))
+    Ok(got)
 }
 
-struct Matrix {
-    name: String,
-    rows: usize,
-    cols: usize,
-    values: Vec<f64>,
+/// An element tag: (type, byte count, small-element form). In the small form the data (≤ 4
+/// bytes) sits in the tag's second word, which this consumes too.
+fn read_tag(r: &mut impl Read) -> std::io::Result<(u32, u32, bool)> {
+    let mut t = [0u8; 8];
+    r.read_exact(&mut t)?;
+    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
+    if first >> 16 != 0 {
+        return Ok((first & 0xffff, first >> 16, true));
+    }
+    Ok((first, u32::from_le_bytes([t[4], t[5], t[6], t[7]]), false))
 }
 
-fn matrix(data: &[u8]) -> Result<Matrix, String> {
-    let (ty, flags, p) = element(data, 0)?;
+/// A small sub-element (flags, dimensions, name): type and bytes, padding consumed.
+fn small_element(r: &mut impl Read, what: &str) -> Result<(u32, Vec<u8>), String> {
+    /// Names and dimension lists are short; a larger size means a corrupt file.
+    const MAX_SUB_ELEMENT: u32 = 1 << 16;
+    let mut t = [0u8; 8];
+    r.read_exact(&mut t).map_err(|e| format!("{what}: {e}"))?;
+    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
+    if first >> 16 != 0 {
+        let n = ((first >> 16) as usize).min(4);
+        return Ok((first & 0xffff, t[4..4 + n].to_vec()));
+    }
+    let n = u32::from_le_bytes([t[4], t[5], t[6], t[7]]);
+    if n > MAX_SUB_ELEMENT {
+        return Err(format!("{what} of {n} bytes"));
+    }
+    let mut data = vec![0u8; (n as usize).div_ceil(8) * 8];
+    r.read_exact(&mut data)
+        .map_err(|e| format!("{what}: {e}"))?;
+    data.truncate(n as usize);
+    Ok((first, data))
+}
+
+enum Parsed {
+    DataImu(DataImu),
+    Other(String),
+}
+
+/// Parses a miMATRIX body; reads the values only when it is `data_imu`.
+fn matrix(r: &mut impl Read) -> Result<Parsed, String> {
+    let (ty, flags) = small_element(r, "array flags")?;
     if ty != MI_UINT32 || flags.len() < 8 {
         return Err("array flags missing".into());
     }
-    let class = flags[0];
-    let complex = flags[1] & 0x08 != 0;
-    let (ty, dims, p) = element(data, p)?;
+    let (class, complex) = (flags[0], flags[1] & 0x08 != 0);
+    let (ty, dims) = small_element(r, "dimensions")?;
     if ty != MI_INT32 {
         return Err("dimensions missing".into());
     }
-    let dims: Vec<usize> = dims.chunks_exact(4).map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]).max(0) as usize).collect();
-    let (_, name, p) = element(data, p)?;
-    let name = String::from_utf8_lossy(name).into_owned();
-    // Classes 6..=15 are numeric (double, single, int8 … uint64); cells, structs, objects,
-    // chars and sparse matrices are only listed by name.
-    if !(6..=15).contains(&class) {
-        if name == VAR_NAME {
-            return Err(format!("'{name}' is not a numeric matrix (class {class})"));
-        }
-        return Ok(Matrix { name, rows: 0, cols: 0, values: Vec::new() });
+    let dims: Vec<usize> = dims
+        .chunks_exact(4)
+        .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]).max(0) as usize)
+        .collect();
+    let (_, name) = small_element(r, "array name")?;
+    let name = String::from_utf8_lossy(&name).into_owned();
+    if name != VAR_NAME {
+        return Ok(Parsed::Other(name));
     }
-    if dims.len() != 2 {
-        return Err(format!("'{name}' has {} dimensions; expected a 2-D matrix", dims.len()));
+    // Classes 6..=15 are numeric (double, single, int8 … uint64).
+    if !(6..=15).contains(&class) {
+        return Err(format!("'{name}' is not a numeric matrix (class {class})"));
+    }
+    if dims.len() != 2 || dims[1] != COLS {
+        return Err(format!(
+            "data_imu is {}; expected N×7 [t ax ay az wx wy wz]",
+            dims.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join("×")
+        ));
     }
     if complex {
         return Err(format!("'{name}' is complex"));
     }
-    let (ty, real, _) = element(data, p)?;
-    let values = numbers(ty, real)?;
-    if values.len() != dims[0] * dims[1] {
-        return Err(format!("'{name}' holds {} values for {}×{}", values.len(), dims[0], dims[1]));
+    let rows = dims[0];
+    let mut t = [0u8; 8];
+    r.read_exact(&mut t)
+        .map_err(|e| format!("real part: {e}"))?;
+    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
+    let (ty, n, inline) = if first >> 16 != 0 {
+        (first & 0xffff, first >> 16, true)
+    } else {
+        (first, u32::from_le_bytes([t[4], t[5], t[6], t[7]]), false)
+    };
+    let width = type_width(ty)?;
+    if n as usize != rows * COLS * width {
+        return Err(format!(
+            "'{name}' holds {n} bytes of type {ty} for {rows}×{COLS}"
+        ));
     }
-    Ok(Matrix { name, rows: dims[0], cols: dims[1], values })
+    let mut d = DataImu::with_capacity(rows);
+    if inline {
+        // Only an empty matrix fits in a small element here (0 bytes).
+        return Ok(Parsed::DataImu(d));
+    }
+    let mut buf = vec![0u8; 8192 * width];
+    for col in d.columns.iter_mut() {
+        let mut left = rows;
+        while left > 0 {
+            let k = left.min(8192);
+            r.read_exact(&mut buf[..k * width])
+                .map_err(|e| format!("values: {e}"))?;
+            col.extend(buf[..k * width].chunks_exact(width).map(|b| number(ty, b)));
+            left -= k;
+        }
+    }
+    Ok(Parsed::DataImu(d))
 }
 
-fn numbers(ty: u32, b: &[u8]) -> Result<Vec<f64>, String> {
-    macro_rules! conv {
-        ($t:ty, $n:expr) => {
-            b.chunks_exact($n).map(|c| <$t>::from_le_bytes(c.try_into().expect("exact chunk")) as f64).collect()
-        };
-    }
+fn type_width(ty: u32) -> Result<usize, String> {
     Ok(match ty {
-        1 => b.iter().map(|&v| v as i8 as f64).collect(),
-        2 => b.iter().map(|&v| v as f64).collect(),
-        3 => conv!(i16, 2),
-        4 => conv!(u16, 2),
-        5 => conv!(i32, 4),
-        6 => conv!(u32, 4),
-        7 => conv!(f32, 4),
-        9 => conv!(f64, 8),
-        12 => conv!(i64, 8),
-        13 => conv!(u64, 8),
+        1 | 2 => 1,
+        3 | 4 => 2,
+        5..=7 => 4,
+        9 | 12 | 13 => 8,
         other => return Err(format!("unsupported numeric storage type {other}")),
     })
+}
+
+fn number(ty: u32, b: &[u8]) -> f64 {
+    match ty {
+        1 => b[0] as i8 as f64,
+        2 => b[0] as f64,
+        3 => i16::from_le_bytes([b[0], b[1]]) as f64,
+        4 => u16::from_le_bytes([b[0], b[1]]) as f64,
+        5 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        6 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        7 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        9 => f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
+        12 => i64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]) as f64,
+        _ => u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]) as f64,
+    }
 }
 
 #[cfg(test)]
@@ -257,7 +351,15 @@ mod tests {
         let mut d = DataImu::with_capacity(n);
         for i in 0..n {
             let x = i as f64;
-            d.push([1.6e9 + x * 0.005, x, -x, 9.81, 1e-3 * x, f64::MIN_POSITIVE, -0.0]);
+            d.push([
+                1.6e9 + x * 0.005,
+                x,
+                -x,
+                9.81,
+                1e-3 * x,
+                f64::MIN_POSITIVE,
+                -0.0,
+            ]);
         }
         d
     }

@@ -23,12 +23,23 @@ impl AtomicFile {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        let name = target
-            .file_name()
-            .ok_or_else(|| Error::io(target, std::io::Error::other("output path has no file name")))?;
-        let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
+        let name = target.file_name().ok_or_else(|| {
+            Error::io(
+                target,
+                std::io::Error::other("output path has no file name"),
+            )
+        })?;
+        let tmp = dir.join(format!(
+            ".{}.{}.tmp",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
         let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        Ok(AtomicFile { tmp, target: target.to_path_buf(), file: Some(BufWriter::with_capacity(1 << 20, file)) })
+        Ok(AtomicFile {
+            tmp,
+            target: target.to_path_buf(),
+            file: Some(BufWriter::with_capacity(1 << 20, file)),
+        })
     }
 
     /// The writer (buffered).
@@ -46,7 +57,9 @@ impl AtomicFile {
     /// interrupted runs, not power loss, and an fsync of a 1 GB bag would double its cost.
     pub fn commit(mut self) -> Result<(), Error> {
         let file = self.file.take().expect("AtomicFile committed twice");
-        let file = file.into_inner().map_err(|e| Error::io(&self.tmp, e.into_error()))?;
+        let file = file
+            .into_inner()
+            .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
         drop(file);
         std::fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))
     }

@@ -10,7 +10,12 @@ pub fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         use plotters::style::FontStyle;
-        for style in [FontStyle::Normal, FontStyle::Bold, FontStyle::Italic, FontStyle::Oblique] {
+        for style in [
+            FontStyle::Normal,
+            FontStyle::Bold,
+            FontStyle::Italic,
+            FontStyle::Oblique,
+        ] {
             // The bytes are a valid TrueType font checked in with the sources; failure here
             // would be a build defect, and then text is simply not drawn.
             let _ = plotters::style::register_font("sans-serif", style, FONT);

@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use crate::bag::read::{BagReader, StreamReport};
 use crate::bag::RosTime;
+use crate::bag::read::{BagReader, StreamReport};
 use crate::error::Error;
 
 /// How to read.

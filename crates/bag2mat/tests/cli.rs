@@ -17,7 +17,10 @@ fn default_output_goes_beside_the_bag() {
     std::fs::copy(case_bag("p3_short_61s"), &bag).unwrap();
     let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu"));
     assert!(ok, "{err}");
-    assert!(err.contains("BAG Path is:") && err.contains("Done processing IMU data"), "{err}");
+    assert!(
+        err.contains("BAG Path is:") && err.contains("Done processing IMU data"),
+        "{err}"
+    );
     let d = bag2mat::mat::read_data_imu(&dir.path().join("rec.2024.mat")).unwrap();
     assert_eq!(d.rows(), 12200);
 }
@@ -29,20 +32,38 @@ fn missing_topic_fails_lists_topics_and_writes_nothing() {
     write_synthetic(&bag, "/imu0", 300, Compression::Bz2, true);
     let (ok, _, err) = run(bag2mat().arg(&bag).arg("/camera"));
     assert!(!ok);
-    assert!(err.contains("no sensor_msgs/Imu topic '/camera'") && err.contains("/imu0") && err.contains("/status"), "{err}");
-    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(
+        err.contains("no sensor_msgs/Imu topic '/camera'")
+            && err.contains("/imu0")
+            && err.contains("/status"),
+        "{err}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(left.len(), 1, "only the bag remains: {left:?}");
 }
 
 #[test]
 fn slash_fallback_is_said_on_stderr() {
     let dir = tempfile::tempdir().unwrap();
-    let (ok, _, err) = run(bag2mat().arg(case_bag("p1_high_200hz")).arg("/imu").arg("--format").arg("csv").arg("-o").arg(dir.path().join("x.csv")));
+    let (ok, _, err) = run(bag2mat()
+        .arg(case_bag("p1_high_200hz"))
+        .arg("/imu")
+        .arg("--format")
+        .arg("csv")
+        .arg("-o")
+        .arg(dir.path().join("x.csv")));
     assert!(ok, "{err}");
     assert!(err.contains("using 'imu'"), "{err}");
     let text = std::fs::read_to_string(dir.path().join("x.csv")).unwrap();
     assert_eq!(text.lines().count(), 180_001);
-    assert!(text.starts_with("t,ax,ay,az,wx,wy,wz\n1600000000,"), "{}", &text[..60]);
+    assert!(
+        text.starts_with("t,ax,ay,az,wx,wy,wz\n1600000000,"),
+        "{}",
+        &text[..60]
+    );
 }
 
 #[test]
@@ -51,14 +72,37 @@ fn bad_inputs_fail_cleanly() {
     let junk = dir.path().join("junk.bag");
     std::fs::write(&junk, b"not a bag at all").unwrap();
     for (args, needle) in [
-        (vec![dir.path().join("missing.bag").display().to_string(), "imu".into()], "No such file"),
-        (vec![junk.display().to_string(), "imu".into()], "not a ROS 1 bag"),
-        (vec![dir.path().display().to_string(), "imu".into()], "error"),
+        (
+            vec![
+                dir.path().join("missing.bag").display().to_string(),
+                "imu".into(),
+            ],
+            "No such file",
+        ),
+        (
+            vec![junk.display().to_string(), "imu".into()],
+            "not a ROS 1 bag",
+        ),
+        (
+            vec![dir.path().display().to_string(), "imu".into()],
+            "error",
+        ),
     ] {
         let (ok, _, err) = run(bag2mat().args(&args).arg("-q"));
         assert!(!ok, "{args:?} should fail");
-        assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
+        assert!(
+            err.contains(needle) && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
     }
-    let (ok, _, err) = run(bag2mat().arg(case_bag("p3_short_61s")).arg("imu").arg("-o").arg("/nonexistent-dir/x.mat").arg("-q"));
-    assert!(!ok && err.contains("/nonexistent-dir") && !err.contains("panicked"), "{err}");
+    let (ok, _, err) = run(bag2mat()
+        .arg(case_bag("p3_short_61s"))
+        .arg("imu")
+        .arg("-o")
+        .arg("/nonexistent-dir/x.mat")
+        .arg("-q"));
+    assert!(
+        !ok && err.contains("/nonexistent-dir") && !err.contains("panicked"),
+        "{err}"
+    );
 }

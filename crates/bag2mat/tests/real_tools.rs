@@ -15,7 +15,10 @@ const PYTHON: &str = "/usr/bin/python3";
 const N: u32 = 5000;
 
 fn yaml_value<'a>(yaml: &'a str, key: &str) -> &'a str {
-    yaml.lines().find_map(|l| l.trim_start().strip_prefix(&format!("{key}:"))).unwrap_or_else(|| panic!("no {key} in\n{yaml}")).trim()
+    yaml.lines()
+        .find_map(|l| l.trim_start().strip_prefix(&format!("{key}:")))
+        .unwrap_or_else(|| panic!("no {key} in\n{yaml}"))
+        .trim()
 }
 
 #[test]
@@ -28,16 +31,33 @@ fn rosbag_info_check_and_python_read_our_bags() {
 
         let (ok, info, err) = run(Command::new("rosbag").arg("info").arg("--yaml").arg(&path));
         assert!(ok, "{c:?}: rosbag info failed: {err}");
-        assert_eq!(yaml_value(&info, "messages"), N.to_string(), "{c:?}\n{info}");
+        assert_eq!(
+            yaml_value(&info, "messages"),
+            N.to_string(),
+            "{c:?}\n{info}"
+        );
         assert_eq!(yaml_value(&info, "compression"), c.name(), "{c:?}\n{info}");
         let duration: f64 = yaml_value(&info, "duration").parse().unwrap();
-        assert!((duration - (N - 1) as f64 * 0.005).abs() < 1e-9, "{c:?}: duration {duration}");
-        assert!(info.contains("type: sensor_msgs/Imu") && info.contains("md5: 6a62c6daae103f4ff57a132d6f95cec2"), "{info}");
-        assert!(info.contains("topic: imu") && info.contains(&format!("messages: {N}")), "{info}");
+        assert!(
+            (duration - (N - 1) as f64 * 0.005).abs() < 1e-9,
+            "{c:?}: duration {duration}"
+        );
+        assert!(
+            info.contains("type: sensor_msgs/Imu")
+                && info.contains("md5: 6a62c6daae103f4ff57a132d6f95cec2"),
+            "{info}"
+        );
+        assert!(
+            info.contains("topic: imu") && info.contains(&format!("messages: {N}")),
+            "{info}"
+        );
 
         let (ok, out, err) = run(Command::new("rosbag").arg("check").arg(&path));
         assert!(ok, "{c:?}: rosbag check failed: {out}{err}");
-        assert!(out.contains("does not need any migrations"), "{c:?}: {out}{err}");
+        assert!(
+            out.contains("does not need any migrations"),
+            "{c:?}: {out}{err}"
+        );
 
         let (ok, out, err) = run(Command::new(PYTHON).arg(&script).arg(&path));
         assert!(ok, "{c:?}: python rosbag read failed: {err}");
@@ -47,7 +67,10 @@ fn rosbag_info_check_and_python_read_our_bags() {
             let (t, imu) = synthetic(i as u32);
             let mut buf = Vec::new();
             imu.encode(&mut buf);
-            let doubles: Vec<String> = buf[buf.len() - 296..].chunks(8).map(|b| b.iter().map(|x| format!("{x:02x}")).collect()).collect();
+            let doubles: Vec<String> = buf[buf.len() - 296..]
+                .chunks(8)
+                .map(|b| b.iter().map(|x| format!("{x:02x}")).collect())
+                .collect();
             let want = format!(
                 "imu {} {} {} {} {} {}",
                 t.as_nanos(),
@@ -76,10 +99,16 @@ fn octave_and_scipy_load_our_mat() {
         "load('{}'); printf('%d %d %.17g %.17g %.17g\\n', size(data_imu), data_imu(1,1), data_imu(end,7), data_imu(400,4));",
         mat.display()
     );
-    let (ok, out, err) = run(Command::new("octave").args(["--no-gui", "--quiet", "--eval"]).arg(&script));
+    let (ok, out, err) = run(Command::new("octave")
+        .args(["--no-gui", "--quiet", "--eval"])
+        .arg(&script));
     assert!(ok, "octave failed: {err}");
     let v: Vec<f64> = out.split_whitespace().map(|x| x.parse().unwrap()).collect();
-    assert_eq!(v, vec![777.0, 7.0, d.row(0)[0], d.row(776)[6], d.row(399)[3]], "octave: {out}");
+    assert_eq!(
+        v,
+        vec![777.0, 7.0, d.row(0)[0], d.row(776)[6], d.row(399)[3]],
+        "octave: {out}"
+    );
 
     let code = format!(
         "import scipy.io; m = scipy.io.loadmat('{}')['data_imu']; print(m.shape[0], m.shape[1], repr(float(m[0,0])), repr(float(m[-1,6])), repr(float(m[399,3])))",
@@ -88,13 +117,22 @@ fn octave_and_scipy_load_our_mat() {
     let (ok, out, err) = run(Command::new(PYTHON).arg("-c").arg(&code));
     assert!(ok, "scipy failed: {err}");
     let v: Vec<f64> = out.split_whitespace().map(|x| x.parse().unwrap()).collect();
-    assert_eq!(v, vec![777.0, 7.0, d.row(0)[0], d.row(776)[6], d.row(399)[3]], "scipy: {out}");
+    assert_eq!(
+        v,
+        vec![777.0, 7.0, d.row(0)[0], d.row(776)[6], d.row(399)[3]],
+        "scipy: {out}"
+    );
 
     // An empty matrix (0×7) loads too.
     let empty = dir.path().join("e.mat");
     write(&empty, &bag2mat::mat::DataImu::default(), Format::Mat).unwrap();
-    let (ok, out, err) = run(Command::new("octave").args(["--no-gui", "--quiet", "--eval"]).arg(format!("load('{}'); disp(size(data_imu))", empty.display())));
-    assert!(ok && out.split_whitespace().collect::<Vec<_>>() == ["0", "7"], "octave empty: {out}{err}");
+    let (ok, out, err) = run(Command::new("octave")
+        .args(["--no-gui", "--quiet", "--eval"])
+        .arg(format!("load('{}'); disp(size(data_imu))", empty.display())));
+    assert!(
+        ok && out.split_whitespace().collect::<Vec<_>>() == ["0", "7"],
+        "octave empty: {out}{err}"
+    );
 }
 
 #[test]
@@ -106,7 +144,9 @@ fn octave_v7_compressed_mat_reads_back() {
         "data_imu = [1600000000 + (0:99)'*0.005, reshape(sin(1:600), 100, 6)]; other = 'x'; save('-v7', '{}', 'other', 'data_imu');",
         mat.display()
     );
-    let (ok, _, err) = run(Command::new("octave").args(["--no-gui", "--quiet", "--eval"]).arg(&script));
+    let (ok, _, err) = run(Command::new("octave")
+        .args(["--no-gui", "--quiet", "--eval"])
+        .arg(&script));
     assert!(ok, "octave failed: {err}");
     let d = bag2mat::mat::read_data_imu(&mat).unwrap();
     assert_eq!(d.rows(), 100);
@@ -115,7 +155,11 @@ fn octave_v7_compressed_mat_reads_back() {
     // Column 2 is sin(1..100) as Octave computed it: compare to Rust's sin within 1 ulp.
     for i in 0..100 {
         let want = ((i + 1) as f64).sin();
-        assert!((d.row(i)[1] - want).abs() <= f64::EPSILON, "row {i}: {} vs {want}", d.row(i)[1]);
+        assert!(
+            (d.row(i)[1] - want).abs() <= f64::EPSILON,
+            "row {i}: {} vs {want}",
+            d.row(i)[1]
+        );
     }
 }
 
@@ -139,5 +183,8 @@ fn numpy_loads_our_npy_and_csv() {
     );
     let (ok, out, err) = run(Command::new(PYTHON).arg("-c").arg(&code));
     assert!(ok, "numpy failed: {err}");
-    assert_eq!(out.trim(), format!("(50, 7) float64 True {:?}", d.row(49)[6]));
+    assert_eq!(
+        out.trim(),
+        format!("(50, 7) float64 True {:?}", d.row(49)[6])
+    );
 }

@@ -15,7 +15,9 @@ fn first_quoted_after<'a>(json: &'a str, key: &str) -> &'a str {
 }
 
 fn json_field<'a>(json: &'a str, key: &str) -> &'a str {
-    let at = json.find(&format!("\"{key}\"")).unwrap_or_else(|| panic!("no {key} in json"));
+    let at = json
+        .find(&format!("\"{key}\""))
+        .unwrap_or_else(|| panic!("no {key} in json"));
     let rest = &json[at + key.len() + 2..];
     let start = rest.find('"').unwrap() + 1;
     let end = start + rest[start..].find('"').unwrap();
@@ -25,7 +27,9 @@ fn json_field<'a>(json: &'a str, key: &str) -> &'a str {
 #[test]
 fn matrix_equals_bagconvert_bit_for_bit() {
     for (case, topic) in CASES {
-        let json = std::fs::read_to_string(testdata().join(case).join("kalibr/bagconvert_mat.json")).unwrap();
+        let json =
+            std::fs::read_to_string(testdata().join(case).join("kalibr/bagconvert_mat.json"))
+                .unwrap();
         let conv = bag_to_data_imu(&case_bag(case), topic, true).unwrap();
         let d = &conv.data;
         let mut h = Sha256::new();
@@ -35,9 +39,16 @@ fn matrix_equals_bagconvert_bit_for_bit() {
             }
         }
         let got = format!("{:x}", h.finalize());
-        assert_eq!(got, json_field(&json, "sha256_rowmajor_f64le"), "case {case}: sha256 of data_imu");
+        assert_eq!(
+            got,
+            json_field(&json, "sha256_rowmajor_f64le"),
+            "case {case}: sha256 of data_imu"
+        );
         let shape = &json[json.find("\"shape\"").unwrap()..];
-        let rows: usize = shape[shape.find('[').unwrap() + 1..shape.find(',').unwrap()].trim().parse().unwrap();
+        let rows: usize = shape[shape.find('[').unwrap() + 1..shape.find(',').unwrap()]
+            .trim()
+            .parse()
+            .unwrap();
         assert_eq!(d.rows(), rows, "case {case}: rows");
         // The first row's time, printed at 17 significant digits, parses to the same double.
         let first_t: f64 = first_quoted_after(&json, "first_rows").parse().unwrap();

@@ -19,7 +19,10 @@ fn imu_bytes_equal_genpy() {
     cov[0] = -1.0;
     let imu = Imu {
         seq: 7,
-        stamp: RosTime { sec: 1_600_000_000, nsec: 5_000_000 },
+        stamp: RosTime {
+            sec: 1_600_000_000,
+            nsec: 5_000_000,
+        },
         frame_id: "imu".into(),
         orientation: [0.0, 0.0, 0.0, 1.0],
         orientation_covariance: cov,
@@ -68,7 +71,11 @@ fn md5_recomputed_from_msg_files() {
     assert_eq!(header, "2176decaecbce78abc3b96ef049fabed");
     assert_eq!(quat, "a779879fadf0160734f906b8c19c7004");
     assert_eq!(vec3, "4a842b65f413084dc2b10fb484ea7f17");
-    let deps = [("Header".to_string(), header), ("Quaternion".into(), quat), ("Vector3".into(), vec3)];
+    let deps = [
+        ("Header".to_string(), header),
+        ("Quaternion".into(), quat),
+        ("Vector3".into(), vec3),
+    ];
     let deps: Vec<(&str, String)> = deps.iter().map(|(a, b)| (a.as_str(), b.clone())).collect();
     assert_eq!(hash_text(&read("sensor_msgs_Imu.msg"), &deps), imu_msg::MD5);
 }
@@ -88,7 +95,13 @@ fn write_then_read_every_compression() {
             let k = i as usize;
             assert_eq!(
                 (s.record_time[k], s.stamp[k], s.seq[k], s.gyro[k], s.acc[k]),
-                (t, imu.stamp, imu.seq, imu.angular_velocity, imu.linear_acceleration),
+                (
+                    t,
+                    imu.stamp,
+                    imu.seq,
+                    imu.angular_velocity,
+                    imu.linear_acceleration
+                ),
                 "{c:?} message {i}"
             );
         }
@@ -105,7 +118,11 @@ fn slash_form_fallback_is_noted() {
     write_synthetic(&path, "imu", 10, Compression::None, false);
     let s = read_imu_series(&path, "/imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!((s.len(), s.topic.as_str()), (10, "imu"));
-    assert!(s.notes.iter().any(|n| n.contains("using 'imu'")), "{:?}", s.notes);
+    assert!(
+        s.notes.iter().any(|n| n.contains("using 'imu'")),
+        "{:?}",
+        s.notes
+    );
 }
 
 #[test]
@@ -116,8 +133,14 @@ fn missing_topic_lists_every_topic() {
     let err = read_imu_series(&path, "/cam0", &ReadOptions { quiet: true }).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, Error::TopicNotFound { .. }), "{msg}");
-    assert!(msg.contains("/imu0") && msg.contains("1000 msgs") && msg.contains("sensor_msgs/Imu"), "{msg}");
-    assert!(msg.contains("/status") && msg.contains("10 msgs") && msg.contains("std_msgs/String"), "{msg}");
+    assert!(
+        msg.contains("/imu0") && msg.contains("1000 msgs") && msg.contains("sensor_msgs/Imu"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("/status") && msg.contains("10 msgs") && msg.contains("std_msgs/String"),
+        "{msg}"
+    );
     let err = read_imu_series(&path, "/status", &ReadOptions { quiet: true }).unwrap_err();
     assert!(matches!(err, Error::WrongType { .. }), "{err}");
 }
@@ -150,10 +173,21 @@ fn truncated_bag_keeps_complete_chunks() {
         let cut = full.len() * 3 / 4;
         std::fs::write(&path, &full[..cut]).unwrap();
         let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
-        assert!(!s.is_empty() && s.len() < 6000, "{c:?}: {} messages", s.len());
-        assert!(s.notes.iter().any(|n| n.contains("truncated")), "{c:?}: {:?}", s.notes);
+        assert!(
+            !s.is_empty() && s.len() < 6000,
+            "{c:?}: {} messages",
+            s.len()
+        );
+        assert!(
+            s.notes.iter().any(|n| n.contains("truncated")),
+            "{c:?}: {:?}",
+            s.notes
+        );
         for (k, seq) in s.seq.iter().enumerate() {
-            assert_eq!(*seq as usize, k, "{c:?}: messages of the complete chunks, in order");
+            assert_eq!(
+                *seq as usize, k,
+                "{c:?}: messages of the complete chunks, in order"
+            );
         }
     }
 }
@@ -171,7 +205,11 @@ fn unfinished_bag_is_scanned() {
     std::fs::write(&path, &bytes).unwrap();
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.len(), 3000);
-    assert!(s.notes.iter().any(|n| n.contains("index_pos = 0")), "{:?}", s.notes);
+    assert!(
+        s.notes.iter().any(|n| n.contains("index_pos = 0")),
+        "{:?}",
+        s.notes
+    );
 }
 
 #[test]

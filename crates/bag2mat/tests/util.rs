@@ -46,7 +46,14 @@ pub fn synthetic(i: u32) -> (RosTime, Imu) {
 pub fn write_synthetic(path: &Path, topic: &str, n: u32, compression: Compression, extra: bool) {
     let mut w = BagWriter::create(path, compression).unwrap();
     let c = w.add_imu_connection(topic);
-    let s = extra.then(|| w.add_connection("/status", "std_msgs/String", "992ce8a1687cec8c8bd883ec73ca41d1", "string data"));
+    let s = extra.then(|| {
+        w.add_connection(
+            "/status",
+            "std_msgs/String",
+            "992ce8a1687cec8c8bd883ec73ca41d1",
+            "string data",
+        )
+    });
     for i in 0..n {
         let (t, imu) = synthetic(i);
         w.write_imu(c, t, &imu).unwrap();
@@ -62,6 +69,12 @@ pub fn write_synthetic(path: &Path, topic: &str, n: u32, compression: Compressio
 
 /// Runs a command, returning (success, stdout, stderr).
 pub fn run(cmd: &mut std::process::Command) -> (bool, String, String) {
-    let out = cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e} (scripts/test.sh installs the tools)"));
-    (out.status.success(), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e} (scripts/test.sh installs the tools)"));
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }

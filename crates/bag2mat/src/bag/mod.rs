@@ -33,7 +33,10 @@ impl RosTime {
     /// From nanoseconds since the epoch. Saturates at the largest representable second.
     pub fn from_nanos(ns: u64) -> RosTime {
         let sec = (ns / 1_000_000_000).min(u32::MAX as u64) as u32;
-        RosTime { sec, nsec: (ns % 1_000_000_000) as u32 }
+        RosTime {
+            sec,
+            nsec: (ns % 1_000_000_000) as u32,
+        }
     }
 
     /// Nanoseconds since the epoch.
@@ -110,7 +113,8 @@ impl Compression {
 impl std::str::FromStr for Compression {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Compression::from_name(s).ok_or_else(|| format!("unknown compression '{s}' (use none, bz2 or lz4)"))
+        Compression::from_name(s)
+            .ok_or_else(|| format!("unknown compression '{s}' (use none, bz2 or lz4)"))
     }
 }
 
@@ -120,15 +124,27 @@ mod tests {
 
     #[test]
     fn ros_time_nanos_round_trip() {
-        for ns in [0u64, 1, 999_999_999, 1_000_000_000, 1_600_000_899_995_000_000] {
+        for ns in [
+            0u64,
+            1,
+            999_999_999,
+            1_000_000_000,
+            1_600_000_899_995_000_000,
+        ] {
             assert_eq!(RosTime::from_nanos(ns).as_nanos(), ns);
-            assert_eq!(RosTime::from_bytes(&RosTime::from_nanos(ns).to_bytes()), Some(RosTime::from_nanos(ns)));
+            assert_eq!(
+                RosTime::from_bytes(&RosTime::from_nanos(ns).to_bytes()),
+                Some(RosTime::from_nanos(ns))
+            );
         }
     }
 
     #[test]
     fn to_sec_is_sec_plus_1e_minus_9_nsec() {
-        let t = RosTime { sec: 1_600_000_000, nsec: 5_000_000 };
+        let t = RosTime {
+            sec: 1_600_000_000,
+            nsec: 5_000_000,
+        };
         assert_eq!(t.to_sec(), 1_600_000_000f64 + 1e-9 * 5_000_000f64);
     }
 }

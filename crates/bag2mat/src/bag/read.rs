@@ -97,14 +97,25 @@ impl BagReader {
         head.truncate(got);
         if head.len() < MAGIC.len() || &head[..MAGIC.len()] != MAGIC {
             let what = if head.starts_with(b"#ROSBAG V") {
-                format!("unsupported version line {:?}", String::from_utf8_lossy(&head[..head.len().min(13)]))
+                format!(
+                    "unsupported version line {:?}",
+                    String::from_utf8_lossy(&head[..head.len().min(13)])
+                )
             } else {
                 "missing the '#ROSBAG V2.0' magic line".to_string()
             };
-            return Err(Error::NotABag { path: path.to_path_buf(), what });
+            return Err(Error::NotABag {
+                path: path.to_path_buf(),
+                what,
+            });
         }
-        let corrupt = |offset: u64, what: String| Error::Corrupt { path: path.to_path_buf(), offset, what };
-        let rec = record::raw_record(&head, MAGIC.len()).ok_or_else(|| corrupt(13, "bag header record is incomplete".into()))?;
+        let corrupt = |offset: u64, what: String| Error::Corrupt {
+            path: path.to_path_buf(),
+            offset,
+            what,
+        };
+        let rec = record::raw_record(&head, MAGIC.len())
+            .ok_or_else(|| corrupt(13, "bag header record is incomplete".into()))?;
         let h = Header::parse(rec.header).map_err(|w| corrupt(13, w))?;
         if h.op().map_err(|w| corrupt(13, w))? != Op::BagHeader {
             return Err(corrupt(13, "first record is not the bag header".into()));
@@ -125,7 +136,9 @@ impl BagReader {
             },
             notes: Vec::new(),
         };
-        let indexed = index_pos >= first && index_pos < len && reader.read_index(index_pos, chunk_count).is_ok();
+        let indexed = index_pos >= first
+            && index_pos < len
+            && reader.read_index(index_pos, chunk_count).is_ok();
         if !indexed {
             reader.notes.push(if index_pos == 0 {
                 "the bag has no index (index_pos = 0: the writer did not finish); scanning its chunks (`rosbag reindex` repairs it)".to_string()
@@ -151,26 +164,38 @@ impl BagReader {
     pub fn topics(&self) -> Vec<TopicSummary> {
         let mut by_topic: BTreeMap<(&str, &str), u64> = BTreeMap::new();
         for c in &self.index.connections {
-            *by_topic.entry((&c.topic, &c.msg_type)).or_default() += self.index.counts.get(&c.id).copied().unwrap_or(0);
+            *by_topic.entry((&c.topic, &c.msg_type)).or_default() +=
+                self.index.counts.get(&c.id).copied().unwrap_or(0);
         }
         by_topic
             .into_iter()
-            .map(|((t, ty), count)| TopicSummary { topic: t.to_string(), msg_type: ty.to_string(), count })
+            .map(|((t, ty), count)| TopicSummary {
+                topic: t.to_string(),
+                msg_type: ty.to_string(),
+                count,
+            })
             .collect()
     }
 
     fn corrupt(&self, offset: u64, what: impl Into<String>) -> Error {
-        Error::Corrupt { path: self.path.clone(), offset, what: what.into() }
+        Error::Corrupt {
+            path: self.path.clone(),
+            offset,
+            what: what.into(),
+        }
     }
 
     fn read_index(&mut self, index_pos: u64, chunk_count: u32) -> Result<(), String> {
         let mut buf = vec![0u8; (self.len - index_pos) as usize];
-        self.file.read_exact_at(&mut buf, index_pos).map_err(|e| e.to_string())?;
+        self.file
+            .read_exact_at(&mut buf, index_pos)
+            .map_err(|e| e.to_string())?;
         let mut pos = 0;
         let mut connections = Vec::new();
         let mut infos = Vec::new();
         while pos < buf.len() {
-            let rec = record::raw_record(&buf, pos).ok_or("incomplete record in the index section")?;
+            let rec =
+                record::raw_record(&buf, pos).ok_or("incomplete record in the index section")?;
             let h = Header::parse(rec.header)?;
             match h.op()? {
                 Op::Connection => connections.push(Connection::decode(&h, rec.data)?),
@@ -180,7 +205,10 @@ impl BagReader {
             pos = rec.end;
         }
         if infos.len() != chunk_count as usize {
-            return Err(format!("bag header announces {chunk_count} chunks, index lists {}", infos.len()));
+            return Err(format!(
+                "bag header announces {chunk_count} chunks, index lists {}",
+                infos.len()
+            ));
         }
         infos.sort_by_key(|i| i.chunk_pos);
         for info in &infos {
@@ -192,7 +220,13 @@ impl BagReader {
         connections.dedup_by_key(|c| c.id);
         self.index.connections = connections;
         self.index.chunk_count = infos.len();
-        self.chunks = infos.into_iter().map(|i| ChunkLoc { pos: i.chunk_pos, counts: i.counts }).collect();
+        self.chunks = infos
+            .into_iter()
+            .map(|i| ChunkLoc {
+                pos: i.chunk_pos,
+                counts: i.counts,
+            })
+            .collect();
         self.index.indexed = true;
         Ok(())
     }
@@ -213,9 +247,19 @@ impl BagReader {
             match h.op().map_err(|w| self.corrupt(pos, w))? {
                 Op::Chunk => {
                     let (mut raw, mut decompressed) = (Vec::new(), Vec::new());
-                    match self.read_chunk_into(&h_bytes, data_pos, data_len, &mut raw, &mut decompressed) {
+                    match self.read_chunk_into(
+                        &h_bytes,
+                        data_pos,
+                        data_len,
+                        &mut raw,
+                        &mut decompressed,
+                    ) {
                         Ok(compression) => {
-                            let body = if compression == Compression::None { &raw } else { &decompressed };
+                            let body = if compression == Compression::None {
+                                &raw
+                            } else {
+                                &decompressed
+                            };
                             let mut bpos = 0;
                             while let Some(rec) = record::raw_record(body, bpos) {
                                 if let Ok(bh) = Header::parse(rec.header) {
@@ -235,9 +279,14 @@ impl BagReader {
                                 }
                                 bpos = rec.end;
                             }
-                            self.chunks.push(ChunkLoc { pos, counts: Vec::new() });
+                            self.chunks.push(ChunkLoc {
+                                pos,
+                                counts: Vec::new(),
+                            });
                         }
-                        Err(e) => self.notes.push(format!("chunk at byte {pos} is unreadable and was skipped: {e}")),
+                        Err(e) => self.notes.push(format!(
+                            "chunk at byte {pos} is unreadable and was skipped: {e}"
+                        )),
                     }
                 }
                 Op::Connection => {
@@ -256,7 +305,9 @@ impl BagReader {
 
     fn bytes_at(&self, pos: u64, len: u32) -> Result<Vec<u8>, Error> {
         let mut buf = vec![0u8; len as usize];
-        self.file.read_exact_at(&mut buf, pos).map_err(|e| Error::io(&self.path, e))?;
+        self.file
+            .read_exact_at(&mut buf, pos)
+            .map_err(|e| Error::io(&self.path, e))?;
         Ok(buf)
     }
 
@@ -282,33 +333,54 @@ impl BagReader {
     /// Reads and decompresses the chunk whose record starts at `pos`, and hands its body to
     /// `f`. The raw and decompressed bytes live in per-thread buffers reused from chunk to
     /// chunk: a 4 h bag is ~1300 chunks, and fresh zeroed buffers cost more than the parsing.
-    fn with_chunk_body<R>(&self, pos: u64, f: impl FnOnce(&[u8]) -> Result<R, String>) -> Result<R, String> {
-        let (h, data_pos, dlen) = self.record_at(pos).ok_or("chunk record runs past the end of the file")?;
+    fn with_chunk_body<R>(
+        &self,
+        pos: u64,
+        f: impl FnOnce(&[u8]) -> Result<R, String>,
+    ) -> Result<R, String> {
+        let (h, data_pos, dlen) = self
+            .record_at(pos)
+            .ok_or("chunk record runs past the end of the file")?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
             let compression = self.read_chunk_into(&h, data_pos, dlen, raw, body)?;
-            if compression == Compression::None { f(raw) } else { f(body) }
+            if compression == Compression::None {
+                f(raw)
+            } else {
+                f(body)
+            }
         })
     }
 
     /// Reads the chunk data into `raw` and, when compressed, decompresses it into `body`.
-    fn read_chunk_into(&self, h_bytes: &[u8], data_pos: u64, dlen: u32, raw: &mut Vec<u8>, body: &mut Vec<u8>) -> Result<Compression, String> {
+    fn read_chunk_into(
+        &self,
+        h_bytes: &[u8],
+        data_pos: u64,
+        dlen: u32,
+        raw: &mut Vec<u8>,
+        body: &mut Vec<u8>,
+    ) -> Result<Compression, String> {
         let h = Header::parse(h_bytes)?;
         if h.op()? != Op::Chunk {
             return Err("index points at a record that is not a chunk".into());
         }
         let name = h.str("compression")?;
-        let compression = Compression::from_name(name).ok_or_else(|| format!("unknown chunk compression '{name}'"))?;
+        let compression = Compression::from_name(name)
+            .ok_or_else(|| format!("unknown chunk compression '{name}'"))?;
         let size = h.u32("size")? as usize;
         raw.resize(dlen as usize, 0);
-        self.file.read_exact_at(raw, data_pos).map_err(|e| e.to_string())?;
+        self.file
+            .read_exact_at(raw, data_pos)
+            .map_err(|e| e.to_string())?;
         body.clear();
         let got = match compression {
             Compression::None => raw.len(),
-            Compression::Bz2 => {
-                bzip2::read::BzDecoder::new(&raw[..]).take(size as u64 + 1).read_to_end(body).map_err(|e| format!("bz2: {e}"))?
-            }
+            Compression::Bz2 => bzip2::read::BzDecoder::new(&raw[..])
+                .take(size as u64 + 1)
+                .read_to_end(body)
+                .map_err(|e| format!("bz2: {e}"))?,
             Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&raw[..])
                 .take(size as u64 + 1)
                 .read_to_end(body)
@@ -323,7 +395,13 @@ impl BagReader {
     /// Resolves `topic` to its `sensor_msgs/Imu` connections: the exact name first, else the
     /// other slash form (`imu` ↔ `/imu`, with a note); errors list every topic of the bag.
     pub fn select_imu_topic(&self, topic: &str) -> Result<TopicSelection, Error> {
-        let matching = |t: &str| -> Vec<&Connection> { self.index.connections.iter().filter(|c| c.topic == t).collect() };
+        let matching = |t: &str| -> Vec<&Connection> {
+            self.index
+                .connections
+                .iter()
+                .filter(|c| c.topic == t)
+                .collect()
+        };
         let mut chosen = topic.to_string();
         let mut conns = matching(topic);
         let mut note = None;
@@ -334,20 +412,40 @@ impl BagReader {
             };
             let alt = matching(&other);
             if !alt.is_empty() {
-                note = Some(format!("topic '{topic}' is not in the bag; using '{other}'"));
+                note = Some(format!(
+                    "topic '{topic}' is not in the bag; using '{other}'"
+                ));
                 chosen = other;
                 conns = alt;
             }
         }
         if conns.is_empty() {
-            return Err(Error::TopicNotFound { topic: topic.to_string(), available: self.topics() });
+            return Err(Error::TopicNotFound {
+                topic: topic.to_string(),
+                available: self.topics(),
+            });
         }
-        if let Some(bad) = conns.iter().find(|c| c.msg_type != imu_msg::TYPE || c.md5sum != imu_msg::MD5) {
-            return Err(Error::WrongType { topic: chosen, msg_type: bad.msg_type.clone(), md5sum: bad.md5sum.clone() });
+        if let Some(bad) = conns
+            .iter()
+            .find(|c| c.msg_type != imu_msg::TYPE || c.md5sum != imu_msg::MD5)
+        {
+            return Err(Error::WrongType {
+                topic: chosen,
+                msg_type: bad.msg_type.clone(),
+                md5sum: bad.md5sum.clone(),
+            });
         }
         let ids: Vec<u32> = conns.iter().map(|c| c.id).collect();
-        let expected = ids.iter().map(|id| self.index.counts.get(id).copied().unwrap_or(0)).sum();
-        Ok(TopicSelection { topic: chosen, conns: ids, expected, note })
+        let expected = ids
+            .iter()
+            .map(|id| self.index.counts.get(id).copied().unwrap_or(0))
+            .sum();
+        Ok(TopicSelection {
+            topic: chosen,
+            conns: ids,
+            expected,
+            note,
+        })
     }
 
     /// Streams every Imu sample of the selection to `sink` as `(record time, sample)`, in file
@@ -367,7 +465,9 @@ impl BagReader {
         let chunks: Vec<&ChunkLoc> = self
             .chunks
             .iter()
-            .filter(|c| c.counts.is_empty() || c.counts.iter().any(|(conn, n)| wanted(*conn) && *n > 0))
+            .filter(|c| {
+                c.counts.is_empty() || c.counts.iter().any(|(conn, n)| wanted(*conn) && *n > 0)
+            })
             .collect();
         let pb = crate::progress::bar(sel.expected.max(1), quiet, "msgs");
         pb.set_message("reading");
@@ -376,8 +476,10 @@ impl BagReader {
         let mut last = 0u64;
         let mut lost = 0u64;
         for batch in chunks.chunks(BATCH_CHUNKS) {
-            let decoded: Vec<Result<Vec<(RosTime, ImuSample)>, String>> =
-                batch.par_iter().map(|c| self.decode_chunk(c.pos, &sel.conns)).collect();
+            let decoded: Vec<Result<Vec<(RosTime, ImuSample)>, String>> = batch
+                .par_iter()
+                .map(|c| self.decode_chunk(c.pos, &sel.conns))
+                .collect();
             for (loc, res) in batch.iter().zip(decoded) {
                 match res {
                     Ok(samples) => {
@@ -391,22 +493,36 @@ impl BagReader {
                         pb.inc(samples.len() as u64);
                     }
                     Err(e) => {
-                        let n: u64 = loc.counts.iter().filter(|(c, _)| wanted(*c)).map(|(_, n)| *n as u64).sum();
+                        let n: u64 = loc
+                            .counts
+                            .iter()
+                            .filter(|(c, _)| wanted(*c))
+                            .map(|(_, n)| *n as u64)
+                            .sum();
                         lost += n;
-                        report.notes.push(format!("chunk at byte {} is unreadable ({e}); {n} messages of the topic lost", loc.pos));
+                        report.notes.push(format!(
+                            "chunk at byte {} is unreadable ({e}); {n} messages of the topic lost",
+                            loc.pos
+                        ));
                     }
                 }
             }
         }
         pb.finish_and_clear();
         if lost > 0 {
-            report.notes.push(format!("{lost} of {} messages were lost to unreadable chunks", sel.expected));
+            report.notes.push(format!(
+                "{lost} of {} messages were lost to unreadable chunks",
+                sel.expected
+            ));
         }
         report.delivered = times.len() as u64;
         if !sorted {
             let mut order: Vec<usize> = (0..times.len()).collect();
             order.sort_by_key(|&i| times[i]);
-            report.notes.push("messages were not stored in record-time order; sorted as rosbag::View does".to_string());
+            report.notes.push(
+                "messages were not stored in record-time order; sorted as rosbag::View does"
+                    .to_string(),
+            );
             report.order = Some(order);
         }
         Ok(report)
@@ -417,7 +533,8 @@ impl BagReader {
             let mut out = Vec::with_capacity(body.len() / 300);
             let mut bpos = 0;
             while bpos < body.len() {
-                let rec = record::raw_record(body, bpos).ok_or_else(|| format!("incomplete record at body offset {bpos}"))?;
+                let rec = record::raw_record(body, bpos)
+                    .ok_or_else(|| format!("incomplete record at body offset {bpos}"))?;
                 let (op, conn, time) = record::op_conn_time(rec.header)?;
                 if op == Some(Op::MessageData as u8) {
                     let conn = conn.ok_or("message record without 'conn'")?;

@@ -69,26 +69,39 @@ pub fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, String> {
     while pos < header.len() {
         let len = read_u32(header, pos).ok_or("header field length overruns the header")? as usize;
         pos += 4;
-        let field = header.get(pos..pos + len).ok_or("header field overruns the header")?;
-        let eq = field.iter().position(|&b| b == b'=').ok_or("header field without '='")?;
-        let name = std::str::from_utf8(&field[..eq]).map_err(|_| "header field name is not UTF-8")?;
+        let field = header
+            .get(pos..pos + len)
+            .ok_or("header field overruns the header")?;
+        let eq = field
+            .iter()
+            .position(|&b| b == b'=')
+            .ok_or("header field without '='")?;
+        let name =
+            std::str::from_utf8(&field[..eq]).map_err(|_| "header field name is not UTF-8")?;
         out.push((name, &field[eq + 1..]));
         pos += len;
     }
     Ok(out)
 }
 
+/// `op`, `conn` and `time` of a record header, each `None` when absent.
+pub type OpConnTime = (Option<u8>, Option<u32>, Option<RosTime>);
+
 /// The `op`, `conn` and `time` fields of a record header, found without allocating: the hot
 /// path of reading, run once per message. Fields missing from the header stay `None`.
-pub fn op_conn_time(header: &[u8]) -> Result<(Option<u8>, Option<u32>, Option<RosTime>), String> {
+pub fn op_conn_time(header: &[u8]) -> Result<OpConnTime, String> {
     let (mut op, mut conn, mut time) = (None, None, None);
     let mut pos = 0usize;
     while pos < header.len() {
         let len = read_u32(header, pos).ok_or("header field length overruns the header")? as usize;
-        let field = header.get(pos + 4..pos + 4 + len).ok_or("header field overruns the header")?;
+        let field = header
+            .get(pos + 4..pos + 4 + len)
+            .ok_or("header field overruns the header")?;
         match field {
             [b'o', b'p', b'=', v] => op = Some(*v),
-            [b'c', b'o', b'n', b'n', b'=', v @ ..] if v.len() == 4 => conn = Some(u32::from_le_bytes([v[0], v[1], v[2], v[3]])),
+            [b'c', b'o', b'n', b'n', b'=', v @ ..] if v.len() == 4 => {
+                conn = Some(u32::from_le_bytes([v[0], v[1], v[2], v[3]]))
+            }
             [b't', b'i', b'm', b'e', b'=', v @ ..] => time = RosTime::from_bytes(v),
             _ => {}
         }
@@ -105,12 +118,17 @@ pub struct Header<'a> {
 impl<'a> Header<'a> {
     /// Parses the header bytes of one record.
     pub fn parse(bytes: &'a [u8]) -> Result<Header<'a>, String> {
-        Ok(Header { fields: fields(bytes)? })
+        Ok(Header {
+            fields: fields(bytes)?,
+        })
     }
 
     /// The raw value of a field.
     pub fn get(&self, name: &str) -> Option<&'a [u8]> {
-        self.fields.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
+        self.fields
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| *v)
     }
 
     /// The record's op.
@@ -150,7 +168,9 @@ impl<'a> Header<'a> {
 
     /// A required text field.
     pub fn str(&self, name: &str) -> Result<&'a str, String> {
-        let v = self.get(name).ok_or_else(|| format!("record header lacks a '{name}' field"))?;
+        let v = self
+            .get(name)
+            .ok_or_else(|| format!("record header lacks a '{name}' field"))?;
         std::str::from_utf8(v).map_err(|_| format!("field '{name}' is not UTF-8"))
     }
 }
@@ -180,7 +200,11 @@ pub fn raw_record(buf: &[u8], pos: usize) -> Option<RawRecord<'_>> {
     let dlen = read_u32(buf, dlen_pos)? as usize;
     let dstart = dlen_pos + 4;
     let data = buf.get(dstart..dstart.checked_add(dlen)?)?;
-    Some(RawRecord { header, data, end: dstart + dlen })
+    Some(RawRecord {
+        header,
+        data,
+        end: dstart + dlen,
+    })
 }
 
 /// A connection: one topic with its message type.
@@ -213,7 +237,11 @@ impl Connection {
         push_field(&mut data, "topic", self.topic.as_bytes());
         push_field(&mut data, "type", self.msg_type.as_bytes());
         push_field(&mut data, "md5sum", self.md5sum.as_bytes());
-        push_field(&mut data, "message_definition", self.message_definition.as_bytes());
+        push_field(
+            &mut data,
+            "message_definition",
+            self.message_definition.as_bytes(),
+        );
         if let Some(c) = &self.callerid {
             push_field(&mut data, "callerid", c.as_bytes());
         }
@@ -263,7 +291,11 @@ impl ChunkInfo {
         push_field(&mut header, "chunk_pos", &self.chunk_pos.to_le_bytes());
         push_field(&mut header, "start_time", &self.start_time.to_bytes());
         push_field(&mut header, "end_time", &self.end_time.to_bytes());
-        push_field(&mut header, "count", &(self.counts.len() as u32).to_le_bytes());
+        push_field(
+            &mut header,
+            "count",
+            &(self.counts.len() as u32).to_le_bytes(),
+        );
         let mut data = Vec::with_capacity(8 * self.counts.len());
         for (conn, count) in &self.counts {
             data.extend_from_slice(&conn.to_le_bytes());
@@ -276,11 +308,19 @@ impl ChunkInfo {
     pub fn decode(header: &Header<'_>, data: &[u8]) -> Result<ChunkInfo, String> {
         let count = header.u32("count")? as usize;
         if data.len() != count * 8 {
-            return Err(format!("chunk info lists {count} connections in {} bytes", data.len()));
+            return Err(format!(
+                "chunk info lists {count} connections in {} bytes",
+                data.len()
+            ));
         }
         let counts = data
             .chunks_exact(8)
-            .map(|c| (u32::from_le_bytes([c[0], c[1], c[2], c[3]]), u32::from_le_bytes([c[4], c[5], c[6], c[7]])))
+            .map(|c| {
+                (
+                    u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
+                    u32::from_le_bytes([c[4], c[5], c[6], c[7]]),
+                )
+            })
             .collect();
         Ok(ChunkInfo {
             chunk_pos: header.u64("chunk_pos")?,
@@ -370,8 +410,13 @@ mod tests {
     #[test]
     fn truncated_record_is_none_not_a_panic() {
         let mut buf = Vec::new();
-        ChunkInfo { chunk_pos: 4117, start_time: RosTime::default(), end_time: RosTime::default(), counts: vec![(0, 5)] }
-            .encode(&mut buf);
+        ChunkInfo {
+            chunk_pos: 4117,
+            start_time: RosTime::default(),
+            end_time: RosTime::default(),
+            counts: vec![(0, 5)],
+        }
+        .encode(&mut buf);
         for len in 0..buf.len() {
             assert!(raw_record(&buf[..len], 0).is_none(), "len {len}");
         }

@@ -45,7 +45,9 @@ impl BagWriter {
         let mut out = AtomicFile::create(path)?;
         let header = record::bag_header(0, 0, 0);
         let w = out.writer();
-        w.write_all(MAGIC).and_then(|_| w.write_all(&header)).map_err(|e| Error::io(path, e))?;
+        w.write_all(MAGIC)
+            .and_then(|_| w.write_all(&header))
+            .map_err(|e| Error::io(path, e))?;
         Ok(BagWriter {
             out,
             compression,
@@ -68,7 +70,13 @@ impl BagWriter {
     }
 
     /// Declares a topic with its type, md5 and full definition.
-    pub fn add_connection(&mut self, topic: &str, msg_type: &str, md5sum: &str, definition: &str) -> ConnId {
+    pub fn add_connection(
+        &mut self,
+        topic: &str,
+        msg_type: &str,
+        md5sum: &str,
+        definition: &str,
+    ) -> ConnId {
         let id = self.connections.len() as u32;
         self.connections.push(Connection {
             id,
@@ -103,7 +111,9 @@ impl BagWriter {
     pub fn write_raw(&mut self, conn: ConnId, time: RosTime, data: &[u8]) -> Result<(), Error> {
         let c = conn.0 as usize;
         if c >= self.connections.len() {
-            return Err(Error::BadMessage { what: format!("unknown connection {}", conn.0) });
+            return Err(Error::BadMessage {
+                what: format!("unknown connection {}", conn.0),
+            });
         }
         if !self.conn_written[c] {
             self.connections[c].encode(&mut self.chunk);
@@ -115,7 +125,8 @@ impl BagWriter {
         record::message_header(&mut self.chunk, conn.0, time);
         let hlen = (self.chunk.len() - offset as usize - 4) as u32;
         self.chunk[offset as usize..offset as usize + 4].copy_from_slice(&hlen.to_le_bytes());
-        self.chunk.extend_from_slice(&(data.len() as u32).to_le_bytes());
+        self.chunk
+            .extend_from_slice(&(data.len() as u32).to_le_bytes());
         self.chunk.extend_from_slice(data);
         self.chunk_index[c].push((time, offset));
         self.chunk_range = Some(match self.chunk_range {
@@ -141,8 +152,11 @@ impl BagWriter {
         match self.compression {
             Compression::None => {}
             Compression::Bz2 => {
-                let mut enc = bzip2::write::BzEncoder::new(&mut self.compressed, bzip2::Compression::best());
-                enc.write_all(&self.chunk).and_then(|_| enc.finish().map(|_| ())).map_err(|e| Error::io(self.out.target(), e))?;
+                let mut enc =
+                    bzip2::write::BzEncoder::new(&mut self.compressed, bzip2::Compression::best());
+                enc.write_all(&self.chunk)
+                    .and_then(|_| enc.finish().map(|_| ()))
+                    .map_err(|e| Error::io(self.out.target(), e))?;
             }
             Compression::Lz4 => {
                 use lz4_flex::frame::{BlockMode, BlockSize, FrameEncoder, FrameInfo};
@@ -151,11 +165,17 @@ impl BagWriter {
                     .block_mode(BlockMode::Independent)
                     .content_checksum(true);
                 let mut enc = FrameEncoder::with_frame_info(info, &mut self.compressed);
-                enc.write_all(&self.chunk).map_err(|e| Error::io(self.out.target(), e))?;
-                enc.finish().map_err(|e| Error::io(self.out.target(), std::io::Error::other(e)))?;
+                enc.write_all(&self.chunk)
+                    .map_err(|e| Error::io(self.out.target(), e))?;
+                enc.finish()
+                    .map_err(|e| Error::io(self.out.target(), std::io::Error::other(e)))?;
             }
         }
-        let body: &[u8] = if self.compression == Compression::None { &self.chunk } else { &self.compressed };
+        let body: &[u8] = if self.compression == Compression::None {
+            &self.chunk
+        } else {
+            &self.compressed
+        };
         let chunk_pos = self.pos;
         let header = record::chunk_header(self.compression, size);
         let mut tail = Vec::with_capacity(256);
@@ -177,7 +197,12 @@ impl BagWriter {
         })();
         r.map_err(|e| self.io(e))?;
         self.pos += 8 + header.len() as u64 + body.len() as u64 + tail.len() as u64;
-        self.chunk_infos.push(ChunkInfo { chunk_pos, start_time, end_time, counts });
+        self.chunk_infos.push(ChunkInfo {
+            chunk_pos,
+            start_time,
+            end_time,
+            counts,
+        });
         self.chunk.clear();
         Ok(())
     }
@@ -194,7 +219,11 @@ impl BagWriter {
         for ci in &self.chunk_infos {
             ci.encode(&mut index);
         }
-        let header = record::bag_header(index_pos, self.connections.len() as u32, self.chunk_infos.len() as u32);
+        let header = record::bag_header(
+            index_pos,
+            self.connections.len() as u32,
+            self.chunk_infos.len() as u32,
+        );
         let w = self.out.writer();
         let r = (|| {
             w.write_all(&index)?;
