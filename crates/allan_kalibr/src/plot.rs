@@ -59,23 +59,10 @@ pub fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2]
     }
     bag2mat::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
 
-    // PNG: plotters encodes by extension, so the temporary name keeps `.png`; it is
-    // renamed into place only after a successful encode.
-    let tmp = dir.join(format!(".{stem}.{}.tmp.png", std::process::id()));
-    let result = (|| {
-        let root = BitMapBackend::new(&tmp, PNG_SIZE).into_drawing_area();
-        draw(chart, &root, PNG_SIZE.0 as f64 / SVG_SIZE.0 as f64)?;
-        root.present()?;
-        Ok::<(), Box<dyn std::error::Error>>(())
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(Error::Plot {
-            path: png,
-            what: e.to_string(),
-        });
-    }
-    std::fs::rename(&tmp, &png).map_err(|e| bag2mat::Error::io(&png, e))?;
+    bag2mat::plot::png_atomic(&png, PNG_SIZE, |root| {
+        draw(chart, &root, PNG_SIZE.0 as f64 / SVG_SIZE.0 as f64).map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())
+    })?;
     Ok([png, svg])
 }
 

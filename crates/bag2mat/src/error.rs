@@ -72,6 +72,14 @@ pub enum Error {
         /// What is wrong.
         what: String,
     },
+    /// A plot could not be drawn.
+    #[error("plot {path}: {what}")]
+    Plot {
+        /// The output file.
+        path: PathBuf,
+        /// The backend's message.
+        what: String,
+    },
     /// A `.mat` file could not be read or written as an N×7 `data_imu`.
     #[error("{path}: {what}")]
     Mat {

@@ -10,6 +10,7 @@
 //!   lists the bag's topics).
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written.
 //! * [`convert`]: the bagconvert rules (rows, output path) and the csv/npy alternatives.
+//! * [`cfmt`]: C `printf` number layouts (`%g`, `%.16e`) for upstream-compatible text.
 //! * [`output`], [`progress`], [`plot`]: atomic output files, progress bars and the embedded
 //!   plot font, shared by every binary of the workspace.
 //!
@@ -18,6 +19,7 @@
 #![deny(missing_docs)]
 
 pub mod bag;
+pub mod cfmt;
 pub mod convert;
 mod error;
 pub mod imu_msg;

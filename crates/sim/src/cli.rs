@@ -66,7 +66,9 @@ impl TryFrom<CompareArgs> for crate::compare::CompareConfig {
     type Error = SimError;
     fn try_from(a: CompareArgs) -> Result<Self> {
         if !(a.rate > 0.0 && a.duration > 0.0) {
-            return Err(SimError::InvalidArgument("--rate and --duration must be positive".into()));
+            return Err(SimError::InvalidArgument(
+                "--rate and --duration must be positive".into(),
+            ));
         }
         let presets = a
             .presets
@@ -75,11 +77,20 @@ impl TryFrom<CompareArgs> for crate::compare::CompareConfig {
                 PresetArg::Low => Ok(Preset::Low),
                 PresetArg::Medium => Ok(Preset::Medium),
                 PresetArg::High => Ok(Preset::High),
-                PresetArg::Master => Err(SimError::InvalidArgument("compare takes low, medium or high".into())),
+                PresetArg::Master => Err(SimError::InvalidArgument(
+                    "compare takes low, medium or high".into(),
+                )),
             })
             .collect::<Result<Vec<_>>>()?;
         let output = a.output.unwrap_or_else(|| a.root.join("compare.md"));
-        Ok(crate::compare::CompareConfig { root: a.root, presets, rate: a.rate, duration: a.duration, output, check: a.check })
+        Ok(crate::compare::CompareConfig {
+            root: a.root,
+            presets,
+            rate: a.rate,
+            duration: a.duration,
+            output,
+            check: a.check,
+        })
     }
 }
 

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Result, SimError};
 use crate::noise::{
-    ContinuousNoise, Preset, random_walk_to_continuous, random_walk_to_discrete, white_to_continuous,
-    white_to_discrete,
+    ContinuousNoise, Preset, random_walk_to_continuous, random_walk_to_discrete,
+    white_to_continuous, white_to_discrete,
 };
 
 /// The two sensors.
@@ -171,13 +171,19 @@ pub fn read_imu_utils_yaml(path: &Path) -> Result<BTreeMap<String, f64>> {
             continue;
         }
         if in_avg && let Some((k, v)) = t.split_once(':') {
-            let v: f64 = v.trim().parse().map_err(|_| SimError::Input(format!("{}: bad number in '{t}'", path.display())))?;
+            let v: f64 = v
+                .trim()
+                .parse()
+                .map_err(|_| SimError::Input(format!("{}: bad number in '{t}'", path.display())))?;
             out.insert(k.trim().to_string(), v);
         }
     }
     for k in ["gyr_n", "gyr_w", "acc_n", "acc_w"] {
         if !out.contains_key(k) {
-            return Err(SimError::Input(format!("{}: no avg-axis {k}", path.display())));
+            return Err(SimError::Input(format!(
+                "{}: no avg-axis {k}",
+                path.display()
+            )));
         }
     }
     Ok(out)
@@ -201,7 +207,12 @@ pub fn read_kalibr_yaml(path: &Path) -> Result<BTreeMap<String, f64>> {
             out.insert(k.trim().to_string(), x);
         }
     }
-    for k in ["gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density", "accelerometer_random_walk"] {
+    for k in [
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+    ] {
         if !out.contains_key(k) {
             return Err(SimError::Input(format!("{}: no {k}", path.display())));
         }
@@ -215,9 +226,19 @@ pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Inter
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
     };
-    let (cs, ct, cv, cl, ch, cr) = (col("sensor")?, col("term")?, col("value")?, col("ci95_lo")?, col("ci95_hi")?, col("resolved")?);
+    let (cs, ct, cv, cl, ch, cr) = (
+        col("sensor")?,
+        col("term")?,
+        col("value")?,
+        col("ci95_lo")?,
+        col("ci95_hi")?,
+        col("resolved")?,
+    );
     let mut acc: BTreeMap<(Sensor, Quantity), Vec<(f64, f64, f64, bool)>> = BTreeMap::new();
     for line in lines {
         let f: Vec<&str> = line.split(',').collect();
@@ -233,7 +254,9 @@ pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Inter
             _ => continue,
         };
         let num = |i: usize| get(i).parse::<f64>().unwrap_or(f64::NAN);
-        acc.entry((sensor, q)).or_default().push((num(cv), num(cl), num(ch), get(cr) == "true"));
+        acc.entry((sensor, q))
+            .or_default()
+            .push((num(cv), num(cl), num(ch), get(cr) == "true"));
     }
     let mut out = BTreeMap::new();
     for (key, v) in acc {
@@ -249,7 +272,10 @@ pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Inter
         );
     }
     if out.len() != 4 {
-        return Err(SimError::Input(format!("{}: expected N and K rows for both sensors", path.display())));
+        return Err(SimError::Input(format!(
+            "{}: expected N and K rows for both sensors",
+            path.display()
+        )));
     }
     Ok(out)
 }
@@ -261,7 +287,8 @@ pub fn compare(cfg: &CompareConfig) -> Result<Comparison> {
     for &p in &cfg.presets {
         let name = preset_name(p);
         let dir = cfg.root.join(name);
-        let iu = read_imu_utils_yaml(&dir.join("imu_utils").join(format!("{name}_imu_param.yaml")))?;
+        let iu =
+            read_imu_utils_yaml(&dir.join("imu_utils").join(format!("{name}_imu_param.yaml")))?;
         let ka = read_kalibr_yaml(&dir.join("kalibr").join("imu.yaml"))?;
         let ie = read_ieee_terms(&dir.join("kalibr").join("ieee952_terms.csv"))?;
         let t = p.params();
@@ -287,7 +314,11 @@ pub fn compare(cfg: &CompareConfig) -> Result<Comparison> {
             }
         }
     }
-    Ok(Comparison { rate: cfg.rate, duration: cfg.duration, rows })
+    Ok(Comparison {
+        rate: cfg.rate,
+        duration: cfg.duration,
+        rows,
+    })
 }
 
 fn label(s: Sensor, q: Quantity, discrete: bool) -> &'static str {
@@ -304,15 +335,29 @@ fn label(s: Sensor, q: Quantity, discrete: bool) -> &'static str {
 }
 
 fn cell(v: f64, truth: f64) -> String {
-    if v.is_finite() { format!("{v:.4e} (×{:.2})", v / truth) } else { "NaN".to_string() }
+    if v.is_finite() {
+        format!("{v:.4e} (×{:.2})", v / truth)
+    } else {
+        "NaN".to_string()
+    }
 }
 
 fn ieee_cell(i: &Interval, truth: f64, scale: f64) -> String {
     if i.resolved_axes == 0 {
         return format!("not resolved (≤ {:.2e})", i.hi * scale);
     }
-    let partial = if i.resolved_axes < 3 { format!(", {}/3 axes resolved", i.resolved_axes) } else { String::new() };
-    format!("{:.4e} (×{:.2}) [{:.2e}, {:.2e}]{partial}", i.value * scale, i.value / truth, i.lo * scale, i.hi * scale)
+    let partial = if i.resolved_axes < 3 {
+        format!(", {}/3 axes resolved", i.resolved_axes)
+    } else {
+        String::new()
+    };
+    format!(
+        "{:.4e} (×{:.2}) [{:.2e}, {:.2e}]{partial}",
+        i.value * scale,
+        i.value / truth,
+        i.lo * scale,
+        i.hi * scale
+    )
 }
 
 /// The two Markdown tables: continuous time, then discrete time at the sample rate.
@@ -332,13 +377,27 @@ pub fn markdown(c: &Comparison) -> String {
         let _ = writeln!(
             s,
             "## {}\n\n| preset | quantity | truth | imu_utils raw | imu_utils | kalibr_allan | IEEE 952 [95 % CI] |\n|---|---|---|---|---|---|---|",
-            if discrete { format!("Discrete time at {} Hz (per sample)", c.rate) } else { "Continuous time".to_string() }
+            if discrete {
+                format!("Discrete time at {} Hz (per sample)", c.rate)
+            } else {
+                "Continuous time".to_string()
+            }
         );
         for r in &c.rows {
-            let conv = |v: f64| if discrete { to_discrete(r.quantity, v, dt) } else { v };
+            let conv = |v: f64| {
+                if discrete {
+                    to_discrete(r.quantity, v, dt)
+                } else {
+                    v
+                }
+            };
             let truth = conv(r.truth);
             let scale = conv(1.0);
-            let iu_raw = if discrete { cell(r.imu_utils_raw, truth) } else { format!("{:.4e}", r.imu_utils_raw) };
+            let iu_raw = if discrete {
+                cell(r.imu_utils_raw, truth)
+            } else {
+                format!("{:.4e}", r.imu_utils_raw)
+            };
             let _ = writeln!(
                 s,
                 "| {} | {} | {:.4e} | {} | {} | {} | {} |",
@@ -379,7 +438,10 @@ pub fn check(c: &Comparison) -> Vec<String> {
         match r.quantity {
             Quantity::WhiteNoise => {
                 if !(rel(r.ieee.value) <= IEEE_N_REL_TOL) {
-                    fails.push(format!("{what}: IEEE 952 N {:.4e} vs truth {:.4e} (tolerance {IEEE_N_REL_TOL})", r.ieee.value, r.truth));
+                    fails.push(format!(
+                        "{what}: IEEE 952 N {:.4e} vs truth {:.4e} (tolerance {IEEE_N_REL_TOL})",
+                        r.ieee.value, r.truth
+                    ));
                 }
                 if !(rel(r.kalibr) <= KALIBR_N_REL_TOL) {
                     fails.push(format!("{what}: kalibr_allan {:.4e} vs truth {:.4e} (tolerance {KALIBR_N_REL_TOL})", r.kalibr, r.truth));
@@ -418,12 +480,16 @@ mod tests {
         // The seed's table: imu_utils gyr_n 0.20988682986301069 at 200 Hz → 0.01484124… continuous.
         let v = imu_utils_to_continuous(Quantity::WhiteNoise, 0.20988682986301069, 0.005);
         assert!((v - 0.014841240).abs() < 1e-9, "{v}");
-        assert_eq!(to_discrete(Quantity::WhiteNoise, v, 0.005), white_to_discrete(v, 0.005));
+        assert_eq!(
+            to_discrete(Quantity::WhiteNoise, v, 0.005),
+            white_to_discrete(v, 0.005)
+        );
     }
 
     #[test]
     fn reads_the_real_imu_utils_yaml() {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/p1_high_200hz/imu_utils/p1_imu_param.yaml");
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../testdata/p1_high_200hz/imu_utils/p1_imu_param.yaml");
         let v = read_imu_utils_yaml(&p).unwrap();
         assert_eq!(v["gyr_n"], 4.1388663882331872e-01);
         assert_eq!(v["acc_w"], 4.2834587892313708e-03);

@@ -41,7 +41,6 @@
 pub mod bag_sim;
 pub mod cli;
 pub mod compare;
-pub mod cppfmt;
 pub mod error;
 pub mod grid;
 pub mod integrate;

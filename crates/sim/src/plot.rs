@@ -226,24 +226,7 @@ pub fn plot_integration(
         path: p.into(),
         msg,
     };
-    // PNG: plotters picks the encoder from the extension, so the temp file keeps ".png";
-    // it is renamed into place once complete (atomic output).
-    let name = png
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = png.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
-    let r = draw(
-        BitMapBackend::new(&tmp, SIZE).into_drawing_area(),
-        title,
-        truth,
-        tracks,
-    );
-    if let Err(m) = r {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(perr(&png, m));
-    }
-    std::fs::rename(&tmp, &png).map_err(|e| SimError::io(&png, e))?;
+    bag2mat::plot::png_atomic(&png, SIZE, |area| draw(area, title, truth, tracks))?;
     let mut s = String::new();
     draw(
         SVGBackend::with_string(&mut s, SIZE).into_drawing_area(),

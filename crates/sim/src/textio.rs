@@ -1,11 +1,11 @@
 //! The upstream text layouts (vio_data_simulation.md §5), read and written. Writers go
-//! through bag2mat's atomic file helper; numbers use [`crate::cppfmt`] for upstream parity
+//! through bag2mat's atomic file helper; numbers use [`bag2mat::cfmt`] for upstream parity
 //! (`%g`, 6 significant digits) or the shortest round-trip form for full precision.
 
-use crate::cppfmt::push_g;
 use crate::error::{Result, SimError};
 use crate::rotation::matrix_from_quat;
 use crate::spline::Pose;
+use bag2mat::cfmt::push_g;
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -21,7 +21,7 @@ pub enum NumFormat {
 
 fn push(out: &mut String, x: f64, f: NumFormat) {
     match f {
-        NumFormat::CppG => push_g(out, x),
+        NumFormat::CppG => push_g(out, x, 6),
         NumFormat::Full => {
             let _ = write!(out, "{x:?}");
         }

@@ -9,7 +9,6 @@
 //! comes from a seeded generator. Additional file: `imu_pose_tum.txt` (IMU poses, TUM layout
 //! with 9 decimals — a suitable `sim spline --poses` input, unlike the 5-decimal camera file).
 
-use crate::cppfmt::push_g;
 use crate::error::{Result, SimError};
 use crate::grid::Grid;
 use crate::integrate::model_rows;
@@ -17,6 +16,7 @@ use crate::motion::{Mode, ellipse_with};
 use crate::noise::{ContinuousNoise, NoiseGenerator};
 use crate::rotation::quat_from_matrix;
 use crate::textio::{NumFormat, PoseRow, format_pose_rows, format_tum, write_string};
+use bag2mat::cfmt::push_g;
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 
@@ -153,7 +153,7 @@ fn g_line(out: &mut String, vals: &[f64], trailing_space: bool) {
         if i > 0 {
             out.push(' ');
         }
-        push_g(out, *v);
+        push_g(out, *v, 6);
     }
     if trailing_space {
         out.push(' ');
