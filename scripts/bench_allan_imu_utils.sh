@@ -22,7 +22,7 @@ if [ -z "$bag" ]; then
   if [ ! -f "$bag" ]; then
     mkdir -p "$dir"
     cargo build --release -q -p sim
-    "$target/release/sim" bag --output "$bag" --rate 200 --duration 14400 --start-time 1600000000 --compression none --quiet >/dev/null
+    "$target/release/sim" bag --output "$bag" --rate 200 --duration 14400 --start-time 1600000000 --compression none --quiet >/dev/null 2>&1
   fi
 fi
 out="$(mktemp -d)"

@@ -63,7 +63,10 @@ pub fn allan_step(
     // parallel.
     let integrated: Vec<(Vec<f64>, f64, Option<usize>)> = (0..6usize)
         .into_par_iter()
-        .map(|axis| estimator::thetas_checked(c.values(axis), n, freq))
+        .map(|axis| match axis {
+            0..3 => estimator::thetas_checked(c.gyro_values(axis), n, freq),
+            _ => estimator::thetas_checked(c.acc_values(axis - 3), n, freq),
+        })
         .collect();
     if let Some((axis, index)) = integrated
         .iter()

@@ -6,7 +6,8 @@
 //! kept (quirk 10). Where the node waits forever because the bag ended first (issues #15,
 //! #25), we stop at the end and report it.
 //!
-//! The pushed values are not copied into columns: [`Collected::values`] yields them from the
+//! The pushed values are not copied into columns: [`Collected::gyro_values`] and
+//! [`Collected::acc_values`] yield them from the
 //! bag reader's rows on demand, and the Allan step turns them straight into θ (one pass, no
 //! extra 160 MB of columns for a 4 h bag).
 
@@ -66,21 +67,16 @@ impl Collected<'_> {
         self.series.len()
     }
 
-    /// The pushed values of accumulator `axis` (0–2 gyro x, y, z in pseudo-deg/h; 3–5 acc
-    /// x, y, z in m/s²), in message order.
-    pub fn values(&self, axis: usize) -> impl Iterator<Item = f64> + '_ {
-        let n = self.len();
-        let (gyro, k) = (axis < 3, axis % 3);
-        self.series.gyro[..n]
+    /// The pushed gyro values of axis `k` (0–2: x, y, z) in pseudo-deg/h, in message order.
+    pub fn gyro_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
+        self.series.gyro[..self.len()]
             .iter()
-            .zip(&self.series.acc[..n])
-            .map(move |(w, a)| {
-                if gyro {
-                    w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR
-                } else {
-                    a[k]
-                }
-            })
+            .map(move |w| w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
+    }
+
+    /// The pushed accelerations of axis `k` (0–2: x, y, z) in m/s², in message order.
+    pub fn acc_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
+        self.series.acc[..self.len()].iter().map(move |a| a[k])
     }
 
     /// The error for a non-finite value of accumulator `axis` at message `index`.
@@ -145,8 +141,8 @@ mod tests {
         let ser = series(1000, 5_000_000);
         let c = collect(&ser, 1);
         assert_eq!((c.len(), c.stop), (1000, Stop::EndOfBag));
-        assert_eq!(c.values(0).next(), Some(0.001 * 57.3 * 3600.0));
-        assert_eq!(c.values(5).nth(999), Some(9.81));
-        assert_eq!(c.values(4).count(), 1000);
+        assert_eq!(c.gyro_values(0).next(), Some(0.001 * 57.3 * 3600.0));
+        assert_eq!(c.acc_values(2).nth(999), Some(9.81));
+        assert_eq!(c.acc_values(1).count(), 1000);
     }
 }
