@@ -33,7 +33,6 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod analysis;
-pub mod cfmt;
 pub mod cli;
 pub mod collect;
 pub mod error;

@@ -127,35 +127,21 @@ fn curves<'a>(an: &'a Analysis, name: &str, base: usize) -> Curves<'a> {
     }
 }
 
+/// Draws one file: PNG through bag2mat's atomic PNG helper, SVG rendered to a string and
+/// written atomically.
 fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
-    let err = |what: String| Error::Plot {
-        path: path.to_path_buf(),
-        what,
-    };
-    // Draw to a temporary name in the same directory, then rename (atomic output).
-    let tmp = path.with_file_name(format!(
-        ".{}.{}.tmp.{}",
-        path.file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        std::process::id(),
-        if svg { "svg" } else { "png" }
-    ));
-    let result = if svg {
-        let root = SVGBackend::new(&tmp, SIZE).into_drawing_area();
-        draw(&root, c)
-    } else {
-        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
-        draw(&root, c)
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(err(e));
+    if !svg {
+        return bag2mat::plot::png_atomic(path, SIZE, |root| draw(&root, c)).map_err(Error::from);
     }
-    std::fs::rename(&tmp, path).map_err(|e| Error::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+        draw(&root, c).map_err(|what| Error::Plot {
+            path: path.to_path_buf(),
+            what,
+        })?;
+    }
+    crate::report::write_text(path, &text)
 }
 
 /// Writes the four plot files into `dir`; returns their paths.

@@ -11,9 +11,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::analysis::{AXIS_NAMES, Analysis};
-use crate::cfmt::{g, g6};
 use crate::error::Error;
 use crate::fit::{SECONDS_PER_HOUR, find_min_index};
+use bag2mat::cfmt::{g, g6};
 
 /// Upstream's fit headers (capital X only; trailing space).
 const FIT_HEADERS: [&str; 6] = [
