@@ -44,6 +44,7 @@ pub fn thetas_checked(
     let mut sum = 0.0;
     let mut bad = None;
     let mut out = Vec::with_capacity(n);
+    advise_huge_pages(&mut out);
     for (i, v) in x.enumerate() {
         if !v.is_finite() && bad.is_none() {
             bad = Some(i);
@@ -53,6 +54,32 @@ pub fn thetas_checked(
     }
     (out, sum, bad)
 }
+
+/// Asks Linux to back a large, not yet touched buffer with transparent huge pages (the
+/// kernel's default here is `madvise`): a 4 h bag's six θ buffers are 138 MB, i.e. 34 000
+/// page faults with 4 KiB pages, a sizeable share of the run's system time. Only a hint;
+/// failure changes nothing.
+#[cfg(target_os = "linux")]
+fn advise_huge_pages(v: &mut Vec<f64>) {
+    const MIN_BYTES: usize = 4 << 20;
+    const PAGE: usize = 4096;
+    let bytes = v.capacity() * std::mem::size_of::<f64>();
+    if bytes < MIN_BYTES {
+        return;
+    }
+    let start = v.as_mut_ptr() as usize;
+    let aligned = start.next_multiple_of(PAGE);
+    let len = (start + bytes - aligned) / PAGE * PAGE;
+    // SAFETY: [aligned, aligned + len) lies inside the Vec's own allocation, page-aligned as
+    // madvise requires; MADV_HUGEPAGE only changes how the kernel backs those pages, never
+    // their contents or validity.
+    unsafe {
+        libc::madvise(aligned as *mut libc::c_void, len, libc::MADV_HUGEPAGE);
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn advise_huge_pages(_: &mut Vec<f64>) {}
 
 /// Plain mean (`getAvgValue`): sequential sum over N.
 pub fn mean(x: &[f64]) -> f64 {
