@@ -153,3 +153,107 @@ pub fn write_curve_files(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<Pa
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::AxisAllan;
+    use crate::fit::{AxisFit, Sensor};
+
+    /// A small synthetic analysis: white noise only; axis y gets its own taus to expose
+    /// which taus the files use.
+    fn analysis(n: usize) -> Analysis {
+        let period = 0.005;
+        let factors = crate::factors::factors(n, 100);
+        let axes: Vec<AxisAllan> = AXIS_NAMES
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| {
+                let scale = if i % 3 == 1 { 1.01 } else { 1.0 };
+                let taus: Vec<f64> = factors.iter().map(|&m| m as f64 * period * scale).collect();
+                let variance = taus.iter().map(|t| 0.09 / t).collect();
+                AxisAllan {
+                    name,
+                    n,
+                    start_t: 1.6e9,
+                    end_t: 1.6e9 + (n - 1) as f64 * period,
+                    freq: 1.0 / period,
+                    period,
+                    factors: factors.clone(),
+                    taus,
+                    variance,
+                }
+            })
+            .collect();
+        let fits = axes
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                AxisFit::fit(
+                    if i < 3 { Sensor::Gyro } else { Sensor::Acc },
+                    &a.taus,
+                    &a.variance,
+                    a.freq,
+                )
+            })
+            .collect();
+        Analysis {
+            max_cluster: 100,
+            axes,
+            gyro_mean: [1.0, 2.0, 3.0],
+            fits,
+        }
+    }
+
+    /// Quirk 11: every curve file uses the x-axis taus, also for y/z and the sim curves.
+    #[test]
+    fn quirk_11_all_curve_files_use_x_axis_taus() {
+        let an = analysis(4000);
+        let files = curve_files(&an, "t");
+        assert_eq!(files.len(), 16);
+        let x_taus = curve_text(&an.axes[0].taus);
+        let get = |f: &str| {
+            files
+                .iter()
+                .find(|(n, _)| n == f)
+                .map(|(_, t)| t.clone())
+                .unwrap()
+        };
+        assert_eq!(get("data_t_gyr_t.txt"), x_taus);
+        assert_eq!(get("data_t_sim_gyr_t.txt"), x_taus);
+        let sim_y = curve_text(&an.fits[1].sim(&an.axes[0].taus));
+        assert_eq!(get("data_t_sim_gyr_y.txt"), sim_y);
+        let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            &names[..2],
+            &["data_t_sim_gyr_t.txt", "data_t_sim_gyr_x.txt"]
+        );
+        assert_eq!(names[8], "data_t_sim_acc_t.txt");
+    }
+
+    /// Quirk 14: short data only warns, with upstream's exact lines and spacing.
+    #[test]
+    fn quirk_14_short_data_only_warns() {
+        let text = stdout_text(&analysis(4000));
+        assert!(
+            text.contains("gyr x  numData 4000\ngyr x  Too few number\ngyr x  start_t 1.6e+09\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("-------------19.995 s\n-------------0.33325 min\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("gyr x  Too short time!!!!\ngyr x  freq 200\ngyr x  period 0.005\n"),
+            "{text}"
+        );
+        assert!(text.contains("gyr x dt \n"));
+        assert!(text.starts_with("gyr x  num of Cluster 100\n"));
+        assert_eq!(
+            text.matches("==============================================\n")
+                .count(),
+            2
+        );
+        assert!(text.contains("Gyro X \nC ") && text.contains("acc z \nC "));
+    }
+}

@@ -193,6 +193,72 @@ mod tests {
         );
     }
 
+    fn fixed(sensor: Sensor, params: Params, fit_taus: Vec<f64>, freq: f64) -> AxisFit {
+        let summary = dogleg::Summary {
+            termination: dogleg::Termination::Convergence,
+            attempts: 0,
+            accepted: 0,
+            initial_cost: 0.0,
+            final_cost: 0.0,
+        };
+        AxisFit {
+            sensor,
+            start: params,
+            params,
+            fit_taus,
+            freq,
+            summary,
+        }
+    }
+
+    /// Quirk 1: `*_n` is the whole fitted ADEV at τ = 1 s times √freq (discrete), not |N|.
+    #[test]
+    fn quirk_01_white_noise_is_discrete_and_uses_all_terms() {
+        let p = [0.0, 0.03, 0.0, 0.0, 0.0];
+        let f = fixed(Sensor::Acc, p, vec![1.0], 200.0);
+        assert_eq!(f.white_noise(), 200f64.sqrt() * 0.03);
+        assert_eq!(f.continuous_white_noise(), 0.03);
+        let f = fixed(Sensor::Acc, [0.0, 0.03, 0.01, 0.0, 0.0], vec![1.0], 200.0);
+        assert_eq!(
+            f.white_noise(),
+            200f64.sqrt() * (0.03f64 * 0.03 + 0.01 * 0.01).sqrt()
+        );
+    }
+
+    /// Quirk 2: `*_w` is the minimum of the fitted deviation over the fit taus, not √3·|K|.
+    #[test]
+    fn quirk_02_w_is_the_curve_minimum() {
+        let p = [0.0, 0.03, 0.0, 0.001, 0.0];
+        let taus = vec![1.0, 100.0, 900.0, 10_000.0];
+        let f = fixed(Sensor::Acc, p, taus.clone(), 100.0);
+        let min = taus
+            .iter()
+            .map(|&t| model::deviation(&p, t))
+            .fold(f64::MAX, f64::min);
+        assert_eq!(f.bias_instability(), min);
+        assert_eq!(f.continuous_random_walk(), 3f64.sqrt() * 0.001);
+    }
+
+    /// Quirks 4 and 5: gyro values go through 57.3 (not 180/π); the first "White Noise" line
+    /// is √freq·|N|/57.3 (rad/h, N only).
+    #[test]
+    fn quirk_04_05_gyro_units() {
+        let p = [1.0, 6000.0, 300.0, 1.0, 0.5];
+        let f = fixed(Sensor::Gyro, p, vec![0.01, 1.0, 100.0], 200.0);
+        assert_eq!(
+            f.gyro_n_line_value(),
+            200f64.sqrt() * (6000.0 / 60.0) * 60.0 / 57.3
+        );
+        assert_eq!(
+            f.gyro_b_line_value(),
+            300.0 / 0.6642824703 / (57.3 * 3600.0)
+        );
+        assert_eq!(
+            f.white_noise(),
+            200f64.sqrt() * model::variance(&p, 1.0).sqrt() / (57.3 * 3600.0)
+        );
+    }
+
     /// Quirk 6: only τ < 1 points that set a new running max are dropped.
     #[test]
     fn quirk_06_acc_check_data() {
