@@ -109,7 +109,7 @@ pub struct Analysis {
 }
 
 /// Fails with [`Error::TooFewSamples`] unless the grid has [`MIN_VALID_POINTS`] factors with
-/// N − 2m > 0.
+/// N − 2m > 0, and when the stamps give no positive mean period (upstream would print NaNs).
 pub fn check_enough(c: &Collected<'_>, max_cluster: usize) -> Result<(), Error> {
     let n = c.len();
     let valid = if n < 2 {
@@ -126,6 +126,14 @@ pub fn check_enough(c: &Collected<'_>, max_cluster: usize) -> Result<(), Error> 
             n,
             valid,
             needed: MIN_VALID_POINTS,
+        });
+    }
+    let period = estimator::mean_period(&c.t);
+    if !(period.is_finite() && period > 0.0) {
+        return Err(Error::BadStamps {
+            topic: c.topic().to_string(),
+            period,
+            n,
         });
     }
     Ok(())

@@ -35,6 +35,18 @@ pub enum Error {
         /// Message index.
         index: usize,
     },
+    /// The header stamps give no positive, finite mean period.
+    #[error(
+        "the header stamps of topic '{topic}' do not advance (mean period {period} s over {n} messages): no sample rate"
+    )]
+    BadStamps {
+        /// Topic.
+        topic: String,
+        /// Mean period found.
+        period: f64,
+        /// Samples.
+        n: usize,
+    },
     /// A roslaunch file could not be used.
     #[error("{path}: {what}")]
     Launch {

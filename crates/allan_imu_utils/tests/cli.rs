@@ -31,6 +31,11 @@ const SEED: u64 = 0xB0A7_5EED;
 
 /// A 200 Hz bag of `n` messages of white noise; `nan_at` puts a NaN into acc y there.
 fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
+    write_bag_dt(path, n, nan_at, 5_000_000);
+}
+
+/// As [`write_bag`] with stamps `dt_ns` apart.
+fn write_bag_dt(path: &Path, n: usize, nan_at: Option<usize>, dt_ns: u64) {
     let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
     let conn = w.add_imu_connection("/imu");
     let mut state = SEED;
@@ -41,7 +46,7 @@ fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
         (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     for i in 0..n {
-        let stamp = RosTime::from_nanos(1_600_000_000_000_000_000 + i as u64 * 5_000_000);
+        let stamp = RosTime::from_nanos(1_600_000_000_000_000_000 + i as u64 * dt_ns);
         let mut m = Imu {
             seq: i as u32,
             stamp,
@@ -170,6 +175,20 @@ fn nan_in_the_data_is_an_error() {
         stderr.contains("linear_acceleration.y") && stderr.contains("message 1234"),
         "stderr:\n{stderr}"
     );
+}
+
+#[test]
+fn frozen_stamps_are_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("frozen.bag");
+    write_bag_dt(&bag, 3000, None, 0);
+    let out = run(bin()
+        .arg(&bag)
+        .args(["--quiet", "--data-save-path"])
+        .arg(dir.path()));
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("do not advance"), "stderr:\n{stderr}");
 }
 
 /// Reads every real of a FileStorage yaml with OpenCV (Debian python3-opencv, the system
