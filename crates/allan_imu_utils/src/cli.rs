@@ -52,6 +52,9 @@ pub struct Args {
     /// Print the time of each phase on stderr (for benchmarks)
     #[arg(long)]
     pub timings: bool,
+    /// Only what imu_utils produces: skip the IEEE 952 section and its files
+    #[arg(long)]
+    pub compat_only: bool,
 }
 
 /// What a run uses.
@@ -75,6 +78,8 @@ pub struct Config {
     pub plots: bool,
     /// Report phase times.
     pub timings: bool,
+    /// Also run the IEEE 952 analysis (allan_kalibr::ieee952) beside the compat outputs.
+    pub ieee952: bool,
 }
 
 fn from_launch(lp: Option<&LaunchParams>, param: &str) -> Result<Option<String>, Error> {
@@ -155,6 +160,7 @@ impl TryFrom<Args> for Config {
             quiet: a.quiet,
             plots: !a.no_plots,
             timings: a.timings,
+            ieee952: !a.compat_only,
         })
     }
 }

@@ -74,6 +74,14 @@ impl Collected<'_> {
             .map(move |w| w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
     }
 
+    /// The pushed gyro values of axis `k` (0–2) in rad/s, as the bag holds them.
+    pub fn gyro_rad_s(&self, k: usize) -> Vec<f64> {
+        self.series.gyro[..self.len()]
+            .iter()
+            .map(|w| w[k])
+            .collect()
+    }
+
     /// The pushed accelerations of axis `k` (0–2: x, y, z) in m/s², in message order.
     pub fn acc_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
         self.series.acc[..self.len()].iter().map(move |a| a[k])

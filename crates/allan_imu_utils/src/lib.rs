@@ -39,7 +39,6 @@ pub mod error;
 pub mod estimator;
 pub mod factors;
 pub mod fit;
-pub mod ieee952;
 pub mod launch;
 pub mod opencv_yaml;
 pub mod plot;

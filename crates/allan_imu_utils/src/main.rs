@@ -31,6 +31,12 @@ fn run() -> anyhow::Result<()> {
         .lock()
         .write_all(outcome.stdout.as_bytes())
         .context("writing stdout")?;
+    if let Some(t) = &outcome.ieee952_text {
+        std::io::stdout()
+            .lock()
+            .write_all(t.as_bytes())
+            .context("writing stdout")?;
+    }
     if config.timings {
         for (phase, d) in &outcome.timings {
             eprintln!("timing {phase} {:.3} s", d.as_secs_f64());

@@ -15,6 +15,8 @@ use crate::{plot, report};
 pub struct Outcome {
     /// Upstream's terminal output.
     pub stdout: String,
+    /// The IEEE 952 section printed after it (when enabled and the data allow it).
+    pub ieee952_text: Option<String>,
     /// Things to say on stderr (end of bag, topic fallback, …).
     pub notes: Vec<String>,
     /// Files written.
@@ -50,6 +52,37 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     let t1 = Instant::now();
     let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster)?;
     timings.push(("allan", t1.elapsed()));
+    // The IEEE 952 analysis of the same samples (rad/s, m/s²) at imu_utils' mean-period
+    // rate. Data too short for it only costs the section, with a note.
+    let t1 = Instant::now();
+    let ieee = if config.ieee952 {
+        let cols: Vec<Vec<f64>> = (0..3)
+            .map(|k| collected.gyro_rad_s(k))
+            .chain((0..3).map(|k| collected.acc_values(k).collect()))
+            .collect();
+        let series = [
+            &cols[0][..],
+            &cols[1][..],
+            &cols[2][..],
+            &cols[3][..],
+            &cols[4][..],
+            &cols[5][..],
+        ];
+        match allan_kalibr::ieee952::imu::analyse_imu(
+            series,
+            axes[0].freq,
+            &allan_kalibr::ieee952::Config::default(),
+        ) {
+            Ok(an) => Some(an),
+            Err(e) => {
+                notes.push(format!("IEEE 952 analysis skipped: {e}"));
+                None
+            }
+        }
+    } else {
+        None
+    };
+    timings.push(("ieee952", t1.elapsed()));
     drop(collected);
     drop(series);
     let t1 = Instant::now();
@@ -75,9 +108,19 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     if config.plots {
         files.extend(plot::write_plots(&analysis, &config.name, &config.out_dir)?);
     }
+    if let Some(an) = &ieee {
+        let prefix = format!("{}_", config.name);
+        files.extend(allan_kalibr::ieee952::imu::write_outputs(
+            an,
+            &config.out_dir,
+            &prefix,
+            &config.topic,
+        )?);
+    }
     timings.push(("write_outputs", t2.elapsed()));
     Ok(Outcome {
         stdout: report::stdout_text(&analysis),
+        ieee952_text: ieee.as_ref().map(allan_kalibr::ieee952::imu::summary_text),
         notes,
         files,
         analysis,

@@ -82,7 +82,26 @@ fn launch_file_with_overrides_reproduces_p3() {
         stderr.contains("bag ended after 12200 messages before max_time_min (120)"),
         "stderr:\n{stderr}"
     );
-    let ours = text(&out.stdout);
+    // Upstream's report comes first, unchanged; the IEEE 952 section follows it.
+    let full = text(&out.stdout);
+    let marker = "\n=> IEEE 952 noise terms";
+    let at = full
+        .find(marker)
+        .unwrap_or_else(|| panic!("no IEEE 952 section in stdout:\n{full}"));
+    let ours = &full[..at];
+    assert!(
+        full[at..].contains("gyroscope_noise_density = "),
+        "{}",
+        &full[at..]
+    );
+    for f in [
+        "p3_ieee952_terms.csv",
+        "p3_kalibr_imu_ieee952.yaml",
+        "p3_vins_imu_ieee952.yaml",
+        "p3_orbslam3_imu_ieee952.yaml",
+    ] {
+        assert!(dir.path().join(f).exists(), "{f} missing");
+    }
     let theirs = case.read("stdout.txt");
     assert_eq!(
         ours.lines().count(),

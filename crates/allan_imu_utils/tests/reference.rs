@@ -37,6 +37,9 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
         quiet: true,
         plots: false,
         timings: false,
+        // Parity of the compat outputs; the IEEE 952 section is checked in allan_kalibr
+        // and in cli.rs.
+        ieee952: false,
     };
     run(&config).unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
 }

@@ -36,6 +36,10 @@ pub struct Args {
     /// Replay upstream's running-mean recursion: curves bit-identical to kalibr_allan (slower).
     #[arg(long)]
     pub bit_exact: bool,
+    /// Only what kalibr_allan produces: skip the IEEE 952 section and its files
+    /// (ieee952_terms.csv, ieee952_curves.csv, kalibr/vins/orbslam3 *_ieee952.yaml).
+    #[arg(long)]
+    pub compat_only: bool,
     /// Output directory (default: the input's directory).
     #[arg(short = 'o', long, value_name = "OUTDIR")]
     pub outdir: Option<PathBuf>,
@@ -65,6 +69,7 @@ impl From<Args> for Config {
             },
             outdir,
             quiet: a.quiet,
+            ieee952: !a.compat_only,
             timings: a.timings,
         }
     }

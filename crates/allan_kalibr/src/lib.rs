@@ -38,6 +38,7 @@ pub mod curves;
 pub mod error;
 pub mod estimator;
 pub mod fit;
+pub mod ieee952;
 pub mod input;
 pub mod plot;
 pub mod report;

@@ -21,6 +21,9 @@ fn main() -> ExitCode {
                 eprintln!("{n}");
             }
             print!("{}", out.text);
+            if let Some(t) = &out.ieee952_text {
+                print!("{t}");
+            }
             for p in &out.written {
                 eprintln!("wrote {}", p.display());
             }

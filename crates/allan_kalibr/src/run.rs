@@ -35,6 +35,8 @@ pub struct Config {
     pub quiet: bool,
     /// Print phase timings on stderr (for the benchmark).
     pub timings: bool,
+    /// Also run the IEEE 952 analysis (section and files beside the compat outputs).
+    pub ieee952: bool,
 }
 
 /// The numbers of one run.
@@ -83,6 +85,8 @@ pub struct RunOutput {
     pub rate: RateChoice,
     /// Upstream's printed text (stdout).
     pub text: String,
+    /// The IEEE 952 section printed after it (when enabled and the data allow it).
+    pub ieee952_text: Option<String>,
     /// Notes and warnings (stderr), in order.
     pub notes: Vec<String>,
     /// Files written.
@@ -98,6 +102,8 @@ pub struct Timings {
     pub load: f64,
     /// τ grid, sig2 curves and both fits.
     pub analyse: f64,
+    /// The IEEE 952 analysis (0 when disabled).
+    pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
 }
@@ -106,8 +112,8 @@ impl std::fmt::Display for Timings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "timings: load {:.3} s, allan+fit {:.3} s, outputs {:.3} s",
-            self.load, self.analyse, self.output
+            "timings: load {:.3} s, allan+fit {:.3} s, ieee952 {:.3} s, outputs {:.3} s",
+            self.load, self.analyse, self.ieee952, self.output
         )
     }
 }
@@ -132,6 +138,34 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     let rate = input::choose_rate(config.update_rate, &data.t)?;
     notes.extend(rate.message.clone());
     let topic = data.topic.clone().unwrap_or_else(|| config.topic.clone());
+    // The IEEE 952 analysis reads the raw columns, so it runs before the compat path turns
+    // them into prefix sums. Data too short for it only costs the section, with a note.
+    let start = Instant::now();
+    let ieee = if config.ieee952 {
+        let a = &data.axes;
+        let series = [
+            &a[3][..],
+            &a[4][..],
+            &a[5][..],
+            &a[0][..],
+            &a[1][..],
+            &a[2][..],
+        ];
+        match crate::ieee952::imu::analyse_imu(
+            series,
+            rate.used,
+            &crate::ieee952::Config::default(),
+        ) {
+            Ok(an) => Some(an),
+            Err(e) => {
+                notes.push(format!("IEEE 952 analysis skipped: {e}"));
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let ieee_s = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let ImuData { axes, .. } = data;
     let analysis = analyse(axes, rate.used, config.estimator, config.quiet)?;
@@ -150,7 +184,7 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
         accelerometer_random_walk: analysis.accel.bias,
         gyroscope_noise_density: analysis.gyro.white,
         gyroscope_random_walk: analysis.gyro.bias,
-        rostopic: topic,
+        rostopic: topic.clone(),
         update_rate: rate.used,
     }
     .render(&source);
@@ -184,15 +218,20 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
         config.title.clone()
     };
     written.extend(write_plots(&analysis, &title, dir)?);
+    if let Some(an) = &ieee {
+        written.extend(crate::ieee952::imu::write_outputs(an, dir, "", &topic)?);
+    }
     let timings = Timings {
         load: 0.0,
         analyse: analyse_s,
+        ieee952: ieee_s,
         output: start.elapsed().as_secs_f64(),
     };
     Ok(RunOutput {
         analysis,
         rate,
         text,
+        ieee952_text: ieee.as_ref().map(crate::ieee952::imu::summary_text),
         notes,
         written,
         timings,

@@ -52,37 +52,27 @@ fn yaml_str(s: &str) -> String {
 }
 
 impl ImuYaml {
-    /// The file text. `source` (input file name) goes into a comment.
+    /// The file text of the kalibr_allan-compatible run. `source` (input file name) goes
+    /// into a comment.
     pub fn render(&self, source: &str) -> String {
+        let first = format!("IMU noise model for Kalibr, written by allan_kalibr from {source}");
+        self.render_with(&[
+            &first,
+            "(rpng/kalibr_allan method: non-overlapping Allan deviation, averaged axes,",
+            " -1/2 line read at tau = 1 s, +1/2 line read at tau = 3 s).",
+            "These are CONTINUOUS-TIME values (noise densities and random walks);",
+            "Kalibr discretises them with update_rate. Values from static data are",
+            "optimistic: users commonly inflate them (x10 or more) before use.",
+            ".nan means the fit window was empty (Allan minimum too close to the end).",
+        ])
+    }
+
+    /// The file text after the given comment lines (each written as `# line`).
+    pub fn render_with(&self, comments: &[&str]) -> String {
         let mut o = String::new();
-        let _ = writeln!(
-            o,
-            "# IMU noise model for Kalibr, written by allan_kalibr from {source}"
-        );
-        let _ = writeln!(
-            o,
-            "# (rpng/kalibr_allan method: non-overlapping Allan deviation, averaged axes,"
-        );
-        let _ = writeln!(
-            o,
-            "#  -1/2 line read at tau = 1 s, +1/2 line read at tau = 3 s)."
-        );
-        let _ = writeln!(
-            o,
-            "# These are CONTINUOUS-TIME values (noise densities and random walks);"
-        );
-        let _ = writeln!(
-            o,
-            "# Kalibr discretises them with update_rate. Values from static data are"
-        );
-        let _ = writeln!(
-            o,
-            "# optimistic: users commonly inflate them (x10 or more) before use."
-        );
-        let _ = writeln!(
-            o,
-            "# .nan means the fit window was empty (Allan minimum too close to the end)."
-        );
+        for c in comments {
+            let _ = writeln!(o, "# {c}");
+        }
         let w = |o: &mut String, key: &str, v: String, c: &str| {
             let _ = writeln!(o, "{:<29}{:<24}#{c}", format!("{key}:"), v);
         };

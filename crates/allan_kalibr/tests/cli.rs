@@ -60,6 +60,17 @@ fn assert_no_outputs(dir: &Path) {
     }
 }
 
+/// The line that opens the IEEE 952 section after upstream's text.
+const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
+/// What the IEEE 952 section writes beside the compat outputs.
+const IEEE_OUTPUTS: [&str; 5] = [
+    "ieee952_terms.csv",
+    "ieee952_curves.csv",
+    "kalibr_imu_ieee952.yaml",
+    "vins_imu_ieee952.yaml",
+    "orbslam3_imu_ieee952.yaml",
+];
+
 /// p3 (uncompressed, 61 s): stdout is upstream's text, imu.yaml holds the four numbers.
 #[test]
 fn bag_input_prints_upstream_text_and_writes_outputs() {
@@ -76,7 +87,20 @@ fn bag_input_prints_upstream_text_and_writes_outputs() {
         "p3",
     ]);
     assert!(o.status.success(), "stderr: {}", s(&o.stderr));
-    let stdout = s(&o.stdout);
+    // Upstream's text comes first, unchanged; the IEEE 952 section follows it.
+    let full = s(&o.stdout);
+    let at = full
+        .find(IEEE_MARKER)
+        .unwrap_or_else(|| panic!("no IEEE 952 section:\n{full}"));
+    assert!(
+        full[at..].contains("accelerometer_noise_density = "),
+        "{}",
+        &full[at..]
+    );
+    for f in IEEE_OUTPUTS {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let stdout = full[..at].to_string();
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(lines[0], "=> opening the mat file.");
     assert_eq!(lines[1], "=> plotting accelerometer.");
@@ -131,7 +155,7 @@ fn bag_input_prints_upstream_text_and_writes_outputs() {
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names.len(), OUTPUTS.len(), "{names:?}");
+    assert_eq!(names.len(), OUTPUTS.len() + IEEE_OUTPUTS.len(), "{names:?}");
 }
 
 /// The same samples as a .mat (written through bag2mat) give the same text; `--bit-exact`
@@ -161,6 +185,7 @@ fn mat_input_matches_bag_input() {
         "--update-rate",
         "200",
         "--bit-exact",
+        "--compat-only",
         "-q",
     ]);
     assert!(o.status.success(), "stderr: {}", s(&o.stderr));

@@ -35,6 +35,7 @@ pub mod ci;
 pub mod edf;
 pub mod error;
 pub mod fit;
+pub mod imu;
 pub mod noise_id;
 pub mod oadev;
 pub mod tau_grid;

@@ -1,0 +1,124 @@
+//! The IEEE 952 configuration files read by the parsers their consumers use: Kalibr loads
+//! `imu.yaml` with PyYAML; VINS-Mono/VINS-Fusion and ORB-SLAM3 read their settings with
+//! OpenCV's `cv2.FileStorage`. Run on p4 (60 min at 100 Hz), whose terms are all resolved
+//! except where the record is too short; the values read back must be the ones in
+//! `ieee952_terms.csv` (largest axis), exactly.
+
+use std::process::Command;
+
+use crate::common::CASES;
+
+/// Debian's interpreter, which sees python3-yaml and python3-opencv.
+const PYTHON: &str = "/usr/bin/python3";
+
+fn python(code: &str) -> String {
+    let o = Command::new(PYTHON)
+        .arg("-c")
+        .arg(code)
+        .output()
+        .expect("run /usr/bin/python3 (scripts/test.sh installs it)");
+    assert!(
+        o.status.success(),
+        "python failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The value the files carry for a term (the documented rule of `ieee952::imu`): the
+/// largest resolved axis value; for K with no resolved axis, the largest 95 % upper bound.
+fn largest(csv: &str, sensor: &str, term: &str) -> f64 {
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f.len() > 7 && f[0] == sensor && f[2] == term)
+        .collect();
+    let num = |s: &str| s.parse::<f64>().unwrap();
+    let resolved = rows
+        .iter()
+        .filter(|f| f[7] == "true" || term == "N")
+        .map(|f| num(f[3]))
+        .fold(f64::NAN, f64::max);
+    if resolved.is_finite() {
+        resolved
+    } else {
+        rows.iter().map(|f| num(f[6])).fold(f64::NAN, f64::max)
+    }
+}
+
+#[test]
+fn pyyaml_and_opencv_read_the_ieee952_files() {
+    let case = &CASES[3];
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path();
+    let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .arg(case.bag())
+        .args(["--topic", case.topic, "-q", "-o"])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("ieee952_terms.csv")).unwrap();
+    let (gn, an) = (
+        largest(&csv, "gyroscope", "N"),
+        largest(&csv, "accelerometer", "N"),
+    );
+    let (gk, ak) = (
+        largest(&csv, "gyroscope", "K"),
+        largest(&csv, "accelerometer", "K"),
+    );
+
+    let kalibr = python(&format!(
+        "import yaml; d = yaml.safe_load(open('{}')); print(repr(d['gyroscope_noise_density']), repr(d['gyroscope_random_walk']), repr(d['accelerometer_noise_density']), repr(d['accelerometer_random_walk']), repr(d['update_rate']), d['rostopic'])",
+        out.join("kalibr_imu_ieee952.yaml").display()
+    ));
+    let v: Vec<&str> = kalibr.split_whitespace().collect();
+    let num = |s: &str| {
+        s.parse::<f64>()
+            .unwrap_or_else(|_| panic!("not a float: {s} in {kalibr}"))
+    };
+    assert_eq!(
+        [num(v[0]), num(v[1]), num(v[2]), num(v[3]), num(v[4])],
+        [gn, gk, an, ak, 100.0],
+        "{kalibr}"
+    );
+    assert_eq!(v[5], "imu");
+    // The compat imu.yaml reads with PyYAML too.
+    python(&format!(
+        "import yaml; d = yaml.safe_load(open('{}')); assert isinstance(d['gyroscope_noise_density'], float)",
+        out.join("imu.yaml").display()
+    ));
+
+    let cv = |file: &str, keys: &[&str]| -> Vec<f64> {
+        let code = format!(
+            "import cv2; fs = cv2.FileStorage('{}', cv2.FILE_STORAGE_READ); print(' '.join(repr(fs.getNode(k).real()) for k in {:?}))",
+            out.join(file).display(),
+            keys
+        );
+        python(&code)
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    assert_eq!(
+        cv(
+            "vins_imu_ieee952.yaml",
+            &["acc_n", "gyr_n", "acc_w", "gyr_w", "g_norm"]
+        ),
+        vec![an, gn, ak, gk, 9.81]
+    );
+    assert_eq!(
+        cv(
+            "orbslam3_imu_ieee952.yaml",
+            &[
+                "IMU.NoiseGyro",
+                "IMU.NoiseAcc",
+                "IMU.GyroWalk",
+                "IMU.AccWalk",
+                "IMU.Frequency"
+            ]
+        ),
+        vec![gn, an, gk, ak, 100.0]
+    );
+}
