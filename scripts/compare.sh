@@ -26,12 +26,16 @@ if [ -z "${BIN_DIR:-}" ]; then
 fi
 minutes=$(( (${duration%.*} + 59) / 60 + 1 ))
 start=$(date +%s)
+i=0
 for preset in low medium high; do
   d="$out/$preset"
+  # One seed per preset: medium and high have the same N/K ratio, so a shared seed would
+  # give them the same relative errors.
+  pseed=$((seed + i)); i=$((i + 1))
   rm -rf "$d"; mkdir -p "$d"
   echo "== $preset: sim bag ($duration s at $rate Hz)" >&2
   "$BIN_DIR/sim" bag -o "$d/imu.bag" --preset "$preset" --duration "$duration" --rate "$rate" \
-    --seed "$seed" --start-time 1700000000 --quiet 2>"$d/sim.log"
+    --seed "$pseed" --start-time 1700000000 --quiet 2>"$d/sim.log"
   "$BIN_DIR/bag2mat" "$d/imu.bag" imu --quiet
   "$BIN_DIR/allan_imu_utils" "$d/imu.bag" --topic imu --name "$preset" --max-time-min "$minutes" \
     --data-save-path "$d/imu_utils" --quiet >"$d/imu_utils.txt" 2>"$d/imu_utils.err"

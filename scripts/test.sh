@@ -16,7 +16,14 @@ if [ ${#need[@]} -gt 0 ]; then
   echo "installing test tools: ${need[*]}"
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
 fi
 
 cargo test --workspace "$@"
+
+# The seed's comparison, short enough for CI (30 min at 100 Hz, three presets), with the
+# tolerances `sim compare --check` states for that length, on the binaries cargo test built.
+target_dir=$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+BIN_DIR="$target_dir/debug" scripts/compare.sh --duration 1800 --rate 100 --out "$out" --check

@@ -106,16 +106,21 @@ pub fn run(cfg: &CompareConfig) -> Result<bool> {
     print!("{md}");
     bag2mat::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
     eprintln!("wrote {}", cfg.output.display());
+    for f in crate::compare_plot::plot(cfg)? {
+        eprintln!("wrote {}", f.display());
+    }
     if !cfg.check {
         return Ok(true);
     }
-    let failures = check(&c);
+    let (checked, failures) = check(&c);
     for f in &failures {
         eprintln!("check failed: {f}");
     }
-    if failures.is_empty() {
-        eprintln!("all comparison checks passed");
-    }
+    println!(
+        "comparison checks: {} passed, {} failed",
+        checked - failures.len(),
+        failures.len()
+    );
     Ok(failures.is_empty())
 }
 
@@ -371,8 +376,8 @@ pub fn markdown(c: &Comparison) -> String {
         "# IMU noise: simulated truth vs imu_utils vs kalibr_allan vs IEEE 952 fit\n\n\
          Static IMU, {} Hz, {} s per preset. Ratios are estimate / truth. imu_utils is converted as the \
          seed did (`*_n`·√Δt, `*_w`/√Δt); its `*_w` is a bias-instability floor, not a random walk. \
-         IEEE 952: weighted fit of the overlapping Allan variance, mean of the three axes with the widest \
-         per-axis 95 % interval.\n",
+         IEEE 952: generalised least-squares fit of the overlapping Allan variance, mean of the three axes \
+         with the widest per-axis 95 % interval.\n",
         c.rate, c.duration
     );
     for discrete in [false, true] {
@@ -420,10 +425,11 @@ pub fn markdown(c: &Comparison) -> String {
 /// IEEE 952 white-noise density: within 3 % of the truth (the issue's accuracy target; the
 /// statistical error of N from even 30 min at 100 Hz is ~0.3 %, so 3 % flags real bias).
 pub const IEEE_N_REL_TOL: f64 = 0.03;
-/// kalibr_allan reads the −½ line at τ = 1 s from the averaged non-overlapping curve: its
-/// white-noise density is within 10 % (its least-squares line over the whole window, not
-/// a bias-free estimator; measured within 4 % on 30 min runs).
-pub const KALIBR_N_REL_TOL: f64 = 0.10;
+/// kalibr_allan reads the −½ line at τ = 1 s from the averaged non-overlapping curve, fitted
+/// over every grid point left of the curve's minimum: on a short record that window includes
+/// points the random walk has lifted, so the method reads high where K/N is largest
+/// (measured +10.5 % on the low-preset accelerometer at 30 min, within 2 % elsewhere).
+pub const KALIBR_N_REL_TOL: f64 = 0.15;
 /// imu_utils' `*_n` converted by ·√Δt: within 10 % of the density (its fit evaluated at
 /// τ = 1 s; measured within 3 %).
 pub const IMU_UTILS_N_REL_TOL: f64 = 0.10;
@@ -431,12 +437,17 @@ pub const IMU_UTILS_N_REL_TOL: f64 = 0.10;
 /// floor (imu_utils.md §6). The check pins the quirk: the ratio stays above this.
 pub const IMU_UTILS_W_MIN_RATIO: f64 = 3.0;
 
-/// The assertions of the CI comparison; returns one message per failure.
-pub fn check(c: &Comparison) -> Vec<String> {
+/// The assertions of the CI comparison: how many were made, and one message per failure.
+pub fn check(c: &Comparison) -> (usize, Vec<String>) {
     let mut fails = Vec::new();
+    let mut checked = 0;
     for r in &c.rows {
         let what = format!("{} {:?} {:?}", r.preset, r.sensor, r.quantity);
         let rel = |v: f64| (v / r.truth - 1.0).abs();
+        checked += match r.quantity {
+            Quantity::WhiteNoise => 3,
+            Quantity::RandomWalk => 2,
+        };
         match r.quantity {
             Quantity::WhiteNoise => {
                 if rel(r.ieee.value).is_nan() || rel(r.ieee.value) > IEEE_N_REL_TOL {
@@ -474,7 +485,7 @@ pub fn check(c: &Comparison) -> Vec<String> {
             }
         }
     }
-    fails
+    (checked, fails)
 }
 
 #[cfg(test)]

@@ -41,6 +41,7 @@
 pub mod bag_sim;
 pub mod cli;
 pub mod compare;
+pub mod compare_plot;
 pub mod error;
 pub mod grid;
 pub mod integrate;

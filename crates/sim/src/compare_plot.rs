@@ -1,0 +1,200 @@
+//! The plot of `sim compare`: per sensor, each preset's Allan deviation as the tools see it —
+//! kalibr_allan's averaged non-overlapping curve, the IEEE 952 overlapping curve (mean of the
+//! three axes) — against the truth's model √(N²/τ + K²τ/3), log-log, PNG and SVG.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::compare::{CompareConfig, preset_name};
+use crate::error::{Result, SimError};
+
+/// One preset's curves for one sensor: (τ, deviation) series.
+struct Curves {
+    preset: &'static str,
+    kalibr: Vec<(f64, f64)>,
+    ieee: Vec<(f64, f64)>,
+    truth: (f64, f64),
+}
+
+const COLORS: [RGBColor; 3] = [
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+];
+const SIZE: (u32, u32) = (1200, 800);
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| SimError::Input(format!("{}: {e}", path.display())))
+}
+
+/// kalibr_allan's averaged curve (`acc_avg` or `gyro_avg`) from `allan_curves.csv`.
+fn kalibr_curve(path: &Path, column: &str) -> Result<Vec<(f64, f64)>> {
+    let text = read(path)?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let c = header
+        .iter()
+        .position(|h| *h == column)
+        .ok_or_else(|| SimError::Input(format!("{}: no {column}", path.display())))?;
+    Ok(lines
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            Some((f.first()?.parse().ok()?, f.get(c)?.parse().ok()?))
+        })
+        .filter(|(t, v): &(f64, f64)| *t > 0.0 && v.is_finite() && *v > 0.0)
+        .collect())
+}
+
+/// Mean over the three axes of the IEEE 952 overlapping deviation (`ieee952_curves.csv`).
+fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
+    let text = read(path)?;
+    let mut by_m: std::collections::BTreeMap<u64, (f64, f64, usize)> = Default::default();
+    for l in text.lines().skip(1) {
+        let f: Vec<&str> = l.split(',').collect();
+        if f.len() < 4 || !axes.contains(&f[0]) {
+            continue;
+        }
+        let (Ok(m), Ok(tau), Ok(adev)) = (
+            f[1].parse::<u64>(),
+            f[2].parse::<f64>(),
+            f[3].parse::<f64>(),
+        ) else {
+            continue;
+        };
+        let e = by_m.entry(m).or_insert((tau, 0.0, 0));
+        e.1 += adev;
+        e.2 += 1;
+    }
+    Ok(by_m
+        .values()
+        .filter(|e| e.2 == 3)
+        .map(|e| (e.0, e.1 / 3.0))
+        .collect())
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    unit: &str,
+    curves: &[Curves],
+) -> std::result::Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let all = curves.iter().flat_map(|c| c.kalibr.iter().chain(&c.ieee));
+    let (mut t0, mut t1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+    for &(t, v) in all {
+        (t0, t1, y0, y1) = (t0.min(t), t1.max(t), y0.min(v), y1.max(v));
+    }
+    if !(t0 < t1 && y0 < y1) {
+        return Err("no curve points to draw".into());
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 30))
+        .margin(20)
+        .x_label_area_size(60)
+        .y_label_area_size(100)
+        .build_cartesian_2d((t0..t1).log_scale(), (y0 / 1.5..y1 * 1.5).log_scale())
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("τ [s]")
+        .y_desc(format!("Allan deviation [{unit}]"))
+        .label_style(("sans-serif", 18))
+        .axis_desc_style(("sans-serif", 22))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()
+        .map_err(|x| e(&x))?;
+    for (i, c) in curves.iter().enumerate() {
+        let col = COLORS[i % COLORS.len()];
+        chart
+            .draw_series(LineSeries::new(
+                c.kalibr.iter().copied(),
+                col.mix(0.35).stroke_width(1),
+            ))
+            .map_err(|x| e(&x))?
+            .label(format!("{}: kalibr_allan (non-overlapping, avg)", c.preset))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], col.mix(0.35).stroke_width(3))
+            });
+        chart
+            .draw_series(c.ieee.iter().map(|&p| Circle::new(p, 4, col.filled())))
+            .map_err(|x| e(&x))?
+            .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
+        let (n, k) = c.truth;
+        let model = (0..=200).map(|j| {
+            let t = t0 * (t1 / t0).powf(j as f64 / 200.0);
+            (t, (n * n / t + k * k * t / 3.0).sqrt())
+        });
+        let truth = chart
+            .draw_series(LineSeries::new(model, BLACK.stroke_width(1)))
+            .map_err(|x| e(&x))?;
+        if i == 0 {
+            truth.label("truth: sqrt(N²/τ + K²τ/3)").legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
+            });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .label_font(("sans-serif", 16))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))
+}
+
+/// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison root.
+pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for (sensor, column, axes, unit) in [
+        ("gyro", "gyro_avg", ["gx", "gy", "gz"], "rad/s"),
+        ("acc", "acc_avg", ["ax", "ay", "az"], "m/s^2"),
+    ] {
+        let mut curves = Vec::new();
+        for &p in &cfg.presets {
+            let dir = cfg.root.join(preset_name(p)).join("kalibr");
+            let t = p.params();
+            curves.push(Curves {
+                preset: preset_name(p),
+                kalibr: kalibr_curve(&dir.join("allan_curves.csv"), column)?,
+                ieee: ieee_curve(&dir.join("ieee952_curves.csv"), axes)?,
+                truth: if sensor == "gyro" {
+                    (t.gyro_noise, t.gyro_bias_rw)
+                } else {
+                    (t.acc_noise, t.acc_bias_rw)
+                },
+            });
+        }
+        let title = format!(
+            "{sensor}: {} Hz, {} s — kalibr_allan, IEEE 952 and the truth",
+            cfg.rate, cfg.duration
+        );
+        let png = cfg.root.join(format!("compare_{sensor}.png"));
+        bag2mat::plot::png_atomic(&png, SIZE, |area| draw(area, &title, unit, &curves))?;
+        files.push(png);
+        let svg = cfg.root.join(format!("compare_{sensor}.svg"));
+        let mut text = String::new();
+        draw(
+            SVGBackend::with_string(&mut text, SIZE).into_drawing_area(),
+            &title,
+            unit,
+            &curves,
+        )
+        .map_err(|msg| SimError::Plot {
+            path: svg.clone(),
+            msg,
+        })?;
+        bag2mat::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
+        files.push(svg);
+    }
+    Ok(files)
+}
