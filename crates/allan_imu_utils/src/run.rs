@@ -68,17 +68,7 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
             &cols[4][..],
             &cols[5][..],
         ];
-        match allan_kalibr::ieee952::imu::analyse_imu(
-            series,
-            axes[0].freq,
-            &allan_kalibr::ieee952::Config::default(),
-        ) {
-            Ok(an) => Some(an),
-            Err(e) => {
-                notes.push(format!("IEEE 952 analysis skipped: {e}"));
-                None
-            }
-        }
+        allan_kalibr::ieee952::imu::analyse_section(series, axes[0].freq, &mut notes)
     } else {
         None
     };

@@ -151,17 +151,7 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
             &a[1][..],
             &a[2][..],
         ];
-        match crate::ieee952::imu::analyse_imu(
-            series,
-            rate.used,
-            &crate::ieee952::Config::default(),
-        ) {
-            Ok(an) => Some(an),
-            Err(e) => {
-                notes.push(format!("IEEE 952 analysis skipped: {e}"));
-                None
-            }
-        }
+        crate::ieee952::imu::analyse_section(series, rate.used, &mut notes)
     } else {
         None
     };

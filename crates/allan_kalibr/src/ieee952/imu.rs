@@ -42,6 +42,23 @@ pub fn analyse_imu(
     Ok(ImuAnalysis { rate, axes })
 }
 
+/// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
+/// output: data the analysis cannot use (too short, non-finite) only cost the section, and
+/// the reason is added to `notes`.
+pub fn analyse_section(
+    series: [&[f64]; 6],
+    rate: f64,
+    notes: &mut Vec<String>,
+) -> Option<ImuAnalysis> {
+    match analyse_imu(series, rate, &Config::default()) {
+        Ok(an) => Some(an),
+        Err(e) => {
+            notes.push(format!("IEEE 952 analysis skipped: {e}"));
+            None
+        }
+    }
+}
+
 /// The two sensors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sensor {
@@ -93,7 +110,24 @@ pub struct SensorValue {
     pub upper_bound: bool,
 }
 
+/// The four numbers every configuration file takes.
+struct FileValues {
+    acc_n: SensorValue,
+    acc_w: SensorValue,
+    gyr_n: SensorValue,
+    gyr_w: SensorValue,
+}
+
 impl ImuAnalysis {
+    fn file_values(&self) -> FileValues {
+        FileValues {
+            acc_n: self.noise_density(Sensor::Acc),
+            acc_w: self.random_walk(Sensor::Acc),
+            gyr_n: self.noise_density(Sensor::Gyro),
+            gyr_w: self.random_walk(Sensor::Gyro),
+        }
+    }
+
     /// White-noise density N of a sensor: the largest axis value.
     pub fn noise_density(&self, s: Sensor) -> SensorValue {
         let v = s
@@ -314,12 +348,12 @@ pub fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
 /// continuous-time densities (it multiplies by the integration period), so these are the
 /// continuous-time values, stated in the file.
 pub fn vins_yaml(a: &ImuAnalysis) -> String {
-    let (an, aw, gn, gw) = (
-        a.noise_density(Sensor::Acc),
-        a.random_walk(Sensor::Acc),
-        a.noise_density(Sensor::Gyro),
-        a.random_walk(Sensor::Gyro),
-    );
+    let FileValues {
+        acc_n: an,
+        acc_w: aw,
+        gyr_n: gn,
+        gyr_w: gw,
+    } = a.file_values();
     format!(
         "%YAML:1.0\n\
          # VINS-Mono / VINS-Fusion IMU parameters from the IEEE 952 fit (largest of the three axes).\n\
@@ -343,12 +377,12 @@ pub fn vins_yaml(a: &ImuAnalysis) -> String {
 /// ORB-SLAM3 settings keys (continuous-time densities; ORB-SLAM3 discretises with
 /// IMU.Frequency).
 pub fn orbslam3_yaml(a: &ImuAnalysis) -> String {
-    let (an, aw, gn, gw) = (
-        a.noise_density(Sensor::Acc),
-        a.random_walk(Sensor::Acc),
-        a.noise_density(Sensor::Gyro),
-        a.random_walk(Sensor::Gyro),
-    );
+    let FileValues {
+        acc_n: an,
+        acc_w: aw,
+        gyr_n: gn,
+        gyr_w: gw,
+    } = a.file_values();
     format!(
         "%YAML:1.0\n\
          # ORB-SLAM3 IMU noise from the IEEE 952 fit (largest of the three axes).\n\
