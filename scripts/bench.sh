@@ -52,10 +52,15 @@ echo "cat: ${t_cat} s   bag2mat (none, best of 3): ${best} s   bag2mat (lz4): ${
 echo "ratio bag2mat/cat: $(ratio "$best" "$t_cat")x   [target < 3x]   python/bag2mat: $(ratio "$t_pyr_full" "$best")x"
 echo "bag2mat peak RSS: ${best_kb} KB   output matrix: ${mat_kb} KB   ratio: $(ratio "$best_kb" "$mat_kb")x   [target < 2x]"
 
-for s in scripts/bench_allan_kalibr.sh scripts/bench_allan_imu_utils.sh; do
-  if [ -x "$s" ]; then
-    echo
-    echo "== $s"
-    "$s" "$work/imu.bag" "$work/imu.mat"
-  fi
-done
+echo
+echo "== scripts/bench_allan_kalibr.sh (from the .mat, then from the bag)"
+scripts/bench_allan_kalibr.sh "$work/imu.mat" --update-rate 200
+scripts/bench_allan_kalibr.sh "$work/imu.bag" --topic imu --no-bit-exact
+echo
+echo "== scripts/bench_allan_imu_utils.sh"
+scripts/bench_allan_imu_utils.sh "$work/imu.bag"
+echo
+echo "== the IEEE 952 section (not part of the upstream tools; both analysers run it by default)"
+/usr/bin/time -f "%e %M" -o "$work/.time" "$bin/allan_kalibr" "$work/imu.mat" --update-rate 200 -q --timings \
+  -o "$work/kalibr_ieee" >/dev/null 2>"$work/.ieee"
+echo "allan_kalibr with the section: $(grep '^timings:' "$work/.ieee")   wall s / peak KB: $(cat "$work/.time")"

@@ -32,7 +32,7 @@ echo "allan_imu_utils on $bag ($(du -h "$bag" | cut -f1)), $runs runs"
 totals=(); allans=(); reads=(); fits=()
 for _ in $(seq "$runs"); do
   start=$(date +%s.%N)
-  "$bin" "$bag" --max-time-min 100000 --data-save-path "$out" --quiet --no-plots --timings >/dev/null 2>"$out/stderr"
+  "$bin" "$bag" --max-time-min 100000 --data-save-path "$out" --quiet --no-plots --compat-only --timings >/dev/null 2>"$out/stderr"
   end=$(date +%s.%N)
   totals+=("$(echo "$end - $start" | bc -l)")
   allans+=("$(awk '$1=="timing" && $2=="allan" {print $3}' "$out/stderr")")

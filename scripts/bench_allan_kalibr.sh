@@ -51,9 +51,9 @@ echo "== input $INPUT ($(du -h "$INPUT" | cut -f1)), $CPUS CPUs"
 run_ak() {
   local out="$1"; shift
   /usr/bin/time -f "%e %M" -o "$WORK/time.txt" \
-    "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings -o "$out" "$@" \
+    "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings --compat-only -o "$out" "$@" \
     >"$WORK/stdout.txt" 2>"$WORK/stderr.txt"
-  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \3/')"
+  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \4/')"
   echo "$(cat "$WORK/time.txt") $t"
 }
 
