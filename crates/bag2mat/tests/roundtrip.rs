@@ -234,3 +234,19 @@ fn corrupt_bytes_never_panic() {
         assert!(matches!(e, Error::NotABag { .. }), "{e}");
     }
 }
+
+#[test]
+fn unfinished_writer_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("never.bag");
+    {
+        let mut w = BagWriter::create(&path, Compression::Lz4).unwrap();
+        let c = w.add_imu_connection("imu");
+        for i in 0..5000 {
+            let (t, imu) = synthetic(i);
+            w.write_imu(c, t, &imu).unwrap();
+        }
+        // dropped here without finish(): an interrupted run
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no bag and no temporary file");
+}

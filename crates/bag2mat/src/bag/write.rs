@@ -3,9 +3,15 @@
 //! their index-data records, then the index section (every connection again, one chunk info
 //! per chunk). lz4 chunks are LZ4 frames with the content checksum, which roslz4 requires.
 //! The file is written under a temporary name and renamed into place by [`BagWriter::finish`].
+//!
+//! Closed chunks go to a background thread that compresses and writes them, so encoding the
+//! next chunk overlaps with compression and the write system calls; the chunk buffers travel
+//! back to be reused (a fresh 800 KB buffer per chunk would cost a page fault per 4 KB).
 
 use std::io::{Seek, SeekFrom, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
 
 use super::record::{self, ChunkInfo, Connection, MAGIC};
 use super::{Compression, RosTime};
@@ -15,18 +21,130 @@ use crate::output::AtomicFile;
 
 /// rosbag's default chunk threshold: a chunk is closed once its body reaches 768 KiB.
 pub const DEFAULT_CHUNK_THRESHOLD: usize = 768 * 1024;
+/// Closed chunks that may wait for the writer thread (bounds the memory to a few MB).
+const QUEUED_CHUNKS: usize = 4;
 
 /// A connection handle returned by [`BagWriter::add_connection`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ConnId(pub u32);
 
-/// Streams messages into a new bag.
-pub struct BagWriter {
+/// A closed chunk on its way to the writer thread.
+struct ChunkJob {
+    body: Vec<u8>,
+    start_time: RosTime,
+    end_time: RosTime,
+    /// Per connection with messages in the chunk: `(time, offset in body)` of each.
+    index: Vec<(u32, Vec<(RosTime, u32)>)>,
+}
+
+/// The file side: owned by the writer thread while chunks flow, then by `finish`.
+struct ChunkSink {
     out: AtomicFile,
+    path: PathBuf,
     compression: Compression,
-    chunk_threshold: usize,
     /// File offset where the next record goes.
     pos: u64,
+    chunk_infos: Vec<ChunkInfo>,
+    compressed: Vec<u8>,
+}
+
+impl ChunkSink {
+    fn io(&self, e: std::io::Error) -> Error {
+        Error::io(&self.path, e)
+    }
+
+    fn write_chunk(&mut self, job: &ChunkJob) -> Result<(), Error> {
+        self.compressed.clear();
+        match self.compression {
+            Compression::None => {}
+            Compression::Bz2 => {
+                let mut enc =
+                    bzip2::write::BzEncoder::new(&mut self.compressed, bzip2::Compression::best());
+                let r = enc
+                    .write_all(&job.body)
+                    .and_then(|_| enc.finish().map(|_| ()));
+                r.map_err(|e| Error::io(&self.path, e))?;
+            }
+            Compression::Lz4 => {
+                use lz4_flex::frame::{BlockMode, BlockSize, FrameEncoder, FrameInfo};
+                let info = FrameInfo::new()
+                    .block_size(BlockSize::Max1MB)
+                    .block_mode(BlockMode::Independent)
+                    .content_checksum(true);
+                let mut enc = FrameEncoder::with_frame_info(info, &mut self.compressed);
+                enc.write_all(&job.body)
+                    .map_err(|e| Error::io(&self.path, e))?;
+                enc.finish()
+                    .map_err(|e| Error::io(&self.path, std::io::Error::other(e)))?;
+            }
+        }
+        let body: &[u8] = if self.compression == Compression::None {
+            &job.body
+        } else {
+            &self.compressed
+        };
+        let header = record::chunk_header(self.compression, job.body.len() as u32);
+        let mut tail =
+            Vec::with_capacity(256 + 12 * job.index.iter().map(|(_, e)| e.len()).sum::<usize>());
+        for (conn, entries) in &job.index {
+            record::encode_index_data(&mut tail, *conn, entries);
+        }
+        let w = self.out.writer();
+        let r = (|| {
+            w.write_all(&(header.len() as u32).to_le_bytes())?;
+            w.write_all(&header)?;
+            w.write_all(&(body.len() as u32).to_le_bytes())?;
+            w.write_all(body)?;
+            w.write_all(&tail)
+        })();
+        r.map_err(|e| self.io(e))?;
+        let chunk_pos = self.pos;
+        self.pos += 8 + header.len() as u64 + body.len() as u64 + tail.len() as u64;
+        self.chunk_infos.push(ChunkInfo {
+            chunk_pos,
+            start_time: job.start_time,
+            end_time: job.end_time,
+            counts: job
+                .index
+                .iter()
+                .map(|(c, e)| (*c, e.len() as u32))
+                .collect(),
+        });
+        Ok(())
+    }
+
+    /// Writes the index section, rewrites the bag header and renames the file into place.
+    fn finish(mut self, connections: &[Connection]) -> Result<(), Error> {
+        let index_pos = self.pos;
+        let mut index = Vec::new();
+        for c in connections {
+            c.encode(&mut index);
+        }
+        for ci in &self.chunk_infos {
+            ci.encode(&mut index);
+        }
+        let header = record::bag_header(
+            index_pos,
+            connections.len() as u32,
+            self.chunk_infos.len() as u32,
+        );
+        let w = self.out.writer();
+        let r = (|| {
+            w.write_all(&index)?;
+            w.flush()?;
+            let f = w.get_mut();
+            f.seek(SeekFrom::Start(MAGIC.len() as u64))?;
+            f.write_all(&header)?;
+            f.seek(SeekFrom::End(0)).map(|_| ())
+        })();
+        r.map_err(|e| self.io(e))?;
+        self.out.commit()
+    }
+}
+
+/// Streams messages into a new bag.
+pub struct BagWriter {
+    chunk_threshold: usize,
     connections: Vec<Connection>,
     /// Whether each connection's record has been written into a chunk yet.
     conn_written: Vec<bool>,
@@ -34,9 +152,10 @@ pub struct BagWriter {
     chunk_range: Option<(RosTime, RosTime)>,
     /// Per connection: index entries of the open chunk.
     chunk_index: Vec<Vec<(RosTime, u32)>>,
-    chunk_infos: Vec<ChunkInfo>,
     scratch: Vec<u8>,
-    compressed: Vec<u8>,
+    jobs: Option<SyncSender<ChunkJob>>,
+    spare: Receiver<Vec<u8>>,
+    thread: Option<JoinHandle<Result<ChunkSink, Error>>>,
 }
 
 impl BagWriter {
@@ -48,19 +167,39 @@ impl BagWriter {
         w.write_all(MAGIC)
             .and_then(|_| w.write_all(&header))
             .map_err(|e| Error::io(path, e))?;
-        Ok(BagWriter {
+        let mut sink = ChunkSink {
             out,
+            path: path.to_path_buf(),
             compression,
-            chunk_threshold: DEFAULT_CHUNK_THRESHOLD,
             pos: record::FIRST_RECORD_POS,
+            chunk_infos: Vec::new(),
+            compressed: Vec::new(),
+        };
+        let (jobs, job_rx) = sync_channel::<ChunkJob>(QUEUED_CHUNKS);
+        let (spare_tx, spare) = sync_channel::<Vec<u8>>(QUEUED_CHUNKS + 2);
+        let thread = std::thread::Builder::new()
+            .name("bag-writer".into())
+            .spawn(move || {
+                for job in job_rx {
+                    sink.write_chunk(&job)?;
+                    let mut body = job.body;
+                    body.clear();
+                    let _ = spare_tx.try_send(body);
+                }
+                Ok(sink)
+            })
+            .map_err(|e| Error::io(path, e))?;
+        Ok(BagWriter {
+            chunk_threshold: DEFAULT_CHUNK_THRESHOLD,
             connections: Vec::new(),
             conn_written: Vec::new(),
             chunk: Vec::with_capacity(DEFAULT_CHUNK_THRESHOLD + 64 * 1024),
             chunk_range: None,
             chunk_index: Vec::new(),
-            chunk_infos: Vec::new(),
             scratch: Vec::with_capacity(512),
-            compressed: Vec::new(),
+            jobs: Some(jobs),
+            spare,
+            thread: Some(thread),
         })
     }
 
@@ -139,101 +278,71 @@ impl BagWriter {
         Ok(())
     }
 
-    fn io(&self, e: std::io::Error) -> Error {
-        Error::io(self.out.target(), e)
-    }
-
+    /// Hands the open chunk to the writer thread.
     fn close_chunk(&mut self) -> Result<(), Error> {
         let Some((start_time, end_time)) = self.chunk_range.take() else {
             return Ok(());
         };
-        let size = self.chunk.len() as u32;
-        self.compressed.clear();
-        match self.compression {
-            Compression::None => {}
-            Compression::Bz2 => {
-                let mut enc =
-                    bzip2::write::BzEncoder::new(&mut self.compressed, bzip2::Compression::best());
-                enc.write_all(&self.chunk)
-                    .and_then(|_| enc.finish().map(|_| ()))
-                    .map_err(|e| Error::io(self.out.target(), e))?;
-            }
-            Compression::Lz4 => {
-                use lz4_flex::frame::{BlockMode, BlockSize, FrameEncoder, FrameInfo};
-                let info = FrameInfo::new()
-                    .block_size(BlockSize::Max1MB)
-                    .block_mode(BlockMode::Independent)
-                    .content_checksum(true);
-                let mut enc = FrameEncoder::with_frame_info(info, &mut self.compressed);
-                enc.write_all(&self.chunk)
-                    .map_err(|e| Error::io(self.out.target(), e))?;
-                enc.finish()
-                    .map_err(|e| Error::io(self.out.target(), std::io::Error::other(e)))?;
-            }
-        }
-        let body: &[u8] = if self.compression == Compression::None {
-            &self.chunk
-        } else {
-            &self.compressed
-        };
-        let chunk_pos = self.pos;
-        let header = record::chunk_header(self.compression, size);
-        let mut tail = Vec::with_capacity(256);
-        let mut counts = Vec::new();
-        for (c, entries) in self.chunk_index.iter_mut().enumerate() {
-            if !entries.is_empty() {
-                record::encode_index_data(&mut tail, c as u32, entries);
-                counts.push((c as u32, entries.len() as u32));
-                entries.clear();
-            }
-        }
-        let w = self.out.writer();
-        let r = (|| {
-            w.write_all(&(header.len() as u32).to_le_bytes())?;
-            w.write_all(&header)?;
-            w.write_all(&(body.len() as u32).to_le_bytes())?;
-            w.write_all(body)?;
-            w.write_all(&tail)
-        })();
-        r.map_err(|e| self.io(e))?;
-        self.pos += 8 + header.len() as u64 + body.len() as u64 + tail.len() as u64;
-        self.chunk_infos.push(ChunkInfo {
-            chunk_pos,
+        let next = self
+            .spare
+            .try_recv()
+            .unwrap_or_else(|_| Vec::with_capacity(self.chunk_threshold + 64 * 1024));
+        let body = std::mem::replace(&mut self.chunk, next);
+        let index = self
+            .chunk_index
+            .iter_mut()
+            .enumerate()
+            .filter(|(_, e)| !e.is_empty())
+            .map(|(c, e)| (c as u32, std::mem::take(e)))
+            .collect();
+        let job = ChunkJob {
+            body,
             start_time,
             end_time,
-            counts,
-        });
-        self.chunk.clear();
+            index,
+        };
+        let sent = self
+            .jobs
+            .as_ref()
+            .map(|tx| tx.send(job).is_ok())
+            .unwrap_or(false);
+        if !sent {
+            // The writer thread stopped: its error says why.
+            return Err(self.join().err().unwrap_or_else(|| Error::BadMessage {
+                what: "bag writer thread stopped".into(),
+            }));
+        }
         Ok(())
+    }
+
+    /// Stops the writer thread and takes back the file side.
+    fn join(&mut self) -> Result<ChunkSink, Error> {
+        self.jobs = None;
+        match self.thread.take().map(|t| t.join()) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err(Error::BadMessage {
+                what: "bag writer thread panicked".into(),
+            }),
+            None => Err(Error::BadMessage {
+                what: "bag writer already finished".into(),
+            }),
+        }
     }
 
     /// Closes the last chunk, writes the index section, rewrites the bag header and renames
     /// the file into place.
     pub fn finish(mut self) -> Result<(), Error> {
         self.close_chunk()?;
-        let index_pos = self.pos;
-        let mut index = Vec::new();
-        for c in &self.connections {
-            c.encode(&mut index);
+        let sink = self.join()?;
+        sink.finish(&self.connections)
+    }
+}
+
+impl Drop for BagWriter {
+    fn drop(&mut self) {
+        // Unfinished: stop the thread; dropping its AtomicFile removes the temporary file.
+        if self.thread.is_some() {
+            let _ = self.join();
         }
-        for ci in &self.chunk_infos {
-            ci.encode(&mut index);
-        }
-        let header = record::bag_header(
-            index_pos,
-            self.connections.len() as u32,
-            self.chunk_infos.len() as u32,
-        );
-        let w = self.out.writer();
-        let r = (|| {
-            w.write_all(&index)?;
-            w.flush()?;
-            let f = w.get_mut();
-            f.seek(SeekFrom::Start(MAGIC.len() as u64))?;
-            f.write_all(&header)?;
-            f.seek(SeekFrom::End(0)).map(|_| ())
-        })();
-        r.map_err(|e| self.io(e))?;
-        self.out.commit()
     }
 }
