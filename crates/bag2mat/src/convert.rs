@@ -81,10 +81,17 @@ pub struct Converted {
     pub notes: Vec<String>,
 }
 
-/// Reads the topic straight into the N×7 matrix (no intermediate copy of the messages).
+/// Reads the topic straight into the N×7 matrix. For an indexed bag every chunk is decoded in
+/// parallel directly into its rows (the chunk infos give each chunk's row count); otherwise,
+/// or if that fails, the messages are streamed in order.
 pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Converted, Error> {
     let bag = BagReader::open(bag_path)?;
     let sel = bag.select_imu_topic(topic)?;
+    if let Some(plan) = bag.chunk_plan(&sel)
+        && let Some(conv) = planned(&bag, &sel, &plan)
+    {
+        return Ok(conv);
+    }
     let mut data = DataImu::with_capacity(sel.expected as usize);
     let report = bag.stream_imu(&sel, quiet, &mut |t, m| {
         data.push([
@@ -106,6 +113,68 @@ pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Conv
         data,
         topic: sel.topic,
         notes: report.notes,
+    })
+}
+
+/// One chunk's rows of every column, and of the record times.
+struct RowsPart<'a> {
+    cols: [&'a mut [f64]; COLS],
+    times: &'a mut [u64],
+}
+
+/// The parallel path of [`bag_to_data_imu`]; `None` when it does not apply (a chunk that
+/// does not match its index) or the record times are out of order (the streaming path sorts).
+fn planned(
+    bag: &BagReader,
+    sel: &crate::bag::read::TopicSelection,
+    plan: &[(u64, usize)],
+) -> Option<Converted> {
+    let n: usize = plan.iter().map(|(_, k)| k).sum();
+    let mut columns: [Vec<f64>; COLS] = std::array::from_fn(|_| vec![0.0; n]);
+    let mut times = vec![0u64; n];
+    {
+        let mut rest_cols: [&mut [f64]; COLS] = {
+            let mut it = columns.iter_mut();
+            std::array::from_fn(|_| it.next().map(|c| c.as_mut_slice()).unwrap_or_default())
+        };
+        let mut rest_times = times.as_mut_slice();
+        let mut parts = Vec::with_capacity(plan.len());
+        for &(_, k) in plan {
+            let cols = std::array::from_fn(|c| {
+                let (head, tail) = std::mem::take(&mut rest_cols[c]).split_at_mut(k);
+                rest_cols[c] = tail;
+                head
+            });
+            let (head, tail) = std::mem::take(&mut rest_times).split_at_mut(k);
+            rest_times = tail;
+            parts.push(RowsPart { cols, times: head });
+        }
+        bag.decode_planned(sel, plan, &mut parts, |p, i, t, m| {
+            let row = [
+                t.to_sec(),
+                m.acc[0],
+                m.acc[1],
+                m.acc[2],
+                m.gyro[0],
+                m.gyro[1],
+                m.gyro[2],
+            ];
+            for (c, v) in row.into_iter().enumerate() {
+                p.cols[c][i] = v;
+            }
+            p.times[i] = t.as_nanos();
+        })
+        .ok()?;
+    }
+    if times.windows(2).any(|w| w[1] < w[0]) {
+        return None;
+    }
+    let mut notes = bag.notes().to_vec();
+    notes.extend(sel.note.iter().cloned());
+    Some(Converted {
+        data: DataImu { columns },
+        topic: sel.topic.clone(),
+        notes,
     })
 }
 

@@ -248,5 +248,9 @@ fn unfinished_writer_leaves_nothing_behind() {
         }
         // dropped here without finish(): an interrupted run
     }
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "no bag and no temporary file");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no bag and no temporary file"
+    );
 }

@@ -529,8 +529,21 @@ impl BagReader {
     }
 
     fn decode_chunk(&self, pos: u64, conns: &[u32]) -> Result<Vec<(RosTime, ImuSample)>, String> {
+        let mut out = Vec::new();
+        self.for_each_in_chunk(pos, conns, |t, s| out.push((t, *s)))?;
+        Ok(out)
+    }
+
+    /// Calls `f(record time, sample)` for each selected Imu message of the chunk at `pos`, in
+    /// body order; returns how many there were.
+    fn for_each_in_chunk(
+        &self,
+        pos: u64,
+        conns: &[u32],
+        mut f: impl FnMut(RosTime, &ImuSample),
+    ) -> Result<usize, String> {
         self.with_chunk_body(pos, |body| {
-            let mut out = Vec::with_capacity(body.len() / 300);
+            let mut n = 0;
             let mut bpos = 0;
             while bpos < body.len() {
                 let rec = record::raw_record(body, bpos)
@@ -540,14 +553,73 @@ impl BagReader {
                     let conn = conn.ok_or("message record without 'conn'")?;
                     if conns.contains(&conn) {
                         let t = time.ok_or("message record without 'time'")?;
-                        let s = ImuSample::decode(rec.data).map_err(|e| e.to_string())?;
-                        out.push((t, s));
+                        f(t, &ImuSample::decode(rec.data).map_err(|e| e.to_string())?);
+                        n += 1;
                     }
                 }
                 bpos = rec.end;
             }
-            Ok(out)
+            Ok(n)
         })
+    }
+
+    /// For an indexed bag: the chunks holding the selection, in file order, with the number
+    /// of selected messages in each (from the chunk infos). `None` for a scanned bag.
+    pub fn chunk_plan(&self, sel: &TopicSelection) -> Option<Vec<(u64, usize)>> {
+        if !self.index.indexed {
+            return None;
+        }
+        Some(
+            self.chunks
+                .iter()
+                .map(|c| {
+                    (
+                        c.pos,
+                        c.counts
+                            .iter()
+                            .filter(|(conn, _)| sel.conns.contains(conn))
+                            .map(|(_, n)| *n as usize)
+                            .sum(),
+                    )
+                })
+                .filter(|(_, n)| *n > 0)
+                .collect(),
+        )
+    }
+
+    /// Decodes the planned chunks in parallel, each into its own `part` (the caller splits
+    /// its output so that part `i` holds exactly the rows of chunk `i` of `plan`):
+    /// `put(part, row within the chunk, record time, sample)`. Fails — and the caller falls
+    /// back to [`BagReader::stream_imu`] — when a chunk is unreadable or holds a different
+    /// number of messages than its chunk info says.
+    pub fn decode_planned<P: Send>(
+        &self,
+        sel: &TopicSelection,
+        plan: &[(u64, usize)],
+        parts: &mut [P],
+        put: impl Fn(&mut P, usize, RosTime, &ImuSample) + Sync,
+    ) -> Result<(), String> {
+        if plan.len() != parts.len() {
+            return Err("plan and parts differ in length".into());
+        }
+        parts
+            .par_iter_mut()
+            .zip(plan.par_iter())
+            .try_for_each(|(part, &(pos, expected))| {
+                let mut k = 0;
+                let got = self.for_each_in_chunk(pos, &sel.conns, |t, s| {
+                    if k < expected {
+                        put(part, k, t, s);
+                    }
+                    k += 1;
+                })?;
+                if got != expected {
+                    return Err(format!(
+                        "chunk at byte {pos} holds {got} messages, its index says {expected}"
+                    ));
+                }
+                Ok(())
+            })
     }
 
     /// The path this reader was opened on.
