@@ -88,7 +88,7 @@ pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Conv
     let bag = BagReader::open(bag_path)?;
     let sel = bag.select_imu_topic(topic)?;
     if let Some(plan) = bag.chunk_plan(&sel)
-        && let Some(conv) = planned(&bag, &sel, &plan)
+        && let Some(conv) = planned(&bag, &sel, &plan, quiet)
     {
         return Ok(conv);
     }
@@ -128,28 +128,24 @@ fn planned(
     bag: &BagReader,
     sel: &crate::bag::read::TopicSelection,
     plan: &[(u64, usize)],
+    quiet: bool,
 ) -> Option<Converted> {
     let n: usize = plan.iter().map(|(_, k)| k).sum();
     let mut columns: [Vec<f64>; COLS] = std::array::from_fn(|_| vec![0.0; n]);
     let mut times = vec![0u64; n];
     {
-        let mut rest_cols: [&mut [f64]; COLS] = {
-            let mut it = columns.iter_mut();
-            std::array::from_fn(|_| it.next().map(|c| c.as_mut_slice()).unwrap_or_default())
-        };
-        let mut rest_times = times.as_mut_slice();
-        let mut parts = Vec::with_capacity(plan.len());
-        for &(_, k) in plan {
-            let cols = std::array::from_fn(|c| {
-                let (head, tail) = std::mem::take(&mut rest_cols[c]).split_at_mut(k);
-                rest_cols[c] = tail;
-                head
-            });
-            let (head, tail) = std::mem::take(&mut rest_times).split_at_mut(k);
-            rest_times = tail;
-            parts.push(RowsPart { cols, times: head });
-        }
-        bag.decode_planned(sel, plan, &mut parts, |p, i, t, m| {
+        let mut cols = columns
+            .iter_mut()
+            .map(|c| BagReader::split_rows(c, plan).into_iter());
+        let mut col_parts: [_; COLS] = std::array::from_fn(|_| cols.next().expect("seven columns"));
+        let mut parts: Vec<RowsPart> = BagReader::split_rows(&mut times, plan)
+            .into_iter()
+            .map(|times| RowsPart {
+                cols: std::array::from_fn(|c| col_parts[c].next().expect("one slice per chunk")),
+                times,
+            })
+            .collect();
+        bag.decode_planned(sel, plan, &mut parts, quiet, |p, i, t, m| {
             let row = [
                 t.to_sec(),
                 m.acc[0],

@@ -50,6 +50,12 @@ impl ImuSeries {
 pub fn read_imu_series(path: &Path, topic: &str, opts: &ReadOptions) -> Result<ImuSeries, Error> {
     let bag = BagReader::open(path)?;
     let sel = bag.select_imu_topic(topic)?;
+    // Indexed bags: every chunk decoded in parallel straight into its rows.
+    if let Some(plan) = bag.chunk_plan(&sel)
+        && let Some(s) = planned(&bag, &sel, &plan, opts.quiet)
+    {
+        return Ok(s);
+    }
     let n = sel.expected as usize;
     let mut s = ImuSeries {
         topic: sel.topic.clone(),
@@ -77,6 +83,64 @@ pub fn read_imu_series(path: &Path, topic: &str, opts: &ReadOptions) -> Result<I
     }
     s.notes = notes;
     Ok(s)
+}
+
+/// One chunk's rows of every column.
+struct Part<'a> {
+    record_time: &'a mut [RosTime],
+    stamp: &'a mut [RosTime],
+    seq: &'a mut [u32],
+    acc: &'a mut [[f64; 3]],
+    gyro: &'a mut [[f64; 3]],
+}
+
+/// The parallel path of [`read_imu_series`]; `None` when a chunk does not match its index or
+/// the record times are out of order (the streaming path handles both).
+fn planned(
+    bag: &BagReader,
+    sel: &crate::bag::read::TopicSelection,
+    plan: &[(u64, usize)],
+    quiet: bool,
+) -> Option<ImuSeries> {
+    let n: usize = plan.iter().map(|(_, k)| k).sum();
+    let mut s = ImuSeries {
+        topic: sel.topic.clone(),
+        record_time: vec![RosTime::default(); n],
+        stamp: vec![RosTime::default(); n],
+        seq: vec![0; n],
+        acc: vec![[0.0; 3]; n],
+        gyro: vec![[0.0; 3]; n],
+        notes: bag.notes().to_vec(),
+    };
+    s.notes.extend(sel.note.iter().cloned());
+    {
+        let mut parts: Vec<Part> = BagReader::split_rows(&mut s.record_time, plan)
+            .into_iter()
+            .zip(BagReader::split_rows(&mut s.stamp, plan))
+            .zip(BagReader::split_rows(&mut s.seq, plan))
+            .zip(BagReader::split_rows(&mut s.acc, plan))
+            .zip(BagReader::split_rows(&mut s.gyro, plan))
+            .map(|((((record_time, stamp), seq), acc), gyro)| Part {
+                record_time,
+                stamp,
+                seq,
+                acc,
+                gyro,
+            })
+            .collect();
+        bag.decode_planned(sel, plan, &mut parts, quiet, |p, i, t, m| {
+            p.record_time[i] = t;
+            p.stamp[i] = m.stamp;
+            p.seq[i] = m.seq;
+            p.acc[i] = m.acc;
+            p.gyro[i] = m.gyro;
+        })
+        .ok()?;
+    }
+    if s.record_time.windows(2).any(|w| w[1] < w[0]) {
+        return None;
+    }
+    Some(s)
 }
 
 /// `v` reordered so that element `i` is `v[order[i]]`.

@@ -262,7 +262,9 @@ fn planned_and_streamed_matrices_agree() {
     use bag2mat::convert::{bag_to_data_imu, data_imu_from_series};
     let p2 = crate::util::case_bag("p2_medium_100hz");
     let planned = bag_to_data_imu(&p2, "/imu/data", true).unwrap().data;
-    let streamed = data_imu_from_series(&read_imu_series(&p2, "/imu/data", &ReadOptions { quiet: true }).unwrap());
+    let streamed = data_imu_from_series(
+        &read_imu_series(&p2, "/imu/data", &ReadOptions { quiet: true }).unwrap(),
+    );
     assert_eq!(planned, streamed);
 
     let dir = tempfile::tempdir().unwrap();
@@ -277,5 +279,9 @@ fn planned_and_streamed_matrices_agree() {
     let conv = bag_to_data_imu(&path, "imu", true).unwrap();
     let want: Vec<f64> = (0..6).map(|i| synthetic(i).0.to_sec()).collect();
     assert_eq!(conv.data.t(), &want[..]);
-    assert!(conv.notes.iter().any(|n| n.contains("sorted")), "{:?}", conv.notes);
+    assert!(
+        conv.notes.iter().any(|n| n.contains("sorted")),
+        "{:?}",
+        conv.notes
+    );
 }

@@ -587,6 +587,18 @@ impl BagReader {
         )
     }
 
+    /// Splits a column of the whole selection into one slice per planned chunk.
+    pub fn split_rows<'a, T>(column: &'a mut [T], plan: &[(u64, usize)]) -> Vec<&'a mut [T]> {
+        let mut rest = column;
+        plan.iter()
+            .map(|&(_, k)| {
+                let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
+                rest = tail;
+                head
+            })
+            .collect()
+    }
+
     /// Decodes the planned chunks in parallel, each into its own `part` (the caller splits
     /// its output so that part `i` holds exactly the rows of chunk `i` of `plan`):
     /// `put(part, row within the chunk, record time, sample)`. Fails — and the caller falls
@@ -597,29 +609,37 @@ impl BagReader {
         sel: &TopicSelection,
         plan: &[(u64, usize)],
         parts: &mut [P],
+        quiet: bool,
         put: impl Fn(&mut P, usize, RosTime, &ImuSample) + Sync,
     ) -> Result<(), String> {
         if plan.len() != parts.len() {
             return Err("plan and parts differ in length".into());
         }
-        parts
-            .par_iter_mut()
-            .zip(plan.par_iter())
-            .try_for_each(|(part, &(pos, expected))| {
-                let mut k = 0;
-                let got = self.for_each_in_chunk(pos, &sel.conns, |t, s| {
-                    if k < expected {
-                        put(part, k, t, s);
+        let total: u64 = plan.iter().map(|(_, k)| *k as u64).sum();
+        let pb = crate::progress::bar(total.max(1), quiet, "msgs");
+        pb.set_message("reading");
+        let r =
+            parts
+                .par_iter_mut()
+                .zip(plan.par_iter())
+                .try_for_each(|(part, &(pos, expected))| {
+                    let mut k = 0;
+                    let got = self.for_each_in_chunk(pos, &sel.conns, |t, s| {
+                        if k < expected {
+                            put(part, k, t, s);
+                        }
+                        k += 1;
+                    })?;
+                    if got != expected {
+                        return Err(format!(
+                            "chunk at byte {pos} holds {got} messages, its index says {expected}"
+                        ));
                     }
-                    k += 1;
-                })?;
-                if got != expected {
-                    return Err(format!(
-                        "chunk at byte {pos} holds {got} messages, its index says {expected}"
-                    ));
-                }
-                Ok(())
-            })
+                    pb.inc(expected as u64);
+                    Ok(())
+                });
+        pb.finish_and_clear();
+        r
     }
 
     /// The path this reader was opened on.
