@@ -39,7 +39,7 @@ pub enum Quantity {
 /// An interval estimate from the IEEE 952 fit (mean over the three axes).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Interval {
-    /// Mean of the per-axis values.
+    /// Mean of the per-axis values over the axes that resolve the term (all when none does).
     pub value: f64,
     /// Lowest per-axis 95 % lower bound.
     pub lo: f64,
@@ -271,7 +271,15 @@ pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Inter
         out.insert(
             key,
             Interval {
-                value: v.iter().map(|x| x.0).sum::<f64>() / n,
+                // The mean of the axes that resolve the term (all axes when none does).
+                value: {
+                    let r: Vec<f64> = v.iter().filter(|x| x.3).map(|x| x.0).collect();
+                    if r.is_empty() {
+                        v.iter().map(|x| x.0).sum::<f64>() / n
+                    } else {
+                        r.iter().sum::<f64>() / r.len() as f64
+                    }
+                },
                 lo: v.iter().map(|x| x.1).fold(f64::INFINITY, f64::min),
                 hi: v.iter().map(|x| x.2).fold(f64::NEG_INFINITY, f64::max),
                 resolved_axes: v.iter().filter(|x| x.3).count(),
@@ -376,8 +384,8 @@ pub fn markdown(c: &Comparison) -> String {
         "# IMU noise: simulated truth vs imu_utils vs kalibr_allan vs IEEE 952 fit\n\n\
          Static IMU, {} Hz, {} s per preset. Ratios are estimate / truth. imu_utils is converted as the \
          seed did (`*_n`·√Δt, `*_w`/√Δt); its `*_w` is a bias-instability floor, not a random walk. \
-         IEEE 952: generalised least-squares fit of the overlapping Allan variance, mean of the three axes \
-         with the widest per-axis 95 % interval.\n",
+         IEEE 952: generalised least-squares fit of the overlapping Allan variance, mean of the axes that \
+         resolve the term, with the widest per-axis 95 % interval.\n",
         c.rate, c.duration
     );
     for discrete in [false, true] {
