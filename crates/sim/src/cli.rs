@@ -243,7 +243,7 @@ pub struct BagArgs {
     /// Chunk compression.
     #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     pub compression: CompressionArg,
-    /// No progress bar.
+    /// No progress bar and no parameter report (errors are still printed)
     #[arg(short, long)]
     pub quiet: bool,
 }

@@ -19,10 +19,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Bag(a) => {
             let cfg = sim::bag_sim::BagConfig::try_from(a)?;
-            eprintln!("{}", sim::report::bag_header(&cfg));
+            if !cfg.quiet {
+                eprintln!("{}", sim::report::bag_header(&cfg));
+            }
             let s = sim::bag_sim::run(&cfg)
                 .with_context(|| format!("writing {}", cfg.out.display()))?;
-            eprintln!("{}", sim::report::bag_done(&cfg, &s));
+            if !cfg.quiet {
+                eprintln!("{}", sim::report::bag_done(&cfg, &s));
+            }
         }
         Command::Traj(a) => {
             let cfg = sim::traj::TrajConfig::try_from(a)?;

@@ -61,10 +61,9 @@ fn default_bag_content_matches_the_seed_run() {
             SEED,
             "--start-time",
             START,
-            "-q",
         ],
     );
-    // The parameters are printed in both forms.
+    // The parameters are printed in both forms (without --quiet).
     for needle in [
         "1.5000e-2 rad/s/sqrt(Hz)",
         "2.1213e-1 rad/s per sample",
