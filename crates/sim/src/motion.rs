@@ -123,20 +123,7 @@ pub fn ellipse_with(t: f64, mode: Mode) -> MotionSample {
         -k2 * ELLIPSE_Y * s,
         -Z_AMP * K1 * K1 * k2 * sz,
     );
-    let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), K * t);
-    let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), K);
-    let r_wb = euler_to_rotation(rpy);
-    let gyro = euler_rates_to_body_rates(rpy) * rates;
-    let acc = r_wb.transpose() * (a - GRAVITY_W);
-    MotionSample {
-        t,
-        r_wb,
-        p,
-        v,
-        a,
-        gyro,
-        acc,
-    }
+    with_attitude(t, K, p, v, a)
 }
 
 /// Upstream's arithmetic, C++ promotion rules spelled out: float × float products are
@@ -159,6 +146,18 @@ fn ellipse_compat_f32(t: f64) -> MotionSample {
         -k2 * 20.0 * s,
         (-10.0f32 * 10.0f32) as f64 * k2 * sz, // -z*K1*K1 in float (z = 1)
     );
+    with_attitude(t, k, p, v, a)
+}
+
+/// The attitude part shared by both arithmetics: Z-Y-X Euler angles (0.1 cos t, 0.2 sin t,
+/// K t) and their rates, body rates by the Euler-rate matrix, specific force Rᵀ(a − g).
+fn with_attitude(
+    t: f64,
+    k: f64,
+    p: Vector3<f64>,
+    v: Vector3<f64>,
+    a: Vector3<f64>,
+) -> MotionSample {
     let rpy = Vector3::new(K_ROLL * t.cos(), K_PITCH * t.sin(), k * t);
     let rates = Vector3::new(-K_ROLL * t.sin(), K_PITCH * t.cos(), k);
     let r_wb = euler_to_rotation(rpy);
