@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::bag::RosTime;
 use crate::bag::read::BagReader;
 use crate::error::Error;
 use crate::mat::{self, COLS, DataImu};
@@ -52,20 +53,24 @@ pub fn default_output(bag: &Path, format: Format) -> PathBuf {
     }
 }
 
+/// bagconvert's row for one message: `[record time (s), acc x y z, gyro x y z]`.
+pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f64; COLS] {
+    [
+        record_time.to_sec(),
+        acc[0],
+        acc[1],
+        acc[2],
+        gyro[0],
+        gyro[1],
+        gyro[2],
+    ]
+}
+
 /// The matrix of one Imu series: `t` is the record time.
 pub fn data_imu_from_series(s: &ImuSeries) -> DataImu {
     let mut d = DataImu::with_capacity(s.len());
     for i in 0..s.len() {
-        let (a, g) = (s.acc[i], s.gyro[i]);
-        d.push([
-            s.record_time[i].to_sec(),
-            a[0],
-            a[1],
-            a[2],
-            g[0],
-            g[1],
-            g[2],
-        ]);
+        d.push(bagconvert_row(s.record_time[i], s.acc[i], s.gyro[i]));
     }
     d
 }
@@ -94,15 +99,7 @@ pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Conv
     }
     let mut data = DataImu::with_capacity(sel.expected as usize);
     let report = bag.stream_imu(&sel, quiet, &mut |t, m| {
-        data.push([
-            t.to_sec(),
-            m.acc[0],
-            m.acc[1],
-            m.acc[2],
-            m.gyro[0],
-            m.gyro[1],
-            m.gyro[2],
-        ]);
+        data.push(bagconvert_row(t, m.acc, m.gyro));
     })?;
     if let Some(order) = &report.order {
         for c in data.columns.iter_mut() {
@@ -146,16 +143,7 @@ fn planned(
             })
             .collect();
         bag.decode_planned(sel, plan, &mut parts, quiet, |p, i, t, m| {
-            let row = [
-                t.to_sec(),
-                m.acc[0],
-                m.acc[1],
-                m.acc[2],
-                m.gyro[0],
-                m.gyro[1],
-                m.gyro[2],
-            ];
-            for (c, v) in row.into_iter().enumerate() {
+            for (c, v) in bagconvert_row(t, m.acc, m.gyro).into_iter().enumerate() {
                 p.cols[c][i] = v;
             }
             p.times[i] = t.as_nanos();
