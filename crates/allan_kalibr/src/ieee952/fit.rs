@@ -4,28 +4,55 @@
 //! AVAR(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2
 //! ```
 //!
-//! linear in the non-negative coefficients c = (Q², N², B², K², R²), fitted to the curve
-//! points on a 2-per-octave sub-grid ([`FitConfig::per_octave`]).
+//! linear in the coefficients c = (Q², N², B², K², R²), fitted to the curve points on a
+//! 2-per-octave sub-grid ([`FitConfig::per_octave`]).
 //!
-//! 1. Diagonal IRLS: var(AVAR_i) ≈ 2·AVAR_i²/ν_i with the *model-predicted* AVAR (weighting
-//!    by the measured value would favour points that scattered low and bias every term down)
-//!    and ν_i Greenhall's EDF for the α of the term dominating the model at τ_i
-//!    (Q → 2, N → 0, B → −1, K and R → −2).
-//! 2. GLS (default, [`FitMethod::Gls`]): the full covariance of the overlapping AVAR points
-//!    under the current model ([`super::avar_cov`]), re-evaluated until the coefficients
-//!    settle. Neighbouring overlapping points are strongly correlated; treating them as
-//!    independent (step 1 alone) under-states every standard error 2–4× (measured: 95 %
-//!    intervals covering the truth in only ~50 % of simulated cases).
-//! 3. Forward selection of the nuisance terms Q, B, R ([`fit`]): fitting terms the data do not
-//!    have costs the others precision (B and R trade off against K at long τ).
+//! # Weighting: generalised least squares with a model-discrepancy component
+//! The statistical covariance Σ(c) of the overlapping AVAR points under the model
+//! ([`super::avar_cov`]) is exact when the model is right. Real sensors are not exactly the
+//! model (a low-pass filter, a flicker floor with corners, a Gauss–Markov bump), and the
+//! short-τ points of a long record carry error bars of 0.1 %: weighted by Σ alone they steer
+//! the whole fit, and a few-percent shape error there turns into a white noise dropped and a
+//! random walk invented (issue 10). So the covariance is
 //!
-//! Non-negativity: every subset of terms is solved unconstrained and the cheapest feasible one
-//! kept — with five unknowns this enumeration of active sets is the exact NNLS optimum.
-//! Standard errors: the (whitened) normal equations of the terms in the final model, scaled by
-//! √max(1, χ²/dof) against model misfit; intervals by test inversion ([`inverted_interval`]).
+//! ```text
+//! V = Σ(c) + δ²·diag(A_model²)
+//! ```
+//!
+//! with δ, the relative model discrepancy, estimated from the data as the value that makes
+//! the generalised χ²/dof equal 1 (δ = 0 when the model already fits within the statistics:
+//! then this is the plain GLS). A point can then never claim more precision than the model
+//! has; high-precision points are capped at δ, noisy ones keep their statistical weight.
+//! The alternatives, measured on the real-IMU curves of `testdata/real_curves`: Σ alone
+//! (χ²/dof 10³–10⁵, terms dropped and invented), and Σ scaled by χ²/dof (same weights, same
+//! wrong terms, only wider intervals) — see the `tests_real` module.
+//!
+//! # Which τ the model may describe ([`choose_start`])
+//! The model's log-AVAR is convex in log τ (a sum of power laws). A band-limited sensor's
+//! curve is not: below a few filter time constants it lies under the white-noise line, or
+//! rises (a heavily filtered accelerometer). Those points are excluded: first the stretch
+//! before the curve starts to fall like white noise, then, one at a time, each shortest point
+//! whose inclusion raises the χ² by more than [`TRIM_CHI2`] times the χ² per degree of
+//! freedom of the points after it (a deletion F-test, with the scale taken from the data so
+//! that real-curve misfit elsewhere does not decide it). The
+//! asymptotic effect of a low-pass filter on the white-noise region is a negative 1/τ²
+//! correction (AVAR = N²/τ − c/τ², c = (N²/4π²)∫(1 − |H|²)/f² df); with
+//! [`FitConfig::band_limit`] the 1/τ² coefficient may be negative so that this region is
+//! described rather than cut, and the white-noise region keeps τ = 1 s.
+//!
+//! # Terms
+//! Forward selection of the nuisance terms Q, B, R ([`fit`]): N and K are always fitted,
+//! the others enter when they lower χ² (under the full model's discrepancy) by more than
+//! [`SELECT_CHI2`]; fitting terms the data do not have costs the others precision (B and R
+//! trade off against K at long τ). Non-negativity: every subset of terms is solved
+//! unconstrained and the cheapest feasible one kept — with five unknowns this enumeration
+//! of active sets is the exact NNLS optimum. Intervals by test inversion
+//! ([`inverted_interval`]).
 
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
+
+use super::avar_cov::CovBasis;
 
 /// The five IEEE 952 terms, in coefficient order.
 pub const TERM_COUNT: usize = 5;
@@ -55,46 +82,37 @@ pub fn alpha_index(alpha: i32) -> usize {
     (2 - alpha.clamp(-2, 2)) as usize
 }
 
-/// How the points are weighted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FitMethod {
-    /// Independent points, var(AVAR_i) = 2·AVAR_i²/ν_i (Greenhall EDF of the dominant term).
-    Diagonal,
-    /// Generalised least squares with the full model covariance of the overlapping AVAR points
-    /// ([`super::avar_cov`]), iterated from the diagonal solution.
-    Gls,
-}
-
 /// Fit settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitConfig {
     /// Which of Q, N, B, K, R are in the model.
     pub terms: [bool; TERM_COUNT],
-    /// Weighting.
-    pub method: FitMethod,
     /// The fit uses the curve points nearest to m = 2^(k/p), k = 0, 1, … for this p (2 is
     /// enough: the accuracy study gives the same estimates with 4).
     pub per_octave: u32,
     /// Iteration cap of the re-weighting.
     pub max_iter: usize,
-    /// Factor on every standard error, for the diagonal method only: neighbouring overlapping
-    /// AVAR points are correlated, which independent weights ignore (1 = no inflation).
-    pub correlation_inflation: f64,
-    /// Forward selection of the nuisance terms Q, B, R (see [`fit`]). Measured in the
-    /// accuracy study: on white + random-walk data, fitting B and R that are not there
-    /// doubles the spread of K and biases it low (the B–K–R trade-off at long τ).
+    /// Forward selection of the nuisance terms Q, B, R (see [`fit`]).
     pub select: bool,
+    /// Model-discrepancy variance component (see the module docs). Off: plain GLS with the
+    /// statistical covariance, standard errors scaled by √max(1, χ²/dof).
+    pub discrepancy: bool,
+    /// Choose the start of the fitted range ([`choose_start`]); off: fit every point.
+    pub trim: bool,
+    /// Allow a negative 1/τ² coefficient (the low-pass correction; module docs).
+    pub band_limit: bool,
 }
 
 impl Default for FitConfig {
     fn default() -> Self {
         FitConfig {
             terms: [true; TERM_COUNT],
-            method: FitMethod::Gls,
             per_octave: 2,
             max_iter: 50,
-            correlation_inflation: 1.0,
             select: true,
+            discrepancy: true,
+            trim: true,
+            band_limit: true,
         }
     }
 }
@@ -108,61 +126,39 @@ pub struct FitPoint {
     pub tau: f64,
     /// Measured AVAR.
     pub avar: f64,
-    /// Greenhall EDF of this point for α = 2, 1, 0, −1, −2 (see [`alpha_index`]).
-    pub edf: [f64; 5],
 }
 
-/// Fit result in the coefficient space c = (Q², N², B², K², R²).
-#[derive(Clone, Debug, PartialEq)]
-pub struct FitResult {
-    /// Fitted coefficients (0 for a term at its bound or not in the model).
-    pub coef: [f64; TERM_COUNT],
-    /// Covariance of the coefficients (zero rows for terms not in the model).
-    pub cov: [[f64; TERM_COUNT]; TERM_COUNT],
-    /// Terms strictly positive in the solution.
-    pub free: [bool; TERM_COUNT],
-    /// Re-weighting iterations done (diagonal + GLS).
-    pub iterations: usize,
-    /// Whether the re-weighting converged.
-    pub converged: bool,
-    /// χ² per degree of freedom of the final fit (whitened residuals for GLS).
-    pub chi2_per_dof: f64,
-    /// Index of the dominant model term at each input point.
-    pub dominant: Vec<usize>,
-    /// Indices (into the input points) of the points the fit used.
-    pub used: Vec<usize>,
-    /// Weighted (GLS: whitened) χ² of the final fit.
-    pub chi2: f64,
-    /// Terms left out by [`FitConfig::select`] (coefficient 0; their variance is the full model's).
-    pub left_out: [bool; TERM_COUNT],
-}
-
-impl FitResult {
-    /// Model AVAR at τ.
-    pub fn predict(&self, tau: f64) -> f64 {
-        (0..TERM_COUNT).map(|j| self.coef[j] * basis(j, tau)).sum()
-    }
+/// The points of one curve on the fit grid, with their statistical covariance model.
+#[derive(Clone, Debug)]
+pub struct FitData<'a> {
+    /// Points, ascending τ, AVAR > 0.
+    pub points: Vec<FitPoint>,
+    /// Index of each point into the caller's curve.
+    pub curve_index: Vec<usize>,
+    /// Statistical covariance (None when the sample count is unknown: then only relative
+    /// weights, no intervals).
+    pub basis: Option<&'a CovBasis>,
+    /// Index of each point into the basis.
+    pub basis_index: Vec<usize>,
 }
 
 /// Indices of the points nearest (in log m) to each 2^(k/p), k = 0, 1, …, without repeats.
 /// When the curve's grid is a refinement of the p-per-octave grid these are exactly its
 /// points; otherwise the nearest ones.
-fn thin_to_grid(points: &[FitPoint], p: u32) -> Vec<usize> {
+pub fn thin_to_grid(ms: &[usize], p: u32) -> Vec<usize> {
     let p = p.max(1) as f64;
-    let Some(max_m) = points.iter().map(|q| q.m).max() else {
+    let Some(&max_m) = ms.iter().max() else {
         return Vec::new();
     };
     let mut out: Vec<usize> = Vec::new();
     let mut k = 0.0;
     while 2f64.powf(k / p) <= max_m as f64 * 2f64.powf(0.5 / p) {
         let target = k / p;
-        let best = (0..points.len())
-            .filter(|&i| points[i].m > 0)
-            .min_by(|&a, &b| {
-                let da = ((points[a].m as f64).log2() - target).abs();
-                let db = ((points[b].m as f64).log2() - target).abs();
-                da.total_cmp(&db)
-            });
+        let best = (0..ms.len()).filter(|&i| ms[i] > 0).min_by(|&a, &b| {
+            let da = ((ms[a] as f64).log2() - target).abs();
+            let db = ((ms[b] as f64).log2() - target).abs();
+            da.total_cmp(&db)
+        });
         if let Some(i) = best.filter(|i| !out.contains(i)) {
             out.push(i);
         }
@@ -172,246 +168,538 @@ fn thin_to_grid(points: &[FitPoint], p: u32) -> Vec<usize> {
     out
 }
 
-/// GLS re-evaluations of the covariance at most.
-const GLS_MAX_ITER: usize = 10;
-/// GLS stops when no coefficient moves by more than this fraction (far below any standard error).
-const GLS_REL_TOL: f64 = 1e-5;
+/// Result of a fit over a range of the fit grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitResult {
+    /// Fitted coefficients (0 for a term at its bound or not in the model; the 1/τ²
+    /// coefficient may be negative with [`FitConfig::band_limit`]).
+    pub coef: [f64; TERM_COUNT],
+    /// Covariance of the coefficients (zero rows for terms not in the model).
+    pub cov: [[f64; TERM_COUNT]; TERM_COUNT],
+    /// Terms in the final model (nonzero coefficient).
+    pub free: [bool; TERM_COUNT],
+    /// Terms left out by [`FitConfig::select`] (coefficient 0; their variance is the full model's).
+    pub left_out: [bool; TERM_COUNT],
+    /// Positions (into [`FitData::points`]) of the points used: a contiguous range.
+    pub used: Vec<usize>,
+    /// Re-weighting iterations of the final fit.
+    pub iterations: usize,
+    /// Whether the re-weighting converged.
+    pub converged: bool,
+    /// Statistical χ² per degree of freedom over the used range (Σ only; NaN without a
+    /// sample count). ≈ 1 when the model describes the points within their statistics.
+    pub chi2_per_dof: f64,
+    /// Relative model discrepancy δ (0: the model fits within the statistics).
+    pub delta: f64,
+    /// Degrees of freedom (points − free terms).
+    pub dof: usize,
+    /// Index of the dominant model term at each used point (same order as `used`).
+    pub dominant: Vec<usize>,
+}
 
+impl FitResult {
+    /// Model AVAR at τ.
+    pub fn predict(&self, tau: f64) -> f64 {
+        (0..TERM_COUNT).map(|j| self.coef[j] * basis(j, tau)).sum()
+    }
+}
+
+/// A short-τ point is dropped when it raises χ² by more than this many times the χ² per
+/// degree of freedom of the points after it: the χ²(1) quantile at 1 − 1e-4 (one point in
+/// 10⁴ wrongly dropped on data the model describes; a band-limited point raises χ² by
+/// 10²–10⁶).
+pub const TRIM_CHI2: f64 = 15.136_705_226_623_606;
 /// Nuisance terms [`FitConfig::select`] adds only when the data ask for them: Q, B, R.
 const NUISANCE: [usize; 3] = [0, 2, 4];
 /// χ²(1) quantile at 0.99: a nuisance term enters when it lowers the fit's χ² by more than
 /// this (a 1 % chance of adding a term the data do not have).
 pub const SELECT_CHI2: f64 = 6.634_896_601_021_214;
+/// Iterations of the discrepancy root-finding (bisection in log δ).
+const DELTA_BISECT: usize = 60;
+/// Bracket of δ: far below any useful precision, and 10× the value itself.
+const DELTA_RANGE: (f64, f64) = (1e-7, 10.0);
+/// The re-weighting stops when no coefficient moves by more than this fraction.
+const GLS_REL_TOL: f64 = 1e-6;
 
-/// Fits the model to `points` (see [`fit_once`]). With [`FitConfig::select`], forward
-/// selection: start from the enabled ones of N and K, then repeatedly add the enabled nuisance
-/// term (Q, B, R) that lowers χ² most, while it lowers it by more than [`SELECT_CHI2`].
-/// Terms left out are reported at 0 with the upper bound of the all-terms fit.
-pub fn fit(
-    points: &[FitPoint],
-    initial_alpha: &[Option<i32>],
-    n: usize,
-    tau0: f64,
-    cfg: &FitConfig,
-) -> Option<FitResult> {
-    let full = fit_once(points, initial_alpha, n, tau0, cfg);
-    if !cfg.select {
-        return full;
-    }
-    let mut terms = [false; TERM_COUNT];
-    terms[1] = cfg.terms[1];
-    terms[3] = cfg.terms[3];
-    if !terms.iter().any(|t| *t) {
-        return full;
-    }
-    let mut cur = fit_once(points, initial_alpha, n, tau0, &FitConfig { terms, ..*cfg })?;
-    loop {
-        let best = NUISANCE
-            .iter()
-            .copied()
-            .filter(|&j| cfg.terms[j] && !terms[j])
-            .filter_map(|j| {
-                let mut t = terms;
-                t[j] = true;
-                let r = fit_once(
-                    points,
-                    initial_alpha,
-                    n,
-                    tau0,
-                    &FitConfig { terms: t, ..*cfg },
-                )?;
-                Some((j, cur.chi2 - r.chi2, r))
-            })
-            .max_by(|x, y| x.1.total_cmp(&y.1));
-        match best {
-            Some((j, drop, r)) if drop > SELECT_CHI2 => {
-                terms[j] = true;
-                cur = r;
-            }
-            _ => break,
-        }
-    }
-    for j in 0..TERM_COUNT {
-        if cfg.terms[j] && !terms[j] {
-            cur.left_out[j] = true;
-            cur.coef[j] = 0.0;
-            cur.cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
-        }
-    }
-    Some(cur)
+/// How δ is set in one solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Delta {
+    /// Statistical covariance only.
+    Zero,
+    /// Given.
+    Fixed(f64),
+    /// Estimated (χ²/dof = 1).
+    Estimate,
 }
 
-/// Fits the model to `points` (overlapping AVAR of `n` rate samples at period `tau0`);
-/// `initial_alpha` (per point, may be empty) picks the EDF of the first weights.
-/// `None` with fewer usable points than enabled terms + 1, or no solution.
-pub fn fit_once(
-    points: &[FitPoint],
-    initial_alpha: &[Option<i32>],
-    n: usize,
-    tau0: f64,
-    cfg: &FitConfig,
-) -> Option<FitResult> {
-    let pts: Vec<(usize, &FitPoint)> = thin_to_grid(points, cfg.per_octave)
-        .into_iter()
-        .map(|i| (i, &points[i]))
-        .filter(|(_, p)| {
-            p.avar > 0.0 && p.avar.is_finite() && p.tau > 0.0 && p.edf.iter().all(|e| *e > 0.0)
-        })
-        .collect();
-    let enabled: Vec<usize> = (0..TERM_COUNT).filter(|&j| cfg.terms[j]).collect();
-    if enabled.is_empty() || pts.len() < enabled.len() + 1 {
+/// One GLS solve.
+#[derive(Clone, Debug)]
+struct Solve {
+    coef: [f64; TERM_COUNT],
+    cov: [[f64; TERM_COUNT]; TERM_COUNT],
+    /// χ² with the covariance used (Σ + δ²D).
+    chi2: f64,
+    /// χ² with Σ alone (NaN without a basis).
+    chi2_stat: f64,
+    dof: usize,
+    delta: f64,
+    iterations: usize,
+    converged: bool,
+}
+
+struct Problem<'d, 'a> {
+    data: &'d FitData<'a>,
+    sel: Vec<usize>,
+    g: Vec<[f64; TERM_COUNT]>,
+    a: Vec<f64>,
+}
+
+impl<'d, 'a> Problem<'d, 'a> {
+    fn new(data: &'d FitData<'a>, sel: &[usize]) -> Self {
+        let g = sel
+            .iter()
+            .map(|&i| std::array::from_fn(|j| basis(j, data.points[i].tau)))
+            .collect();
+        let a = sel.iter().map(|&i| data.points[i].avar).collect();
+        Problem {
+            data,
+            sel: sel.to_vec(),
+            g,
+            a,
+        }
+    }
+
+    fn pred(&self, c: &[f64; TERM_COUNT]) -> Vec<f64> {
+        self.g
+            .iter()
+            .map(|gi| (0..TERM_COUNT).map(|j| c[j] * gi[j]).sum())
+            .collect()
+    }
+
+    /// Statistical covariance at c (the 1/τ² component only where it is a positive Q).
+    fn sigma(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
+        let b = self.data.basis?;
+        let mut cp = *c;
+        cp[0] = cp[0].max(0.0);
+        let idx: Vec<usize> = self.sel.iter().map(|&i| self.data.basis_index[i]).collect();
+        Some(b.cov(&idx, &cp))
+    }
+
+    /// V = Σ + δ²·diag(A²) with A the measured AVAR; without a basis, diag(A²) alone (δ
+    /// factored out). The discrepancy is a fraction of the curve as measured: scaling it by
+    /// the model instead lets a model that overshoots a stretch of the curve weight that
+    /// stretch down and run away from it.
+    fn v(&self, sigma: &Option<Vec<Vec<f64>>>, delta: f64) -> Vec<Vec<f64>> {
+        let k = self.a.len();
+        match sigma {
+            Some(s) => {
+                let mut v = s.clone();
+                for i in 0..k {
+                    v[i][i] += delta * delta * self.a[i] * self.a[i];
+                }
+                v
+            }
+            None => {
+                let mut v = vec![vec![0.0; k]; k];
+                for i in 0..k {
+                    v[i][i] = self.a[i] * self.a[i];
+                }
+                v
+            }
+        }
+    }
+}
+
+/// χ² = rᵀV⁻¹r.
+fn chi2_of(v: &[Vec<f64>], r: &[f64]) -> Option<f64> {
+    let (_, rw) = whiten(v, &[], r)?;
+    Some(rw.iter().map(|x| x * x).sum())
+}
+
+/// δ ≥ 0 with rᵀ(Σ + δ²·diag(A²))⁻¹r = dof (0 when already ≤ dof).
+fn solve_delta(sigma: &[Vec<f64>], a: &[f64], r: &[f64], dof: usize) -> f64 {
+    let target = dof.max(1) as f64;
+    let at = |d: f64| -> f64 {
+        let mut v = sigma.to_vec();
+        for i in 0..a.len() {
+            v[i][i] += d * d * a[i] * a[i];
+        }
+        chi2_of(&v, r).unwrap_or(f64::INFINITY)
+    };
+    if at(0.0) <= target {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (DELTA_RANGE.0.ln(), DELTA_RANGE.1.ln());
+    if at(DELTA_RANGE.1) > target {
+        return DELTA_RANGE.1;
+    }
+    for _ in 0..DELTA_BISECT {
+        let mid = 0.5 * (lo + hi);
+        if at(mid.exp()) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi.exp()
+}
+
+/// GLS of the terms `enabled` (those in `signed` may be negative) on the points `sel`.
+fn gls(
+    data: &FitData,
+    sel: &[usize],
+    enabled: [bool; TERM_COUNT],
+    signed: [bool; TERM_COUNT],
+    delta_mode: Delta,
+    max_iter: usize,
+) -> Option<Solve> {
+    let p = Problem::new(data, sel);
+    let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
+    if terms.is_empty() || sel.len() < terms.len() + 1 {
         return None;
     }
-    let g: Vec<[f64; TERM_COUNT]> = pts
-        .iter()
-        .map(|(_, p)| std::array::from_fn(|j| basis(j, p.tau)))
-        .collect();
-    let a: Vec<f64> = pts.iter().map(|(_, p)| p.avar).collect();
-    let dominant_of = |coef: &[f64; TERM_COUNT], gi: &[f64; TERM_COUNT]| {
-        (0..TERM_COUNT)
-            .max_by(|&x, &y| (coef[x] * gi[x]).total_cmp(&(coef[y] * gi[y])))
-            .unwrap_or(1)
+    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
+    // start: relative weights 1/A²
+    let w0: Vec<f64> = p.a.iter().map(|a| 1.0 / (a * a)).collect();
+    let mut coef = nnls_subsets(&p.g, &p.a, &w0, &terms, &signed, &feasible)?;
+    let no_basis = data.basis.is_none();
+    let mut delta = match delta_mode {
+        Delta::Fixed(d) => d,
+        _ => 0.0,
     };
-    // 1. diagonal IRLS; first weights from the measured AVAR and the identified α
-    let mut pred = a.clone();
-    let mut edf: Vec<f64> = pts
-        .iter()
-        .map(|(i, p)| p.edf[alpha_index(initial_alpha.get(*i).copied().flatten().unwrap_or(0))])
-        .collect();
-    let mut coef = [0.0; TERM_COUNT];
     let mut iterations = 0;
     let mut converged = false;
-    while iterations < cfg.max_iter {
+    for _ in 0..max_iter {
         iterations += 1;
-        let w: Vec<f64> = pred
-            .iter()
-            .zip(&edf)
-            .map(|(p, e)| e / (2.0 * p * p))
-            .collect();
-        coef = nnls_subsets(&g, &a, &w, &enabled)?;
-        let new_pred: Vec<f64> = g
-            .iter()
-            .map(|gi| (0..TERM_COUNT).map(|j| coef[j] * gi[j]).sum::<f64>())
-            .collect();
-        if new_pred.iter().any(|v| !is_positive(*v)) {
-            return None;
+        let pred = p.pred(&coef);
+        let sigma = p.sigma(&coef);
+        if delta_mode == Delta::Estimate && !no_basis {
+            let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
+            let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
+            delta = solve_delta(sigma.as_ref()?, &p.a, &r, sel.len().saturating_sub(nfree));
         }
-        let new_edf: Vec<f64> = pts
-            .iter()
-            .zip(&g)
-            .map(|((_, p), gi)| p.edf[alpha_index(TERM_ALPHA[dominant_of(&coef, gi)])])
-            .collect();
-        let change = pred
-            .iter()
-            .zip(&new_pred)
-            .map(|(o, n)| ((n - o) / n).abs())
+        let v = p.v(&sigma, delta);
+        let (gw, aw) = whiten(&v, &p.g, &p.a)?;
+        let ones = vec![1.0; gw.len()];
+        let new = nnls_subsets(&gw, &aw, &ones, &terms, &signed, &feasible)?;
+        let change = (0..TERM_COUNT)
+            .filter(|&j| new[j] != 0.0 || coef[j] != 0.0)
+            .map(|j| ((new[j] - coef[j]) / new[j].abs().max(coef[j].abs())).abs())
             .fold(0.0, f64::max);
-        let edf_same = new_edf == edf;
-        pred = new_pred;
-        edf = new_edf;
-        if change < 1e-10 && edf_same {
+        coef = new;
+        if change < GLS_REL_TOL {
             converged = true;
             break;
         }
     }
-    let (chi2, base_cov, scale_extra) = match cfg.method {
-        FitMethod::Diagonal => {
-            let w: Vec<f64> = pred
+    let pred = p.pred(&coef);
+    let sigma = p.sigma(&coef);
+    let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
+    let dof = sel.len().saturating_sub(nfree);
+    let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
+    if delta_mode == Delta::Estimate {
+        delta = match &sigma {
+            Some(s) => solve_delta(s, &p.a, &r, dof),
+            // relative least squares: δ² = Σ(r/A)²/dof
+            None => (r
                 .iter()
-                .zip(&edf)
-                .map(|(p, e)| e / (2.0 * p * p))
-                .collect();
-            let chi2: f64 = a
-                .iter()
-                .zip(&pred)
-                .zip(&w)
-                .map(|((ai, pi), wi)| wi * (ai - pi).powi(2))
-                .sum();
-            (
-                chi2,
-                covariance(&g, &w, &enabled)?,
-                cfg.correlation_inflation.powi(2),
-            )
-        }
-        FitMethod::Gls => {
-            // 2. GLS with the model covariance, re-evaluated at each new solution
-            let ms: Vec<usize> = pts.iter().map(|(_, p)| p.m).collect();
-            converged = false;
-            let mut last = None;
-            for _ in 0..cfg.max_iter.min(GLS_MAX_ITER) {
-                iterations += 1;
-                let sigma = super::avar_cov::avar_cov(&ms, n, tau0, &coef);
-                let (gw, aw) = whiten(&sigma, &g, &a)?;
-                let ones = vec![1.0; gw.len()];
-                let new = nnls_subsets(&gw, &aw, &ones, &enabled)?;
-                let change = (0..TERM_COUNT)
-                    .filter(|&j| new[j] > 0.0 || coef[j] > 0.0)
-                    .map(|j| ((new[j] - coef[j]) / new[j].max(coef[j])).abs())
-                    .fold(0.0, f64::max);
-                coef = new;
-                last = Some((gw, aw));
-                if change < GLS_REL_TOL {
-                    converged = true;
-                    break;
-                }
-            }
-            let (gw, aw) = last?;
-            let ones = vec![1.0; gw.len()];
-            let chi2: f64 = aw
-                .iter()
-                .zip(&gw)
-                .map(|(ai, gi)| {
-                    (ai - (0..TERM_COUNT).map(|j| coef[j] * gi[j]).sum::<f64>()).powi(2)
-                })
-                .sum();
-            (chi2, covariance(&gw, &ones, &enabled)?, 1.0)
-        }
+                .zip(&p.a)
+                .map(|(ri, q)| (ri / q).powi(2))
+                .sum::<f64>()
+                / dof.max(1) as f64)
+                .sqrt(),
+        };
+    }
+    let v = p.v(&sigma, delta);
+    let (gw, _) = whiten(&v, &p.g, &p.a)?;
+    let ones = vec![1.0; gw.len()];
+    let free_terms: Vec<usize> = terms.iter().copied().filter(|&j| coef[j] != 0.0).collect();
+    let mut cov = if free_terms.is_empty() {
+        [[0.0; TERM_COUNT]; TERM_COUNT]
+    } else {
+        covariance(&gw, &ones, &free_terms)?
     };
-    let free: [bool; TERM_COUNT] = std::array::from_fn(|j| coef[j] > 0.0);
-    let dof = pts
-        .len()
-        .saturating_sub(free.iter().filter(|f| **f).count())
-        .max(1);
-    let chi2_per_dof = chi2 / dof as f64;
-    let scale = chi2_per_dof.max(1.0) * scale_extra;
-    let mut cov = [[0.0; TERM_COUNT]; TERM_COUNT];
-    for r in 0..TERM_COUNT {
-        for c in 0..TERM_COUNT {
-            cov[r][c] = base_cov[r][c] * scale;
+    if no_basis {
+        // the weights are relative: scale by δ² (no statistical meaning, kept for the record)
+        for row in cov.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= delta * delta;
+            }
         }
     }
-    let dominant = points
+    let chi2 = if no_basis {
+        if delta > 0.0 {
+            chi2_of(&v, &r)? / (delta * delta)
+        } else {
+            0.0
+        }
+    } else {
+        chi2_of(&v, &r)?
+    };
+    let chi2_stat = match &sigma {
+        Some(s) => chi2_of(s, &r).unwrap_or(f64::NAN),
+        None => f64::NAN,
+    };
+    Some(Solve {
+        coef,
+        cov,
+        chi2,
+        chi2_stat,
+        dof,
+        delta,
+        iterations,
+        converged,
+    })
+}
+
+/// Weighted least squares of the terms `enabled` on `sel` with the covariance held fixed at
+/// the coefficients `at` and discrepancy `delta` (no re-weighting): the χ² of nested models
+/// under one covariance, so that their difference is a likelihood-ratio statistic (with the
+/// covariance re-evaluated per model, a model could lower its χ² by inflating its own
+/// variances). Returns the coefficients, χ² and the whitened residuals.
+fn fixed_ls(
+    data: &FitData,
+    sel: &[usize],
+    enabled: [bool; TERM_COUNT],
+    signed: [bool; TERM_COUNT],
+    at: &[f64; TERM_COUNT],
+    delta: f64,
+) -> Option<([f64; TERM_COUNT], f64, Vec<f64>)> {
+    let p = Problem::new(data, sel);
+    let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
+    if terms.is_empty() || sel.len() < terms.len() + 1 {
+        return None;
+    }
+    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
+    let sigma = p.sigma(at);
+    let v = p.v(&sigma, delta);
+    let (gw, aw) = whiten(&v, &p.g, &p.a)?;
+    let ones = vec![1.0; gw.len()];
+    let c = nnls_subsets(&gw, &aw, &ones, &terms, &signed, &feasible)?;
+    let r: Vec<f64> = p.a.iter().zip(p.pred(&c)).map(|(a, q)| a - q).collect();
+    let (_, rw) = whiten(&v, &[], &r)?;
+    let chi2 = rw.iter().map(|x| x * x).sum::<f64>()
+        / if data.basis.is_none() {
+            delta * delta
+        } else {
+            1.0
+        };
+    Some((c, chi2, rw))
+}
+
+/// Median of χ²(1): a robust scale is median(e²)/this.
+const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
+
+/// Robust χ² per degree of freedom of a fit: the median squared whitened residual over the
+/// median of χ²(1), so a few band-limited points do not set the scale they are judged by.
+fn robust_scale(resid_w: &[f64]) -> f64 {
+    let mut e: Vec<f64> = resid_w.iter().map(|x| x * x).collect();
+    if e.is_empty() {
+        return f64::NAN;
+    }
+    e.sort_by(f64::total_cmp);
+    let k = e.len();
+    let med = if k % 2 == 1 {
+        e[k / 2]
+    } else {
+        0.5 * (e[k / 2 - 1] + e[k / 2])
+    };
+    med / CHI2_1_MEDIAN
+}
+
+fn signed_terms(cfg: &FitConfig) -> [bool; TERM_COUNT] {
+    [cfg.band_limit, false, false, false, false]
+}
+
+/// First position of the fitted range on `data` (see the module docs): 0 unless
+/// [`FitConfig::trim`].
+///
+/// 1. Shape: the points before the first one from which the curve falls with a log-log
+///    slope of at most [`RISE_SLOPE`] are band-limited — no IEEE 952 term makes the Allan
+///    deviation flat or rising at the shortest τ and falling after (a heavily filtered
+///    sensor; white noise always dominates there otherwise).
+/// 2. Statistics: from there, the first point is dropped while it fails the deletion test
+///    against the fit of the points after it: including it raises χ² by more than
+///    [`TRIM_CHI2`] times the robust χ² per degree of freedom of that fit (the median squared
+///    whitened residual over the median of χ²(1): the scale comes from the data, so a model
+///    that misses the curve elsewhere does not decide it, and neither do the band-limited
+///    points still in).
+pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
+    let n = data.points.len();
+    if !cfg.trim || n < MIN_FIT_POINTS + 1 {
+        return 0;
+    }
+    let dev: Vec<f64> = data.points.iter().map(|p| p.avar.sqrt()).collect();
+    let fwd_slope =
+        |i: usize| (dev[i + 1] / dev[i]).ln() / (data.points[i + 1].tau / data.points[i].tau).ln();
+    let mut s = (0..n - 1)
+        .find(|&i| fwd_slope(i) <= RISE_SLOPE)
+        .unwrap_or(0);
+    let signed = signed_terms(cfg);
+    let mode = if data.basis.is_some() {
+        Delta::Zero
+    } else {
+        Delta::Fixed(1.0)
+    };
+    let delta = match mode {
+        Delta::Fixed(d) => d,
+        _ => 0.0,
+    };
+    while n - s > MIN_FIT_POINTS {
+        let rest: Vec<usize> = (s + 1..n).collect();
+        let all: Vec<usize> = (s..n).collect();
+        let Some(base) = gls(data, &rest, cfg.terms, signed, mode, cfg.max_iter) else {
+            break;
+        };
+        // both fits under the covariance of the fit without the point
+        let (Some((_, chi_without, rw)), Some((_, chi_with, _))) = (
+            fixed_ls(data, &rest, cfg.terms, signed, &base.coef, delta),
+            fixed_ls(data, &all, cfg.terms, signed, &base.coef, delta),
+        ) else {
+            break;
+        };
+        let scale = if data.basis.is_some() {
+            robust_scale(&rw).max(1.0)
+        } else {
+            robust_scale(&rw)
+        };
+        if chi_with - chi_without <= TRIM_CHI2 * scale {
+            break;
+        }
+        s += 1;
+    }
+    s
+}
+
+/// Log-log slope at or below which the curve is falling like white noise (−½) or faster:
+/// halfway between flat and −½.
+pub const RISE_SLOPE: f64 = -0.25;
+/// Fewest points a fitted range keeps (five terms and two degrees of freedom).
+pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
+
+/// Fits the model on the contiguous positions `used` of `data`. With
+/// [`FitConfig::select`], forward selection: start from the enabled ones of N and K, then
+/// repeatedly add the enabled nuisance term (Q, B, R) that lowers χ² most (with the full
+/// model's discrepancy δ held fixed), while it lowers it by more than [`SELECT_CHI2`]; the
+/// chosen model is then refitted with its own δ. Terms left out are reported at 0 with the
+/// upper bound of the all-terms fit.
+pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
+    let signed = signed_terms(cfg);
+    let est = if cfg.discrepancy {
+        Delta::Estimate
+    } else {
+        Delta::Zero
+    };
+    let full = gls(data, used, cfg.terms, signed, est, cfg.max_iter);
+    let mut terms = cfg.terms;
+    if cfg.select {
+        let mut t = [false; TERM_COUNT];
+        t[1] = cfg.terms[1];
+        t[3] = cfg.terms[3];
+        if t.iter().any(|x| *x) {
+            // each step tests the candidates under the covariance of the current model (the
+            // null hypothesis), with the full model's discrepancy (see [`fixed_ls`])
+            let d = match (&full, est) {
+                (Some(f), Delta::Estimate) if data.basis.is_some() => f.delta,
+                _ if data.basis.is_none() => 1.0,
+                _ => 0.0,
+            };
+            let dmode = if data.basis.is_none() {
+                Delta::Fixed(1.0)
+            } else {
+                Delta::Fixed(d)
+            };
+            loop {
+                let base = gls(data, used, t, signed, dmode, cfg.max_iter)?;
+                let chi = |tt: [bool; TERM_COUNT]| {
+                    fixed_ls(data, used, tt, signed, &base.coef, d).map(|x| x.1)
+                };
+                let cur = chi(t)?;
+                let best = NUISANCE
+                    .iter()
+                    .copied()
+                    .filter(|&j| cfg.terms[j] && !t[j])
+                    .filter_map(|j| {
+                        let mut tt = t;
+                        tt[j] = true;
+                        Some((j, cur - chi(tt)?))
+                    })
+                    .max_by(|x, y| x.1.total_cmp(&y.1));
+                match best {
+                    Some((j, drop)) if drop > SELECT_CHI2 => t[j] = true,
+                    _ => break,
+                }
+            }
+            terms = t;
+        }
+    }
+    let mut s = if terms == cfg.terms {
+        full.clone()?
+    } else {
+        gls(data, used, terms, signed, est, cfg.max_iter)?
+    };
+    if !cfg.discrepancy && data.basis.is_some() {
+        // plain GLS: standard errors scaled against misfit
+        let scale = (s.chi2 / s.dof.max(1) as f64).max(1.0);
+        for row in s.cov.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= scale;
+            }
+        }
+    }
+    let mut left_out = [false; TERM_COUNT];
+    let mut coef = s.coef;
+    let mut cov = s.cov;
+    for j in 0..TERM_COUNT {
+        if cfg.terms[j] && !terms[j] {
+            left_out[j] = true;
+            coef[j] = 0.0;
+            cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
+        }
+    }
+    let dominant = used
         .iter()
-        .map(|p| dominant_of(&coef, &std::array::from_fn(|j| basis(j, p.tau))))
+        .map(|&i| dominant_term(&coef, data.points[i].tau))
         .collect();
     Some(FitResult {
         coef,
         cov,
-        free,
-        iterations,
-        converged,
-        chi2_per_dof,
+        free: std::array::from_fn(|j| coef[j] != 0.0),
+        left_out,
+        used: used.to_vec(),
+        iterations: s.iterations,
+        converged: s.converged,
+        chi2_per_dof: s.chi2_stat / s.dof.max(1) as f64,
+        delta: if data.basis.is_some() || cfg.discrepancy {
+            s.delta
+        } else {
+            f64::NAN
+        },
+        dof: s.dof,
         dominant,
-        used: pts.iter().map(|(i, _)| *i).collect(),
-        chi2,
-        left_out: [false; TERM_COUNT],
     })
 }
 
+/// The model term contributing most AVAR at τ.
+pub fn dominant_term(coef: &[f64; TERM_COUNT], tau: f64) -> usize {
+    (0..TERM_COUNT)
+        .max_by(|&x, &y| (coef[x] * basis(x, tau)).total_cmp(&(coef[y] * basis(y, tau))))
+        .unwrap_or(1)
+}
+
 /// Interval for coefficient j by inverting the test |ĉ − c| ≤ z·se(c), with se(c) the GLS
-/// standard error when the truth has c_j = c (the other coefficients at their estimates).
+/// standard error when the truth has c_j = c (the other coefficients at their estimates,
+/// the discrepancy δ at its estimate).
 ///
 /// The plain interval ĉ ± z·se(ĉ) is too short above a low estimate: the AVAR variance grows
 /// with the term, so an estimate that came out low also reports a small error. Found with a
-/// fixed-point iteration (≤ [`INVERSION_MAX_ITER`] covariance evaluations per end). For the
-/// diagonal method, or if the covariance cannot be evaluated, the plain interval is returned.
+/// fixed-point iteration (≤ [`INVERSION_MAX_ITER`] covariance evaluations per end). Without a
+/// basis, or if the covariance cannot be evaluated, the plain interval is returned.
 /// Returns (lo, hi) of the coefficient (a squared term), lo ≥ 0; hi = ∞ when the data bound
 /// the term from above at no value (se(c) grows as fast as c/z).
 pub fn inverted_interval(
-    points: &[FitPoint],
+    data: &FitData,
     res: &FitResult,
-    n: usize,
-    tau0: f64,
     cfg: &FitConfig,
     j: usize,
     z: f64,
@@ -419,27 +707,29 @@ pub fn inverted_interval(
     let c_hat = res.coef[j];
     let se_hat = res.cov[j][j].max(0.0).sqrt();
     let plain = ((c_hat - z * se_hat).max(0.0), c_hat + z * se_hat);
-    if cfg.method != FitMethod::Gls || res.left_out[j] {
+    if data.basis.is_none() || res.left_out[j] {
         return plain;
     }
-    let enabled: Vec<usize> = (0..TERM_COUNT)
-        .filter(|&t| cfg.terms[t] && !res.left_out[t])
-        .collect();
-    let ms: Vec<usize> = res.used.iter().map(|&i| points[i].m).collect();
-    let g: Vec<[f64; TERM_COUNT]> = res
-        .used
-        .iter()
-        .map(|&i| std::array::from_fn(|t| basis(t, points[i].tau)))
-        .collect();
-    let a: Vec<f64> = res.used.iter().map(|&i| points[i].avar).collect();
-    let ones = vec![1.0; a.len()];
-    let misfit = res.chi2_per_dof.max(1.0).sqrt();
+    let free: Vec<usize> = (0..TERM_COUNT).filter(|&t| res.free[t] || t == j).collect();
+    let p = Problem::new(data, &res.used);
+    let misfit = if cfg.discrepancy {
+        1.0
+    } else {
+        res.chi2_per_dof.max(1.0).sqrt()
+    };
+    let delta = if cfg.discrepancy { res.delta } else { 0.0 };
     let se_at = |c: f64| -> Option<f64> {
         let mut coef = res.coef;
         coef[j] = c.max(0.0);
-        let sigma = super::avar_cov::avar_cov(&ms, n, tau0, &coef);
-        let (gw, _) = whiten(&sigma, &g, &a)?;
-        Some(covariance(&gw, &ones, &enabled)?[j][j].max(0.0).sqrt() * misfit)
+        let pred = p.pred(&coef);
+        if pred.iter().any(|v| !is_positive(*v)) {
+            return None;
+        }
+        let sigma = p.sigma(&coef);
+        let v = p.v(&sigma, delta);
+        let (gw, _) = whiten(&v, &p.g, &p.a)?;
+        let ones = vec![1.0; gw.len()];
+        Some(covariance(&gw, &ones, &free)?[j][j].max(0.0).sqrt() * misfit)
     };
     let mut hi = plain.1;
     let mut hi_ok = false;
@@ -476,21 +766,22 @@ pub const INVERSION_MAX_ITER: usize = 12;
 /// Fixed point reached when an end moves by less than this fraction.
 const INVERSION_REL_TOL: f64 = 1e-3;
 
-/// L⁻¹G and L⁻¹A with Σ = LLᵀ (Σ scaled to unit diagonal first, tiny ridge for safety).
+/// L⁻¹G and L⁻¹A with V = LLᵀ (V scaled to unit diagonal first, tiny ridge for safety).
+/// `g` may be empty (then only `a` is whitened).
 fn whiten(
-    sigma: &[Vec<f64>],
+    v: &[Vec<f64>],
     g: &[[f64; TERM_COUNT]],
     a: &[f64],
 ) -> Option<(Vec<[f64; TERM_COUNT]>, Vec<f64>)> {
     let k = a.len();
-    let d: Vec<f64> = (0..k).map(|i| sigma[i][i].sqrt()).collect();
-    if d.iter().any(|v| !is_positive(*v)) {
+    let d: Vec<f64> = (0..k).map(|i| v[i][i].sqrt()).collect();
+    if d.iter().any(|x| !is_positive(*x)) {
         return None;
     }
     let mut l = vec![vec![0.0; k]; k];
     for i in 0..k {
         for j in 0..=i {
-            let mut s = sigma[i][j] / (d[i] * d[j]) + if i == j { 1e-10 } else { 0.0 };
+            let mut s = v[i][j] / (d[i] * d[j]) + if i == j { 1e-10 } else { 0.0 };
             for p in 0..j {
                 s -= l[i][p] * l[j][p];
             }
@@ -504,32 +795,40 @@ fn whiten(
             }
         }
     }
-    // forward substitution on the scaled rows (row i divided by d_i)
-    let mut gw = vec![[0.0; TERM_COUNT]; k];
+    let with_g = !g.is_empty();
+    let mut gw = vec![[0.0; TERM_COUNT]; if with_g { k } else { 0 }];
     let mut aw = vec![0.0; k];
     for i in 0..k {
-        let mut ga: [f64; TERM_COUNT] = std::array::from_fn(|j| g[i][j] / d[i]);
         let mut av = a[i] / d[i];
         for p in 0..i {
-            for j in 0..TERM_COUNT {
-                ga[j] -= l[i][p] * gw[p][j];
-            }
             av -= l[i][p] * aw[p];
         }
-        for j in 0..TERM_COUNT {
-            gw[i][j] = ga[j] / l[i][i];
-        }
         aw[i] = av / l[i][i];
+        if with_g {
+            let mut ga: [f64; TERM_COUNT] = std::array::from_fn(|j| g[i][j] / d[i]);
+            for p in 0..i {
+                for j in 0..TERM_COUNT {
+                    ga[j] -= l[i][p] * gw[p][j];
+                }
+            }
+            for j in 0..TERM_COUNT {
+                gw[i][j] = ga[j] / l[i][i];
+            }
+        }
     }
     Some((gw, aw))
 }
 
-/// Weighted NNLS over the enabled terms by enumerating the sets of free terms.
+/// Weighted least squares over the enabled terms with sign constraints (terms not in
+/// `signed` ≥ 0), by enumerating the sets of free terms; `feasible` rejects solutions (e.g.
+/// a model that is not positive at every point).
 fn nnls_subsets(
     g: &[[f64; TERM_COUNT]],
     a: &[f64],
     w: &[f64],
     enabled: &[usize],
+    signed: &[bool; TERM_COUNT],
+    feasible: &dyn Fn(&[f64; TERM_COUNT]) -> bool,
 ) -> Option<[f64; TERM_COUNT]> {
     let k = enabled.len();
     let mut best: Option<(f64, [f64; TERM_COUNT])> = None;
@@ -541,12 +840,15 @@ fn nnls_subsets(
         let Some(sol) = wls(g, a, w, &set) else {
             continue;
         };
-        if sol.iter().any(|v| *v < 0.0) {
+        if set.iter().zip(&sol).any(|(&j, v)| *v < 0.0 && !signed[j]) {
             continue;
         }
         let mut c = [0.0; TERM_COUNT];
         for (s, &j) in set.iter().enumerate() {
             c[j] = sol[s];
+        }
+        if !feasible(&c) {
+            continue;
         }
         let cost: f64 = g
             .iter()
@@ -610,13 +912,16 @@ fn wls(g: &[[f64; TERM_COUNT]], a: &[f64], w: &[f64], set: &[usize]) -> Option<V
     Some(x.iter().zip(&s).map(|(xi, si)| xi / si).collect())
 }
 
-/// (GᵀWG)⁻¹ over the enabled terms, embedded in a 5×5 matrix.
+/// (GᵀWG)⁻¹ over the terms of `set`, embedded in a 5×5 matrix.
 fn covariance(
     g: &[[f64; TERM_COUNT]],
     w: &[f64],
     set: &[usize],
 ) -> Option<[[f64; TERM_COUNT]; TERM_COUNT]> {
     let s = col_scale(g, w, set);
+    if s.iter().any(|v| !is_positive(*v)) {
+        return None;
+    }
     let zeros = vec![0.0; g.len()];
     let (n, _) = normal_eq(g, &zeros, w, set, &s);
     let k = set.len();
@@ -673,38 +978,52 @@ pub(super) fn solve_spd(n: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::oadev::Overlap;
     use super::*;
 
     /// Noise-free data: the fit must return the generating coefficients to rounding.
-    const EXACT_REL_TOL: f64 = 1e-8;
+    const EXACT_REL_TOL: f64 = 1e-7;
 
-    fn pts(coef: [f64; 5]) -> Vec<FitPoint> {
-        (0..40)
-            .map(|k| {
-                let tau = 0.005 * 1.4f64.powi(k);
-                let avar = (0..5).map(|j| coef[j] * basis(j, tau)).sum();
+    fn data_for<'a>(
+        truth: [f64; 5],
+        ms: &[usize],
+        tau0: f64,
+        cov_basis: Option<&'a CovBasis>,
+    ) -> FitData<'a> {
+        let points: Vec<FitPoint> = ms
+            .iter()
+            .map(|&m| {
+                let tau = m as f64 * tau0;
                 FitPoint {
-                    m: k as usize + 1,
+                    m,
                     tau,
-                    avar,
-                    edf: [100.0; 5],
+                    avar: (0..5).map(|j| truth[j] * basis(j, tau)).sum(),
                 }
             })
-            .collect()
+            .collect();
+        let n = points.len();
+        FitData {
+            points,
+            curve_index: (0..n).collect(),
+            basis: cov_basis,
+            basis_index: (0..n).collect(),
+        }
     }
 
     #[test]
-    fn recovers_exact_model() {
+    fn recovers_exact_model_without_basis() {
         let truth = [1e-8, 2.25e-4, 1e-7, 2.5e-9, 1e-14];
+        let ms: Vec<usize> = (0..40).map(|k| 1.4f64.powi(k).round() as usize).collect();
+        let mut ms = ms;
+        ms.dedup();
+        let d = data_for(truth, &ms, 0.005, None);
+        let used: Vec<usize> = (0..d.points.len()).collect();
         let r = fit(
-            &pts(truth),
-            &[],
-            1_000_000,
-            0.005,
+            &d,
+            &used,
             &FitConfig {
-                method: FitMethod::Diagonal,
-                per_octave: 1000,
                 select: false,
+                band_limit: false,
                 ..FitConfig::default()
             },
         )
@@ -735,16 +1054,7 @@ mod tests {
             min_clusters: 4,
         }
         .cluster_sizes(n);
-        let pts: Vec<FitPoint> = fine
-            .iter()
-            .map(|&m| FitPoint {
-                m,
-                tau: m as f64,
-                avar: 1.0,
-                edf: [1.0; 5],
-            })
-            .collect();
-        let got: Vec<usize> = thin_to_grid(&pts, 2).iter().map(|&i| pts[i].m).collect();
+        let got: Vec<usize> = thin_to_grid(&fine, 2).iter().map(|&i| fine[i]).collect();
         // the coarse grid, plus the fine grid's last point when it is within half a coarse
         // step of the next coarse target (it carries the longest τ)
         assert_eq!(got[..coarse.len()], coarse[..]);
@@ -758,16 +1068,7 @@ mod tests {
             min_clusters: 4,
         }
         .cluster_sizes(n);
-        let pts: Vec<FitPoint> = odd
-            .iter()
-            .map(|&m| FitPoint {
-                m,
-                tau: m as f64,
-                avar: 1.0,
-                edf: [1.0; 5],
-            })
-            .collect();
-        let got = thin_to_grid(&pts, 2);
+        let got = thin_to_grid(&odd, 2);
         assert!(
             got.len() + 3 >= coarse.len() && got.len() <= coarse.len() + 1,
             "{} vs {}",
@@ -777,33 +1078,16 @@ mod tests {
     }
 
     #[test]
-    fn gls_recovers_exact_model() {
-        // noise-free AVAR of a white + random-walk model: GLS and the selection must return it
+    fn gls_recovers_exact_model_and_keeps_the_whole_range() {
+        // noise-free AVAR of a white + random-walk model: GLS, the range choice and the
+        // selection must return it
         let truth = [0.0, 2.25e-4, 0.0, 2.5e-9, 0.0];
         let ms: Vec<usize> = (0..20).map(|k| 1usize << k).collect();
-        let pts: Vec<FitPoint> = ms
-            .iter()
-            .map(|&m| {
-                let tau = m as f64 * 0.005;
-                FitPoint {
-                    m,
-                    tau,
-                    avar: (0..5).map(|j| truth[j] * basis(j, tau)).sum(),
-                    edf: [100.0; 5],
-                }
-            })
-            .collect();
-        let r = fit(
-            &pts,
-            &[],
-            4_000_000,
-            0.005,
-            &FitConfig {
-                per_octave: 1,
-                ..FitConfig::default()
-            },
-        )
-        .unwrap();
+        let b = CovBasis::new(&ms, 4_000_000, 0.005, Overlap::Overlapping);
+        let d = data_for(truth, &ms, 0.005, Some(&b));
+        assert_eq!(choose_start(&d, &FitConfig::default()), 0);
+        let used: Vec<usize> = (0..ms.len()).collect();
+        let r = fit(&d, &used, &FitConfig::default()).unwrap();
         for j in [1, 3] {
             assert!(
                 ((r.coef[j] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
@@ -818,41 +1102,47 @@ mod tests {
             "nuisance terms must stay out: {:?}",
             r.left_out
         );
+        assert_eq!(r.delta, 0.0, "an exact model needs no discrepancy");
         assert!(r.converged);
     }
 
     #[test]
-    fn absent_terms_stay_at_zero() {
-        let truth = [0.0, 2.25e-4, 0.0, 2.5e-9, 0.0];
-        let r = fit(
-            &pts(truth),
-            &[],
-            1_000_000,
-            0.005,
-            &FitConfig {
-                method: FitMethod::Diagonal,
-                per_octave: 1000,
-                select: false,
-                ..FitConfig::default()
-            },
-        )
-        .unwrap();
-        for j in [1, 3] {
-            assert!(
-                ((r.coef[j] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
-                "term {}: {:e}",
-                TERM_NAMES[j],
-                r.coef[j]
-            );
+    fn band_limited_start_is_excluded() {
+        // white noise through a first-order low-pass of time constant T (exact AVAR,
+        // AVAR = N²/τ·[1 − T/(2τ)(3 − 4e^{−τ/T} + e^{−2τ/T})]) plus a random walk: the
+        // points within a few T are not the model's and must be left out, the rest kept
+        let (n2, k2, t) = (2.25e-4, 2.5e-9, 0.05);
+        let ms: Vec<usize> = (0..20).map(|k| 1usize << k).collect();
+        let tau0 = 0.005;
+        let b = CovBasis::new(&ms, 4_000_000, tau0, Overlap::Overlapping);
+        let mut d = data_for([0.0; 5], &ms, tau0, Some(&b));
+        for p in d.points.iter_mut() {
+            let x = p.tau / t;
+            let filt = 1.0 - (3.0 - 4.0 * (-x).exp() + (-2.0 * x).exp()) / (2.0 * x);
+            p.avar = n2 / p.tau * filt + k2 * p.tau / 3.0;
         }
-        for j in [0, 2, 4] {
-            assert!(
-                r.coef[j] >= 0.0 && r.coef[j] * basis(j, 1.0) < 1e-10 * 2.25e-4,
-                "term {}: {:e}",
-                TERM_NAMES[j],
-                r.coef[j]
-            );
-        }
+        let s = choose_start(&d, &FitConfig::default());
+        let tau_start = d.points[s].tau;
+        assert!(
+            tau_start > 2.0 * t && tau_start < 40.0 * t,
+            "start {tau_start} s for a {t} s filter"
+        );
+        let used: Vec<usize> = (s..ms.len()).collect();
+        let r = fit(&d, &used, &FitConfig::default()).unwrap();
+        // the filter's exponential remainder just above the start bends the fitted terms a
+        // little (measured: N −0.8 %, K −8 % on these noise-free points)
+        const N_FILTER_REL_TOL: f64 = 0.02;
+        const K_FILTER_REL_TOL: f64 = 0.10;
+        assert!(
+            (r.coef[1].sqrt() / n2.sqrt() - 1.0).abs() < N_FILTER_REL_TOL,
+            "N² {:e} vs {n2:e}",
+            r.coef[1]
+        );
+        assert!(
+            (r.coef[3].sqrt() / k2.sqrt() - 1.0).abs() < K_FILTER_REL_TOL,
+            "K² {:e} vs {k2:e}",
+            r.coef[3]
+        );
     }
 
     #[test]
@@ -865,7 +1155,7 @@ mod tests {
             .map(|k| 1.0 / k as f64 - 0.01 * k as f64 / 3.0)
             .collect();
         let w = vec![1.0; g.len()];
-        let c = nnls_subsets(&g, &a, &w, &[1, 3]).unwrap();
+        let c = nnls_subsets(&g, &a, &w, &[1, 3], &[false; 5], &|_| true).unwrap();
         assert_eq!(c[3], 0.0, "K must be clamped at 0");
         // with K = 0, N² is the 1-D LS solution
         let num: f64 = g.iter().zip(&a).map(|(gi, ai)| gi[1] * ai).sum();

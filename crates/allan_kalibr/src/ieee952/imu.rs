@@ -93,7 +93,7 @@ impl Sensor {
             Sensor::Acc => "m/s^2",
         }
     }
-    fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             Sensor::Gyro => "gyroscope",
             Sensor::Acc => "accelerometer",
@@ -175,6 +175,11 @@ fn term_text(t: &Term, unit: &str) -> String {
             "not resolved: never dominant in this record ({:.2e} {unit}, 95 % up to {:.2e})",
             t.value, t.hi
         ),
+        Verdict::RegionReading => format!(
+            "{:.4e} {unit} [95 %: {:.4e}, {:.4e}] (IEEE 952 region reading)",
+            t.value, t.lo, t.hi
+        ),
+        Verdict::RegionBound => format!("not resolved (95 % upper bound {:.2e} {unit})", t.hi),
         Verdict::NotFitted => "not in the fitted model".to_string(),
     }
 }

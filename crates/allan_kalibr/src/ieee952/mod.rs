@@ -1,11 +1,14 @@
-//! The corrected estimator shared by both analysers (issue 6): fully overlapping Allan
-//! deviation on a log grid of distinct cluster sizes, Greenhall EDF confidence intervals,
-//! power-law noise identification, and a weighted fit of the IEEE Std 952 terms with a standard
-//! error and a "resolved" verdict for each.
+//! The corrected estimator shared by both analysers: fully overlapping Allan deviation on a
+//! log grid of distinct cluster sizes, Greenhall EDF confidence intervals, power-law noise
+//! identification, and a fit of the IEEE Std 952 terms that holds on real sensors — a τ range
+//! the model can describe, weights that survive model error, a goodness of fit and a verdict
+//! per axis, a 95 % interval and a verdict per term, and the classic region readings as a
+//! cross-check and fallback.
 //!
 //! # Units
 //! The input is a rate series y in a unit U (rad/s for a gyro, m/s² for an accelerometer),
-//! one sample every τ0 seconds. Deviations are in U. The terms are continuous-time:
+//! one sample every τ0 seconds, or an Allan curve in U. Deviations are in U. The terms are
+//! continuous-time:
 //!
 //! | term | meaning | unit (gyro / acc) |
 //! |---|---|---|
@@ -18,11 +21,23 @@
 //! N is Kalibr's `*_noise_density` and K its `*_random_walk`.
 //!
 //! # Overview
-//! [`analyse`] runs everything: [`oadev::Phase`] (estimator), [`tau_grid::GridSpec`] (which m),
-//! [`noise_id::identify`] (α per point, lag-1 ACF or B1), [`edf::greenhall_edf`] (Greenhall &
-//! Riley 2004, the EDF behind IEEE 1139 / Stable32 — not the simpler Howe/Barnes formulas),
-//! [`ci::chi2_interval`] (per-point χ² bounds), [`fit::fit`] (IEEE 952 terms by generalised
-//! least squares with the covariance of the overlapping points from [`avar_cov`]).
+//! [`analyse`] (samples) and [`analyse_curve`] (a curve from any tool) run everything:
+//! [`oadev::Phase`] (estimator), [`tau_grid::GridSpec`] (which m), [`noise_id::identify`]
+//! (α per point, lag-1 ACF or B1), [`edf::greenhall_edf`] (Greenhall & Riley 2004, the EDF
+//! behind IEEE 1139 / Stable32), [`ci::chi2_interval`] (per-point χ² bounds),
+//! [`fit`] (the τ range, the GLS fit with its model-discrepancy component, term selection —
+//! the rules are in that module's docs) with the covariance of the points from
+//! [`avar_cov`], [`region`] (the IEEE 952 graphical readings), [`curves_in`] (reading other tools'
+//! curves), [`imu`] (the six axes as both analysers print them) and [`files`] (the terms
+//! and curves CSVs and the Kalibr/VINS/ORB-SLAM3 files).
+//!
+//! # Verdicts
+//! Per axis ([`AxisVerdict`]): the model fits the whole curve; the model fits from τ_lo on
+//! (the shorter τ are band-limited: the sensor's low-pass filter or decimation); or no
+//! reliable fit (then the terms are the region readings, and say so). A fit is declared only
+//! where the fitted model stays within the larger of [`FIT_TOL`] and the point's own 95 %
+//! band at every curve point of its range. Per term ([`Verdict`]): resolved only with a
+//! 95 % lower bound above 0, dominant somewhere in the fitted range, and a fitting model.
 //!
 //! # How good can K be?
 //! For white noise N plus random walk K over T seconds no unbiased estimator beats
@@ -32,27 +47,39 @@
 
 pub mod avar_cov;
 pub mod ci;
+pub mod curves_in;
 pub mod edf;
 pub mod error;
+pub mod files;
 pub mod fit;
 pub mod imu;
 pub mod noise_id;
 pub mod oadev;
+pub mod region;
 pub mod tau_grid;
 
 #[cfg(test)]
 mod tests_accuracy;
 #[cfg(test)]
+mod tests_real;
+#[cfg(test)]
 mod tests_stable32;
 
+pub use avar_cov::CovBasis;
 pub use error::Ieee952Error;
-pub use fit::{FitConfig, FitMethod};
+pub use fit::FitConfig;
 pub use noise_id::IdMethod;
 pub use oadev::{Overlap, Phase};
 pub use tau_grid::GridSpec;
 
 use rayon::prelude::*;
 use statrs::distribution::{ContinuousCDF, Normal};
+
+/// The model may miss a curve point by this fraction (ADEV) where the point's own 95 % band
+/// is narrower: the issue's bar for "the model describes the curve".
+pub const FIT_TOL: f64 = 0.10;
+/// A declared fit range spans at least this many decades of τ; shorter is "no reliable fit".
+pub const MIN_RANGE_DECADES: f64 = 1.0;
 
 /// Analysis settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,42 +118,153 @@ pub enum AlphaSource {
     Assumed,
 }
 
-/// One point of the overlapping Allan deviation curve.
+/// One measured point handed to the analysis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurvePoint {
+    /// Cluster size in samples (of τ0).
+    pub m: usize,
+    /// τ = m·τ0 in seconds.
+    pub tau: f64,
+    /// Allan variance, U² (NaN or ≤ 0 when the tool gave none).
+    pub avar: f64,
+    /// Identified α, when the samples were at hand.
+    pub id: Option<i32>,
+    /// How α was identified.
+    pub id_method: IdMethod,
+}
+
+/// A measured Allan curve of one axis, from samples or from another tool's file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurveData {
+    /// Sample period τ0 (or the curve's τ unit), s.
+    pub tau0: f64,
+    /// Rate samples behind the curve; `None` when unknown (then no intervals).
+    pub n: Option<usize>,
+    /// Estimator of the curve.
+    pub kind: Overlap,
+    /// Points, ascending m.
+    pub points: Vec<CurvePoint>,
+}
+
+impl CurveData {
+    /// Overlapping Allan variance of `y` on the grid of `cfg`, with the noise identification.
+    pub fn from_samples(y: &[f64], tau0: f64, cfg: &Config) -> Result<CurveData, Ieee952Error> {
+        check_config(tau0, cfg)?;
+        if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(Ieee952Error::NonFinite { index, value });
+        }
+        let ms = cfg.grid.cluster_sizes(y.len());
+        let min = 3 * cfg.grid.min_clusters.max(3);
+        if ms.is_empty() || y.len() < min {
+            return Err(Ieee952Error::TooShort { n: y.len(), min });
+        }
+        let phase = Phase::from_rate(y, tau0);
+        let points = ms
+            .par_iter()
+            .filter_map(|&m| {
+                let p = phase.avar(m, Overlap::Overlapping)?;
+                let id = noise_id::identify(&phase, m);
+                Some(CurvePoint {
+                    m: p.m,
+                    tau: p.tau,
+                    avar: p.avar,
+                    id: id.alpha,
+                    id_method: id.method,
+                })
+            })
+            .collect();
+        Ok(CurveData {
+            tau0,
+            n: Some(y.len()),
+            kind: Overlap::Overlapping,
+            points,
+        })
+    }
+
+    /// Cluster sizes of the fit grid (the valid points nearest 2^(k/p)).
+    pub fn fit_ms(&self, per_octave: u32) -> Vec<usize> {
+        let valid: Vec<usize> = self
+            .points
+            .iter()
+            .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+            .map(|p| p.m)
+            .collect();
+        fit::thin_to_grid(&valid, per_octave)
+            .into_iter()
+            .map(|i| valid[i])
+            .collect()
+    }
+
+    /// The statistical covariance basis of the fit grid (None without a sample count).
+    pub fn basis(&self, per_octave: u32) -> Option<CovBasis> {
+        let n = self.n?;
+        Some(CovBasis::new(
+            &self.fit_ms(per_octave),
+            n,
+            self.tau0,
+            self.kind,
+        ))
+    }
+}
+
+fn check_config(tau0: f64, cfg: &Config) -> Result<(), Ieee952Error> {
+    if !(tau0 > 0.0 && tau0.is_finite()) {
+        return Err(Ieee952Error::BadSamplePeriod(tau0));
+    }
+    for c in [cfg.curve_confidence, cfg.term_confidence] {
+        if !(c > 0.0 && c < 1.0) {
+            return Err(Ieee952Error::BadConfidence(c));
+        }
+    }
+    Ok(())
+}
+
+/// One point of the analysed Allan deviation curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {
     /// Cluster size in samples.
     pub m: usize,
     /// τ = m·τ0 in seconds.
     pub tau: f64,
-    /// Overlapping Allan variance, U².
+    /// Allan variance, U².
     pub avar: f64,
-    /// Overlapping Allan deviation, U.
+    /// Allan deviation, U.
     pub adev: f64,
-    /// Lower bound of the deviation at `Config::curve_confidence`, U.
+    /// Lower bound of the deviation at `Config::curve_confidence`, U (NaN: no sample count).
     pub lo: f64,
     /// Upper bound of the deviation at `Config::curve_confidence`, U.
     pub hi: f64,
+    /// Lower bound at 95 %, U.
+    pub lo95: f64,
+    /// Upper bound at 95 %, U.
+    pub hi95: f64,
     /// Greenhall EDF used for the bounds.
     pub edf: f64,
     /// Power-law α used for the EDF.
     pub alpha: i32,
     /// Where α came from.
     pub alpha_source: AlphaSource,
-    /// Number of second differences averaged.
-    pub n_terms: usize,
+    /// Inside the fitted range.
+    pub in_range: bool,
+    /// Fitted model deviation at this τ (NaN without a fit).
+    pub model: f64,
 }
 
 /// Whether a term can be reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
-    /// Positive with its lower bound above 0 and dominant somewhere on the curve.
+    /// Positive with its lower bound above 0 and dominant somewhere in the fitted range.
     Resolved,
     /// The lower bound of its interval is 0: the data do not show the term.
     NotSignificant,
-    /// Significant, but never the largest term at any τ of the curve: the record is too short
-    /// (or too long) to see it on its own, so its value leans on the model.
+    /// Significant, but never the largest term in the fitted range: its value leans on the
+    /// model.
     NeverDominant,
-    /// Not in the fitted model, or the fit failed.
+    /// No reliable fit: the value is the IEEE 952 region reading, with its own interval.
+    RegionReading,
+    /// No reliable fit and no region for the term: only the 95 % upper bound is known.
+    RegionBound,
+    /// Not in the fitted model, or nothing could be computed.
     NotFitted,
 }
 
@@ -139,7 +277,7 @@ pub struct Term {
     pub std_err: f64,
     /// Lower end of the interval at `Config::term_confidence`, in the term's unit: the
     /// square root of the coefficient interval {c ≥ 0 : |ĉ − c| ≤ z·se(c)}
-    /// ([`fit::inverted_interval`]).
+    /// ([`fit::inverted_interval`]). NaN without a sample count.
     pub lo: f64,
     /// Upper end of the interval.
     pub hi: f64,
@@ -148,9 +286,10 @@ pub struct Term {
 }
 
 impl Term {
-    /// The value when resolved, else `None` ("say so instead of printing a number").
+    /// The value when resolved (or read from its region), else `None` ("say so instead of
+    /// printing a number").
     pub fn reported(&self) -> Option<f64> {
-        (self.verdict == Verdict::Resolved).then_some(self.value)
+        matches!(self.verdict, Verdict::Resolved | Verdict::RegionReading).then_some(self.value)
     }
 
     fn not_fitted() -> Term {
@@ -160,6 +299,26 @@ impl Term {
             lo: f64::NAN,
             hi: f64::NAN,
             verdict: Verdict::NotFitted,
+        }
+    }
+
+    fn from_reading(r: Option<region::Reading>) -> Term {
+        match r {
+            Some(r) if r.kind == region::ReadingKind::Line => Term {
+                value: r.value,
+                std_err: f64::NAN,
+                lo: r.lo,
+                hi: r.hi,
+                verdict: Verdict::RegionReading,
+            },
+            Some(r) => Term {
+                value: 0.0,
+                std_err: f64::NAN,
+                lo: 0.0,
+                hi: r.hi,
+                verdict: Verdict::RegionBound,
+            },
+            None => Term::not_fitted(),
         }
     }
 }
@@ -186,97 +345,224 @@ impl Terms {
     }
 }
 
+/// What the fit says about one axis.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AxisVerdict {
+    /// The model describes the curve over `range` (τ of the first and last fit point, s):
+    /// every curve point there is within [`FIT_TOL`] or its own 95 % band of the model.
+    Fits {
+        /// Declared range, s.
+        range: (f64, f64),
+        /// Shorter τ left out: band-limited (the sensor's low-pass filter or decimation).
+        short_cut: bool,
+        /// Longer τ left out: the curve does something the model has no term for there (a
+        /// bump, a dip, a turn-down).
+        long_cut: bool,
+    },
+    /// No reliable fit; the terms are the IEEE 952 region readings.
+    NoReliableFit {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+impl AxisVerdict {
+    /// The model describes a declared range.
+    pub fn fits(&self) -> bool {
+        matches!(self, AxisVerdict::Fits { .. })
+    }
+
+    /// The declared range, when the model fits.
+    pub fn range(&self) -> Option<(f64, f64)> {
+        match self {
+            AxisVerdict::Fits { range, .. } => Some(*range),
+            AxisVerdict::NoReliableFit { .. } => None,
+        }
+    }
+}
+
+impl std::fmt::Display for AxisVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AxisVerdict::Fits {
+                range,
+                short_cut,
+                long_cut,
+            } => {
+                if !short_cut && !long_cut {
+                    return write!(f, "model fits");
+                }
+                write!(
+                    f,
+                    "model fits τ = {} – {} s; ",
+                    short(range.0),
+                    short(range.1)
+                )?;
+                match (short_cut, long_cut) {
+                    (true, true) => write!(
+                        f,
+                        "does not describe τ < {} s (band-limited) nor τ > {} s (the curve bends where the model has no term)",
+                        short(range.0),
+                        short(range.1)
+                    ),
+                    (true, false) => write!(
+                        f,
+                        "does not describe τ < {} s (band-limited)",
+                        short(range.0)
+                    ),
+                    _ => write!(
+                        f,
+                        "does not describe τ > {} s (the curve bends where the model has no term)",
+                        short(range.1)
+                    ),
+                }
+            }
+            AxisVerdict::NoReliableFit { reason } => write!(f, "no reliable fit: {reason}"),
+        }
+    }
+}
+
+/// A number in 3 significant digits for messages.
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let e = x.abs().log10().floor() as i32;
+    if (-3..5).contains(&e) {
+        let d = (2 - e).max(0) as usize;
+        format!("{x:.d$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
 /// Fit diagnostics.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FitSummary {
-    /// Coefficients Q², N², B², K², R².
+    /// Coefficients Q², N², B², K², R² (Q² < 0: the low-pass correction).
     pub coef: [f64; 5],
-    /// Their covariance (inflated, see [`FitConfig::correlation_inflation`]).
+    /// Their covariance.
     pub cov: [[f64; 5]; 5],
     /// Re-weighting iterations.
     pub iterations: usize,
     /// Whether the re-weighting converged.
     pub converged: bool,
-    /// Weighted χ² per degree of freedom (≈ 1 or below when the model fits).
+    /// Statistical χ² per degree of freedom over the fitted range (NaN without a sample
+    /// count); ≈ 1 when the model describes the points within their statistics.
     pub chi2_per_dof: f64,
+    /// Relative model discrepancy δ: the fraction by which the model misses a point beyond
+    /// the statistics (0 when it does not).
+    pub delta: f64,
+    /// Fitted range (τ of the first and last fit point), s.
+    pub tau_range: (f64, f64),
+    /// Fit points used.
+    pub points: usize,
+    /// Largest |model/data − 1| (ADEV) over the curve points of the range.
+    pub max_misfit: f64,
 }
 
 /// Everything [`analyse`] finds for one series.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Analysis {
-    /// Number of samples analysed.
-    pub n: usize,
+    /// Number of samples analysed (None: unknown, curve given without it).
+    pub n: Option<usize>,
     /// Sample period, s.
     pub tau0: f64,
-    /// Overlapping Allan deviation curve.
+    /// Estimator of the curve.
+    pub kind: Overlap,
+    /// Allan deviation curve.
     pub curve: Vec<Point>,
     /// IEEE 952 terms.
     pub terms: Terms,
-    /// Fit diagnostics (`None` when the fit failed, then every term is `NotFitted`).
+    /// Fit diagnostics (`None` when no fit was possible).
     pub fit: Option<FitSummary>,
+    /// The verdict on the axis.
+    pub verdict: AxisVerdict,
+    /// The region readings (cross-check; the terms when there is no reliable fit).
+    pub region: region::Readings,
 }
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
 pub fn analyse(y: &[f64], tau0: f64, cfg: &Config) -> Result<Analysis, Ieee952Error> {
-    if !(tau0 > 0.0 && tau0.is_finite()) {
-        return Err(Ieee952Error::BadSamplePeriod(tau0));
-    }
-    for c in [cfg.curve_confidence, cfg.term_confidence] {
-        if !(c > 0.0 && c < 1.0) {
-            return Err(Ieee952Error::BadConfidence(c));
-        }
-    }
-    if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(Ieee952Error::NonFinite { index, value });
-    }
-    let ms = cfg.grid.cluster_sizes(y.len());
-    let min = 3 * cfg.grid.min_clusters.max(3);
-    if ms.is_empty() || y.len() < min {
-        return Err(Ieee952Error::TooShort { n: y.len(), min });
-    }
-    let phase = Phase::from_rate(y, tau0);
-    let n_phase = y.len() + 1;
-    // per point: AVAR, noise ID and the EDF for every α (all independent: parallel over m)
-    let raw: Vec<(oadev::AvarPoint, noise_id::NoiseId, [f64; 5])> = ms
-        .par_iter()
-        .filter_map(|&m| {
-            let p = phase.avar(m, Overlap::Overlapping)?;
-            let id = noise_id::identify(&phase, m);
-            let edf: [f64; 5] = std::array::from_fn(|k| {
-                edf::greenhall_edf(2 - k as i32, m, n_phase, Overlap::Overlapping)
-                    .unwrap_or(f64::NAN)
-            });
-            Some((p, id, edf))
-        })
-        .collect();
-    let fit_points: Vec<fit::FitPoint> = raw
-        .iter()
-        .map(|(p, _, edf)| fit::FitPoint {
-            m: p.m,
-            tau: p.tau,
-            avar: p.avar,
-            edf: *edf,
-        })
-        .collect();
-    let ids: Vec<Option<i32>> = raw.iter().map(|(_, id, _)| id.alpha).collect();
-    let fitted = fit::fit(&fit_points, &ids, y.len(), tau0, &cfg.fit);
+    let data = CurveData::from_samples(y, tau0, cfg)?;
+    let basis = data.basis(cfg.fit.per_octave);
+    Ok(analyse_curve(&data, cfg, basis.as_ref()))
+}
 
-    let curve: Vec<Point> = raw
+/// The z of the two-sided interval at `confidence`.
+fn z_of(confidence: f64) -> f64 {
+    Normal::new(0.0, 1.0)
+        .map(|d| d.inverse_cdf(0.5 + confidence / 2.0))
+        .unwrap_or(1.96)
+}
+
+/// Analyses a measured curve. `basis` is the statistical covariance of its fit grid
+/// ([`CurveData::basis`]; shared by the axes of an IMU), `None` when the sample count is
+/// unknown.
+pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
+    let fit_ms = data.fit_ms(cfg.fit.per_octave);
+    let valid: Vec<&CurvePoint> = data
+        .points
         .iter()
-        .enumerate()
-        .map(|(i, (p, id, edf))| {
-            let (alpha, alpha_source) = match (id.alpha, id.method) {
+        .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+        .collect();
+    let basis = basis.filter(|b| fit_ms.iter().all(|m| b.ms().binary_search(m).is_ok()));
+    let fd = fit::FitData {
+        points: fit_ms
+            .iter()
+            .map(|&m| {
+                let p = valid
+                    .iter()
+                    .find(|p| p.m == m)
+                    .expect("fit grid from valid");
+                fit::FitPoint {
+                    m,
+                    tau: p.tau,
+                    avar: p.avar,
+                }
+            })
+            .collect(),
+        curve_index: fit_ms
+            .iter()
+            .map(|&m| data.points.iter().position(|p| p.m == m).unwrap_or(0))
+            .collect(),
+        basis,
+        basis_index: fit_ms
+            .iter()
+            .map(|m| basis.map_or(0, |b| b.ms().binary_search(m).unwrap_or(0)))
+            .collect(),
+    };
+    let n_phase = data.n.map(|n| n + 1);
+
+    // the range and the fit, then the declared-fit check
+    let (fitted, verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg);
+    // the curve with its bounds
+    let range = verdict.range();
+    let curve: Vec<Point> = data
+        .points
+        .iter()
+        .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+        .map(|p| {
+            let (alpha, alpha_source) = match (p.id, p.id_method) {
                 (Some(a), IdMethod::Lag1) => (a, AlphaSource::Lag1),
                 (Some(a), _) => (a, AlphaSource::B1),
                 (None, _) => match &fitted {
-                    Some(f) => (fit::TERM_ALPHA[f.dominant[i]], AlphaSource::Model),
+                    Some(f) => (
+                        fit::TERM_ALPHA[fit::dominant_term(&f.coef, p.tau)],
+                        AlphaSource::Model,
+                    ),
                     None => (0, AlphaSource::Assumed),
                 },
             };
-            let nu = edf[fit::alpha_index(alpha)];
+            let nu = n_phase
+                .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
+                .unwrap_or(f64::NAN);
             let adev = p.avar.sqrt();
             let (lo, hi) =
                 ci::chi2_interval(adev, nu, cfg.curve_confidence).unwrap_or((f64::NAN, f64::NAN));
+            let (lo95, hi95) = ci::chi2_interval(adev, nu, 0.95).unwrap_or((f64::NAN, f64::NAN));
+            let in_range = range
+                .is_some_and(|(a, b)| p.tau >= a * (1.0 - 1e-12) && p.tau <= b * (1.0 + 1e-12));
             Point {
                 m: p.m,
                 tau: p.tau,
@@ -284,81 +570,262 @@ pub fn analyse(y: &[f64], tau0: f64, cfg: &Config) -> Result<Analysis, Ieee952Er
                 adev,
                 lo,
                 hi,
+                lo95,
+                hi95,
                 edf: nu,
                 alpha,
                 alpha_source,
-                n_terms: p.n_terms,
+                in_range,
+                model: fitted
+                    .as_ref()
+                    .map_or(f64::NAN, |f| f.predict(p.tau).max(0.0).sqrt()),
             }
         })
         .collect();
 
-    let (terms, fit) = match fitted {
-        Some(f) => (make_terms(&f, &fit_points, y.len(), tau0, cfg), Some(f)),
-        None => {
-            let t = Term::not_fitted();
-            (
-                Terms {
-                    q: t,
-                    n: t,
-                    b: t,
-                    k: t,
-                    r: t,
-                },
-                None,
-            )
-        }
+    // region readings on the fit grid of the usable range (all of it without a fit)
+    let region_from = fitted
+        .as_ref()
+        .map_or(0, |f| f.used.first().copied().unwrap_or(0));
+    let region_pts: Vec<Point> = fd.points[region_from..]
+        .iter()
+        .filter_map(|fp| curve.iter().find(|c| c.m == fp.m).copied())
+        .collect();
+    let region = region::read(&region_pts);
+
+    let terms = match (&fitted, verdict.fits()) {
+        (Some(f), true) => make_terms(f, &fd, cfg),
+        _ => Terms {
+            q: Term::not_fitted(),
+            n: Term::from_reading(region.n),
+            b: Term::from_reading(region.b),
+            k: Term::from_reading(region.k),
+            r: Term::not_fitted(),
+        },
     };
-    let fit = fit.map(|f| FitSummary {
+    let fit = fitted.map(|f| FitSummary {
         coef: f.coef,
         cov: f.cov,
         iterations: f.iterations,
         converged: f.converged,
         chi2_per_dof: f.chi2_per_dof,
+        delta: f.delta,
+        tau_range: (
+            fd.points[f.used[0]].tau,
+            fd.points[*f.used.last().unwrap_or(&0)].tau,
+        ),
+        points: f.used.len(),
+        max_misfit,
     });
-    Ok(Analysis {
-        n: y.len(),
-        tau0,
+    Analysis {
+        n: data.n,
+        tau0: data.tau0,
+        kind: data.kind,
         curve,
         terms,
         fit,
-    })
+        verdict,
+        region,
+    }
 }
 
-fn make_terms(
-    f: &fit::FitResult,
-    points: &[fit::FitPoint],
-    n: usize,
-    tau0: f64,
+/// Chooses the fitted range and fits it: the start from [`fit::choose_start`], then the
+/// declared-fit check — every curve point of the range within the larger of [`FIT_TOL`] and
+/// its 95 % band of the model. A miss among the first points of the range moves the start
+/// past it; a miss further up ends the range before it (the long τ the model cannot
+/// describe). Fewer than [`fit::MIN_FIT_POINTS`] points or less than [`MIN_RANGE_DECADES`]
+/// left: no reliable fit. Returns the last fit, the verdict and the largest misfit.
+fn declare_fit(
+    data: &CurveData,
+    fd: &fit::FitData,
+    valid: &[&CurvePoint],
     cfg: &Config,
-) -> Terms {
-    let z = Normal::new(0.0, 1.0)
-        .map(|d| d.inverse_cdf(0.5 + cfg.term_confidence / 2.0))
-        .unwrap_or(1.96);
+) -> (Option<fit::FitResult>, AxisVerdict, f64) {
+    let np = fd.points.len();
+    let mut start = fit::choose_start(fd, &cfg.fit);
+    let mut end = np;
+    let mut long_cut_at: Option<usize> = None;
+    let mut last_fit = None;
+    let mut last_miss: Option<(f64, f64)> = None;
+    loop {
+        if end <= start || end - start < fit::MIN_FIT_POINTS {
+            let reason = match last_miss {
+                Some((tau, mis)) => format!(
+                    "the best model misses the curve by {:.0} % at τ = {} s",
+                    100.0 * mis,
+                    short(tau)
+                ),
+                None => format!("only {} usable points", end.saturating_sub(start)),
+            };
+            return (last_fit, AxisVerdict::NoReliableFit { reason }, f64::NAN);
+        }
+        let Some((f, misses, max_mis)) = fit_and_check(data, fd, valid, cfg, start, end) else {
+            return (
+                None,
+                AxisVerdict::NoReliableFit {
+                    reason: "the fit found no positive model".into(),
+                },
+                f64::NAN,
+            );
+        };
+        if misses.is_empty() {
+            let (mut f, mut max_mis, mut end) = (f, max_mis, end);
+            // after a cut at the long end, extend again while the check holds: the first miss
+            // is where the model stops following, not necessarily where the curve bends
+            if long_cut_at.is_some() {
+                while end < np {
+                    match fit_and_check(data, fd, valid, cfg, start, end + 1) {
+                        Some((g, m, mm)) if m.is_empty() => {
+                            f = g;
+                            max_mis = mm;
+                            end += 1;
+                        }
+                        _ => break,
+                    }
+                }
+            }
+            let (lo_t, hi_t) = (fd.points[start].tau, fd.points[end - 1].tau);
+            if (hi_t / lo_t).log10() < MIN_RANGE_DECADES {
+                let reason = match last_miss {
+                    Some((tau, mis)) => format!(
+                        "the best model misses the curve by {:.0} % at τ = {} s, and fits only {} – {} s",
+                        100.0 * mis,
+                        short(tau),
+                        short(lo_t),
+                        short(hi_t)
+                    ),
+                    None => format!(
+                        "the usable range {} – {} s is shorter than a decade",
+                        short(lo_t),
+                        short(hi_t)
+                    ),
+                };
+                return (Some(f), AxisVerdict::NoReliableFit { reason }, max_mis);
+            }
+            let verdict = AxisVerdict::Fits {
+                range: (lo_t, hi_t),
+                short_cut: start > 0,
+                long_cut: end < np,
+            };
+            return (Some(f), verdict, max_mis);
+        }
+        let first = misses[0];
+        last_miss = Some(
+            misses
+                .iter()
+                .copied()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or(first),
+        );
+        let start_zone = fd.points[(start + 2).min(end - 1)].tau;
+        if first.0 <= start_zone * (1.0 + 1e-12) {
+            // past the last miss inside the start zone
+            let last_in_zone = misses
+                .iter()
+                .filter(|m| m.0 <= start_zone * (1.0 + 1e-12))
+                .map(|m| m.0)
+                .fold(first.0, f64::max);
+            start = fd
+                .points
+                .iter()
+                .position(|p| p.tau > last_in_zone * (1.0 + 1e-12))
+                .unwrap_or(np);
+        } else {
+            end = fd
+                .points
+                .iter()
+                .position(|p| p.tau >= first.0 * (1.0 - 1e-12))
+                .unwrap_or(end);
+            long_cut_at = Some(end);
+        }
+        last_fit = Some(f);
+    }
+}
+
+/// A fit with its check: the misses (τ, |model/data − 1|) and the largest misfit.
+type Checked = (fit::FitResult, Vec<(f64, f64)>, f64);
+
+/// Fits positions `start..end` of `fd` and checks every curve point of that τ range: returns
+/// the fit, the misses (τ, |model/data − 1|) in ascending τ and the largest misfit.
+fn fit_and_check(
+    data: &CurveData,
+    fd: &fit::FitData,
+    valid: &[&CurvePoint],
+    cfg: &Config,
+    start: usize,
+    end: usize,
+) -> Option<Checked> {
+    let n_phase = data.n.map(|n| n + 1);
+    let used: Vec<usize> = (start..end).collect();
+    let f = fit::fit(fd, &used, &cfg.fit)?;
+    let (lo_t, hi_t) = (fd.points[start].tau, fd.points[end - 1].tau);
+    let in_range = |t: f64| t >= lo_t * (1.0 - 1e-12) && t <= hi_t * (1.0 + 1e-12);
+    let mut misses: Vec<(f64, f64)> = Vec::new();
+    let mut max_mis: f64 = 0.0;
+    for p in valid.iter().filter(|p| in_range(p.tau)) {
+        let model = f.predict(p.tau);
+        let mis = if model > 0.0 {
+            (model / p.avar).sqrt() - 1.0
+        } else {
+            -1.0
+        };
+        max_mis = max_mis.max(mis.abs());
+        let alpha = fit::TERM_ALPHA[fit::dominant_term(&f.coef, p.tau)];
+        // the model within the data's 95 % interval: model/data ∈ [lo, hi]
+        let band = n_phase
+            .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
+            .and_then(|nu| ci::chi2_interval(1.0, nu, 0.95))
+            .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
+            .unwrap_or(0.0);
+        if model <= 0.0 || mis.abs() > FIT_TOL.max(band) {
+            misses.push((p.tau, mis.abs()));
+        }
+    }
+    Some((f, misses, max_mis))
+}
+
+fn make_terms(f: &fit::FitResult, fd: &fit::FitData, cfg: &Config) -> Terms {
+    let z = z_of(cfg.term_confidence);
+    let have_stats = fd.basis.is_some();
     let one = |j: usize| -> Term {
         if !cfg.fit.terms[j] {
             return Term::not_fitted();
         }
         let c = f.coef[j];
         let se_c = f.cov[j][j].max(0.0).sqrt();
-        if f.left_out[j] {
-            // left out by the selection: 0, with the all-terms fit's upper bound
+        let nan_if = |v: f64| if have_stats { v } else { f64::NAN };
+        if f.left_out[j] || c <= 0.0 {
+            // left out by the selection, at its bound, or the 1/τ² coefficient negative
+            // (the low-pass correction, not a quantization): 0 with the upper bound
+            let hi = if f.left_out[j] {
+                (z * se_c).sqrt()
+            } else {
+                fit::inverted_interval(fd, f, &cfg.fit, j, z)
+                    .1
+                    .max(0.0)
+                    .sqrt()
+            };
             return Term {
                 value: 0.0,
                 std_err: f64::NAN,
-                lo: 0.0,
-                hi: (z * se_c).sqrt(),
+                lo: nan_if(0.0),
+                hi: nan_if(hi),
                 verdict: Verdict::NotSignificant,
             };
         }
         let value = c.sqrt();
-        let std_err = if c > 0.0 {
-            se_c / (2.0 * value)
-        } else {
-            f64::NAN
-        };
-        let (lo_c, hi_c) = fit::inverted_interval(points, f, n, tau0, &cfg.fit, j, z);
+        let std_err = nan_if(se_c / (2.0 * value));
+        let (lo_c, hi_c) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
         let dominant_somewhere = f.dominant.contains(&j);
-        let verdict = if !fit::is_positive(lo_c) {
+        let verdict = if !have_stats {
+            // no sample count: no interval, so nothing is "resolved" statistically; a term the
+            // model needs and that dominates somewhere is still the model's
+            if dominant_somewhere {
+                Verdict::NeverDominant
+            } else {
+                Verdict::NotSignificant
+            }
+        } else if !fit::is_positive(lo_c) {
             Verdict::NotSignificant
         } else if !dominant_somewhere {
             Verdict::NeverDominant
@@ -368,8 +835,8 @@ fn make_terms(
         Term {
             value,
             std_err,
-            lo: lo_c.sqrt(),
-            hi: hi_c.sqrt(),
+            lo: nan_if(lo_c.sqrt()),
+            hi: nan_if(hi_c.sqrt()),
             verdict,
         }
     };
@@ -435,7 +902,7 @@ mod tests {
                     a.curve.iter().all(|p| p.adev.is_finite() && p.adev > 0.0),
                     "n={n}: bad curve"
                 );
-                false_k += a.terms.k.reported().is_some() as usize;
+                false_k += (a.terms.k.verdict == Verdict::Resolved) as usize;
             }
             println!("n={n}: K reported on white noise in {false_k}/{trials}");
             assert!(
@@ -448,7 +915,7 @@ mod tests {
     #[test]
     fn constant_series_gives_zero_curve_and_no_terms() {
         let a = analyse(&[2.5; 1000], 0.01, &Config::default()).unwrap();
-        assert!(a.curve.iter().all(|p| p.avar == 0.0));
+        assert!(a.curve.is_empty() || a.curve.iter().all(|p| p.avar == 0.0));
         assert!(a.terms.as_array().iter().all(|t| t.reported().is_none()));
     }
 }

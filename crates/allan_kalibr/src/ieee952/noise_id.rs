@@ -43,14 +43,40 @@ pub struct NoiseId {
     pub method: IdMethod,
 }
 
+/// Decimated points the lag-1 method looks at, at most: the middle stretch of that length
+/// (α is a property of the noise, not of the record length; 2¹⁶ points give r1 to ±0.004,
+/// far inside the decision steps of 0.25 in δ). Keeps the identification O(2¹⁶) per τ
+/// instead of O(n/m).
+pub const MAX_ID_POINTS: usize = 1 << 16;
+
 /// Identifies the dominant power-law noise at cluster size m.
 pub fn identify(phase: &Phase, m: usize) -> NoiseId {
-    let x = phase.x();
-    let n = phase.n_rate();
+    identify_on(phase.x(), m)
+}
+
+/// [`identify`] on any phase-like series (n + 1 points; an offset or a linear trend in it
+/// does not matter, a quadratic is removed first): e.g. imu_utils' θ.
+pub fn identify_on(x: &[f64], m: usize) -> NoiseId {
+    let n = x.len().saturating_sub(1);
     if m == 0 || m > n {
         return NoiseId {
             alpha: None,
             method: IdMethod::None,
+        };
+    }
+    let total = n / m + 1;
+    if total > MAX_ID_POINTS {
+        let skip = (total - MAX_ID_POINTS) / 2;
+        let dec: Vec<f64> = x
+            .iter()
+            .skip(skip * m)
+            .step_by(m)
+            .take(MAX_ID_POINTS)
+            .copied()
+            .collect();
+        return NoiseId {
+            alpha: Some(lag1_alpha(dec)),
+            method: IdMethod::Lag1,
         };
     }
     let dec: Vec<f64> = x.iter().step_by(m).copied().collect();

@@ -260,64 +260,40 @@ pub(super) fn k_rel_bound(n: f64, k: f64, t: f64) -> f64 {
 #[test]
 #[ignore = "method comparison on 20 Hz data (K statistics do not depend on the rate); --ignored --nocapture"]
 fn accuracy_methods() {
-    use super::{FitConfig, FitMethod, GridSpec};
+    use super::FitConfig;
     let seeds: Vec<u64> = (1..=8).collect();
     let presets = [presets()[1]];
     let base = Config::default();
-    let variants: [(&str, Config); 6] = [
+    let with = |f: FitConfig| Config { fit: f, ..base };
+    let variants: [(&str, Config); 5] = [
+        ("default (discrepancy, trim, band limit, selection)", base),
         (
-            "diagonal 8/oct full model",
-            Config {
-                fit: FitConfig {
-                    method: FitMethod::Diagonal,
-                    per_octave: 8,
-                    select: false,
-                    ..FitConfig::default()
-                },
-                ..base
-            },
+            "plain GLS (no discrepancy)",
+            with(FitConfig {
+                discrepancy: false,
+                ..FitConfig::default()
+            }),
         ),
         (
-            "diagonal 2/oct selected",
-            Config {
-                fit: FitConfig {
-                    method: FitMethod::Diagonal,
-                    per_octave: 2,
-                    ..FitConfig::default()
-                },
-                ..base
-            },
+            "full model, no selection",
+            with(FitConfig {
+                select: false,
+                ..FitConfig::default()
+            }),
         ),
         (
-            "GLS 2/oct full model",
-            Config {
-                fit: FitConfig {
-                    select: false,
-                    ..FitConfig::default()
-                },
-                ..base
-            },
-        ),
-        ("GLS 2/oct selected (default)", base),
-        (
-            "GLS 4/oct selected",
-            Config {
-                fit: FitConfig {
-                    per_octave: 4,
-                    ..FitConfig::default()
-                },
-                ..base
-            },
+            "4/oct",
+            with(FitConfig {
+                per_octave: 4,
+                ..FitConfig::default()
+            }),
         ),
         (
-            "GLS 2/oct N+K only",
-            Config {
-                fit: FitConfig {
-                    terms: [false, true, false, true, false],
-                    ..FitConfig::default()
-                },
-                ..base
-            },
+            "N+K only",
+            with(FitConfig {
+                terms: [false, true, false, true, false],
+                ..FitConfig::default()
+            }),
         ),
     ];
     let t = 4.0 * 3600.0;
@@ -327,7 +303,6 @@ fn accuracy_methods() {
         100.0 * k_rel_bound(0.019, 5e-4, t)
     );
     for (name, cfg) in variants {
-        let _ = GridSpec::default();
         let t0 = std::time::Instant::now();
         let cases = study(20.0, t, &presets, &seeds, &cfg);
         println!("## {name} ({:.1} s)", t0.elapsed().as_secs_f64());
@@ -573,4 +548,56 @@ fn timing_breakdown() {
         ids.len(),
         pts.len()
     );
+}
+
+#[test]
+#[ignore = "development: one simulated axis (SIM_CASE=medium:1:2); --ignored --nocapture"]
+fn one_case() {
+    let spec = std::env::var("SIM_CASE").unwrap_or("medium:1:2".into());
+    let f: Vec<&str> = spec.split(':').collect();
+    let pi = ["low", "medium", "high"]
+        .iter()
+        .position(|p| *p == f[0])
+        .unwrap();
+    let p = presets()[pi];
+    let s: u64 = f[1].parse().unwrap();
+    let a: usize = f[2].parse().unwrap();
+    let (n, k) = if a < 3 {
+        (p.gyro_n, p.gyro_k)
+    } else {
+        (p.acc_n, p.acc_k)
+    };
+    // the study numbers presets by their position in the list it was given
+    let seed_pi: u64 = f.get(3).map_or(pi as u64, |v| v.parse().unwrap());
+    let y = simulate_axis(
+        n,
+        k,
+        0.05,
+        288_000,
+        BASE_SEED + 1000 * s + 10 * seed_pi + a as u64,
+    );
+    let r = analyse(&y, 0.05, &Config::default()).unwrap();
+    println!("truth N {n:e} K {k:e}");
+    super::tests_real::print_row(
+        "sim",
+        if a < 3 {
+            super::imu::Sensor::Gyro
+        } else {
+            super::imu::Sensor::Acc
+        },
+        a % 3,
+        &r,
+    );
+    for p in &r.curve {
+        println!(
+            "{:>10.3} {:.4e} [{:.3e},{:.3e}] model {:.4e} {:+.3} {}",
+            p.tau,
+            p.adev,
+            p.lo95,
+            p.hi95,
+            p.model,
+            p.model / p.adev - 1.0,
+            if p.in_range { "*" } else { "" }
+        );
+    }
 }

@@ -1,0 +1,146 @@
+//! IEEE Std 952 region readings: the classic graphical rules, each with its own interval.
+//! They are printed beside the fit as a cross-check and replace it when the full model does
+//! not describe the curve ("no reliable fit").
+//!
+//! Rules (on the points of the usable range, local slopes from log-log central differences
+//! on the 2-per-octave fit grid):
+//! * **N** — the −½ line at τ = 1 s. The white-noise region is the points whose local slope is
+//!   within [`SLOPE_TOL`] of −½; N = σ(τ)·√τ at the region's point nearest τ = 1 s, its 95 %
+//!   interval the point's χ² interval scaled the same way. Every term adds to the Allan
+//!   variance, so this reading is biased high by whatever else contributes at that τ.
+//! * **B** — the flat floor / 0.664: the minimum of the curve when its local slope is within
+//!   [`SLOPE_TOL`] of 0, B = σ_min/√(2 ln2/π), interval likewise. (The minimum of noisy
+//!   points is biased low.)
+//! * **K** — the +½ line at τ = 3 s: the long-τ points whose local slope is within
+//!   [`SLOPE_TOL_K`] of +½; K = σ(τ)·√(3/τ) at the region's most precise point (shortest τ).
+//! * A term whose region is absent gets an upper bound instead: every term's Allan deviation
+//!   is at most the curve's, so e.g. K ≤ min over points of σ_hi(τ)·√(3/τ) at 95 %.
+
+use super::Point;
+
+/// Half-width of the slope window that defines the white-noise and floor regions.
+pub const SLOPE_TOL: f64 = 0.1;
+/// Half-width for the +½ region (fewer, noisier points at long τ).
+pub const SLOPE_TOL_K: f64 = 0.15;
+/// √(2 ln2/π): ADEV floor of bias instability B is this times B.
+pub const B_FLOOR_FACTOR: f64 = 0.664_282_471_410_191_1;
+
+/// How a reading was made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReadingKind {
+    /// From the term's region, with its 95 % interval.
+    Line,
+    /// No region: a 95 % upper bound (value = lo = 0, hi = the bound).
+    UpperBound,
+}
+
+/// One region reading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reading {
+    /// The value (term unit; 0 for an upper bound).
+    pub value: f64,
+    /// 95 % lower end.
+    pub lo: f64,
+    /// 95 % upper end.
+    pub hi: f64,
+    /// τ of the point it was read from (NaN for a bound over all points).
+    pub tau: f64,
+    /// Line or bound.
+    pub kind: ReadingKind,
+}
+
+/// The three readings of one curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Readings {
+    /// White noise N (−½ line at 1 s).
+    pub n: Option<Reading>,
+    /// Bias instability B (floor / 0.664).
+    pub b: Option<Reading>,
+    /// Random walk K (+½ line at 3 s).
+    pub k: Option<Reading>,
+}
+
+/// Local log-log slopes at each point (central differences; one-sided at the ends).
+pub fn local_slopes(tau: &[f64], adev: &[f64]) -> Vec<f64> {
+    let n = tau.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = match (i.checked_sub(1), i + 1 < n) {
+                (Some(a), true) => (a, i + 1),
+                (None, true) => (i, i + 1),
+                (Some(a), false) => (a, i),
+                (None, false) => return f64::NAN,
+            };
+            (adev[b] / adev[a]).ln() / (tau[b] / tau[a]).ln()
+        })
+        .collect()
+}
+
+/// Readings from `points` (the usable range of one curve, ascending τ, on the fit grid) with
+/// their 95 % bounds `lo95`/`hi95` (NaN when the sample count is unknown: then the readings
+/// carry no interval).
+pub fn read(points: &[Point]) -> Readings {
+    let pts: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.adev > 0.0 && p.adev.is_finite())
+        .collect();
+    if pts.len() < 2 {
+        return Readings {
+            n: None,
+            b: None,
+            k: None,
+        };
+    }
+    let tau: Vec<f64> = pts.iter().map(|p| p.tau).collect();
+    let adev: Vec<f64> = pts.iter().map(|p| p.adev).collect();
+    let slope = local_slopes(&tau, &adev);
+    let scaled = |i: usize, f: f64| Reading {
+        value: adev[i] * f,
+        lo: pts[i].lo95 * f,
+        hi: pts[i].hi95 * f,
+        tau: tau[i],
+        kind: ReadingKind::Line,
+    };
+    let bound = |f: &dyn Fn(f64) -> f64| -> Option<Reading> {
+        let hi = (0..pts.len())
+            .map(|i| pts[i].hi95 * f(tau[i]))
+            .filter(|v| v.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        hi.is_finite().then_some(Reading {
+            value: 0.0,
+            lo: 0.0,
+            hi,
+            tau: f64::NAN,
+            kind: ReadingKind::UpperBound,
+        })
+    };
+    // N: white region point nearest to 1 s
+    let n = (0..pts.len())
+        .filter(|&i| (slope[i] + 0.5).abs() <= SLOPE_TOL)
+        .min_by(|&a, &b| tau[a].ln().abs().total_cmp(&tau[b].ln().abs()))
+        .map(|i| scaled(i, tau[i].sqrt()))
+        .or_else(|| bound(&|t: f64| t.sqrt()));
+    // B: the minimum, when flat there
+    let imin = (0..pts.len())
+        .min_by(|&a, &b| adev[a].total_cmp(&adev[b]))
+        .unwrap_or(0);
+    let b = if slope[imin].abs() <= SLOPE_TOL {
+        Some(scaled(imin, 1.0 / B_FLOOR_FACTOR))
+    } else {
+        bound(&|_| 1.0 / B_FLOOR_FACTOR)
+    };
+    // K: the +½ region at the long end (contiguous from the last point), its shortest τ
+    let mut first_k = None;
+    for i in (0..pts.len()).rev() {
+        if (slope[i] - 0.5).abs() <= SLOPE_TOL_K {
+            first_k = Some(i);
+        } else {
+            break;
+        }
+    }
+    let k = first_k
+        .filter(|&i| i > imin)
+        .map(|i| scaled(i, (3.0 / tau[i]).sqrt()))
+        .or_else(|| bound(&|t: f64| (3.0 / t).sqrt()));
+    Readings { n, b, k }
+}
