@@ -8,7 +8,7 @@ use crate::collect::Collected;
 use crate::error::Error;
 use crate::estimator;
 use crate::factors;
-use crate::fit::{AxisFit, Sensor};
+use crate::fit::{AxisFit, IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR, Sensor};
 
 /// Upstream's accumulator names, in creation order.
 pub const AXIS_NAMES: [&str; 6] = ["gyr x", "gyr y", "gyr z", "acc x", "acc y", "acc z"];
@@ -37,6 +37,10 @@ pub struct AxisAllan {
     pub taus: Vec<f64>,
     /// Allan variances (pseudo-(deg/h)² or (m/s²)²).
     pub variance: Vec<f64>,
+    /// The IEEE 952 section's noise identification at each factor (empty unless asked for).
+    pub noise_ids: Vec<allan_kalibr::ieee952::noise_id::NoiseId>,
+    /// The IEEE 952 warm-up check's statistics, in rad/s or m/s² (None unless asked for).
+    pub start: Option<allan_kalibr::ieee952::stationarity::StartStats>,
 }
 
 impl AxisAllan {
@@ -48,39 +52,63 @@ impl AxisAllan {
 
 /// The Allan step alone, all six axes (the part the benchmark times), plus the gyro means
 /// (`getAvgValue`: the same sequential sum θ is built from, over N). Fails on the first
-/// non-finite value.
+/// non-finite value. One axis at a time: its θ (23 MB for a 4 h 200 Hz bag) stays in cache
+/// while both cores sweep the factors, and only one θ is alive. With `ieee`, also what the
+/// IEEE 952 section takes from θ while it is there: the noise identification at each factor
+/// and the warm-up statistics (no second pass over the samples).
 pub fn allan_step(
     c: &Collected<'_>,
     max_cluster: usize,
+    ieee: bool,
 ) -> Result<(Vec<AxisAllan>, [f64; 3]), Error> {
+    use allan_kalibr::ieee952::{noise_id, stationarity::StartStats};
     let n = c.len();
     let period = estimator::mean_period(&c.t);
     let freq = 1.0 / period;
     let f = factors::factors(n, max_cluster);
     let taus = estimator::taus(period, &f);
-    // θ for all axes at once, straight from the bag rows (one sequential cumulative sum
-    // each), then one axis at a time so its θ stays in cache while the factors run in
-    // parallel.
-    let integrated: Vec<(Vec<f64>, f64, Option<usize>)> = (0..6usize)
-        .into_par_iter()
-        .map(|axis| match axis {
+    let mut axes = Vec::with_capacity(6);
+    let mut sums = [0.0; 6];
+    let mut first_bad: Option<(usize, usize)> = None; // (index, axis)
+    for (axis, name) in AXIS_NAMES.into_iter().enumerate() {
+        let (theta, sum, bad) = match axis {
             0..3 => estimator::thetas_checked(c.gyro_values(axis), n, freq),
             _ => estimator::thetas_checked(c.acc_values(axis - 3), n, freq),
-        })
-        .collect();
-    if let Some((axis, index)) = integrated
-        .iter()
-        .enumerate()
-        .filter_map(|(a, (_, _, bad))| bad.map(|i| (a, i)))
-        .min_by_key(|&(a, i)| (i, a))
-    {
-        return Err(c.non_finite(axis, index));
-    }
-    let gyro_mean = [0, 1, 2].map(|k| integrated[k].1 / n as f64);
-    let axes = integrated
-        .iter()
-        .zip(AXIS_NAMES)
-        .map(|((theta, _, _), name)| AxisAllan {
+        };
+        sums[axis] = sum;
+        if let Some(i) = bad {
+            if first_bad.is_none_or(|b| i < b.0) {
+                first_bad = Some((i, axis));
+            }
+            continue;
+        }
+        if first_bad.is_some() {
+            continue;
+        }
+        let variance = estimator::allan_variance(&theta, &f, period);
+        let (noise_ids, start) = if ieee {
+            // θ[k] = (x[0] + … + x[k])/freq in the internal unit: back to SI running sums
+            let to_si = if axis < 3 {
+                IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR
+            } else {
+                1.0
+            };
+            let ids = f
+                .par_iter()
+                .map(|&m| noise_id::identify_on(&theta, m))
+                .collect();
+            let start = StartStats::from_cumsum(n, period, |k| {
+                if k == 0 {
+                    0.0
+                } else {
+                    theta[k - 1] * freq / to_si
+                }
+            });
+            (ids, start)
+        } else {
+            (Vec::new(), None)
+        };
+        axes.push(AxisAllan {
             name,
             n,
             start_t: c.t[0],
@@ -89,9 +117,15 @@ pub fn allan_step(
             period,
             factors: f.clone(),
             taus: taus.clone(),
-            variance: estimator::allan_variance(theta, &f, period),
-        })
-        .collect();
+            variance,
+            noise_ids,
+            start,
+        });
+    }
+    if let Some((index, axis)) = first_bad {
+        return Err(c.non_finite(axis, index));
+    }
+    let gyro_mean = [0, 1, 2].map(|k| sums[k] / n as f64);
     Ok((axes, gyro_mean))
 }
 
@@ -106,6 +140,42 @@ pub struct Analysis {
     pub gyro_mean: [f64; 3],
     /// The six fits, same order as `axes`.
     pub fits: Vec<AxisFit>,
+}
+
+impl Analysis {
+    /// The analysis of curves read from an imu_utils data directory (imu_utils.md §5.2): the
+    /// taus and deviations of its files (pseudo-deg/h for the gyro), the given fits, at the
+    /// rate `freq`; sample-dependent fields (counts, stamps, gyro means) are unknown.
+    pub fn from_curves(
+        raw: &allan_kalibr::ieee952::curves_in::ImuUtilsRaw,
+        fits: Vec<AxisFit>,
+        freq: f64,
+    ) -> Analysis {
+        let period = 1.0 / freq;
+        let axis = |name: &'static str, t: &[f64], dev: &[f64]| AxisAllan {
+            name,
+            n: 0,
+            start_t: f64::NAN,
+            end_t: f64::NAN,
+            freq,
+            period,
+            factors: t.iter().map(|x| (x / t[0]).round() as usize).collect(),
+            taus: t.to_vec(),
+            variance: dev.iter().map(|d| d * d).collect(),
+            noise_ids: Vec::new(),
+            start: None,
+        };
+        let axes = (0..3)
+            .map(|k| axis(AXIS_NAMES[k], &raw.gyr_t, &raw.gyr[k]))
+            .chain((0..3).map(|k| axis(AXIS_NAMES[3 + k], &raw.acc_t, &raw.acc[k])))
+            .collect();
+        Analysis {
+            max_cluster: 0,
+            axes,
+            gyro_mean: [f64::NAN; 3],
+            fits,
+        }
+    }
 }
 
 /// Fails with [`Error::TooFewSamples`] unless the grid has [`MIN_VALID_POINTS`] factors with
@@ -153,7 +223,7 @@ pub fn fit_all(axes: &[AxisAllan]) -> Vec<AxisFit> {
 /// Checks there is enough data, runs the Allan step and the fits.
 pub fn analyse(c: &Collected<'_>, max_cluster: usize) -> Result<Analysis, Error> {
     check_enough(c, max_cluster)?;
-    let (axes, gyro_mean) = allan_step(c, max_cluster)?;
+    let (axes, gyro_mean) = allan_step(c, max_cluster, false)?;
     let fits = fit_all(&axes);
     Ok(Analysis {
         max_cluster,

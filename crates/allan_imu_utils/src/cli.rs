@@ -19,12 +19,38 @@ pub const DEFAULT_MAX_CLUSTER: usize = 100;
 
 /// imu_utils' Allan variance and noise fit, read straight from a ROS 1 bag (no roscore, no
 /// replay). Prints upstream's report and writes `<name>_imu_param.yaml`, a continuous-time
-/// `<name>_imu_param_continuous.yaml`, the 16 `data_<name>_*.txt` curves and plots.
+/// `<name>_imu_param_continuous.yaml`, the 16 `data_<name>_*.txt` curves and plots. Then the
+/// IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted range and
+/// fit quality per axis, recording-length advice, warm-up and gap checks, and its files
+/// prefixed `<name>_`. With --curves it works on Allan curves another tool wrote.
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version)]
 pub struct Args {
     /// The ROS 1 bag (uncompressed, bz2 or lz4 chunks).
-    pub bag: PathBuf,
+    #[arg(required_unless_present = "curves")]
+    pub bag: Option<PathBuf>,
+    /// Analyse existing Allan curves instead of a bag: an imu_utils data directory (then
+    /// imu_utils' own fit is re-run and its yaml files written), allan_variance_ros'
+    /// allan_variance.csv, an allan_curves.csv, an ieee952_curves.csv, or a plain CSV
+    /// `tau,x,y,z` (one sensor; give --units). A plain CSV per sensor may be given twice.
+    #[arg(long, value_name = "PATH", conflicts_with = "bag")]
+    pub curves: Vec<PathBuf>,
+    /// Unit of each plain CSV of --curves, in order: rad/s, deg/s, deg/h, imu_utils, m/s^2,
+    /// g, mg (the values are Allan deviations).
+    #[arg(long, value_name = "UNIT")]
+    pub units: Vec<String>,
+    /// Length of the record behind --curves, in seconds (for the confidence intervals).
+    #[arg(long, value_name = "SECONDS", conflicts_with = "samples")]
+    pub duration: Option<f64>,
+    /// Number of samples behind --curves (for the confidence intervals).
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub rate: Option<f64>,
+    /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
+    #[arg(long, value_name = "SECONDS")]
+    pub skip_start: Option<f64>,
     /// sensor_msgs/Imu topic (`imu` and `/imu` are the same) [default: imu]
     #[arg(long)]
     pub topic: Option<String>,
@@ -57,11 +83,24 @@ pub struct Args {
     pub compat_only: bool,
 }
 
+/// `--curves`: the inputs and what the user said about them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvesInput {
+    /// A directory or files.
+    pub paths: Vec<PathBuf>,
+    /// Record length, sample count, rate, units, name.
+    pub options: allan_kalibr::ieee952::curves_in::Options,
+}
+
 /// What a run uses.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Config {
-    /// Input bag.
+    /// Input bag (empty with --curves).
     pub bag: PathBuf,
+    /// Curves to analyse instead of a bag.
+    pub curves: Option<CurvesInput>,
+    /// Seconds dropped at the start.
+    pub skip_start: Option<f64>,
     /// Topic.
     pub topic: String,
     /// IMU name.
@@ -117,6 +156,7 @@ impl TryFrom<Args> for Config {
             Some(t) => t,
             None => from_launch(lp, "imu_topic")?.unwrap_or_else(|| DEFAULT_TOPIC.into()),
         };
+        let name_given = a.name.is_some();
         let name = match a.name {
             Some(n) => n,
             None => from_launch(lp, "imu_name")?.unwrap_or_else(|| DEFAULT_NAME.into()),
@@ -150,8 +190,21 @@ impl TryFrom<Args> for Config {
                 "the IMU name '{name}' must be non-empty and contain no '/'"
             )));
         }
+        let curves = (!a.curves.is_empty()).then(|| CurvesInput {
+            paths: a.curves.clone(),
+            options: allan_kalibr::ieee952::curves_in::Options {
+                duration: a.duration,
+                samples: a.samples,
+                rate: a.rate,
+                units: a.units.clone(),
+                // an imu_utils directory may hold several IMUs: --name picks one
+                name: name_given.then(|| name.clone()),
+            },
+        });
         Ok(Config {
-            bag: a.bag,
+            bag: a.bag.unwrap_or_default(),
+            curves,
+            skip_start: a.skip_start,
             topic,
             name,
             out_dir,

@@ -47,6 +47,9 @@ pub enum Error {
         /// Samples.
         n: usize,
     },
+    /// `--curves` input that cannot be read.
+    #[error(transparent)]
+    Curves(#[from] allan_kalibr::ieee952::curves_in::CurvesError),
     /// A roslaunch file could not be used.
     #[error("{path}: {what}")]
     Launch {

@@ -3,8 +3,8 @@
 //! `σ²(m) = Σ ((θ[k+2m] − 2θ[k+m]) + θ[k])² / ((2 (period·m)²) (N − 2m))`.
 //!
 //! The fast path ([`allan_variance`]) runs the O(N) pass of every factor in parallel (rayon)
-//! and sums with 32 independent accumulators so the compiler vectorises it (AVX-512/AVX2
-//! chosen at run time). Each squared term is bit-identical to upstream's; only the summation
+//! through the workspace's overlapping kernel, which sums with 32 independent accumulators
+//! so the compiler vectorises it (AVX-512/AVX2 chosen at run time). Each squared term is bit-identical to upstream's; only the summation
 //! order differs, which moves the result by ~1e-13 relative, far inside the 1e-9 parity
 //! tolerance. One axis is processed at a time so its θ (23 MB for a 4 h 200 Hz bag) stays in
 //! the shared L3 cache while both cores sweep it. The naive sequential oracle lives in the
@@ -102,73 +102,11 @@ pub fn divisor(n: usize, m: usize, period: f64) -> f64 {
     2.0 * cluster_period2 * (n as i64 - 2 * m as i64) as f64
 }
 
-const LANES: usize = 32;
-
-#[inline(always)]
-fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    let mut acc = [0.0f64; LANES];
-    let (a8, ar) = a.as_chunks::<LANES>();
-    let (b8, br) = b.as_chunks::<LANES>();
-    let (c8, cr) = c.as_chunks::<LANES>();
-    for ((a, b), c) in a8.iter().zip(b8).zip(c8) {
-        for l in 0..LANES {
-            // Upstream's expression order: (θ[k+2m] − 2θ[k+m]) + θ[k].
-            let d = (c[l] - 2.0 * b[l]) + a[l];
-            acc[l] += d * d;
-        }
-    }
-    // Pairwise reduction of the lanes.
-    let mut width = LANES;
-    while width > 1 {
-        width /= 2;
-        for l in 0..width {
-            acc[l] += acc[l + width];
-        }
-    }
-    let mut s = acc[0];
-    for ((a, b), c) in ar.iter().zip(br).zip(cr) {
-        let d = (c - 2.0 * b) + a;
-        s += d * d;
-    }
-    s
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn second_diff_sum_avx512(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    second_diff_sum_body(a, b, c)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn second_diff_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    second_diff_sum_body(a, b, c)
-}
-
-/// `Σ_k ((θ[k+2m] − 2θ[k+m]) + θ[k])²`, 0 when N − 2m ≤ 0.
+/// `Σ_k ((θ[k+2m] − 2θ[k+m]) + θ[k])²`, 0 when N − 2m ≤ 0: the workspace's overlapping
+/// kernel (`allan_kalibr::ieee952::oadev::second_diff_sum`), whose squared terms are
+/// upstream's bit for bit.
 pub fn second_diff_sum(theta: &[f64], m: usize) -> f64 {
-    let n = theta.len();
-    if n <= 2 * m {
-        return 0.0;
-    }
-    let cnt = n - 2 * m;
-    let (a, b, c) = (
-        &theta[..cnt],
-        &theta[m..m + cnt],
-        &theta[2 * m..2 * m + cnt],
-    );
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F (checked just above).
-            return unsafe { second_diff_sum_avx512(a, b, c) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { second_diff_sum_avx2(a, b, c) };
-        }
-    }
-    second_diff_sum_body(a, b, c)
+    allan_kalibr::ieee952::oadev::second_diff_sum(theta, m)
 }
 
 /// Overlapping Allan variances of one axis for every factor, in factor order

@@ -22,8 +22,29 @@ fn main() -> ExitCode {
 fn run() -> anyhow::Result<()> {
     let t = std::time::Instant::now();
     let config = Config::try_from(Args::parse()).context("bad arguments")?;
-    let outcome = allan_imu_utils::run::run(&config)
-        .with_context(|| format!("analysing {}", config.bag.display()))?;
+    let what = match &config.curves {
+        Some(c) => c
+            .paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        None => config.bag.display().to_string(),
+    };
+    if config.curves.is_some() {
+        let o = allan_imu_utils::run::run_curves(&config)
+            .with_context(|| format!("analysing {what}"))?;
+        for note in &o.notes {
+            eprintln!("{note}");
+        }
+        let mut out = std::io::stdout().lock();
+        out.write_all(o.stdout.as_bytes())
+            .and_then(|_| out.write_all(o.ieee952_text.as_bytes()))
+            .context("writing stdout")?;
+        return Ok(());
+    }
+    let outcome =
+        allan_imu_utils::run::run(&config).with_context(|| format!("analysing {what}"))?;
     for note in &outcome.notes {
         eprintln!("{note}");
     }

@@ -55,30 +55,7 @@ pub fn stdout_text(an: &Analysis) -> String {
         calc_block(&mut out, &an.axes[i]);
     }
     for i in 0..3 {
-        let fit = &an.fits[i];
-        let a = &an.axes[i];
-        let _ = writeln!(out, "{}", FIT_HEADERS[i]);
-        let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
-        let _ = writeln!(
-            out,
-            " Bias Instability {} rad/s",
-            g6(fit.gyro_b_line_value())
-        );
-        let at = a.taus[find_min_index(&fit.sim(&a.taus))];
-        let _ = writeln!(
-            out,
-            " Bias Instability {} rad/s, at {} s",
-            g6(fit.bias_instability()),
-            g6(at)
-        );
-        let _ = writeln!(out, " White Noise {} rad/s", g6(fit.gyro_n_line_value()));
-        let _ = writeln!(out, " White Noise {} rad/s", g6(fit.white_noise()));
-        let _ = writeln!(
-            out,
-            "  bias {} degree/s",
-            g6(an.gyro_mean[i] / SECONDS_PER_HOUR)
-        );
-        out.push_str("-------------------\n");
+        gyro_fit_block(&mut out, an, i, true);
     }
     out.push_str("==============================================\n");
     out.push_str("==============================================\n");
@@ -86,16 +63,67 @@ pub fn stdout_text(an: &Analysis) -> String {
         calc_block(&mut out, &an.axes[i]);
     }
     for i in 3..6 {
-        let fit = &an.fits[i];
-        let _ = writeln!(out, "{}", FIT_HEADERS[i]);
-        let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
+        acc_fit_block(&mut out, an, i);
+    }
+    out
+}
+
+/// Upstream's fit block of gyro axis `i` (header, `C` line, the four value lines and, when
+/// the samples were at hand, the `bias` line).
+fn gyro_fit_block(out: &mut String, an: &Analysis, i: usize, bias: bool) {
+    let fit = &an.fits[i];
+    let a = &an.axes[i];
+    let _ = writeln!(out, "{}", FIT_HEADERS[i]);
+    let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
+    let _ = writeln!(
+        out,
+        " Bias Instability {} rad/s",
+        g6(fit.gyro_b_line_value())
+    );
+    let at = a.taus[find_min_index(&fit.sim(&a.taus))];
+    let _ = writeln!(
+        out,
+        " Bias Instability {} rad/s, at {} s",
+        g6(fit.bias_instability()),
+        g6(at)
+    );
+    let _ = writeln!(out, " White Noise {} rad/s", g6(fit.gyro_n_line_value()));
+    let _ = writeln!(out, " White Noise {} rad/s", g6(fit.white_noise()));
+    if bias {
         let _ = writeln!(
             out,
-            " Bias Instability {} m/s^2",
-            g6(fit.bias_instability())
+            "  bias {} degree/s",
+            g6(an.gyro_mean[i] / SECONDS_PER_HOUR)
         );
-        let _ = writeln!(out, " White Noise {} m/s^2", g6(fit.white_noise()));
-        out.push_str("-------------------\n");
+    }
+    out.push_str("-------------------\n");
+}
+
+/// Upstream's fit block of accelerometer axis `i` (3–5).
+fn acc_fit_block(out: &mut String, an: &Analysis, i: usize) {
+    let fit = &an.fits[i];
+    let _ = writeln!(out, "{}", FIT_HEADERS[i]);
+    let _ = writeln!(out, "{}", crate::fit::init::c_line(&fit.start));
+    let _ = writeln!(
+        out,
+        " Bias Instability {} m/s^2",
+        g6(fit.bias_instability())
+    );
+    let _ = writeln!(out, " White Noise {} m/s^2", g6(fit.white_noise()));
+    out.push_str("-------------------\n");
+}
+
+/// The fit blocks alone, as upstream prints them after its Allan step, for curves read from
+/// an imu_utils data directory (no samples: no `calc()` blocks, no `bias` line).
+pub fn fit_text(an: &Analysis) -> String {
+    let mut out = String::new();
+    for i in 0..3 {
+        gyro_fit_block(&mut out, an, i, false);
+    }
+    out.push_str("==============================================\n");
+    out.push_str("==============================================\n");
+    for i in 3..6 {
+        acc_fit_block(&mut out, an, i);
     }
     out
 }
@@ -182,6 +210,8 @@ mod tests {
                     factors: factors.clone(),
                     taus,
                     variance,
+                    noise_ids: Vec::new(),
+                    start: None,
                 }
             })
             .collect();

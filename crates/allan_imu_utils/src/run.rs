@@ -1,12 +1,17 @@
-//! One whole run: read the bag, collect with the stop rule, analyse, write every output.
+//! One whole run: read the bag, collect with the stop rule, analyse, write every output — or,
+//! with `--curves`, the same outputs from Allan curves another tool wrote.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::analysis::{self, Analysis};
+use allan_kalibr::ieee952::imu::{self, ImuAnalysis, Sensor};
+use allan_kalibr::ieee952::{CurveData, CurvePoint, Overlap, curves_in, files};
+
+use crate::analysis::{self, Analysis, AxisAllan};
 use crate::cli::Config;
 use crate::collect::{self, Stop};
 use crate::error::Error;
+use crate::fit::{AxisFit, IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR};
 use crate::opencv_yaml::{self, YamlMode};
 use crate::{plot, report};
 
@@ -23,15 +28,88 @@ pub struct Outcome {
     pub files: Vec<PathBuf>,
     /// The analysis itself.
     pub analysis: Analysis,
+    /// The IEEE 952 analysis.
+    pub ieee952: Option<ImuAnalysis>,
     /// (phase, wall time).
     pub timings: Vec<(&'static str, Duration)>,
 }
 
-/// Runs the whole pipeline for `config`.
+/// The IEEE 952 curve of one axis from imu_utils' own Allan variances: the same overlapping
+/// estimator on its cluster grid, converted to SI (the gyro from pseudo-deg/h), with the
+/// noise identification the Allan step made on θ. No second pass over the samples.
+pub fn ieee952_curve(a: &AxisAllan, gyro: bool) -> CurveData {
+    let scale = if gyro {
+        1.0 / (IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR).powi(2)
+    } else {
+        1.0
+    };
+    let points = a
+        .factors
+        .iter()
+        .zip(&a.taus)
+        .zip(&a.variance)
+        .enumerate()
+        // N − 2m ≤ 0 (the knife-edge last factor) has no estimate
+        .filter(|(_, ((m, _), v))| 2 * **m < a.n && v.is_finite() && **v > 0.0)
+        .map(|(i, ((&m, &tau), &v))| {
+            let id = a.noise_ids.get(i).copied();
+            CurvePoint {
+                m,
+                tau,
+                avar: v * scale,
+                id: id.and_then(|x| x.alpha),
+                id_method: id.map_or(allan_kalibr::ieee952::IdMethod::None, |x| x.method),
+            }
+        })
+        .collect();
+    CurveData {
+        tau0: a.period,
+        n: Some(a.n),
+        kind: Overlap::Overlapping,
+        points,
+    }
+}
+
+/// Drops the messages whose header stamp is within `seconds` of the first (a warm-up), as
+/// `rosbag play --start` would before imu_utils saw them; returns how many.
+fn skip_start(series: &mut bag2mat::ImuSeries, seconds: f64) -> Result<usize, Error> {
+    if !(seconds >= 0.0 && seconds.is_finite()) {
+        return Err(Error::Config(format!(
+            "--skip-start must be a non-negative number of seconds, got {seconds}"
+        )));
+    }
+    let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
+    let k = allan_kalibr::ieee952::stationarity::skip_index(&t, seconds);
+    series.stamp.drain(..k);
+    series.record_time.drain(..k);
+    series.seq.drain(..k);
+    series.acc.drain(..k);
+    series.gyro.drain(..k);
+    Ok(k)
+}
+
+/// What `--curves` produced.
+#[derive(Debug)]
+pub struct CurvesOutcome {
+    /// imu_utils' fit blocks (imu_utils data directories only), then nothing else.
+    pub stdout: String,
+    /// The IEEE 952 section.
+    pub ieee952_text: String,
+    /// Things to say on stderr.
+    pub notes: Vec<String>,
+    /// Files written.
+    pub files: Vec<PathBuf>,
+    /// imu_utils' analysis of an imu_utils data directory.
+    pub analysis: Option<Analysis>,
+    /// The IEEE 952 analysis.
+    pub ieee952: ImuAnalysis,
+}
+
+/// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`).
 pub fn run(config: &Config) -> Result<Outcome, Error> {
     let mut timings = Vec::new();
     let t0 = Instant::now();
-    let series = bag2mat::read_imu_series(
+    let mut series = bag2mat::read_imu_series(
         &config.bag,
         &config.topic,
         &bag2mat::ReadOptions {
@@ -40,6 +118,13 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     )?;
     timings.push(("read_bag", t0.elapsed()));
     let mut notes = series.notes.clone();
+    if let Some(s) = config.skip_start {
+        let k = skip_start(&mut series, s)?;
+        notes.push(format!(
+            "--skip-start {s}: dropped the first {k} messages ({} left)",
+            series.len()
+        ));
+    }
     let collected = collect::collect(&series, config.max_time_min);
     if collected.stop == Stop::EndOfBag {
         notes.push(format!(
@@ -50,25 +135,29 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     }
     analysis::check_enough(&collected, config.max_cluster)?;
     let t1 = Instant::now();
-    let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster)?;
+    let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster, config.ieee952)?;
     timings.push(("allan", t1.elapsed()));
-    // The IEEE 952 analysis of the same samples (rad/s, m/s²) at imu_utils' mean-period
-    // rate. Data too short for it only costs the section, with a note.
+    // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at its
+    // mean-period rate, plus the time-stamp checks. Data too short for it only cost the
+    // section, with a note.
     let t1 = Instant::now();
     let ieee = if config.ieee952 {
-        let cols: Vec<Vec<f64>> = (0..3)
-            .map(|k| collected.gyro_rad_s(k))
-            .chain((0..3).map(|k| collected.acc_values(k).collect()))
+        let curves: Vec<CurveData> = axes
+            .iter()
+            .enumerate()
+            .map(|(i, a)| ieee952_curve(a, i < 3))
             .collect();
-        let series = [
-            &cols[0][..],
-            &cols[1][..],
-            &cols[2][..],
-            &cols[3][..],
-            &cols[4][..],
-            &cols[5][..],
-        ];
-        allan_kalibr::ieee952::imu::analyse_section(series, axes[0].freq, &mut notes)
+        let mut it = curves.into_iter();
+        let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
+        let sensors = [(Sensor::Gyro, take3()), (Sensor::Acc, take3())];
+        let mut an = imu::analyse_curves(
+            &sensors,
+            axes[0].freq,
+            &allan_kalibr::ieee952::Config::default(),
+        );
+        let starts: Vec<_> = axes.iter().map(|a| a.start.clone()).collect();
+        imu::add_stationarity(&mut an, &starts, Some(&collected.t));
+        Some(an)
     } else {
         None
     };
@@ -99,21 +188,91 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
         files.extend(plot::write_plots(&analysis, &config.name, &config.out_dir)?);
     }
     if let Some(an) = &ieee {
-        let prefix = format!("{}_", config.name);
-        files.extend(allan_kalibr::ieee952::imu::write_outputs(
-            an,
-            &config.out_dir,
-            &prefix,
-            &config.topic,
-        )?);
+        files.extend(write_ieee952(an, config)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
     Ok(Outcome {
         stdout: report::stdout_text(&analysis),
-        ieee952_text: ieee.as_ref().map(allan_kalibr::ieee952::imu::summary_text),
+        ieee952_text: ieee.as_ref().map(imu::summary_text),
         notes,
         files,
         analysis,
+        ieee952: ieee,
         timings,
+    })
+}
+
+/// The section's files (prefixed `<name>_`) and chart.
+fn write_ieee952(an: &ImuAnalysis, config: &Config) -> Result<Vec<PathBuf>, Error> {
+    let prefix = format!("{}_", config.name);
+    let mut out = files::write_outputs(an, &config.out_dir, &prefix, &config.topic)?;
+    if config.plots {
+        out.extend(allan_kalibr::ieee952::plot::write_chart(
+            an,
+            &config.name,
+            None,
+            &config.out_dir,
+            &prefix,
+        )?);
+    }
+    Ok(out)
+}
+
+/// `--curves`: imu_utils' own fit and yaml files when the curves are an imu_utils data
+/// directory (its `*_n` needs the rate, taken as 1/first τ as the files imply), and the
+/// IEEE 952 section on any format.
+pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
+    let Some(input) = config.curves.as_ref() else {
+        return Err(Error::Config("no --curves given".into()));
+    };
+    let c = curves_in::read(&input.paths, &input.options)?;
+    let mut notes = Vec::new();
+    let mut stdout = String::new();
+    let mut files = Vec::new();
+    std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
+        path: config.out_dir.clone(),
+        source: e,
+    })?;
+    let mut analysis = None;
+    if let Some(raw) = &c.imu_utils {
+        let freq = 1.0 / raw.gyr_t[0];
+        let fit = |sensor: crate::fit::Sensor, t: &[f64], dev: &[f64]| {
+            let var: Vec<f64> = dev.iter().map(|d| d * d).collect();
+            AxisFit::fit(sensor, t, &var, freq)
+        };
+        let fits: Vec<AxisFit> = (0..3)
+            .map(|k| fit(crate::fit::Sensor::Gyro, &raw.gyr_t, &raw.gyr[k]))
+            .chain((0..3).map(|k| fit(crate::fit::Sensor::Acc, &raw.acc_t, &raw.acc[k])))
+            .collect();
+        let an = Analysis::from_curves(raw, fits, freq);
+        stdout.push_str(&report::fit_text(&an));
+        for mode in [YamlMode::Compat, YamlMode::Continuous] {
+            let p = config.out_dir.join(mode.file_name(&config.name));
+            report::write_text(&p, &opencv_yaml::yaml_text(&an, &config.name, mode))?;
+            files.push(p);
+        }
+        analysis = Some(an);
+    } else {
+        notes.push(format!(
+            "{}: imu_utils' own fit runs on imu_utils data directories only; IEEE 952 section only",
+            c.format
+        ));
+    }
+    let sensors: Vec<_> = c
+        .sensors
+        .iter()
+        .map(|s| (s.sensor, s.axes.clone()))
+        .collect();
+    let mut an = imu::analyse_curves(&sensors, c.rate, &allan_kalibr::ieee952::Config::default());
+    an.notes = vec![format!("curves: {}", c.format)];
+    an.notes.extend(c.notes.iter().cloned());
+    files.extend(write_ieee952(&an, config)?);
+    Ok(CurvesOutcome {
+        stdout,
+        ieee952_text: imu::summary_text(&an),
+        notes,
+        files,
+        analysis,
+        ieee952: an,
     })
 }

@@ -40,6 +40,8 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
         // Parity of the compat outputs; the IEEE 952 section is checked in allan_kalibr
         // and in cli.rs.
         ieee952: false,
+        curves: None,
+        skip_start: None,
     };
     run(&config).unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
 }

@@ -13,11 +13,36 @@ use crate::run::Config;
 /// non-overlapping Allan deviation on upstream's 2000-point tau grid, fits the -1/2 and +1/2
 /// lines as gen_chart.m does, prints upstream's lines and writes imu.yaml,
 /// allan_curves.csv, allan_accel.{png,svg} and allan_gyro.{png,svg}.
+///
+/// Then the IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted
+/// range and fit quality per axis, recording-length advice, warm-up and gap checks,
+/// ieee952_terms.csv, ieee952_curves.csv, ieee952_allan.{png,svg} and Kalibr/VINS/ORB-SLAM3
+/// yaml files. With --curves it analyses Allan curves another tool wrote instead of samples.
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version)]
 pub struct Args {
     /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
-    pub input: PathBuf,
+    #[arg(required_unless_present = "curves")]
+    pub input: Option<PathBuf>,
+    /// Analyse existing Allan curves instead (IEEE 952 section only): an imu_utils data
+    /// directory, allan_variance_ros' allan_variance.csv, an allan_curves.csv, an
+    /// ieee952_curves.csv, or a plain CSV `tau,x,y,z` (one sensor; give --units). A plain CSV
+    /// per sensor may be given twice.
+    #[arg(long, value_name = "PATH", conflicts_with = "input")]
+    pub curves: Vec<PathBuf>,
+    /// Unit of each plain CSV of --curves, in order: rad/s, deg/s, deg/h, imu_utils, m/s^2,
+    /// g, mg (the values are Allan deviations).
+    #[arg(long, value_name = "UNIT")]
+    pub units: Vec<String>,
+    /// Length of the record behind --curves, in seconds (for the confidence intervals).
+    #[arg(long, value_name = "SECONDS", conflicts_with = "samples")]
+    pub duration: Option<f64>,
+    /// Number of samples behind --curves (for the confidence intervals).
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+    /// Drop the first SECONDS of the record (a warm-up) before any analysis.
+    #[arg(long, value_name = "SECONDS")]
+    pub skip_start: Option<f64>,
     /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml).
     #[arg(long, default_value = "imu")]
     pub topic: String,
@@ -53,12 +78,35 @@ pub struct Args {
 
 impl From<Args> for Config {
     fn from(a: Args) -> Config {
-        let outdir = a.outdir.unwrap_or_else(|| match a.input.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
+        let input = a
+            .input
+            .clone()
+            .or_else(|| a.curves.first().cloned())
+            .unwrap_or_default();
+        // a curves directory holds its own outputs; a file's directory otherwise
+        let outdir = a.outdir.unwrap_or_else(|| {
+            if input.is_dir() {
+                return input.clone();
+            }
+            match input.parent() {
+                Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+                _ => PathBuf::from("."),
+            }
+        });
+        let curves = (!a.curves.is_empty()).then(|| crate::run::CurvesInput {
+            paths: a.curves.clone(),
+            options: crate::ieee952::curves_in::Options {
+                duration: a.duration,
+                samples: a.samples,
+                rate: a.update_rate,
+                units: a.units.clone(),
+                name: None,
+            },
         });
         Config {
-            input: a.input,
+            skip_start: a.skip_start,
+            curves,
+            input,
             topic: a.topic,
             update_rate: a.update_rate,
             title: a.title,

@@ -39,6 +39,9 @@ pub enum Error {
     /// Reading the bag or .mat, or writing an output file, failed.
     #[error(transparent)]
     Io(#[from] bag2mat::Error),
+    /// `--curves` input that cannot be read.
+    #[error(transparent)]
+    Curves(#[from] crate::ieee952::curves_in::CurvesError),
     /// Drawing a plot failed.
     #[error("plot {path}: {what}")]
     Plot {

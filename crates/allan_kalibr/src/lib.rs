@@ -48,4 +48,6 @@ pub mod yaml;
 
 pub use error::Error;
 pub use estimator::Estimator;
-pub use run::{Analysis, Config, RunOutput, analyse, run, run_on};
+pub use run::{
+    Analysis, Config, CurvesInput, CurvesOutput, RunOutput, analyse, run, run_curves, run_on,
+};

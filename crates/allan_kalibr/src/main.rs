@@ -6,10 +6,28 @@ use anyhow::Context;
 use clap::Parser;
 
 use allan_kalibr::cli::Args;
-use allan_kalibr::{Config, run};
+use allan_kalibr::{Config, run, run_curves};
 
 fn main() -> ExitCode {
     let config: Config = Args::parse().into();
+    if let Some(curves) = &config.curves {
+        return match run_curves(&config, curves)
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .context("allan_kalibr --curves")
+        {
+            Ok(out) => {
+                print!("{}", out.text);
+                for p in &out.written {
+                    eprintln!("wrote {}", p.display());
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        };
+    }
     // The library's messages already carry their causes inline, so the error is flattened to
     // its text before the context is added (printing the cause chain would repeat them).
     let result = run(&config)

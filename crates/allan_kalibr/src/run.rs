@@ -37,6 +37,19 @@ pub struct Config {
     pub timings: bool,
     /// Also run the IEEE 952 analysis (section and files beside the compat outputs).
     pub ieee952: bool,
+    /// Seconds dropped at the start of the record (a warm-up), before everything.
+    pub skip_start: Option<f64>,
+    /// Analyse other tools' Allan curves instead of samples (`--curves`).
+    pub curves: Option<CurvesInput>,
+}
+
+/// `--curves`: the files and what the user said about them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvesInput {
+    /// A directory (imu_utils) or files.
+    pub paths: Vec<PathBuf>,
+    /// Record length, sample count, rate, units.
+    pub options: crate::ieee952::curves_in::Options,
 }
 
 /// The numbers of one run.
@@ -129,8 +142,15 @@ pub fn run(config: &Config) -> Result<RunOutput, Error> {
 }
 
 /// [`run`] on samples already in memory.
-pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
+pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let mut notes = data.notes.clone();
+    if let Some(skip) = config.skip_start {
+        let k = skip_start(&mut data, skip)?;
+        notes.push(format!(
+            "--skip-start {skip}: dropped the first {k} samples ({} left)",
+            data.len()
+        ));
+    }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
     }
@@ -151,7 +171,7 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
             &a[1][..],
             &a[2][..],
         ];
-        crate::ieee952::imu::analyse_section(series, rate.used, &mut notes)
+        crate::ieee952::imu::analyse_section(series, rate.used, Some(&data.t), &mut notes)
     } else {
         None
     };
@@ -209,7 +229,10 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     };
     written.extend(write_plots(&analysis, &title, dir)?);
     if let Some(an) = &ieee {
-        written.extend(crate::ieee952::imu::write_outputs(an, dir, "", &topic)?);
+        written.extend(crate::ieee952::files::write_outputs(an, dir, "", &topic)?);
+        written.extend(crate::ieee952::plot::write_chart(
+            an, &title, None, dir, "",
+        )?);
     }
     let timings = Timings {
         load: 0.0,
@@ -225,6 +248,83 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
         notes,
         written,
         timings,
+    })
+}
+
+/// Drops the samples of the first `seconds` of the record; returns how many.
+fn skip_start(data: &mut ImuData, seconds: f64) -> Result<usize, Error> {
+    if !(seconds >= 0.0 && seconds.is_finite()) {
+        return Err(Error::BadData {
+            what: format!("--skip-start must be a non-negative number of seconds, got {seconds}"),
+        });
+    }
+    let k = crate::ieee952::stationarity::skip_index(&data.t, seconds);
+    if k + 3 > data.len() {
+        return Err(Error::BadData {
+            what: format!(
+                "--skip-start {seconds} leaves {} of {} samples",
+                data.len().saturating_sub(k),
+                data.len()
+            ),
+        });
+    }
+    data.t.drain(..k);
+    for c in data.axes.iter_mut() {
+        c.drain(..k);
+    }
+    Ok(k)
+}
+
+/// Result of [`run_curves`].
+#[derive(Debug)]
+pub struct CurvesOutput {
+    /// The IEEE 952 section.
+    pub text: String,
+    /// Notes (how the sample count was found, …).
+    pub notes: Vec<String>,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+    /// The analysis.
+    pub analysis: crate::ieee952::imu::ImuAnalysis,
+}
+
+/// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat
+/// outputs), with the same files and chart as from a bag.
+pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput, Error> {
+    let mut opts = curves.options.clone();
+    if opts.rate.is_none() {
+        opts.rate = config.update_rate;
+    }
+    let c = crate::ieee952::curves_in::read(&curves.paths, &opts)?;
+    let sensors: Vec<_> = c
+        .sensors
+        .iter()
+        .map(|s| (s.sensor, s.axes.clone()))
+        .collect();
+    let mut an =
+        crate::ieee952::imu::analyse_curves(&sensors, c.rate, &crate::ieee952::Config::default());
+    an.notes = vec![format!("curves: {}", c.format)];
+    an.notes.extend(c.notes.iter().cloned());
+    let dir = &config.outdir;
+    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    let title = if config.title.is_empty() {
+        config
+            .input
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    } else {
+        config.title.clone()
+    };
+    let mut written = crate::ieee952::files::write_outputs(&an, dir, "", &config.topic)?;
+    written.extend(crate::ieee952::plot::write_chart(
+        &an, &title, None, dir, "",
+    )?);
+    Ok(CurvesOutput {
+        text: crate::ieee952::imu::summary_text(&an),
+        notes: Vec::new(),
+        written,
+        analysis: an,
     })
 }
 

@@ -39,7 +39,7 @@ pub fn yaml_float(x: f64) -> String {
 }
 
 /// A topic string as a YAML plain scalar when safe, otherwise single-quoted.
-fn yaml_str(s: &str) -> String {
+pub fn yaml_str(s: &str) -> String {
     let plain = !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || "/_-.".contains(c))
@@ -49,6 +49,11 @@ fn yaml_str(s: &str) -> String {
     } else {
         format!("'{}'", s.replace('\'', "''"))
     }
+}
+
+/// One `key: value   #comment` line of the imu.yaml layout (aligned columns).
+pub fn key_line(key: &str, value: &str, comment: &str) -> String {
+    format!("{:<29}{:<24}#{comment}\n", format!("{key}:"), value)
 }
 
 impl ImuYaml {
@@ -73,9 +78,7 @@ impl ImuYaml {
         for c in comments {
             let _ = writeln!(o, "# {c}");
         }
-        let w = |o: &mut String, key: &str, v: String, c: &str| {
-            let _ = writeln!(o, "{:<29}{:<24}#{c}", format!("{key}:"), v);
-        };
+        let w = |o: &mut String, key: &str, v: String, c: &str| o.push_str(&key_line(key, &v, c));
         o.push_str("#Accelerometers\n");
         w(
             &mut o,

@@ -49,17 +49,33 @@ fn kalibr_curve(path: &Path, column: &str) -> Result<Vec<(f64, f64)>> {
 
 /// Mean over the three axes of the IEEE 952 overlapping deviation (`ieee952_curves.csv`).
 fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
+    use allan_kalibr::ieee952::files as f;
     let text = read(path)?;
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
+    };
+    let (ca, cm, ct, cd) = (
+        col(f::CURVE_AXIS)?,
+        col(f::CURVE_M)?,
+        col(f::CURVE_TAU)?,
+        col(f::CURVE_ADEV)?,
+    );
     let mut by_m: std::collections::BTreeMap<u64, (f64, f64, usize)> = Default::default();
-    for l in text.lines().skip(1) {
+    for l in lines {
         let f: Vec<&str> = l.split(',').collect();
-        if f.len() < 4 || !axes.contains(&f[0]) {
+        let get = |i: usize| f.get(i).copied().unwrap_or("");
+        if !axes.contains(&get(ca)) {
             continue;
         }
         let (Ok(m), Ok(tau), Ok(adev)) = (
-            f[1].parse::<u64>(),
-            f[2].parse::<f64>(),
-            f[3].parse::<f64>(),
+            get(cm).parse::<u64>(),
+            get(ct).parse::<f64>(),
+            get(cd).parse::<f64>(),
         ) else {
             continue;
         };
@@ -166,7 +182,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
             curves.push(Curves {
                 preset: preset_name(p),
                 kalibr: kalibr_curve(&dir.join("allan_curves.csv"), column)?,
-                ieee: ieee_curve(&dir.join("ieee952_curves.csv"), axes)?,
+                ieee: ieee_curve(&dir.join(allan_kalibr::ieee952::files::CURVES_FILE), axes)?,
                 truth: if sensor == "gyro" {
                     (t.gyro_noise, t.gyro_bias_rw)
                 } else {

@@ -193,8 +193,9 @@ pub struct FitResult {
     pub delta: f64,
     /// Degrees of freedom (points − free terms).
     pub dof: usize,
-    /// Index of the dominant model term at each used point (same order as `used`).
-    pub dominant: Vec<usize>,
+    /// Largest share of the measured Allan variance each term's own line has at a used point:
+    /// ≈ 1 where it alone makes the curve, ≥ 0.64 where its line comes within 20 % of the data.
+    pub max_share: [f64; TERM_COUNT],
 }
 
 impl FitResult {
@@ -657,10 +658,14 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
             cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
         }
     }
-    let dominant = used
-        .iter()
-        .map(|&i| dominant_term(&coef, data.points[i].tau))
-        .collect();
+    let max_share = std::array::from_fn(|j| {
+        used.iter()
+            .map(|&i| {
+                let p = &data.points[i];
+                (coef[j] * basis(j, p.tau) / p.avar).max(0.0)
+            })
+            .fold(0.0, f64::max)
+    });
     Some(FitResult {
         coef,
         cov,
@@ -676,7 +681,7 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
             f64::NAN
         },
         dof: s.dof,
-        dominant,
+        max_share,
     })
 }
 

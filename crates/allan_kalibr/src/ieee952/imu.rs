@@ -1,104 +1,117 @@
-//! The IEEE 952 analysis of a whole IMU (3 gyro + 3 accelerometer axes), as both binaries
-//! print and write it next to their compat outputs: the printed section, the per-axis terms
-//! and curves (CSV), and the configuration files users feed the numbers into — Kalibr
-//! `imu.yaml`, VINS-Mono/VINS-Fusion keys and ORB-SLAM3 keys — each saying whether its
-//! values are continuous-time or discrete at the given rate (field.md §3–4).
+//! The IEEE 952 analysis of a whole IMU, as both analysers run it next to their compat
+//! outputs: up to six axes (gyro x y z, accelerometer x y z) from samples or from another
+//! tool's curves, the record-length advice per axis, the stationarity checks, and the
+//! printed section. The files it writes are in [`super::files`].
 //!
 //! One value per sensor goes into the configuration files: the largest of the three axes
-//! (the conservative choice, as allan_variance_ros writes). A random walk that no axis
-//! resolves is written as its 95 % upper bound, and the file says so.
+//! (the conservative choice, as allan_variance_ros writes), and never a number the data do
+//! not support — see [`ImuAnalysis::sensor_value`].
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::{Analysis, Config, Ieee952Error, Term, Verdict, analyse};
-use crate::yaml::{ImuYaml, yaml_float};
-
-/// Axis labels in analysis order.
-pub const AXES: [&str; 6] = ["gyro x", "gyro y", "gyro z", "acc x", "acc y", "acc z"];
-
-/// The analysis of all six axes.
-#[derive(Debug, Clone)]
-pub struct ImuAnalysis {
-    /// Sample rate, Hz (1/τ0).
-    pub rate: f64,
-    /// gx, gy, gz (rad/s), ax, ay, az (m/s²).
-    pub axes: Vec<Analysis>,
-}
-
-/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz,
-/// axes in parallel.
-pub fn analyse_imu(
-    series: [&[f64]; 6],
-    rate: f64,
-    cfg: &Config,
-) -> Result<ImuAnalysis, Ieee952Error> {
-    let axes = series
-        .par_iter()
-        .map(|y| analyse(y, 1.0 / rate, cfg))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(ImuAnalysis { rate, axes })
-}
-
-/// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
-/// output: data the analysis cannot use (too short, non-finite) only cost the section, and
-/// the reason is added to `notes`.
-pub fn analyse_section(
-    series: [&[f64]; 6],
-    rate: f64,
-    notes: &mut Vec<String>,
-) -> Option<ImuAnalysis> {
-    match analyse_imu(series, rate, &Config::default()) {
-        Ok(an) => Some(an),
-        Err(e) => {
-            notes.push(format!("IEEE 952 analysis skipped: {e}"));
-            None
-        }
-    }
-}
+use super::advisor::{self, Advice};
+use super::stationarity::{self, StartStats, Timing, Warmup};
+use super::{
+    Analysis, AxisVerdict, Config, CovBasis, CurveData, Ieee952Error, Term, Verdict, analyse_curve,
+    short,
+};
 
 /// The two sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Sensor {
-    /// Axes 0–2.
+    /// Gyroscope (rad/s).
     Gyro,
-    /// Axes 3–5.
+    /// Accelerometer (m/s²).
     Acc,
 }
 
 impl Sensor {
-    fn axes(self) -> std::ops::Range<usize> {
-        match self {
-            Sensor::Gyro => 0..3,
-            Sensor::Acc => 3..6,
-        }
-    }
-    fn n_unit(self) -> &'static str {
+    /// Unit of N.
+    pub fn n_unit(self) -> &'static str {
         match self {
             Sensor::Gyro => "rad/s/sqrt(Hz)",
             Sensor::Acc => "m/s^2/sqrt(Hz)",
         }
     }
-    fn k_unit(self) -> &'static str {
+    /// Unit of K.
+    pub fn k_unit(self) -> &'static str {
         match self {
             Sensor::Gyro => "rad/s^2/sqrt(Hz)",
             Sensor::Acc => "m/s^3/sqrt(Hz)",
         }
     }
-    fn unit(self) -> &'static str {
+    /// Unit of the signal (and of B).
+    pub fn unit(self) -> &'static str {
         match self {
             Sensor::Gyro => "rad/s",
             Sensor::Acc => "m/s^2",
         }
     }
+    /// Unit of Q.
+    pub fn q_unit(self) -> &'static str {
+        match self {
+            Sensor::Gyro => "rad",
+            Sensor::Acc => "m/s",
+        }
+    }
+    /// Unit of R.
+    pub fn r_unit(self) -> &'static str {
+        match self {
+            Sensor::Gyro => "rad/s^2",
+            Sensor::Acc => "m/s^3",
+        }
+    }
+    /// `gyroscope` / `accelerometer`.
     pub fn name(self) -> &'static str {
         match self {
             Sensor::Gyro => "gyroscope",
             Sensor::Acc => "accelerometer",
         }
     }
+    /// Axis code of the curves CSV: `gx` … `az`.
+    pub fn axis_code(self, axis: usize) -> &'static str {
+        match self {
+            Sensor::Gyro => ["gx", "gy", "gz"][axis],
+            Sensor::Acc => ["ax", "ay", "az"][axis],
+        }
+    }
+    /// Label in the printed section: `gyro x` … `acc z`.
+    pub fn axis_label(self, axis: usize) -> &'static str {
+        match self {
+            Sensor::Gyro => ["gyro x", "gyro y", "gyro z"][axis],
+            Sensor::Acc => ["acc x", "acc y", "acc z"][axis],
+        }
+    }
+}
+
+/// One analysed axis.
+#[derive(Debug, Clone)]
+pub struct AxisResult {
+    /// Gyro or accelerometer.
+    pub sensor: Sensor,
+    /// 0, 1, 2 for x, y, z.
+    pub axis: usize,
+    /// The analysis.
+    pub analysis: Analysis,
+    /// Record-length advice (None without a sample count).
+    pub advice: Option<Advice>,
+    /// A warm-up or drift at the start (samples only).
+    pub warmup: Option<Warmup>,
+}
+
+/// The analysis of an IMU.
+#[derive(Debug, Clone)]
+pub struct ImuAnalysis {
+    /// Sample rate, Hz (1/τ0).
+    pub rate: f64,
+    /// The axes, gyro first, x y z.
+    pub axes: Vec<AxisResult>,
+    /// The time stamps' gaps and rate changes (samples with stamps only).
+    pub timing: Option<Timing>,
+    /// Where the curves came from and what was inferred (for the printed section).
+    pub notes: Vec<String>,
 }
 
 /// One number per sensor for the configuration files.
@@ -108,80 +121,262 @@ pub struct SensorValue {
     pub value: f64,
     /// True when the value is a 95 % upper bound (no axis resolved the term).
     pub upper_bound: bool,
+    /// True when the value comes from an IEEE 952 region reading (no reliable fit).
+    pub region: bool,
 }
 
-/// The four numbers every configuration file takes.
-struct FileValues {
-    acc_n: SensorValue,
-    acc_w: SensorValue,
-    gyr_n: SensorValue,
-    gyr_w: SensorValue,
+/// Groups curves by what their statistical covariance depends on, so each basis is built
+/// once (the axes of an IMU share the grid, the sample count and the estimator).
+fn bases(curves: &[&CurveData], cfg: &Config) -> Vec<Option<CovBasis>> {
+    let mut keys: Vec<(Vec<usize>, Option<usize>, u64, super::Overlap)> = Vec::new();
+    let mut which = Vec::with_capacity(curves.len());
+    for c in curves {
+        let key = (c.fit_ms(cfg.fit.per_octave), c.n, c.tau0.to_bits(), c.kind);
+        let i = keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+            keys.push(key);
+            keys.len() - 1
+        });
+        which.push(i);
+    }
+    let built: Vec<Option<CovBasis>> = keys
+        .par_iter()
+        .map(|(ms, n, tau0, kind)| n.map(|n| CovBasis::new(ms, n, f64::from_bits(*tau0), *kind)))
+        .collect();
+    which.into_iter().map(|i| built[i].clone()).collect()
+}
+
+/// Analyses measured curves: `sensors` holds each sensor's three axes; `rate` is 1/τ0.
+pub fn analyse_curves(
+    sensors: &[(Sensor, [CurveData; 3])],
+    rate: f64,
+    cfg: &Config,
+) -> ImuAnalysis {
+    let flat: Vec<(Sensor, usize, &CurveData)> = sensors
+        .iter()
+        .flat_map(|(s, axes)| axes.iter().enumerate().map(move |(i, c)| (*s, i, c)))
+        .collect();
+    let curves: Vec<&CurveData> = flat.iter().map(|x| x.2).collect();
+    let basis = bases(&curves, cfg);
+    let axes = flat
+        .par_iter()
+        .zip(basis.par_iter())
+        .map(|((sensor, axis, c), b)| {
+            let analysis = analyse_curve(c, cfg, b.as_ref());
+            AxisResult {
+                sensor: *sensor,
+                axis: *axis,
+                advice: advisor::advise(&analysis),
+                analysis,
+                warmup: None,
+            }
+        })
+        .collect();
+    ImuAnalysis {
+        rate,
+        axes,
+        timing: None,
+        notes: Vec::new(),
+    }
+}
+
+/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz,
+/// with the warm-up check on each; `t` (s) adds the gap and rate checks.
+pub fn analyse_imu(
+    series: [&[f64]; 6],
+    rate: f64,
+    t: Option<&[f64]>,
+    cfg: &Config,
+) -> Result<ImuAnalysis, Ieee952Error> {
+    let tau0 = 1.0 / rate;
+    let data = series
+        .par_iter()
+        .map(|y| CurveData::from_samples(y, tau0, cfg))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut it = data.into_iter();
+    let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
+    let sensors = [(Sensor::Gyro, take3()), (Sensor::Acc, take3())];
+    let mut an = analyse_curves(&sensors, rate, cfg);
+    let starts: Vec<Option<StartStats>> = series
+        .iter()
+        .map(|y| StartStats::from_samples(y, tau0))
+        .collect();
+    add_stationarity(&mut an, &starts, t);
+    Ok(an)
+}
+
+/// Adds the warm-up checks (each axis' start statistics, gyro x y z then acc x y z, against
+/// its fitted model) and the time-stamp checks.
+pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: Option<&[f64]>) {
+    for ax in an.axes.iter_mut() {
+        let k = match ax.sensor {
+            Sensor::Gyro => ax.axis,
+            Sensor::Acc => 3 + ax.axis,
+        };
+        let Some(Some(st)) = starts.get(k) else {
+            continue;
+        };
+        let Some(f) = ax
+            .analysis
+            .fit
+            .as_ref()
+            .filter(|_| ax.analysis.verdict.fits())
+        else {
+            continue;
+        };
+        let coef = f.coef;
+        let model = move |tau: f64| {
+            (0..super::fit::TERM_COUNT)
+                .map(|j| coef[j] * super::fit::basis(j, tau))
+                .sum::<f64>()
+                .max(0.0)
+        };
+        ax.warmup = stationarity::warmup(st, &model);
+    }
+    an.timing = t.map(stationarity::timing);
+}
+
+/// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
+/// output: data the analysis cannot use (too short, non-finite) only cost the section, and
+/// the reason is added to `notes`.
+pub fn analyse_section(
+    series: [&[f64]; 6],
+    rate: f64,
+    t: Option<&[f64]>,
+    notes: &mut Vec<String>,
+) -> Option<ImuAnalysis> {
+    match analyse_imu(series, rate, t, &Config::default()) {
+        Ok(an) => Some(an),
+        Err(e) => {
+            notes.push(format!("IEEE 952 analysis skipped: {e}"));
+            None
+        }
+    }
 }
 
 impl ImuAnalysis {
-    fn file_values(&self) -> FileValues {
-        FileValues {
-            acc_n: self.noise_density(Sensor::Acc),
-            acc_w: self.random_walk(Sensor::Acc),
-            gyr_n: self.noise_density(Sensor::Gyro),
-            gyr_w: self.random_walk(Sensor::Gyro),
-        }
+    /// The sensors present, gyro first.
+    pub fn sensors(&self) -> Vec<Sensor> {
+        let mut s: Vec<Sensor> = self.axes.iter().map(|a| a.sensor).collect();
+        s.sort();
+        s.dedup();
+        s
     }
 
-    /// White-noise density N of a sensor: the largest axis value.
-    pub fn noise_density(&self, s: Sensor) -> SensorValue {
-        let v = s
-            .axes()
-            .map(|a| self.axes[a].terms.n.value)
-            .fold(f64::NAN, f64::max);
-        SensorValue {
-            value: v,
-            upper_bound: false,
-        }
+    /// The axes of one sensor.
+    pub fn sensor_axes(&self, s: Sensor) -> impl Iterator<Item = &AxisResult> {
+        self.axes.iter().filter(move |a| a.sensor == s)
     }
 
-    /// Random walk K of a sensor: the largest resolved axis value, or the largest 95 % upper
-    /// bound when no axis resolves it.
-    pub fn random_walk(&self, s: Sensor) -> SensorValue {
-        let resolved = s
-            .axes()
-            .filter_map(|a| self.axes[a].terms.k.reported())
-            .fold(f64::NAN, f64::max);
-        if resolved.is_finite() {
-            return SensorValue {
-                value: resolved,
+    /// One value of a term for a sensor (`term` picks it from the terms): the largest
+    /// resolved axis value (or region reading, marked); when no axis has one, the largest
+    /// 95 % upper bound, marked. `None` when the sensor is absent or nothing is known.
+    pub fn sensor_value(&self, s: Sensor, term: fn(&super::Terms) -> &Term) -> Option<SensorValue> {
+        let terms: Vec<&Term> = self
+            .sensor_axes(s)
+            .map(|a| term(&a.analysis.terms))
+            .collect();
+        if terms.is_empty() {
+            return None;
+        }
+        let reported = terms
+            .iter()
+            .filter_map(|t| {
+                t.reported()
+                    .map(|v| (v, t.verdict == Verdict::RegionReading))
+            })
+            .fold(None, |acc: Option<(f64, bool)>, x| match acc {
+                Some(a) if a.0 >= x.0 => Some(a),
+                _ => Some(x),
+            });
+        if let Some((v, region)) = reported {
+            return Some(SensorValue {
+                value: v,
                 upper_bound: false,
-            };
+                region: region || terms.iter().any(|t| t.verdict == Verdict::RegionReading),
+            });
         }
-        let hi = s
-            .axes()
-            .map(|a| self.axes[a].terms.k.hi)
+        let hi = terms
+            .iter()
+            .map(|t| t.hi)
+            .filter(|v| v.is_finite())
             .fold(f64::NAN, f64::max);
-        SensorValue {
+        hi.is_finite().then_some(SensorValue {
             value: hi,
             upper_bound: true,
-        }
+            region: terms
+                .iter()
+                .any(|t| matches!(t.verdict, Verdict::RegionReading | Verdict::RegionBound)),
+        })
+    }
+
+    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]).
+    pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
+        self.sensor_value(s, |t| &t.n)
+    }
+
+    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
+    pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
+        self.sensor_value(s, |t| &t.k)
+    }
+
+    /// Axes without a reliable fit, as `gyro y` labels.
+    pub fn failed_axes(&self, s: Sensor) -> Vec<&'static str> {
+        self.sensor_axes(s)
+            .filter(|a| !a.analysis.verdict.fits())
+            .map(|a| a.sensor.axis_label(a.axis))
+            .collect()
     }
 }
 
 fn term_text(t: &Term, unit: &str) -> String {
+    let iv = |t: &Term| {
+        if t.lo.is_finite() && t.hi.is_finite() {
+            format!(" [95 %: {:.3e}, {:.3e}]", t.lo, t.hi)
+        } else if t.hi.is_infinite() {
+            format!(" [95 %: {:.3e}, unbounded]", t.lo)
+        } else {
+            " (no interval: sample count unknown)".into()
+        }
+    };
     match t.verdict {
-        Verdict::Resolved => format!(
-            "{:.4e} ± {:.1e} {unit} [95 %: {:.4e}, {:.4e}]",
-            t.value, t.std_err, t.lo, t.hi
-        ),
-        Verdict::NotSignificant => format!("not resolved (95 % upper bound {:.2e} {unit})", t.hi),
+        Verdict::Resolved => format!("{:.4e} {unit}{}", t.value, iv(t)),
+        Verdict::NotSignificant => {
+            if t.hi.is_finite() {
+                format!("not resolved (95 % upper bound {:.2e} {unit})", t.hi)
+            } else {
+                "not resolved".into()
+            }
+        }
         Verdict::NeverDominant => format!(
-            "not resolved: never dominant in this record ({:.2e} {unit}, 95 % up to {:.2e})",
-            t.value, t.hi
+            "not resolved: its line never reaches the curve ({:.2e} {unit}{})",
+            t.value,
+            iv(t)
         ),
-        Verdict::RegionReading => format!(
-            "{:.4e} {unit} [95 %: {:.4e}, {:.4e}] (IEEE 952 region reading)",
-            t.value, t.lo, t.hi
+        Verdict::RegionReading => {
+            format!("{:.4e} {unit}{} (IEEE 952 region reading)", t.value, iv(t))
+        }
+        Verdict::RegionBound => format!(
+            "not resolved (95 % upper bound {:.2e} {unit}, IEEE 952 region rule)",
+            t.hi
         ),
-        Verdict::RegionBound => format!("not resolved (95 % upper bound {:.2e} {unit})", t.hi),
         Verdict::NotFitted => "not in the fitted model".to_string(),
     }
+}
+
+fn verdict_line(a: &Analysis) -> String {
+    let mut s = format!("{}", a.verdict);
+    if let Some(f) = &a.fit
+        && a.verdict.fits()
+    {
+        let _ = write!(s, "; χ²/dof {:.2}", f.chi2_per_dof);
+        if f.delta > 0.0 {
+            let _ = write!(s, ", model discrepancy {:.1} %", 100.0 * f.delta);
+        }
+    }
+    if let AxisVerdict::NoReliableFit { .. } = a.verdict {
+        s.push_str(" — terms below are IEEE 952 region readings");
+    }
+    s
 }
 
 /// The section both binaries print after their compat output.
@@ -189,15 +384,21 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "\n=> IEEE 952 noise terms (overlapping Allan deviation, Greenhall EDF, GLS fit), continuous time, {} Hz",
+        "\n=> IEEE 952 noise terms (overlapping Allan deviation, Greenhall EDF, GLS fit with model discrepancy), continuous time, {} Hz",
         a.rate
     );
-    for (i, an) in a.axes.iter().enumerate() {
-        let sensor = if i < 3 { Sensor::Gyro } else { Sensor::Acc };
+    for n in &a.notes {
+        let _ = writeln!(s, "   note: {n}");
+    }
+    for ax in &a.axes {
+        let an = &ax.analysis;
+        let sensor = ax.sensor;
+        let lab = sensor.axis_label(ax.axis);
+        let _ = writeln!(s, "{lab:<7} fit: {}", verdict_line(an));
         let _ = writeln!(
             s,
             "{:<7} white noise N  = {}",
-            AXES[i],
+            "",
             term_text(&an.terms.n, sensor.n_unit())
         );
         let _ = writeln!(
@@ -215,195 +416,150 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
                 term_text(b, sensor.unit())
             );
         }
+        for (name, t, unit) in [
+            ("quantiz. Q", &an.terms.q, sensor.q_unit()),
+            ("rate ramp R", &an.terms.r, sensor.r_unit()),
+        ] {
+            if t.verdict == Verdict::Resolved {
+                let _ = writeln!(s, "{:<7} {name:<11}= {}", "", term_text(t, unit));
+            }
+        }
+        if an.verdict.fits() {
+            let r = &an.region;
+            let rd = |x: Option<super::region::Reading>| match x {
+                Some(x) if x.kind == super::region::ReadingKind::Line => format!("{:.3e}", x.value),
+                Some(x) => format!("< {:.2e}", x.hi),
+                None => "-".into(),
+            };
+            let _ = writeln!(
+                s,
+                "{:<7} region readings (cross-check): N {}  B {}  K {}",
+                "",
+                rd(r.n),
+                rd(r.b),
+                rd(r.k)
+            );
+        }
+        if let Some(w) = &ax.warmup {
+            let _ = writeln!(
+                s,
+                "{:<7} WARNING: the first {} differ from the rest by {:.3e} {} ({:.0} σ of the noise): warm-up or drift; consider --skip-start {:.0}",
+                "",
+                advisor::duration_text(w.duration),
+                w.size,
+                sensor.unit(),
+                w.sigmas,
+                w.duration.ceil()
+            );
+        }
     }
-    for sensor in [Sensor::Gyro, Sensor::Acc] {
-        let (n, k) = (a.noise_density(sensor), a.random_walk(sensor));
+    s.push_str(&advice_text(a));
+    if let Some(t) = &a.timing {
+        s.push_str(&timing_text(t));
+    }
+    for sensor in a.sensors() {
+        let fmt = |v: Option<SensorValue>, unit: &str| match v {
+            Some(v) => format!(
+                "{:.8e} {unit}{}{}",
+                v.value,
+                if v.upper_bound {
+                    " (not resolved: 95 % upper bound)"
+                } else {
+                    ""
+                },
+                if v.region { " (region reading)" } else { "" }
+            ),
+            None => "unknown".into(),
+        };
         let _ = writeln!(
             s,
-            "{}_noise_density = {:.8e} {}   {}_random_walk = {:.8e} {}{}",
+            "{}_noise_density = {}   {}_random_walk = {}",
             sensor.name(),
-            n.value,
-            sensor.n_unit(),
+            fmt(a.noise_density(sensor), sensor.n_unit()),
             sensor.name(),
-            k.value,
-            sensor.k_unit(),
-            if k.upper_bound {
-                " (not resolved: 95 % upper bound)"
-            } else {
-                ""
-            }
+            fmt(a.random_walk(sensor), sensor.k_unit()),
         );
     }
     s
 }
 
-/// Writes the terms and curves CSVs and the three configuration files into `dir`, each name
-/// prefixed with `prefix`; returns the paths.
-pub fn write_outputs(
-    a: &ImuAnalysis,
-    dir: &Path,
-    prefix: &str,
-    rostopic: &str,
-) -> Result<Vec<PathBuf>, bag2mat::Error> {
-    let mut files = Vec::new();
-    let mut put = |name: String, text: String| -> Result<(), bag2mat::Error> {
-        let p = dir.join(format!("{prefix}{name}"));
-        bag2mat::output::write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
-        files.push(p);
-        Ok(())
+/// The record-length advice lines.
+pub fn advice_text(a: &ImuAnalysis) -> String {
+    let mut s = String::new();
+    let Some(record) = a.axes.iter().find_map(|x| x.advice.map(|v| v.record)) else {
+        return s;
     };
-    put("ieee952_terms.csv".into(), terms_csv(a))?;
-    put("ieee952_curves.csv".into(), curves_csv(a))?;
-    put("kalibr_imu_ieee952.yaml".into(), kalibr_yaml(a, rostopic))?;
-    put("vins_imu_ieee952.yaml".into(), vins_yaml(a))?;
-    put("orbslam3_imu_ieee952.yaml".into(), orbslam3_yaml(a))?;
-    Ok(files)
-}
-
-/// Per axis and term: value, standard error, 95 % interval, verdict, unit. Rust's `{}` float
-/// output is the shortest text that reads back to the same double.
-pub fn terms_csv(a: &ImuAnalysis) -> String {
-    let mut s = String::from(
-        "# IEEE 952 terms per axis, continuous time (N: noise density, K: random walk, B: bias instability, Q: quantization, R: ramp)\nsensor,axis,term,value,std_err,ci95_lo,ci95_hi,resolved,verdict,unit\n",
+    let _ = writeln!(
+        s,
+        "record length {}: 95 % precision of each term now, and the record for ±25 % / ±10 %",
+        advisor::duration_text(record)
     );
-    for (i, an) in a.axes.iter().enumerate() {
-        let sensor = if i < 3 { Sensor::Gyro } else { Sensor::Acc };
-        let axis = ["x", "y", "z"][i % 3];
-        let (u, us) = (
-            sensor.unit(),
-            if sensor == Sensor::Gyro { "rad" } else { "m/s" },
+    for ax in &a.axes {
+        let Some(adv) = ax.advice else { continue };
+        let one = |name: &str, t: &advisor::TermAdvice, term: &Term| -> String {
+            if t.precision.is_finite() {
+                format!(
+                    "{name} ±{:.0} % ({} / {})",
+                    100.0 * t.precision,
+                    advisor::duration_text(t.record_25),
+                    advisor::duration_text(t.record_10)
+                )
+            } else if term.verdict == Verdict::NotFitted {
+                format!("{name} -")
+            } else {
+                format!("{name} not resolved: longer than this record")
+            }
+        };
+        let t = &ax.analysis.terms;
+        let _ = writeln!(
+            s,
+            "{:<7} {}   {}   {}",
+            ax.sensor.axis_label(ax.axis),
+            one("N", &adv.n, &t.n),
+            one("B", &adv.b, &t.b),
+            one("K", &adv.k, &t.k)
         );
-        let units = [
-            ("Q", &an.terms.q, us.to_string()),
-            ("N", &an.terms.n, sensor.n_unit().to_string()),
-            ("B", &an.terms.b, u.to_string()),
-            ("K", &an.terms.k, sensor.k_unit().to_string()),
-            ("R", &an.terms.r, format!("{u}/s")),
-        ];
-        for (name, t, unit) in units {
-            let _ = writeln!(
-                s,
-                "{},{axis},{name},{},{},{},{},{},{:?},{unit}",
-                sensor.name(),
-                t.value,
-                t.std_err,
-                t.lo,
-                t.hi,
-                t.verdict == Verdict::Resolved,
-                t.verdict
-            );
-        }
     }
     s
 }
 
-/// The overlapping Allan deviation of every axis with its 68.3 % bounds.
-pub fn curves_csv(a: &ImuAnalysis) -> String {
-    let mut s = String::from("axis,m,tau,adev,adev_lo,adev_hi,edf,alpha\n");
-    for (i, an) in a.axes.iter().enumerate() {
-        let axis = ["gx", "gy", "gz", "ax", "ay", "az"][i];
-        for p in &an.curve {
-            let _ = writeln!(
-                s,
-                "{axis},{},{},{},{},{},{},{}",
-                p.m, p.tau, p.adev, p.lo, p.hi, p.edf, p.alpha
-            );
-        }
+/// The time-stamp findings.
+pub fn timing_text(t: &Timing) -> String {
+    let mut s = String::new();
+    if t.gap_count > 0 {
+        let list: Vec<String> = t
+            .gaps
+            .iter()
+            .map(|g| format!("{} s at {}", short(g.length), advisor::duration_text(g.at)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "WARNING: {} gap(s) in the time stamps (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
+            t.gap_count,
+            t.missing,
+            list.join(", ")
+        );
+    }
+    if t.non_advancing > 0 {
+        let _ = writeln!(
+            s,
+            "WARNING: {} time step(s) do not advance (duplicated or out-of-order stamps)",
+            t.non_advancing
+        );
+    }
+    if t.rate_change_count > 0 {
+        let list: Vec<String> = t
+            .rate_changes
+            .iter()
+            .map(|r| format!("{:.2} Hz from {}", r.rate, advisor::duration_text(r.at)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "WARNING: the sample rate changes ({} stretch(es) off the median {:.3} Hz by > 1 %: {})",
+            t.rate_change_count,
+            1.0 / t.median_step,
+            list.join(", ")
+        );
     }
     s
-}
-
-fn bound_note(v: SensorValue) -> &'static str {
-    if v.upper_bound {
-        " NOT RESOLVED by this record: 95 % upper bound"
-    } else {
-        ""
-    }
-}
-
-/// Kalibr `imu.yaml` (continuous-time, as Kalibr expects), in the same layout as the
-/// compat file ([`crate::yaml::ImuYaml`]).
-pub fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
-    let (aw, gw) = (a.random_walk(Sensor::Acc), a.random_walk(Sensor::Gyro));
-    let y = ImuYaml {
-        accelerometer_noise_density: a.noise_density(Sensor::Acc).value,
-        accelerometer_random_walk: aw.value,
-        gyroscope_noise_density: a.noise_density(Sensor::Gyro).value,
-        gyroscope_random_walk: gw.value,
-        rostopic: rostopic.to_string(),
-        update_rate: a.rate,
-    };
-    let mut comments = vec![
-        "IMU noise model for Kalibr from the IEEE 952 fit of the overlapping Allan deviation",
-        "(largest of the three axes). These are CONTINUOUS-TIME values; Kalibr discretises",
-        "them with update_rate. Values from static data are optimistic: users commonly",
-        "inflate them (x10 or more) before use.",
-    ];
-    if aw.upper_bound {
-        comments
-            .push("accelerometer_random_walk is NOT RESOLVED by this record: 95 % upper bound.");
-    }
-    if gw.upper_bound {
-        comments.push("gyroscope_random_walk is NOT RESOLVED by this record: 95 % upper bound.");
-    }
-    y.render_with(&comments)
-}
-
-/// VINS-Mono / VINS-Fusion keys. Their comments say "standard deviation"; VINS uses them as
-/// continuous-time densities (it multiplies by the integration period), so these are the
-/// continuous-time values, stated in the file.
-pub fn vins_yaml(a: &ImuAnalysis) -> String {
-    let FileValues {
-        acc_n: an,
-        acc_w: aw,
-        gyr_n: gn,
-        gyr_w: gw,
-    } = a.file_values();
-    format!(
-        "%YAML:1.0\n\
-         # VINS-Mono / VINS-Fusion IMU parameters from the IEEE 952 fit (largest of the three axes).\n\
-         # CONTINUOUS-TIME noise densities and random walks, not per-sample values at {rate} Hz.\n\
-         # Static data give optimistic values: inflate before use.\n\
-         acc_n: {}   # accelerometer noise density [m/s^2/sqrt(Hz)]\n\
-         gyr_n: {}   # gyroscope noise density [rad/s/sqrt(Hz)]\n\
-         acc_w: {}   # accelerometer bias random walk [m/s^3/sqrt(Hz)]{}\n\
-         gyr_w: {}   # gyroscope bias random walk [rad/s^2/sqrt(Hz)]{}\n\
-         g_norm: 9.81   # gravity magnitude [m/s^2]\n",
-        yaml_float(an.value),
-        yaml_float(gn.value),
-        yaml_float(aw.value),
-        bound_note(aw),
-        yaml_float(gw.value),
-        bound_note(gw),
-        rate = a.rate
-    )
-}
-
-/// ORB-SLAM3 settings keys (continuous-time densities; ORB-SLAM3 discretises with
-/// IMU.Frequency).
-pub fn orbslam3_yaml(a: &ImuAnalysis) -> String {
-    let FileValues {
-        acc_n: an,
-        acc_w: aw,
-        gyr_n: gn,
-        gyr_w: gw,
-    } = a.file_values();
-    format!(
-        "%YAML:1.0\n\
-         # ORB-SLAM3 IMU noise from the IEEE 952 fit (largest of the three axes).\n\
-         # CONTINUOUS-TIME values; ORB-SLAM3 discretises them with IMU.Frequency.\n\
-         # Static data give optimistic values: inflate before use.\n\
-         IMU.NoiseGyro: {}   # [rad/s/sqrt(Hz)]\n\
-         IMU.NoiseAcc: {}   # [m/s^2/sqrt(Hz)]\n\
-         IMU.GyroWalk: {}   # [rad/s^2/sqrt(Hz)]{}\n\
-         IMU.AccWalk: {}   # [m/s^3/sqrt(Hz)]{}\n\
-         IMU.Frequency: {}   # [Hz]\n",
-        yaml_float(gn.value),
-        yaml_float(an.value),
-        yaml_float(gw.value),
-        bound_note(gw),
-        yaml_float(aw.value),
-        bound_note(aw),
-        yaml_float(a.rate)
-    )
 }

@@ -37,7 +37,10 @@
 //! reliable fit (then the terms are the region readings, and say so). A fit is declared only
 //! where the fitted model stays within the larger of [`FIT_TOL`] and the point's own 95 %
 //! band at every curve point of its range. Per term ([`Verdict`]): resolved only with a
-//! 95 % lower bound above 0, dominant somewhere in the fitted range, and a fitting model.
+//! 95 % lower bound above 0, a fitting model, and where the data show it: the term's own line
+//! comes within 20 % of the curve somewhere in the fitted range ([`RESOLVED_SHARE`] of the
+//! Allan variance) — a bias instability only where there is a floor, not at the V where the
+//! white-noise and random-walk lines cross.
 //!
 //! # How good can K be?
 //! For white noise N plus random walk K over T seconds no unbiased estimator beats
@@ -45,6 +48,7 @@
 //! at 4 h (N/K = 300 s) that is 20 %: about a third of all axes land outside ±20 % whatever the
 //! method. The fit here reaches the bound within sampling error in the accuracy study.
 
+pub mod advisor;
 pub mod avar_cov;
 pub mod ci;
 pub mod curves_in;
@@ -55,7 +59,9 @@ pub mod fit;
 pub mod imu;
 pub mod noise_id;
 pub mod oadev;
+pub mod plot;
 pub mod region;
+pub mod stationarity;
 pub mod tau_grid;
 
 #[cfg(test)]
@@ -78,6 +84,10 @@ use statrs::distribution::{ContinuousCDF, Normal};
 /// The model may miss a curve point by this fraction (ADEV) where the point's own 95 % band
 /// is narrower: the bar for "the model describes the curve".
 pub const FIT_TOL: f64 = 0.10;
+/// A term is resolved only where its own Allan variance is at least this share of the
+/// measured one somewhere in the fitted range: its line within 20 % (0.8² = 0.64) of the
+/// curve.
+pub const RESOLVED_SHARE: f64 = 0.64;
 /// A declared fit range spans at least this many decades of τ; shorter is "no reliable fit".
 pub const MIN_RANGE_DECADES: f64 = 1.0;
 
@@ -253,12 +263,14 @@ pub struct Point {
 /// Whether a term can be reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
-    /// Positive with its lower bound above 0 and dominant somewhere in the fitted range.
+    /// Positive with its lower bound above 0, and its own line within 20 % of the curve
+    /// somewhere in the fitted range.
     Resolved,
     /// The lower bound of its interval is 0: the data do not show the term.
     NotSignificant,
-    /// Significant, but never the largest term in the fitted range: its value leans on the
-    /// model.
+    /// Significant, but its line never comes within 20 % of the curve in the fitted range
+    /// (e.g. a bias instability under the V of the white-noise and random-walk lines): its
+    /// value leans on the model.
     NeverDominant,
     /// No reliable fit: the value is the IEEE 952 region reading, with its own interval.
     RegionReading,
@@ -583,12 +595,12 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         })
         .collect();
 
-    // region readings on the fit grid of the usable range (all of it without a fit)
-    let region_from = fitted
-        .as_ref()
-        .map_or(0, |f| f.used.first().copied().unwrap_or(0));
-    let region_pts: Vec<Point> = fd.points[region_from..]
+    // region readings on the fit grid of the declared range (all of it without a fit)
+    let (rlo, rhi) = range.unwrap_or((0.0, f64::INFINITY));
+    let region_pts: Vec<Point> = fd
+        .points
         .iter()
+        .filter(|fp| fp.tau >= rlo * (1.0 - 1e-12) && fp.tau <= rhi * (1.0 + 1e-12))
         .filter_map(|fp| curve.iter().find(|c| c.m == fp.m).copied())
         .collect();
     let region = region::read(&region_pts);
@@ -816,7 +828,7 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, cfg: &Config) -> Terms {
         let value = c.sqrt();
         let std_err = nan_if(se_c / (2.0 * value));
         let (lo_c, hi_c) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
-        let dominant_somewhere = f.dominant.contains(&j);
+        let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE;
         let verdict = if !have_stats {
             // no sample count: no interval, so nothing is "resolved" statistically; a term the
             // model needs and that dominates somewhere is still the model's

@@ -11,8 +11,9 @@
 //!
 //! with N = n + 1 phase points and M = ⌊n/m⌋ − 1 (the definitions Stable32 uses; the counts
 //! match its "#" column). Subtracting the mean ȳ first changes no second difference but keeps
-//! x near zero, so the compensated prefix sum loses no precision. Each m costs O(N); a set of
-//! m is computed in parallel with rayon.
+//! x near zero, so the compensated prefix sum loses no precision. Each m costs O(N)
+//! ([`second_diff_sum`], the kernel both analysers use); a set of m is computed in parallel
+//! with rayon.
 
 use rayon::prelude::*;
 
@@ -95,11 +96,7 @@ impl Phase {
                 if 2 * m > n {
                     return None;
                 }
-                let cnt = n + 1 - 2 * m;
-                (
-                    sum_sq_second_diff(&x[..cnt], &x[m..m + cnt], &x[2 * m..2 * m + cnt]),
-                    cnt,
-                )
+                (second_diff_sum(x, m), n + 1 - 2 * m)
             }
             Overlap::Normal => {
                 let clusters = n / m;
@@ -130,29 +127,75 @@ impl Phase {
     }
 }
 
-/// Σ (c − 2b + a)² over three equally long slices, four independent accumulators so the loop
-/// vectorises (the order of summation differs from a plain loop by rounding only).
-fn sum_sq_second_diff(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    const LANES: usize = 4;
+/// Independent accumulators of [`second_diff_sum`]: enough for the compiler to fill AVX-512
+/// registers and hide the add latency.
+const LANES: usize = 32;
+
+#[inline(always)]
+fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
     let mut acc = [0.0f64; LANES];
-    let (ca, cb, cc) = (
-        a.chunks_exact(LANES),
-        b.chunks_exact(LANES),
-        c.chunks_exact(LANES),
-    );
-    let (ra, rb, rc) = (ca.remainder(), cb.remainder(), cc.remainder());
-    for ((xa, xb), xc) in ca.zip(cb).zip(cc) {
+    let (a8, ar) = a.as_chunks::<LANES>();
+    let (b8, br) = b.as_chunks::<LANES>();
+    let (c8, cr) = c.as_chunks::<LANES>();
+    for ((a, b), c) in a8.iter().zip(b8).zip(c8) {
         for l in 0..LANES {
-            let d = xc[l] - 2.0 * xb[l] + xa[l];
+            // imu_utils' expression order: (x[k+2m] − 2x[k+m]) + x[k].
+            let d = (c[l] - 2.0 * b[l]) + a[l];
             acc[l] += d * d;
         }
     }
-    let mut tail = 0.0;
-    for ((xa, xb), xc) in ra.iter().zip(rb).zip(rc) {
-        let d = xc - 2.0 * xb + xa;
-        tail += d * d;
+    // Pairwise reduction of the lanes.
+    let mut width = LANES;
+    while width > 1 {
+        width /= 2;
+        for l in 0..width {
+            acc[l] += acc[l + width];
+        }
     }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    let mut s = acc[0];
+    for ((a, b), c) in ar.iter().zip(br).zip(cr) {
+        let d = (c - 2.0 * b) + a;
+        s += d * d;
+    }
+    s
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn second_diff_sum_avx512(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    second_diff_sum_body(a, b, c)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn second_diff_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
+    second_diff_sum_body(a, b, c)
+}
+
+/// `Σ_k ((x[k+2m] − 2x[k+m]) + x[k])²` over every k with k + 2m < x.len() (0 when there is
+/// none): the fully overlapping second-difference sum of both analysers. Each squared term is
+/// bit-identical to imu_utils' (its expression order); the sum uses [`LANES`] accumulators
+/// and AVX-512 or AVX2 when the CPU has them (chosen at run time), which differs from a
+/// sequential sum by rounding only (~1e-13 relative).
+pub fn second_diff_sum(x: &[f64], m: usize) -> f64 {
+    let n = x.len();
+    if n <= 2 * m {
+        return 0.0;
+    }
+    let cnt = n - 2 * m;
+    let (a, b, c) = (&x[..cnt], &x[m..m + cnt], &x[2 * m..2 * m + cnt]);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F (checked just above).
+            return unsafe { second_diff_sum_avx512(a, b, c) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { second_diff_sum_avx2(a, b, c) };
+        }
+    }
+    second_diff_sum_body(a, b, c)
 }
 
 /// Neumaier-compensated sum.

@@ -5,9 +5,11 @@
 //! Rules (on the points of the usable range, local slopes from log-log central differences
 //! on the 2-per-octave fit grid):
 //! * **N** — the −½ line at τ = 1 s. The white-noise region is the points whose local slope is
-//!   within [`SLOPE_TOL`] of −½; N = σ(τ)·√τ at the region's point nearest τ = 1 s, its 95 %
-//!   interval the point's χ² interval scaled the same way. Every term adds to the Allan
-//!   variance, so this reading is biased high by whatever else contributes at that τ.
+//!   within [`SLOPE_TOL`] of −½ left of the curve's minimum; the line of slope −½ fitted to them (least squares in log:
+//!   the geometric mean of σ(τ)·√τ) is read at τ = 1 s. Its 95 % interval is that of the
+//!   region's most precise point, scaled to the line (neighbouring overlapping points are
+//!   strongly correlated, so averaging them narrows it little). Every term adds to the Allan
+//!   variance, so this reading is biased high by whatever else contributes there.
 //! * **B** — the flat floor / 0.664: the minimum of the curve when its local slope is within
 //!   [`SLOPE_TOL`] of 0, B = σ_min/√(2 ln2/π), interval likewise. (The minimum of noisy
 //!   points is biased low.)
@@ -114,16 +116,37 @@ pub fn read(points: &[Point]) -> Readings {
             kind: ReadingKind::UpperBound,
         })
     };
-    // N: white region point nearest to 1 s
-    let n = (0..pts.len())
-        .filter(|&i| (slope[i] + 0.5).abs() <= SLOPE_TOL)
-        .min_by(|&a, &b| tau[a].ln().abs().total_cmp(&tau[b].ln().abs()))
-        .map(|i| scaled(i, tau[i].sqrt()))
-        .or_else(|| bound(&|t: f64| t.sqrt()));
-    // B: the minimum, when flat there
+    // N: the −½ line through the white region (left of the minimum), read at 1 s
     let imin = (0..pts.len())
         .min_by(|&a, &b| adev[a].total_cmp(&adev[b]))
         .unwrap_or(0);
+    let white: Vec<usize> = (0..imin)
+        .filter(|&i| (slope[i] + 0.5).abs() <= SLOPE_TOL)
+        .collect();
+    let n = if white.is_empty() {
+        bound(&|t: f64| t.sqrt())
+    } else {
+        let line = (white
+            .iter()
+            .map(|&i| (adev[i] * tau[i].sqrt()).ln())
+            .sum::<f64>()
+            / white.len() as f64)
+            .exp();
+        // the most precise point: the narrowest relative interval
+        let best = white
+            .iter()
+            .copied()
+            .min_by(|&a, &b| (pts[a].hi95 / pts[a].lo95).total_cmp(&(pts[b].hi95 / pts[b].lo95)))
+            .unwrap_or(white[0]);
+        Some(Reading {
+            value: line,
+            lo: line * pts[best].lo95 / adev[best],
+            hi: line * pts[best].hi95 / adev[best],
+            tau: 1.0,
+            kind: ReadingKind::Line,
+        })
+    };
+    // B: the minimum, when flat there
     let b = if slope[imin].abs() <= SLOPE_TOL {
         Some(scaled(imin, 1.0 / B_FLOOR_FACTOR))
     } else {

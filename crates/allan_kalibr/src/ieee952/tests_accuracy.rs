@@ -601,3 +601,25 @@ fn one_case() {
         );
     }
 }
+
+#[test]
+#[ignore = "OADEV cost per cluster size on one 2.88 M-sample axis; --ignored --nocapture (release)"]
+fn oadev_cost_per_m() {
+    use super::{Overlap, Phase};
+    let y = simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED);
+    let ph = Phase::from_rate(&y, 0.005);
+    for m in [1usize, 8, 64, 512, 4096, 32768, 262_144] {
+        let t = std::time::Instant::now();
+        let reps = 5;
+        let mut s = 0.0;
+        for _ in 0..reps {
+            s += ph.avar(m, Overlap::Overlapping).unwrap().avar;
+        }
+        let dt = t.elapsed().as_secs_f64() / reps as f64;
+        println!(
+            "m={m}: {:.2} ms, {:.3} ns/element ({s:e})",
+            dt * 1e3,
+            dt * 1e9 / (2_880_000 - 2 * m) as f64
+        );
+    }
+}

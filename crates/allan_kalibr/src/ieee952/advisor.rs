@@ -1,0 +1,126 @@
+//! Recording-length advice (users ask exactly this: imu_utils#18, kalibr_allan#30): how
+//! precise each figure of this record is, and how long a record gives the random walk K and
+//! the bias instability B to ±10 % and ±25 % at 95 %.
+//!
+//! The precision of a term is the relative half-width of its 95 % interval,
+//! z·se(T)/T with se from the fit's covariance (delta method from its coefficient, the
+//! expected rather than the realised interval, so that the advice does not jump with the
+//! noise of one record). It improves as 1/√(record length): exactly so for K on white noise
+//! plus a random walk (the Cramér–Rao bound se(K)/K ≈ √(2N/(K·T)), module docs of
+//! [`super`]), and for a flicker floor B, whose information grows with the number of
+//! independent clusters in the floor. So a precision p of this record T becomes x after
+//! T·(p/x)². A term the record does not resolve has no precision; its 95 % upper bound says
+//! how small it is, and that a longer record is needed to see it at all.
+
+use super::{Analysis, Term, Verdict};
+
+/// The two precision targets of the advice (relative, 95 %).
+pub const TARGETS: [f64; 2] = [0.10, 0.25];
+
+/// Advice on one term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TermAdvice {
+    /// Relative half-width of the 95 % interval of this record (NaN when not resolved).
+    pub precision: f64,
+    /// Record length (s) for ±10 % at 95 % (NaN when not resolved).
+    pub record_10: f64,
+    /// Record length (s) for ±25 % at 95 %.
+    pub record_25: f64,
+}
+
+impl TermAdvice {
+    fn none() -> TermAdvice {
+        TermAdvice {
+            precision: f64::NAN,
+            record_10: f64::NAN,
+            record_25: f64::NAN,
+        }
+    }
+}
+
+/// Advice for one axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Advice {
+    /// This record's length, s.
+    pub record: f64,
+    /// White noise N.
+    pub n: TermAdvice,
+    /// Bias instability B.
+    pub b: TermAdvice,
+    /// Random walk K.
+    pub k: TermAdvice,
+}
+
+/// The z of the 95 % intervals.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// Advice for a term of a record of `record` seconds.
+fn term_advice(t: &Term, record: f64) -> TermAdvice {
+    if t.verdict != Verdict::Resolved || !super::fit::is_positive(t.value) || !t.std_err.is_finite() {
+        return TermAdvice::none();
+    }
+    let p = Z95 * t.std_err / t.value;
+    let needed = |x: f64| record * (p / x).powi(2);
+    TermAdvice {
+        precision: p,
+        record_10: needed(TARGETS[0]),
+        record_25: needed(TARGETS[1]),
+    }
+}
+
+/// The advice for an analysed axis (None without a sample count: no precision known).
+pub fn advise(a: &Analysis) -> Option<Advice> {
+    let n = a.n?;
+    let record = n as f64 * a.tau0;
+    Some(Advice {
+        record,
+        n: term_advice(&a.terms.n, record),
+        b: term_advice(&a.terms.b, record),
+        k: term_advice(&a.terms.k, record),
+    })
+}
+
+/// A duration in the unit that reads best (s, min, h, d).
+pub fn duration_text(s: f64) -> String {
+    if !s.is_finite() {
+        return "-".into();
+    }
+    if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else if s < 3.0 * 86400.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.1} d", s / 86400.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(value: f64, se: f64, verdict: Verdict) -> Term {
+        Term {
+            value,
+            std_err: se,
+            lo: value - 2.0 * se,
+            hi: value + 2.0 * se,
+            verdict,
+        }
+    }
+
+    #[test]
+    fn precision_scales_with_the_square_root_of_the_record() {
+        // ±20 % of a 4 h record: ±10 % needs 4× the record, ±25 % 0.64×
+        let t = term(1.0, 0.2 / Z95, Verdict::Resolved);
+        let a = term_advice(&t, 14_400.0);
+        assert!((a.precision - 0.2).abs() < 1e-12);
+        assert!((a.record_10 - 4.0 * 14_400.0).abs() < 1e-6);
+        assert!((a.record_25 - 0.64 * 14_400.0).abs() < 1e-6);
+        let u = term_advice(&term(0.0, f64::NAN, Verdict::NotSignificant), 14_400.0);
+        assert!(u.precision.is_nan() && u.record_10.is_nan());
+        assert_eq!(duration_text(14_400.0), "4.0 h");
+        assert_eq!(duration_text(90.0), "90 s");
+    }
+}

@@ -1,0 +1,280 @@
+//! The IEEE 952 chart, `ieee952_allan.{png,svg}`: one panel per axis with the Allan deviation
+//! and its 95 % band, the τ the fit left out shaded, the fitted model over the range it was
+//! fitted, each fitted term's own line (Q: −1, N: −½, B: flat, K: +½, R: +1), and the truth
+//! curve when `sim` wrote one.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::imu::{AxisResult, ImuAnalysis};
+use super::region::B_FLOOR_FACTOR;
+
+/// Panel size in SVG user units (the PNG is drawn at [`PNG_SCALE`]).
+const PANEL: (u32, u32) = (560, 420);
+/// PNG pixels per SVG unit.
+const PNG_SCALE: f64 = 1.5;
+/// Points on each model or term line.
+const LINE_POINTS: usize = 200;
+/// File stem.
+pub const STEM: &str = "ieee952_allan";
+
+/// Term line colours (Q, N, B, K, R).
+const TERM_COLORS: [RGBColor; 5] = [
+    RGBColor(148, 103, 189),
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(255, 127, 14),
+];
+
+/// A truth curve per axis, in the order of [`ImuAnalysis::axes`]: (τ s, σ).
+pub type Truth = Vec<Vec<(f64, f64)>>;
+
+/// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}`; returns the two paths.
+pub fn write_chart(
+    a: &ImuAnalysis,
+    title: &str,
+    truth: Option<&Truth>,
+    dir: &Path,
+    prefix: &str,
+) -> Result<[PathBuf; 2], bag2mat::Error> {
+    bag2mat::plot::register_font();
+    let cols = 3u32;
+    let rows = a.axes.len().div_ceil(3).max(1) as u32;
+    let size = (PANEL.0 * cols, PANEL.1 * rows + 40);
+    let png = dir.join(format!("{prefix}{STEM}.png"));
+    let svg = dir.join(format!("{prefix}{STEM}.svg"));
+    let plot_err = |p: &Path, e: String| bag2mat::Error::Plot {
+        path: p.to_path_buf(),
+        what: e,
+    };
+    let mut svg_text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg_text, size).into_drawing_area();
+        draw(a, title, truth, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
+        root.present().map_err(|e| plot_err(&svg, e.to_string()))?;
+    }
+    bag2mat::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
+    let psize = (
+        (size.0 as f64 * PNG_SCALE) as u32,
+        (size.1 as f64 * PNG_SCALE) as u32,
+    );
+    bag2mat::plot::png_atomic(&png, psize, |root| {
+        draw(a, title, truth, &root, PNG_SCALE)?;
+        root.present().map_err(|e| e.to_string())
+    })?;
+    Ok([png, svg])
+}
+
+fn draw<DB: DrawingBackend>(
+    a: &ImuAnalysis,
+    title: &str,
+    truth: Option<&Truth>,
+    root: &DrawingArea<DB, Shift>,
+    scale: f64,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (top, body) = root.split_vertically(px(40.0));
+    top.draw(&Text::new(
+        format!("{title} — IEEE 952 (95 % band; shaded: τ not described by the model)"),
+        (px(12.0) as i32, px(10.0) as i32),
+        ("sans-serif", px(18.0)),
+    ))
+    .map_err(|e| e.to_string())?;
+    let rows = a.axes.len().div_ceil(3).max(1);
+    let panels = body.split_evenly((rows, 3));
+    for (i, ax) in a.axes.iter().enumerate() {
+        let t = truth.and_then(|t| t.get(i)).map(|v| v.as_slice());
+        panel(ax, t, &panels[i], scale).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+fn term_line(j: usize, v: f64, tau: f64) -> f64 {
+    match j {
+        0 => 3f64.sqrt() * v / tau,
+        1 => v / tau.sqrt(),
+        2 => B_FLOOR_FACTOR * v,
+        3 => v * (tau / 3.0).sqrt(),
+        _ => v * tau / 2f64.sqrt(),
+    }
+}
+
+fn panel<DB: DrawingBackend>(
+    ax: &AxisResult,
+    truth: Option<&[(f64, f64)]>,
+    area: &DrawingArea<DB, Shift>,
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    let an = &ax.analysis;
+    let pts: Vec<_> = an
+        .curve
+        .iter()
+        .filter(|p| p.tau > 0.0 && p.adev > 0.0 && p.adev.is_finite())
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in &pts {
+        x0 = x0.min(p.tau);
+        x1 = x1.max(p.tau);
+        for v in [p.adev, p.lo95, p.hi95] {
+            if v.is_finite() && v > 0.0 {
+                y0 = y0.min(v);
+                y1 = y1.max(v);
+            }
+        }
+    }
+    if let Some(tr) = truth {
+        for &(t, v) in tr {
+            if t >= x0 && t <= x1 && v > 0.0 {
+                y0 = y0.min(v);
+                y1 = y1.max(v);
+            }
+        }
+    }
+    if !(x0 < x1 && y0 <= y1) {
+        (x0, x1, y0, y1) = (1e-3, 1.0, 1e-3, 1.0);
+    }
+    let (x0, x1) = (x0 / 1.3, x1 * 1.3);
+    let (y0, y1) = (y0 / 2.0, y1 * 2.0);
+    let caption = format!(
+        "{} — {}",
+        ax.sensor.axis_label(ax.axis),
+        match &an.verdict {
+            super::AxisVerdict::Fits { .. } => "model fits".to_string(),
+            super::AxisVerdict::NoReliableFit { .. } => "no reliable fit".to_string(),
+        }
+    );
+    let mut ctx = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", px(15.0)))
+        .margin(px(8.0))
+        .x_label_area_size(px(34.0))
+        .y_label_area_size(px(62.0))
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    ctx.configure_mesh()
+        .x_desc("τ [s]")
+        .y_desc(format!("Allan deviation [{}]", ax.sensor.unit()))
+        .label_style(("sans-serif", px(11.0)))
+        .axis_desc_style(("sans-serif", px(12.0)))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .light_line_style(RGBColor(238, 238, 238))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .draw()?;
+    // τ the model does not describe
+    let shade = RGBColor(200, 200, 200).mix(0.45).filled();
+    match an.verdict.range() {
+        Some((lo, hi)) => {
+            if lo > x0 {
+                ctx.draw_series(std::iter::once(Rectangle::new([(x0, y0), (lo, y1)], shade)))?;
+            }
+            if hi < x1 {
+                ctx.draw_series(std::iter::once(Rectangle::new([(hi, y0), (x1, y1)], shade)))?;
+            }
+        }
+        None => {
+            ctx.draw_series(std::iter::once(Rectangle::new([(x0, y0), (x1, y1)], shade)))?;
+        }
+    }
+    // 95 % band
+    let band: Vec<(f64, f64)> = pts
+        .iter()
+        .filter(|p| p.lo95 > 0.0 && p.hi95.is_finite())
+        .map(|p| (p.tau, p.hi95))
+        .chain(
+            pts.iter()
+                .rev()
+                .filter(|p| p.lo95 > 0.0 && p.hi95.is_finite())
+                .map(|p| (p.tau, p.lo95)),
+        )
+        .collect();
+    let data_color = RGBColor(0, 90, 170);
+    if band.len() > 2 {
+        ctx.draw_series(std::iter::once(Polygon::new(
+            band,
+            data_color.mix(0.18).filled(),
+        )))?
+        .label("95 % band")
+        .legend(move |(x, y)| {
+            Rectangle::new([(x, y - 4), (x + 16, y + 4)], data_color.mix(0.18).filled())
+        });
+    }
+    ctx.draw_series(LineSeries::new(
+        pts.iter().map(|p| (p.tau, p.adev)),
+        data_color.stroke_width(px(1.5).max(1)),
+    ))?
+    .label("data")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data_color.stroke_width(2)));
+    let line_over = |a: f64, b: f64, f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+        (0..LINE_POINTS)
+            .map(|k| {
+                let t = a * (b / a).powf(k as f64 / (LINE_POINTS - 1) as f64);
+                (t, f(t))
+            })
+            .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
+            .collect()
+    };
+    if let (Some(f), Some((lo, hi))) = (&an.fit, an.verdict.range()) {
+        let coef = f.coef;
+        // each fitted term's line, over the whole τ axis
+        let terms = an.terms.as_array();
+        for j in 0..5 {
+            let v = terms[j].value;
+            if !super::fit::is_positive(v) || coef[j] <= 0.0 {
+                continue;
+            }
+            let c = TERM_COLORS[j];
+            let name = super::fit::TERM_NAMES[j];
+            ctx.draw_series(DashedLineSeries::new(
+                line_over(x0, x1, &|t| term_line(j, v, t)),
+                px(5.0),
+                px(4.0),
+                c.stroke_width(px(1.0).max(1)),
+            ))?
+            .label(format!("{name} = {v:.2e}"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+        }
+        let model = |t: f64| {
+            (0..5)
+                .map(|j| coef[j] * super::fit::basis(j, t))
+                .sum::<f64>()
+                .max(0.0)
+                .sqrt()
+        };
+        ctx.draw_series(LineSeries::new(
+            line_over(lo, hi, &model),
+            BLACK.stroke_width(px(2.0)),
+        ))?
+        .label("model (fitted range)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+    }
+    if let Some(tr) = truth {
+        let grey = RGBColor(90, 90, 90);
+        ctx.draw_series(DashedLineSeries::new(
+            tr.iter()
+                .copied()
+                .filter(|&(t, v)| t >= x0 && t <= x1 && v > 0.0),
+            px(2.0),
+            px(3.0),
+            grey.stroke_width(px(1.5).max(1)),
+        ))?
+        .label("truth (sim)")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2)));
+    }
+    ctx.configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.5))
+        .label_font(("sans-serif", px(10.0)))
+        .draw()?;
+    Ok(())
+}

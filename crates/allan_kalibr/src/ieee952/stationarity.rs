@@ -1,0 +1,298 @@
+//! What the Allan analysis assumes and a record may break: a stationary signal sampled at one
+//! rate without gaps.
+//!
+//! * **Warm-up or drift at the start** ([`warmup`]): the mean of each window of the first
+//!   part of the record is compared with the mean of the second half. Under the fitted noise
+//!   model the difference has variance ≈ σ²(w) + σ²(T/2) + 2σ²(Δ) (σ² the model's Allan
+//!   variance, w the window, Δ the distance to the reference: the two means' own noise and
+//!   how far the bias may wander in between). A first window beyond [`WARMUP_Z`] of that is
+//!   reported, with its size and how long the excess lasts; `--skip-start` drops it.
+//! * **Gaps and rate changes** ([`timing`]): steps of the time stamps longer than
+//!   [`GAP_FACTOR`] times the median step of their block, and blocks of samples whose median
+//!   step differs from the record's by more than [`RATE_CHANGE_REL`]. The Allan estimators treat samples as
+//!   uniformly spaced; both distort the short-τ end.
+
+/// A window whose mean is this many standard deviations from the rest is not noise.
+pub const WARMUP_Z: f64 = 5.0;
+/// The excess lasts while windows stay beyond this many standard deviations.
+pub const WARMUP_END_Z: f64 = 3.0;
+/// A time step longer than this many median steps is a gap.
+pub const GAP_FACTOR: f64 = 1.5;
+/// A block's mean step off the median by more than this fraction is a rate change.
+pub const RATE_CHANGE_REL: f64 = 0.01;
+/// Samples per block for the rate check.
+const RATE_BLOCK: usize = 2000;
+/// Gaps and rate changes listed at most (the counts are always given).
+pub const MAX_LISTED: usize = 5;
+
+/// A gap in the time stamps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gap {
+    /// Time since the first sample, s.
+    pub at: f64,
+    /// Length of the step, s.
+    pub length: f64,
+}
+
+/// A stretch sampled at another rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateChange {
+    /// Time since the first sample, s.
+    pub at: f64,
+    /// The rate there, Hz.
+    pub rate: f64,
+}
+
+/// What the time stamps show.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Timing {
+    /// Median step, s.
+    pub median_step: f64,
+    /// Number of gaps.
+    pub gap_count: usize,
+    /// The longest gaps (at most [`MAX_LISTED`]), in time order.
+    pub gaps: Vec<Gap>,
+    /// Samples missing in the gaps (≈ Σ step/median − 1).
+    pub missing: f64,
+    /// Steps that do not advance (≤ 0).
+    pub non_advancing: usize,
+    /// Blocks at another rate (first of each run, at most [`MAX_LISTED`]).
+    pub rate_changes: Vec<RateChange>,
+    /// Number of runs of blocks at another rate.
+    pub rate_change_count: usize,
+}
+
+/// Median of a sample of at most 200 001 steps (exact for shorter records).
+fn median_step(t: &[f64]) -> f64 {
+    let n = t.len().saturating_sub(1);
+    if n == 0 {
+        return f64::NAN;
+    }
+    let stride = (n / 200_000).max(1);
+    let mut d: Vec<f64> = (0..n).step_by(stride).map(|i| t[i + 1] - t[i]).collect();
+    let k = d.len() / 2;
+    let (_, m, _) = d.select_nth_unstable_by(k, f64::total_cmp);
+    *m
+}
+
+/// Gaps, stalls and rate changes of the time stamps `t` (s). Steps are judged against the
+/// median step of their own block of samples, so a stretch at another rate is one rate
+/// change, not thousands of gaps.
+pub fn timing(t: &[f64]) -> Timing {
+    let med = median_step(t);
+    if !super::fit::is_positive(med) || t.len() < 2 {
+        return Timing {
+            median_step: med,
+            ..Timing::default()
+        };
+    }
+    let t0 = t[0];
+    let mut out = Timing {
+        median_step: med,
+        ..Timing::default()
+    };
+    let mut all_gaps: Vec<Gap> = Vec::new();
+    let mut in_change = false;
+    let mut buf: Vec<f64> = Vec::with_capacity(RATE_BLOCK);
+    for b in (0..t.len() - 1).step_by(RATE_BLOCK) {
+        let e = (b + RATE_BLOCK).min(t.len() - 1);
+        buf.clear();
+        buf.extend((b..e).map(|i| t[i + 1] - t[i]).filter(|d| *d > 0.0));
+        out.non_advancing += (e - b) - buf.len();
+        if buf.is_empty() {
+            continue;
+        }
+        let k = buf.len() / 2;
+        let local = *buf.select_nth_unstable_by(k, f64::total_cmp).1;
+        for i in b..e {
+            let d = t[i + 1] - t[i];
+            if d > GAP_FACTOR * local {
+                out.gap_count += 1;
+                out.missing += d / local - 1.0;
+                all_gaps.push(Gap {
+                    at: t[i] - t0,
+                    length: d,
+                });
+            }
+        }
+        if e - b < RATE_BLOCK / 2 {
+            continue;
+        }
+        let off = (local / med - 1.0).abs() > RATE_CHANGE_REL;
+        if off && !in_change {
+            out.rate_change_count += 1;
+            if out.rate_changes.len() < MAX_LISTED {
+                out.rate_changes.push(RateChange {
+                    at: t[b] - t0,
+                    rate: 1.0 / local,
+                });
+            }
+        }
+        in_change = off;
+    }
+    all_gaps.sort_by(|a, b| b.length.total_cmp(&a.length));
+    all_gaps.truncate(MAX_LISTED);
+    all_gaps.sort_by(|a, b| a.at.total_cmp(&b.at));
+    out.gaps = all_gaps;
+    out
+}
+
+/// A warm-up or drift at the start of one axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Warmup {
+    /// Mean of the first window minus the mean of the second half (signal unit).
+    pub size: f64,
+    /// How many standard deviations of the noise that is.
+    pub sigmas: f64,
+    /// How long the excess lasts, s (windows beyond [`WARMUP_END_Z`]).
+    pub duration: f64,
+}
+
+/// What the warm-up check needs of a record: the means of the windows of its first third
+/// and the mean of its second half (small, so it can be taken while the samples are at hand
+/// and judged once the noise model is fitted).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StartStats {
+    /// Samples per window.
+    pub window: usize,
+    /// Sample period, s.
+    pub tau0: f64,
+    /// Samples in the record.
+    pub n: usize,
+    /// Mean of each window of the first third.
+    pub means: Vec<f64>,
+    /// Mean of the second half.
+    pub reference: f64,
+}
+
+impl StartStats {
+    /// From the running sum `cum(k)` = Σ_{i<k} y_i of a record of `n` samples (the windows are
+    /// T/200, at least 10 samples). `None` for records too short to tell.
+    pub fn from_cumsum(n: usize, tau0: f64, cum: impl Fn(usize) -> f64) -> Option<StartStats> {
+        let window = ((n / 200).max(10)).min(n / 6);
+        if window == 0 || n < 60 {
+            return None;
+        }
+        let mean = |a: usize, b: usize| (cum(b) - cum(a)) / (b - a) as f64;
+        let windows = (n / 3) / window;
+        Some(StartStats {
+            window,
+            tau0,
+            n,
+            means: (0..windows)
+                .map(|j| mean(j * window, (j + 1) * window))
+                .collect(),
+            reference: mean(n / 2, n),
+        })
+    }
+
+    /// From the samples.
+    pub fn from_samples(y: &[f64], tau0: f64) -> Option<StartStats> {
+        let mut cum = Vec::with_capacity(y.len() + 1);
+        cum.push(0.0);
+        let mut s = 0.0;
+        for v in y {
+            s += v;
+            cum.push(s);
+        }
+        StartStats::from_cumsum(y.len(), tau0, |k| cum[k])
+    }
+}
+
+/// Judges the start of a record against the Allan variance `model(τ)` of its fitted noise.
+/// `None`: nothing beyond the noise.
+pub fn warmup(st: &StartStats, model: &dyn Fn(f64) -> f64) -> Option<Warmup> {
+    let total = st.n as f64 * st.tau0;
+    let wt = st.window as f64 * st.tau0;
+    let ref_center = 0.75 * total;
+    let z_of = |j: usize| -> (f64, f64) {
+        let d = st.means[j] - st.reference;
+        let center = (j as f64 + 0.5) * wt;
+        let var = model(wt) + model(total / 2.0) + 2.0 * model(ref_center - center);
+        (d, d / var.max(f64::MIN_POSITIVE).sqrt())
+    };
+    let (d0, z0) = z_of(0);
+    if z0.is_nan() || z0.abs() <= WARMUP_Z {
+        return None;
+    }
+    let mut last = 0;
+    for j in 1..st.means.len() {
+        let (d, z) = z_of(j);
+        if z.abs() > WARMUP_END_Z && d.signum() == d0.signum() {
+            last = j;
+        } else {
+            break;
+        }
+    }
+    Some(Warmup {
+        size: d0,
+        sigmas: z0.abs(),
+        duration: (last + 1) as f64 * wt,
+    })
+}
+
+/// Index of the first sample at or after `t[0] + seconds` (the `--skip-start` cut).
+pub fn skip_index(t: &[f64], seconds: f64) -> usize {
+    let Some(&t0) = t.first() else { return 0 };
+    t.partition_point(|&x| x < t0 + seconds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand::rngs::StdRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    const RNG_SEED: u64 = 0x0057_A710;
+
+    #[test]
+    fn finds_gaps_and_rate_changes() {
+        let mut t: Vec<f64> = (0..100_000).map(|i| i as f64 * 0.005).collect();
+        // a 1 s gap at 100 s and a stretch at 100 Hz from 300 s
+        for v in t.iter_mut().skip(20_000) {
+            *v += 1.0;
+        }
+        let k = 60_000;
+        let base = t[k];
+        for (j, v) in t.iter_mut().enumerate().skip(k) {
+            *v = base + (j - k) as f64 * 0.01;
+        }
+        let r = timing(&t);
+        assert!((r.median_step - 0.005).abs() < 1e-12);
+        assert_eq!(r.gap_count, 1);
+        assert!((r.gaps[0].at - 99.995).abs() < 1e-6 && (r.gaps[0].length - 1.005).abs() < 1e-9);
+        assert_eq!(r.rate_change_count, 1, "{r:?}");
+        assert!((r.rate_changes[0].rate - 100.0).abs() < 1e-6);
+        assert_eq!(skip_index(&t, 50.0), 10_000);
+    }
+
+    #[test]
+    fn warmup_beyond_the_noise_only() {
+        let mut rng = StdRng::seed_from_u64(RNG_SEED);
+        let (n, tau0, sd) = (200_000usize, 0.01, 0.1);
+        let white: Vec<f64> = (0..n)
+            .map(|_| {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                sd * z
+            })
+            .collect();
+        // white noise N² = sd²·τ0
+        let model = |tau: f64| sd * sd * tau0 / tau;
+        let st = |y: &[f64]| StartStats::from_samples(y, tau0).unwrap();
+        assert_eq!(
+            warmup(&st(&white), &model),
+            None,
+            "white noise is stationary"
+        );
+        // an exponential warm-up of 0.05 (50 σ of a 10 s window mean) with a 60 s time constant
+        let y: Vec<f64> = white
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 0.05 * (-(i as f64 * tau0) / 60.0).exp())
+            .collect();
+        let w = warmup(&st(&y), &model).expect("warm-up");
+        assert!(w.size > 0.03 && w.sigmas > WARMUP_Z, "{w:?}");
+        assert!(w.duration > 60.0 && w.duration < 600.0, "{w:?}");
+    }
+}
