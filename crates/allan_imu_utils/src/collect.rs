@@ -130,7 +130,7 @@ mod tests {
             seq: (0..n as u32).collect(),
             acc: vec![[0.0, 0.0, 9.81]; n],
             gyro: vec![[0.001, 0.0, 0.0]; n],
-            notes: vec![],
+            ..Default::default()
         }
     }
 

@@ -62,7 +62,8 @@ pub fn analyse(
 ) -> Result<Analysis, Error> {
     let grid = TauGrid::new(axes[0].len(), rate)?;
     let jobs = 6 * grid.distinct_m().len() as u64;
-    let bar = bag2mat::progress::bar(jobs, quiet || estimator == Estimator::PrefixSum, "taus");
+    let bar =
+        bag2mat::shared::progress::bar(jobs, quiet || estimator == Estimator::PrefixSum, "taus");
     bar.set_message("allan");
     let sig2 = sig2_curves(axes, &grid, estimator, &|| bar.inc(1));
     bar.finish_and_clear();
@@ -192,10 +193,10 @@ pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
     std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
-    bag2mat::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
     written.push(yaml_path);
     let csv_path = dir.join("allan_curves.csv");
-    bag2mat::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
+    bag2mat::shared::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
     // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
     let title = if config.title.is_empty() {

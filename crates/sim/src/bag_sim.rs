@@ -165,7 +165,7 @@ pub fn message_count(rate: f64, duration: f64) -> u64 {
 pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
     validate(cfg)?;
     let n = message_count(cfg.rate, cfg.duration);
-    let pb = bag2mat::progress::bar(n, cfg.quiet, "msgs");
+    let pb = bag2mat::shared::progress::bar(n, cfg.quiet, "msgs");
     pb.set_message("writing");
     let mut sink = ImuBagSink::create(&cfg.out, cfg.compression, &cfg.topic, &cfg.frame_id)?;
     let mut noise = NoiseGenerator::new(cfg.noise.discretize(1.0 / cfg.rate), cfg.seed);
