@@ -10,9 +10,11 @@ use crate::error::Error;
 use crate::opencv_yaml::{self, YamlMode};
 use crate::{plot, report};
 
-/// What a run produced; the binary prints `stdout` and `notes`.
+/// What a run produced for one topic; the binary prints `stdout` and `notes`.
 #[derive(Debug)]
 pub struct Outcome {
+    /// The topic, as named in the bag.
+    pub topic: String,
     /// Upstream's terminal output.
     pub stdout: String,
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
@@ -27,20 +29,47 @@ pub struct Outcome {
     pub timings: Vec<(&'static str, Duration)>,
 }
 
-/// Runs the whole pipeline for `config`.
-pub fn run(config: &Config) -> Result<Outcome, Error> {
-    let mut timings = Vec::new();
+/// Runs the whole pipeline for `config`: every selected topic is read in one pass and
+/// analysed on its own. With one topic the outputs go into `out_dir`; with several, into
+/// `out_dir/<topic folder>`.
+pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
-    let series = bag2mat::read_imu_series(
+    let read = bag2mat::read_imu_topics(
         &config.bag,
-        &config.topic,
+        &bag2mat::TopicSelector {
+            topics: config.topics.clone(),
+            all_imu: config.all_imu,
+        },
         &bag2mat::ReadOptions {
             quiet: config.quiet,
         },
     )?;
-    timings.push(("read_bag", t0.elapsed()));
+    let read_time = t0.elapsed();
+    let several = read.series.len() > 1 || config.all_imu;
+    let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
+    let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+    let folders = bag2mat::series::topic_folder_names(&names);
+    let mut outs = Vec::new();
+    for (series, folder) in read.series.into_iter().zip(folders) {
+        let mut c = config.clone();
+        if several {
+            c.out_dir = config.out_dir.join(folder);
+        }
+        outs.push(run_series(&c, series, read_time)?);
+    }
+    Ok(outs)
+}
+
+/// The pipeline on one topic's series.
+fn run_series(
+    config: &Config,
+    series: bag2mat::ImuSeries,
+    read_time: Duration,
+) -> Result<Outcome, Error> {
+    let mut timings = vec![("read_bag", read_time)];
+    let topic = series.topic.clone();
     let mut notes = series.notes.clone();
-    let collected = collect::collect(&series, config.max_time_min);
+    let collected = collect::collect(&series, config.max_time_min, config.time);
     if collected.stop == Stop::EndOfBag {
         notes.push(format!(
             "WARNING: bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
@@ -104,11 +133,12 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
             an,
             &config.out_dir,
             &prefix,
-            &config.topic,
+            &topic,
         )?);
     }
     timings.push(("write_outputs", t2.elapsed()));
     Ok(Outcome {
+        topic,
         stdout: report::stdout_text(&analysis),
         ieee952_text: ieee.as_ref().map(allan_kalibr::ieee952::imu::summary_text),
         notes,

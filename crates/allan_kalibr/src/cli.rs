@@ -18,9 +18,17 @@ use crate::run::Config;
 pub struct Args {
     /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
     pub input: PathBuf,
-    /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml).
-    #[arg(long, default_value = "imu")]
-    pub topic: String,
+    /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml); repeatable,
+    /// each topic then gets its own folder under the output directory [default: imu].
+    #[arg(long = "topic", value_name = "TOPIC")]
+    pub topics: Vec<String>,
+    /// Every topic of the bag that carries sensor_msgs/Imu, each into its own folder.
+    #[arg(long)]
+    pub all_imu_topics: bool,
+    /// The time column the rate is estimated from: record (receive) time, as bagconvert
+    /// writes it, or header.stamp.
+    #[arg(long, value_enum, default_value_t = TimeArg::Record)]
+    pub time: TimeArg,
     /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
     /// from the timestamps.
     #[arg(long, value_name = "HZ")]
@@ -51,6 +59,15 @@ pub struct Args {
     pub timings: bool,
 }
 
+/// The time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeArg {
+    /// Record (receive) time: bagconvert's rule.
+    Record,
+    /// header.stamp.
+    Header,
+}
+
 impl From<Args> for Config {
     fn from(a: Args) -> Config {
         let outdir = a.outdir.unwrap_or_else(|| match a.input.parent() {
@@ -59,7 +76,18 @@ impl From<Args> for Config {
         });
         Config {
             input: a.input,
-            topic: a.topic,
+            topics: bag2mat::TopicSelector {
+                topics: if a.topics.is_empty() && !a.all_imu_topics {
+                    vec!["imu".to_string()]
+                } else {
+                    a.topics
+                },
+                all_imu: a.all_imu_topics,
+            },
+            time: match a.time {
+                TimeArg::Record => bag2mat::TimeColumn::Record,
+                TimeArg::Header => bag2mat::TimeColumn::Header,
+            },
             update_rate: a.update_rate,
             title: a.title,
             estimator: if a.bit_exact {
@@ -89,7 +117,8 @@ mod tests {
     fn defaults() {
         let c = parse(&["data/x.bag"]);
         assert_eq!(c.outdir, PathBuf::from("data"));
-        assert_eq!(c.topic, "imu");
+        assert_eq!(c.topics.topics, vec!["imu".to_string()]);
+        assert_eq!(c.time, bag2mat::TimeColumn::Record);
         assert_eq!(c.update_rate, None);
         assert_eq!(c.estimator, Estimator::PrefixSum);
         assert_eq!(parse(&["x.mat"]).outdir, PathBuf::from("."));
@@ -109,7 +138,7 @@ mod tests {
             "--title",
             "ADIS",
         ]);
-        assert_eq!(c.topic, "/imu0");
+        assert_eq!(c.topics.topics, vec!["/imu0".to_string()]);
         assert_eq!(c.update_rate, Some(200.0));
         assert_eq!(c.estimator, Estimator::BitExact);
         assert_eq!(c.outdir, PathBuf::from("out"));
