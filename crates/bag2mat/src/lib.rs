@@ -38,6 +38,8 @@ pub mod rosbag2;
 pub mod series;
 pub mod shared;
 pub mod source;
+#[doc(hidden)]
+pub mod test_tools;
 pub mod zstd;
 
 pub use bag::{Compression, RosTime};

@@ -315,7 +315,11 @@ impl TryFrom<BagArgs> for BagConfig {
                 MotionArg::Static => Motion::Static,
                 MotionArg::Ellipse => Motion::Ellipse,
             },
-            compression: a.compression.into(),
+            compression: if format == crate::bag_sim::BagFormat::Ros1 {
+                a.compression.into()
+            } else {
+                Compression::None
+            },
             format,
             quiet: a.quiet,
         };

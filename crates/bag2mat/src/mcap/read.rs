@@ -384,6 +384,13 @@ impl McapReader {
             first = false;
             pos = rec_end;
         }
+        if first {
+            return Err(Error::Corrupt {
+                path: self.path.clone(),
+                offset: pos,
+                what: "the MCAP file holds no complete record after its magic (truncated)".into(),
+            });
+        }
         if !seen_data_end && pos >= end && self.summary_used {
             self.notes
                 .push("the data section has no Data End record".to_string());
