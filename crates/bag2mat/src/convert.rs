@@ -73,10 +73,9 @@ pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f
 
 /// The matrix of one Imu series with the chosen time column.
 pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
-    let t = s.time(time);
     let mut d = DataImu::with_capacity(s.len());
-    for i in 0..s.len() {
-        d.push(bagconvert_row(t[i], s.acc[i], s.gyro[i]));
+    for ((t, a), g) in s.time(time).iter().zip(&s.acc).zip(&s.gyro) {
+        d.push(bagconvert_row(*t, *a, *g));
     }
     d
 }

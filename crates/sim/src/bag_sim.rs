@@ -77,7 +77,7 @@ impl BagFormat {
 /// The writer behind [`ImuBagSink`].
 enum SinkWriter {
     Ros1(BagWriter, ConnId),
-    Ros2(Ros2BagWriter, TopicId),
+    Ros2(Box<Ros2BagWriter>, TopicId),
 }
 
 /// What was written.
@@ -128,12 +128,12 @@ impl ImuBagSink {
             BagFormat::Mcap(c) => {
                 let mut w = Ros2BagWriter::create(path, Storage::Mcap(c))?;
                 let t = w.add_imu_topic(topic)?;
-                SinkWriter::Ros2(w, t)
+                SinkWriter::Ros2(Box::new(w), t)
             }
             BagFormat::Sqlite3 => {
                 let mut w = Ros2BagWriter::create(path, Storage::Sqlite3)?;
                 let t = w.add_imu_topic(topic)?;
-                SinkWriter::Ros2(w, t)
+                SinkWriter::Ros2(Box::new(w), t)
             }
         };
         // `header.seq` stays 0 and the covariances zero, as upstream's default-constructed

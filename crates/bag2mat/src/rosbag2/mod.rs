@@ -313,7 +313,7 @@ pub enum Storage {
 
 enum StorageWriter {
     Sqlite3(Sqlite3Writer),
-    Mcap(McapWriter),
+    Mcap(Box<McapWriter>),
 }
 
 /// A topic handle of [`Ros2BagWriter`].
@@ -348,7 +348,7 @@ impl Ros2BagWriter {
             Storage::Mcap(c) => {
                 let f = format!("{stem}_0.mcap");
                 let w = McapWriter::create(&d.path().join(&f), "ros2", c)?;
-                (f, StorageWriter::Mcap(w))
+                (f, StorageWriter::Mcap(Box::new(w)))
             }
         };
         Ok(Ros2BagWriter {
