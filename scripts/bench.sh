@@ -7,8 +7,13 @@
 #   * bag2mat (read + .mat) vs `cat bag > /dev/null` (target: < 3x) and its peak memory vs the
 #     output matrix size (target: < 2x); python rosbag reading the same rows, extrapolated
 #     from BENCH_PY_READ_MSGS messages (python reads ~4k msgs/s: a full read takes ~12 min);
+#   * the same run written by `sim` as ROS 2 bags (MCAP uncompressed, sqlite3): bag2mat vs
+#     `cat` of the storage file (targets: MCAP < 3x, sqlite3 < 10x) and vs the rosbags Python
+#     library reading the same messages (target: >= 30x), extrapolated from
+#     BENCH_ROSBAGS_MSGS messages (needs target/py-venv from scripts/test.sh);
 #   * then each analyser's own benchmark script, on the same bag.
-# Environment: BENCH_PY_WRITE_MSGS (default: all 2,880,001), BENCH_PY_READ_MSGS (200000).
+# Environment: BENCH_PY_WRITE_MSGS (default: all 2,880,001), BENCH_PY_READ_MSGS (200000),
+# BENCH_ROSBAGS_MSGS (300000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -52,6 +57,35 @@ t_pyr_full=$(/usr/bin/python3 -c "print($t_pyr * $N / $py_read)")
 echo "cat: ${t_cat} s   bag2mat (none, best of 3): ${best} s   bag2mat (lz4): ${t_lz4r} s   python read: ${t_pyr} s for $py_read msgs (~${t_pyr_full} s for $N)"
 echo "ratio bag2mat/cat: $(ratio "$best" "$t_cat")x   [target < 3x]   python/bag2mat: $(ratio "$t_pyr_full" "$best")x"
 echo "bag2mat peak RSS: ${best_kb} KB   output matrix: ${mat_kb} KB   ratio: $(ratio "$best_kb" "$mat_kb")x   [target < 2x]"
+
+echo
+echo "== ROS 2: bag2mat on MCAP (uncompressed) and sqlite3 vs cat vs rosbags (python)"
+py_ros2=${BENCH_ROSBAGS_MSGS:-300000}
+venv_py="$root/target/py-venv/bin/python"
+for fmt in mcap sqlite3; do
+  rm -rf "$work/imu_$fmt"
+  read -r t_w _ < <(measure "$bin/sim" bag -o "$work/imu_$fmt" --format "$fmt" --start-time 1700000000 --quiet)
+  file=$(ls "$work/imu_$fmt"/*_0.* | head -1)
+  cat "$file" > /dev/null
+  read -r t_c _ < <(measure cat "$file")
+  best=""
+  for _ in 1 2 3; do
+    rm -f "$work/imu_$fmt.mat"
+    read -r t kb < <(measure "$bin/bag2mat" "$work/imu_$fmt" imu -o "$work/imu_$fmt.mat" --quiet)
+    if [ -z "$best" ] || /usr/bin/python3 -c "import sys; sys.exit(0 if $t < $best else 1)"; then best=$t; best_kb=$kb; fi
+  done
+  cmp -s "$work/imu.mat" "$work/imu_$fmt.mat" && same="identical to the ROS 1 .mat" || same="DIFFERS from the ROS 1 .mat"
+  if [ -x "$venv_py" ]; then
+    t_rb=$("$venv_py" scripts/bench_rosbags_read.py "$work/imu_$fmt" "$py_ros2")
+    t_rb_full=$(/usr/bin/python3 -c "print($t_rb * $N / $py_ros2)")
+    rb="rosbags: ${t_rb} s for $py_ros2 msgs (~${t_rb_full} s for $N); rosbags/bag2mat: $(ratio "$t_rb_full" "$best")x [target >= 30x]"
+  else
+    rb="rosbags: not measured (run scripts/test.sh to install target/py-venv)"
+  fi
+  target=3; [ "$fmt" = sqlite3 ] && target=10
+  echo "$fmt: sim wrote it in ${t_w} s ($(( $(stat -c %s "$file") / 1048576 )) MiB); cat: ${t_c} s; bag2mat (best of 3): ${best} s, peak ${best_kb} KB, output $same"
+  echo "$fmt: ratio bag2mat/cat: $(ratio "$best" "$t_c")x [target < ${target}x]; $rb"
+done
 
 echo
 echo "== scripts/bench_allan_kalibr.sh (from the .mat, then from the bag)"

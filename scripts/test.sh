@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # Runs every test of the workspace. Installs, when missing, the real tools the tests check our
 # files with: Debian's python3-rosbag (rosbag info/check, python API), GNU Octave, scipy,
-# numpy, OpenCV's python bindings (cv2.FileStorage) and PyYAML. Tests never skip for a
-# missing tool: they fail.
+# numpy, OpenCV's python bindings (cv2.FileStorage) and PyYAML; and, in a virtual environment
+# at target/py-venv, the independent ROS 2 implementations (rosbags, Foxglove's mcap and
+# mcap-ros2-support), pinned. Tests never skip for a missing tool: they fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
 command -v rosbag >/dev/null 2>&1 || need+=(python3-rosbag)
 command -v octave >/dev/null 2>&1 || need+=(octave)
+/usr/bin/python3 -c "import ensurepip, venv" >/dev/null 2>&1 || need+=(python3-venv)
 for mod in scipy:python3-scipy numpy:python3-numpy cv2:python3-opencv yaml:python3-yaml sensor_msgs:python3-sensor-msgs; do
   /usr/bin/python3 -c "import ${mod%%:*}" >/dev/null 2>&1 || need+=("${mod##*:}")
 done
@@ -17,6 +19,16 @@ if [ ${#need[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
+fi
+
+# The ROS 2 cross-checks' tools, pinned (bag2mat::test_tools finds them here).
+venv=target/py-venv
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0)
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2" >/dev/null 2>&1 \
+   || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icE '^(rosbags==0.11.9|mcap==1.6.0|mcap-ros2-support==0.6.0)$')" != 3 ]; then
+  echo "installing ${pins[*]} into $venv"
+  /usr/bin/python3 -m venv "$venv"
+  "$venv/bin/python" -m pip install -q "${pins[@]}"
 fi
 
 cargo test --workspace "$@"

@@ -17,16 +17,17 @@ pub const DEFAULT_MAX_TIME_MIN: u32 = 120;
 /// Default `max_cluster` of the shipped launch files.
 pub const DEFAULT_MAX_CLUSTER: usize = 100;
 
-/// imu_utils' Allan variance and noise fit, read straight from a ROS 1 bag (no roscore, no
-/// replay). Prints upstream's report and writes `<name>_imu_param.yaml`, a continuous-time
-/// `<name>_imu_param_continuous.yaml`, the 16 `data_<name>_*.txt` curves and plots. Then the
-/// IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted range and
-/// fit quality per axis, recording-length advice, warm-up and gap checks, and its files
-/// prefixed `<name>_`. With --curves it works on Allan curves another tool wrote.
+/// imu_utils' Allan variance and noise fit, read straight from a bag — ROS 1, a ROS 2 bag
+/// directory, an .mcap or a .db3 (no roscore, no replay). Prints upstream's report and writes
+/// `<name>_imu_param.yaml`, a continuous-time `<name>_imu_param_continuous.yaml`, the 16
+/// `data_<name>_*.txt` curves and plots. Then the IEEE 952 section (unless --compat-only):
+/// terms with 95 % intervals, the fitted range and fit quality per axis, recording-length
+/// advice, warm-up and gap checks, and its files prefixed `<name>_`. With --curves it works on
+/// Allan curves another tool wrote.
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version)]
 pub struct Args {
-    /// The ROS 1 bag (uncompressed, bz2 or lz4 chunks).
+    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3.
     #[arg(required_unless_present = "curves")]
     pub bag: Option<PathBuf>,
     /// Analyse existing Allan curves instead of a bag: an imu_utils data directory (then
@@ -51,9 +52,17 @@ pub struct Args {
     /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
     #[arg(long, value_name = "SECONDS")]
     pub skip_start: Option<f64>,
-    /// sensor_msgs/Imu topic (`imu` and `/imu` are the same) [default: imu]
+    /// sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic then
+    /// gets its own folder under the output directory [default: imu]
+    #[arg(long = "topic", value_name = "TOPIC")]
+    pub topics: Vec<String>,
+    /// Every topic of the bag that carries sensor_msgs/Imu, each into its own folder
     #[arg(long)]
-    pub topic: Option<String>,
+    pub all_imu_topics: bool,
+    /// The time the Allan variance and the stop rule use: header.stamp (imu_utils) or the
+    /// record (receive) time
+    #[arg(long, value_enum, default_value_t = TimeArg::Header)]
+    pub time: TimeArg,
     /// IMU name used in output file names and the yaml [default: imu]
     #[arg(long)]
     pub name: Option<String>,
@@ -83,6 +92,15 @@ pub struct Args {
     pub compat_only: bool,
 }
 
+/// The time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeArg {
+    /// header.stamp: what imu_utils' node reads.
+    Header,
+    /// Record (receive) time.
+    Record,
+}
+
 /// `--curves`: the inputs and what the user said about them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CurvesInput {
@@ -101,8 +119,12 @@ pub struct Config {
     pub curves: Option<CurvesInput>,
     /// Seconds dropped at the start.
     pub skip_start: Option<f64>,
-    /// Topic.
-    pub topic: String,
+    /// Topics (one unless several were asked for).
+    pub topics: Vec<String>,
+    /// Also every other Imu topic of the bag.
+    pub all_imu: bool,
+    /// The time column.
+    pub time: bag2mat::TimeColumn,
     /// IMU name.
     pub name: String,
     /// Output directory.
@@ -152,9 +174,12 @@ impl TryFrom<Args> for Config {
     fn try_from(a: Args) -> Result<Config, Error> {
         let lp = a.launch.as_deref().map(launch::read).transpose()?;
         let lp = lp.as_ref();
-        let topic = match a.topic {
-            Some(t) => t,
-            None => from_launch(lp, "imu_topic")?.unwrap_or_else(|| DEFAULT_TOPIC.into()),
+        let topics = if !a.topics.is_empty() {
+            a.topics
+        } else if a.all_imu_topics {
+            Vec::new()
+        } else {
+            vec![from_launch(lp, "imu_topic")?.unwrap_or_else(|| DEFAULT_TOPIC.into())]
         };
         let name_given = a.name.is_some();
         let name = match a.name {
@@ -182,7 +207,7 @@ impl TryFrom<Args> for Config {
                 "max_cluster must be at least 2 (got {max_cluster})"
             )));
         }
-        if topic.trim().is_empty() {
+        if topics.iter().any(|t| t.trim().is_empty()) {
             return Err(Error::Config("the topic is empty".into()));
         }
         if name.is_empty() || name.contains('/') {
@@ -205,7 +230,12 @@ impl TryFrom<Args> for Config {
             bag: a.bag.unwrap_or_default(),
             curves,
             skip_start: a.skip_start,
-            topic,
+            topics,
+            all_imu: a.all_imu_topics,
+            time: match a.time {
+                TimeArg::Header => bag2mat::TimeColumn::Header,
+                TimeArg::Record => bag2mat::TimeColumn::Record,
+            },
             name,
             out_dir,
             max_time_min,
@@ -233,7 +263,7 @@ mod tests {
         let c = Config::try_from(args(&[])).unwrap();
         assert_eq!(
             (
-                c.topic.as_str(),
+                c.topics[0].as_str(),
                 c.name.as_str(),
                 c.max_time_min,
                 c.max_cluster
@@ -274,7 +304,8 @@ mod tests {
             "100",
         ]))
         .unwrap();
-        assert_eq!(c.topic, "/imu/data");
+        assert_eq!(c.topics, vec!["/imu/data".to_string()]);
+        assert_eq!(c.time, bag2mat::TimeColumn::Header);
         assert_eq!(c.name, "xsens");
         assert_eq!(c.max_time_min, 200);
         assert_eq!(c.max_cluster, 100);

@@ -40,7 +40,7 @@ pub const FIELDS: [&str; 6] = [
 #[derive(Debug, Clone)]
 pub struct Collected<'a> {
     series: &'a bag2mat::ImuSeries,
-    /// `header.stamp.toSec()` of each used message.
+    /// `header.stamp.toSec()` (or the record time, with `--time record`) of each used message.
     pub t: Vec<f64>,
     /// How collection ended.
     pub stop: Stop,
@@ -97,12 +97,17 @@ impl Collected<'_> {
     }
 }
 
-/// Applies the stop rule to a series read from a bag.
-pub fn collect(series: &bag2mat::ImuSeries, max_time_min: u32) -> Collected<'_> {
+/// Applies the stop rule to a series read from a bag, on the chosen time column (imu_utils
+/// uses `header.stamp`).
+pub fn collect(
+    series: &bag2mat::ImuSeries,
+    max_time_min: u32,
+    time: bag2mat::TimeColumn,
+) -> Collected<'_> {
     let limit = max_time_min as f64;
     let mut t = Vec::with_capacity(series.len());
     let mut stop = Stop::EndOfBag;
-    for st in &series.stamp {
+    for st in series.time(time) {
         let ts = st.to_sec();
         t.push(ts);
         if t.len() > 1 && (ts - t[0]) / 60.0 > limit {
@@ -130,7 +135,7 @@ mod tests {
             seq: (0..n as u32).collect(),
             acc: vec![[0.0, 0.0, 9.81]; n],
             gyro: vec![[0.001, 0.0, 0.0]; n],
-            notes: vec![],
+            ..Default::default()
         }
     }
 
@@ -138,7 +143,7 @@ mod tests {
     #[test]
     fn quirk_10_stop_rule_keeps_the_crossing_message() {
         let ser = series(200 * 60 + 50, 5_000_000);
-        let c = collect(&ser, 1);
+        let c = collect(&ser, 1, bag2mat::TimeColumn::Header);
         assert_eq!(c.len(), 200 * 60 + 2);
         assert_eq!(
             c.stop,
@@ -147,7 +152,7 @@ mod tests {
             }
         );
         let ser = series(1000, 5_000_000);
-        let c = collect(&ser, 1);
+        let c = collect(&ser, 1, bag2mat::TimeColumn::Header);
         assert_eq!((c.len(), c.stop), (1000, Stop::EndOfBag));
         assert_eq!(c.gyro_values(0).next(), Some(0.001 * 57.3 * 3600.0));
         assert_eq!(c.acc_values(2).nth(999), Some(9.81));

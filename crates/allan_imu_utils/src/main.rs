@@ -43,25 +43,29 @@ fn run() -> anyhow::Result<()> {
             .context("writing stdout")?;
         return Ok(());
     }
-    let outcome =
+    let outcomes =
         allan_imu_utils::run::run(&config).with_context(|| format!("analysing {what}"))?;
-    for note in &outcome.notes {
-        eprintln!("{note}");
-    }
-    std::io::stdout()
-        .lock()
-        .write_all(outcome.stdout.as_bytes())
-        .context("writing stdout")?;
-    if let Some(t) = &outcome.ieee952_text {
-        std::io::stdout()
-            .lock()
-            .write_all(t.as_bytes())
+    let several = outcomes.len() > 1;
+    for outcome in &outcomes {
+        let mut out = std::io::stdout().lock();
+        if several {
+            writeln!(out, "===== topic {} =====", outcome.topic).context("writing stdout")?;
+        }
+        for note in &outcome.notes {
+            eprintln!("{note}");
+        }
+        out.write_all(outcome.stdout.as_bytes())
             .context("writing stdout")?;
+        if let Some(t) = &outcome.ieee952_text {
+            out.write_all(t.as_bytes()).context("writing stdout")?;
+        }
+        if config.timings {
+            for (phase, d) in &outcome.timings {
+                eprintln!("timing {phase} {:.3} s", d.as_secs_f64());
+            }
+        }
     }
     if config.timings {
-        for (phase, d) in &outcome.timings {
-            eprintln!("timing {phase} {:.3} s", d.as_secs_f64());
-        }
         eprintln!("timing total {:.3} s", t.elapsed().as_secs_f64());
     }
     Ok(())

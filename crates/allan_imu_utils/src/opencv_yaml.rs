@@ -48,7 +48,7 @@ pub fn real(v: f64) -> String {
     if r == v && r >= i32::MIN as f64 && r <= i32::MAX as f64 {
         return format!("{}.", r as i32);
     }
-    bag2mat::cfmt::e16(v)
+    bag2mat::shared::cfmt::e16(v)
 }
 
 /// OpenCV's string rule: bare unless empty, starting with a space, a digit or `+ - .`, or

@@ -131,7 +131,8 @@ fn curves<'a>(an: &'a Analysis, name: &str, base: usize) -> Curves<'a> {
 /// written atomically.
 fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
     if !svg {
-        return bag2mat::plot::png_atomic(path, SIZE, |root| draw(&root, c)).map_err(Error::from);
+        return bag2mat::shared::plot::png_atomic(path, SIZE, |root| draw(&root, c))
+            .map_err(Error::from);
     }
     let mut text = String::new();
     {
@@ -146,7 +147,7 @@ fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
 
 /// Writes the four plot files into `dir`; returns their paths.
 pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    bag2mat::plot::register_font();
+    bag2mat::shared::plot::register_font();
     use rayon::prelude::*;
     let jobs = [
         ("allan_gyr", 0, "png"),

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use crate::analysis::{AXIS_NAMES, Analysis};
 use crate::error::Error;
 use crate::fit::{SECONDS_PER_HOUR, find_min_index};
-use bag2mat::cfmt::{g, g6};
+use bag2mat::shared::cfmt::{g, g6};
 
 /// Upstream's fit headers (capital X only; trailing space).
 const FIT_HEADERS: [&str; 6] = [
@@ -167,7 +167,8 @@ pub fn curve_files(an: &Analysis, name: &str) -> Vec<(String, String)> {
 
 /// Writes one text file atomically.
 pub fn write_text(path: &Path, text: &str) -> Result<(), Error> {
-    bag2mat::output::write_atomic(path, |w| w.write_all(text.as_bytes())).map_err(Error::from)
+    bag2mat::shared::output::write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(Error::from)
 }
 
 /// Writes the curve files into `dir`; returns their paths.

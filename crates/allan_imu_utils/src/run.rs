@@ -15,9 +15,11 @@ use crate::fit::{AxisFit, IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR};
 use crate::opencv_yaml::{self, YamlMode};
 use crate::{plot, report};
 
-/// What a run produced; the binary prints `stdout` and `notes`.
+/// What a run produced for one topic; the binary prints `stdout` and `notes`.
 #[derive(Debug)]
 pub struct Outcome {
+    /// The topic, as named in the bag.
+    pub topic: String,
     /// Upstream's terminal output.
     pub stdout: String,
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
@@ -105,18 +107,45 @@ pub struct CurvesOutcome {
     pub ieee952: ImuAnalysis,
 }
 
-/// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`).
-pub fn run(config: &Config) -> Result<Outcome, Error> {
-    let mut timings = Vec::new();
+/// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
+/// selected topic is read in one pass and analysed on its own. With one topic the outputs go
+/// into `out_dir`; with several, into `out_dir/<topic folder>`.
+pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
-    let mut series = bag2mat::read_imu_series(
+    let read = bag2mat::read_imu_topics(
         &config.bag,
-        &config.topic,
+        &bag2mat::TopicSelector {
+            topics: config.topics.clone(),
+            all_imu: config.all_imu,
+        },
         &bag2mat::ReadOptions {
             quiet: config.quiet,
         },
     )?;
-    timings.push(("read_bag", t0.elapsed()));
+    let read_time = t0.elapsed();
+    let several = read.series.len() > 1 || config.all_imu;
+    let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
+    let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+    let folders = bag2mat::series::topic_folder_names(&names);
+    let mut outs = Vec::new();
+    for (series, folder) in read.series.into_iter().zip(folders) {
+        let mut c = config.clone();
+        if several {
+            c.out_dir = config.out_dir.join(folder);
+        }
+        outs.push(run_series(&c, series, read_time)?);
+    }
+    Ok(outs)
+}
+
+/// The pipeline on one topic's series.
+fn run_series(
+    config: &Config,
+    mut series: bag2mat::ImuSeries,
+    read_time: Duration,
+) -> Result<Outcome, Error> {
+    let mut timings = vec![("read_bag", read_time)];
+    let topic = series.topic.clone();
     let mut notes = series.notes.clone();
     if let Some(s) = config.skip_start {
         let k = skip_start(&mut series, s)?;
@@ -125,7 +154,7 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
             series.len()
         ));
     }
-    let collected = collect::collect(&series, config.max_time_min);
+    let collected = collect::collect(&series, config.max_time_min, config.time);
     if collected.stop == Stop::EndOfBag {
         notes.push(format!(
             "WARNING: bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
@@ -138,8 +167,7 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
     let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster, config.ieee952)?;
     timings.push(("allan", t1.elapsed()));
     // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at its
-    // mean-period rate, plus the time-stamp checks. Data too short for it only cost the
-    // section, with a note.
+    // mean-period rate, plus the time-stamp checks.
     let t1 = Instant::now();
     let ieee = if config.ieee952 {
         let curves: Vec<CurveData> = axes
@@ -188,10 +216,11 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
         files.extend(plot::write_plots(&analysis, &config.name, &config.out_dir)?);
     }
     if let Some(an) = &ieee {
-        files.extend(write_ieee952(an, config)?);
+        files.extend(write_ieee952(an, config, &topic)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
     Ok(Outcome {
+        topic,
         stdout: report::stdout_text(&analysis),
         ieee952_text: ieee.as_ref().map(imu::summary_text),
         notes,
@@ -203,9 +232,9 @@ pub fn run(config: &Config) -> Result<Outcome, Error> {
 }
 
 /// The section's files (prefixed `<name>_`) and chart.
-fn write_ieee952(an: &ImuAnalysis, config: &Config) -> Result<Vec<PathBuf>, Error> {
+fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = files::write_outputs(an, &config.out_dir, &prefix, &config.topic)?;
+    let mut out = files::write_outputs(an, &config.out_dir, &prefix, rostopic)?;
     if config.plots {
         out.extend(allan_kalibr::ieee952::plot::write_chart(
             an,
@@ -266,7 +295,8 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut an = imu::analyse_curves(&sensors, c.rate, &allan_kalibr::ieee952::Config::default());
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
-    files.extend(write_ieee952(&an, config)?);
+    let rostopic = config.topics.first().map_or("imu", |s| s.as_str());
+    files.extend(write_ieee952(&an, config, rostopic)?);
     Ok(CurvesOutcome {
         stdout,
         ieee952_text: imu::summary_text(&an),

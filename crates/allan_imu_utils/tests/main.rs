@@ -10,3 +10,4 @@ mod cli;
 mod common;
 mod fit_reference;
 mod reference;
+mod ros2;

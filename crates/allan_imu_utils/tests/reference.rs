@@ -29,7 +29,9 @@ const FITTED_PRINT_REL_TOL: f64 = 1e-3;
 fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
     let config = Config {
         bag: case.bag(),
-        topic: case.topic.into(),
+        topics: vec![case.topic.into()],
+        all_imu: false,
+        time: bag2mat::TimeColumn::Header,
         name: case.name.into(),
         out_dir: out.to_path_buf(),
         max_time_min: case.max_time_min,
@@ -43,7 +45,9 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
         curves: None,
         skip_start: None,
     };
-    run(&config).unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
+    run(&config)
+        .unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
+        .remove(0)
 }
 
 /// Leaf `key: value` pairs of an OpenCV yaml, keyed by their path (`Gyr/x-axis/gyr_n`).

@@ -43,9 +43,17 @@ pub struct Args {
     /// Drop the first SECONDS of the record (a warm-up) before any analysis.
     #[arg(long, value_name = "SECONDS")]
     pub skip_start: Option<f64>,
-    /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml).
-    #[arg(long, default_value = "imu")]
-    pub topic: String,
+    /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml); repeatable,
+    /// each topic then gets its own folder under the output directory [default: imu].
+    #[arg(long = "topic", value_name = "TOPIC")]
+    pub topics: Vec<String>,
+    /// Every topic of the bag that carries sensor_msgs/Imu, each into its own folder.
+    #[arg(long)]
+    pub all_imu_topics: bool,
+    /// The time column the rate is estimated from: record (receive) time, as bagconvert
+    /// writes it, or header.stamp.
+    #[arg(long, value_enum, default_value_t = TimeArg::Record)]
+    pub time: TimeArg,
     /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
     /// from the timestamps.
     #[arg(long, value_name = "HZ")]
@@ -74,6 +82,15 @@ pub struct Args {
     /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
     #[arg(long)]
     pub timings: bool,
+}
+
+/// The time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TimeArg {
+    /// Record (receive) time: bagconvert's rule.
+    Record,
+    /// header.stamp.
+    Header,
 }
 
 impl From<Args> for Config {
@@ -107,7 +124,18 @@ impl From<Args> for Config {
             skip_start: a.skip_start,
             curves,
             input,
-            topic: a.topic,
+            topics: bag2mat::TopicSelector {
+                topics: if a.topics.is_empty() && !a.all_imu_topics {
+                    vec!["imu".to_string()]
+                } else {
+                    a.topics
+                },
+                all_imu: a.all_imu_topics,
+            },
+            time: match a.time {
+                TimeArg::Record => bag2mat::TimeColumn::Record,
+                TimeArg::Header => bag2mat::TimeColumn::Header,
+            },
             update_rate: a.update_rate,
             title: a.title,
             estimator: if a.bit_exact {
@@ -137,7 +165,8 @@ mod tests {
     fn defaults() {
         let c = parse(&["data/x.bag"]);
         assert_eq!(c.outdir, PathBuf::from("data"));
-        assert_eq!(c.topic, "imu");
+        assert_eq!(c.topics.topics, vec!["imu".to_string()]);
+        assert_eq!(c.time, bag2mat::TimeColumn::Record);
         assert_eq!(c.update_rate, None);
         assert_eq!(c.estimator, Estimator::PrefixSum);
         assert_eq!(parse(&["x.mat"]).outdir, PathBuf::from("."));
@@ -157,7 +186,7 @@ mod tests {
             "--title",
             "ADIS",
         ]);
-        assert_eq!(c.topic, "/imu0");
+        assert_eq!(c.topics.topics, vec!["/imu0".to_string()]);
         assert_eq!(c.update_rate, Some(200.0));
         assert_eq!(c.estimator, Estimator::BitExact);
         assert_eq!(c.outdir, PathBuf::from("out"));

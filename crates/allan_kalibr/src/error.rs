@@ -24,8 +24,11 @@ pub enum Error {
         /// Why.
         what: String,
     },
-    /// Input file extension is neither .bag nor .mat.
-    #[error("{path}: unknown input type (expected a .bag or a .mat file)")]
+    /// The input is neither a `.mat` nor a bag bag2mat reads.
+    #[error(
+        "{path}: unknown input type (expected a .mat file or a bag: {})",
+        bag2mat::source::ACCEPTED
+    )]
     UnknownInput {
         /// The file.
         path: PathBuf,

@@ -39,25 +39,12 @@ impl ImuData {
         self.t.is_empty()
     }
 
-    /// Builds the columns from a bag2mat series (t = record time `to_sec()`, as bagconvert).
-    pub fn from_series(s: bag2mat::ImuSeries) -> Self {
-        // Consumes the series part by part so that at most one 3-column block is held twice
-        // (peak memory stays near the size of the samples).
-        let bag2mat::ImuSeries {
-            topic,
-            record_time,
-            acc,
-            gyro,
-            notes,
-            ..
-        } = s;
-        let t = record_time.iter().map(|r| r.to_sec()).collect();
-        drop(record_time);
-        let split = |v: Vec<[f64; 3]>| -> [Vec<f64>; 3] {
-            std::array::from_fn(|c| v.iter().map(|x| x[c]).collect())
-        };
-        let [ax, ay, az] = split(acc);
-        let [wx, wy, wz] = split(gyro);
+    /// Builds the columns from a bag2mat series with the chosen time column (bagconvert's
+    /// record time by default), through bag2mat's one series-to-matrix conversion.
+    pub fn from_series(s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
+        let topic = s.topic.clone();
+        let notes = s.notes.clone();
+        let [t, ax, ay, az, wx, wy, wz] = bag2mat::convert::into_data_imu(s, time).columns;
         ImuData {
             t,
             axes: [ax, ay, az, wx, wy, wz],
@@ -85,23 +72,38 @@ impl ImuData {
     }
 }
 
-/// Reads a `.bag` (topic `topic`) or a `.mat` (variable `data_imu`), by extension.
+/// True for a `.mat` path (by extension, as upstream's scripts name them).
+fn is_mat(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("mat"))
+}
+
+/// Reads one topic of a bag (any format bag2mat reads) or a `.mat` (variable `data_imu`).
 pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "bag" => {
-            let opts = bag2mat::ReadOptions { quiet };
-            Ok(ImuData::from_series(bag2mat::read_imu_series(
-                path, topic, &opts,
-            )?))
-        }
-        "mat" => load_mat(path),
-        _ => Err(Error::UnknownInput {
+    let sel = bag2mat::TopicSelector::one(topic);
+    Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet)?.remove(0))
+}
+
+/// Reads the selected topics of a bag in one pass, or the one `data_imu` of a `.mat`.
+pub fn load_all(
+    path: &Path,
+    sel: &bag2mat::TopicSelector,
+    time: bag2mat::TimeColumn,
+    quiet: bool,
+) -> Result<Vec<ImuData>, Error> {
+    if is_mat(path) {
+        return Ok(vec![load_mat(path)?]);
+    }
+    match bag2mat::read_imu_topics(path, sel, &bag2mat::ReadOptions { quiet }) {
+        Ok(r) => Ok(r
+            .series
+            .into_iter()
+            .map(|s| ImuData::from_series(s, time))
+            .collect()),
+        Err(bag2mat::Error::NotABag { .. }) => Err(Error::UnknownInput {
             path: path.to_path_buf(),
         }),
+        Err(e) => Err(e.into()),
     }
 }
 

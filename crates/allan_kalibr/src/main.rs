@@ -34,19 +34,25 @@ fn main() -> ExitCode {
         .map_err(|e| anyhow::anyhow!("{e}"))
         .with_context(|| format!("allan_kalibr {}", config.input.display()));
     match result {
-        Ok(out) => {
-            for n in &out.notes {
-                eprintln!("{n}");
-            }
-            print!("{}", out.text);
-            if let Some(t) = &out.ieee952_text {
-                print!("{t}");
-            }
-            for p in &out.written {
-                eprintln!("wrote {}", p.display());
-            }
-            if config.timings {
-                eprintln!("{}", out.timings);
+        Ok(outs) => {
+            let several = outs.len() > 1;
+            for out in &outs {
+                if several {
+                    println!("===== topic {} =====", out.topic.as_deref().unwrap_or("?"));
+                }
+                for n in &out.notes {
+                    eprintln!("{n}");
+                }
+                print!("{}", out.text);
+                if let Some(t) = &out.ieee952_text {
+                    print!("{t}");
+                }
+                for p in &out.written {
+                    eprintln!("wrote {}", p.display());
+                }
+                if config.timings {
+                    eprintln!("{}", out.timings);
+                }
             }
             ExitCode::SUCCESS
         }

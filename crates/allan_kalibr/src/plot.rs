@@ -46,7 +46,7 @@ pub struct Chart<'a> {
 
 /// Draws `chart` into `<stem>.png` and `<stem>.svg` under `dir`; returns the two paths.
 pub fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2], Error> {
-    bag2mat::plot::register_font();
+    bag2mat::shared::plot::register_font();
     let png = dir.join(format!("{stem}.png"));
     let svg = dir.join(format!("{stem}.svg"));
 
@@ -57,9 +57,9 @@ pub fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2]
         draw(chart, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
         root.present().map_err(|e| plot_err(&svg, e))?;
     }
-    bag2mat::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
 
-    bag2mat::plot::png_atomic(&png, PNG_SIZE, |root| {
+    bag2mat::shared::plot::png_atomic(&png, PNG_SIZE, |root| {
         draw(chart, &root, PNG_SIZE.0 as f64 / SVG_SIZE.0 as f64).map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())
     })?;

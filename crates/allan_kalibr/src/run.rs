@@ -21,8 +21,10 @@ use crate::yaml::ImuYaml;
 pub struct Config {
     /// `.bag` or `.mat`.
     pub input: PathBuf,
-    /// Bag topic (bag2mat's topic rules).
-    pub topic: String,
+    /// Bag topics (bag2mat's topic rules); each topic of several gets its own folder.
+    pub topics: bag2mat::TopicSelector,
+    /// The time column used to estimate the rate: the record time, as bagconvert.
+    pub time: bag2mat::TimeColumn,
     /// Hz; None = estimate from the timestamps.
     pub update_rate: Option<f64>,
     /// Chart title prefix (upstream's hard-coded `titlestr`).
@@ -75,7 +77,8 @@ pub fn analyse(
 ) -> Result<Analysis, Error> {
     let grid = TauGrid::new(axes[0].len(), rate)?;
     let jobs = 6 * grid.distinct_m().len() as u64;
-    let bar = bag2mat::progress::bar(jobs, quiet || estimator == Estimator::PrefixSum, "taus");
+    let bar =
+        bag2mat::shared::progress::bar(jobs, quiet || estimator == Estimator::PrefixSum, "taus");
     bar.set_message("allan");
     let sig2 = sig2_curves(axes, &grid, estimator, &|| bar.inc(1));
     bar.finish_and_clear();
@@ -92,6 +95,8 @@ pub fn analyse(
 /// Result of [`run`]: the printed text, the messages for stderr and the files written.
 #[derive(Debug)]
 pub struct RunOutput {
+    /// The topic the samples came from (None for a `.mat`).
+    pub topic: Option<String>,
     /// The numbers.
     pub analysis: Analysis,
     /// How the update rate was chosen.
@@ -131,19 +136,36 @@ impl std::fmt::Display for Timings {
     }
 }
 
-/// Runs the whole job for `config`.
-pub fn run(config: &Config) -> Result<RunOutput, Error> {
+/// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
+/// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`.
+pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     let start = Instant::now();
-    let data = input::load(&config.input, &config.topic, config.quiet)?;
+    let datas = input::load_all(&config.input, &config.topics, config.time, config.quiet)?;
     let load = start.elapsed().as_secs_f64();
-    let mut out = run_on(config, data)?;
-    out.timings.load = load;
-    Ok(out)
+    let several = datas.len() > 1 || config.topics.all_imu;
+    let names: Vec<String> = datas
+        .iter()
+        .map(|d| d.topic.clone().unwrap_or_default())
+        .collect();
+    let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+    let folders = bag2mat::series::topic_folder_names(&names);
+    let mut outs = Vec::new();
+    for (data, folder) in datas.into_iter().zip(folders) {
+        let mut c = config.clone();
+        if several {
+            c.outdir = config.outdir.join(folder);
+        }
+        let mut out = run_on(&c, data)?;
+        out.timings.load = load;
+        outs.push(out);
+    }
+    Ok(outs)
 }
 
 /// [`run`] on samples already in memory.
 pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let mut notes = data.notes.clone();
+    let data_topic = data.topic.clone();
     if let Some(skip) = config.skip_start {
         let k = skip_start(&mut data, skip)?;
         notes.push(format!(
@@ -157,7 +179,14 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     data.check_finite()?;
     let rate = input::choose_rate(config.update_rate, &data.t)?;
     notes.extend(rate.message.clone());
-    let topic = data.topic.clone().unwrap_or_else(|| config.topic.clone());
+    let topic = data.topic.clone().unwrap_or_else(|| {
+        config
+            .topics
+            .topics
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "imu".into())
+    });
     // The IEEE 952 analysis reads the raw columns, so it runs before the compat path turns
     // them into prefix sums. Data too short for it only costs the section, with a note.
     let start = Instant::now();
@@ -212,10 +241,10 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
-    bag2mat::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
     written.push(yaml_path);
     let csv_path = dir.join("allan_curves.csv");
-    bag2mat::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
+    bag2mat::shared::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
     // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
     let title = if config.title.is_empty() {
@@ -241,6 +270,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         output: start.elapsed().as_secs_f64(),
     };
     Ok(RunOutput {
+        topic: data_topic,
         analysis,
         rate,
         text,
@@ -316,7 +346,8 @@ pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput,
     } else {
         config.title.clone()
     };
-    let mut written = crate::ieee952::files::write_outputs(&an, dir, "", &config.topic)?;
+    let rostopic = config.topics.topics.first().map_or("imu", |s| s.as_str());
+    let mut written = crate::ieee952::files::write_outputs(&an, dir, "", rostopic)?;
     written.extend(crate::ieee952::plot::write_chart(
         &an, &title, None, dir, "",
     )?);

@@ -243,7 +243,7 @@ fn unknown_extension_and_wrong_topic_are_clear_errors() {
     let o = run(&[txt.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(
-        s(&o.stderr).contains("expected a .bag or a .mat"),
+        s(&o.stderr).contains("expected a .mat file or a bag"),
         "{}",
         s(&o.stderr)
     );

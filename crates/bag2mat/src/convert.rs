@@ -3,19 +3,24 @@
 //! record-time order, `t = sec + 1e-9·nsec` in double; the output goes beside the bag as
 //! `<stem>.mat`. Unlike bagconvert, a missing topic is an error (bagconvert writes an empty
 //! 0×7 matrix and exits 0), and the output is written atomically. CSV and NPY are offered
-//! for users who do not need MATLAB.
+//! for users who do not need MATLAB. Any input the workspace reads is accepted (ROS 1 bag,
+//! ROS 2 bag directory, `.mcap`, `.db3`); for ROS 2 the record time is the storage's receive
+//! time. `--time header` puts `header.stamp` in the `t` column instead (rows stay in
+//! record-time order). Several topics are read in one pass, each into its own folder.
 
 use std::path::{Path, PathBuf};
 
 use crate::bag::RosTime;
-use crate::bag::read::BagReader;
 use crate::error::Error;
 use crate::mat::{self, COLS, DataImu};
-use crate::output::write_atomic;
-use crate::series::{ImuSeries, permute};
+use crate::series::{
+    ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, read_imu_topics,
+    topic_folder_names,
+};
+use crate::shared::output::write_atomic;
 
 /// Output file formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Format {
     /// MATLAB Level-5 `.mat` with the variable `data_imu` (what kalibr_allan loads).
     #[default]
@@ -66,13 +71,45 @@ pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f
     ]
 }
 
-/// The matrix of one Imu series: `t` is the record time.
-pub fn data_imu_from_series(s: &ImuSeries) -> DataImu {
+/// The matrix of one Imu series with the chosen time column.
+pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
     let mut d = DataImu::with_capacity(s.len());
-    for i in 0..s.len() {
-        d.push(bagconvert_row(s.record_time[i], s.acc[i], s.gyro[i]));
+    for ((t, a), g) in s.time(time).iter().zip(&s.acc).zip(&s.gyro) {
+        d.push(bagconvert_row(*t, *a, *g));
     }
     d
+}
+
+/// The matrix of one Imu series, consuming it column by column so that the samples are
+/// never held twice in full (peak memory stays near the size of the matrix).
+pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
+    let ImuSeries {
+        record_time,
+        stamp,
+        acc,
+        gyro,
+        ..
+    } = s;
+    let t_src = match time {
+        TimeColumn::Record => {
+            drop(stamp);
+            record_time
+        }
+        TimeColumn::Header => {
+            drop(record_time);
+            stamp
+        }
+    };
+    let t: Vec<f64> = t_src.iter().map(|r| r.to_sec()).collect();
+    drop(t_src);
+    let split = |v: Vec<[f64; 3]>| -> [Vec<f64>; 3] {
+        std::array::from_fn(|c| v.iter().map(|x| x[c]).collect())
+    };
+    let [ax, ay, az] = split(acc);
+    let [wx, wy, wz] = split(gyro);
+    DataImu {
+        columns: [t, ax, ay, az, wx, wy, wz],
+    }
 }
 
 /// What [`bag_to_data_imu`] read.
@@ -86,78 +123,14 @@ pub struct Converted {
     pub notes: Vec<String>,
 }
 
-/// Reads the topic straight into the N×7 matrix. For an indexed bag every chunk is decoded in
-/// parallel directly into its rows (the chunk infos give each chunk's row count); otherwise,
-/// or if that fails, the messages are streamed in order.
+/// Reads one topic straight into bagconvert's N×7 matrix (record time).
 pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Converted, Error> {
-    let bag = BagReader::open(bag_path)?;
-    let sel = bag.select_imu_topic(topic)?;
-    if let Some(plan) = bag.chunk_plan(&sel)
-        && let Some(conv) = planned(&bag, &sel, &plan, quiet)
-    {
-        return Ok(conv);
-    }
-    let mut data = DataImu::with_capacity(sel.expected as usize);
-    let report = bag.stream_imu(&sel, quiet, &mut |t, m| {
-        data.push(bagconvert_row(t, m.acc, m.gyro));
-    })?;
-    if let Some(order) = &report.order {
-        for c in data.columns.iter_mut() {
-            *c = permute(c, order);
-        }
-    }
+    let s = read_imu_series(bag_path, topic, &ReadOptions { quiet })?;
+    let topic = s.topic.clone();
+    let notes = s.notes.clone();
     Ok(Converted {
-        data,
-        topic: sel.topic,
-        notes: report.notes,
-    })
-}
-
-/// One chunk's rows of every column, and of the record times.
-struct RowsPart<'a> {
-    cols: [&'a mut [f64]; COLS],
-    times: &'a mut [u64],
-}
-
-/// The parallel path of [`bag_to_data_imu`]; `None` when it does not apply (a chunk that
-/// does not match its index) or the record times are out of order (the streaming path sorts).
-fn planned(
-    bag: &BagReader,
-    sel: &crate::bag::read::TopicSelection,
-    plan: &[(u64, usize)],
-    quiet: bool,
-) -> Option<Converted> {
-    let n: usize = plan.iter().map(|(_, k)| k).sum();
-    let mut columns: [Vec<f64>; COLS] = std::array::from_fn(|_| vec![0.0; n]);
-    let mut times = vec![0u64; n];
-    {
-        let mut cols = columns
-            .iter_mut()
-            .map(|c| BagReader::split_rows(c, plan).into_iter());
-        let mut col_parts: [_; COLS] = std::array::from_fn(|_| cols.next().expect("seven columns"));
-        let mut parts: Vec<RowsPart> = BagReader::split_rows(&mut times, plan)
-            .into_iter()
-            .map(|times| RowsPart {
-                cols: std::array::from_fn(|c| col_parts[c].next().expect("one slice per chunk")),
-                times,
-            })
-            .collect();
-        bag.decode_planned(sel, plan, &mut parts, quiet, |p, i, t, m| {
-            for (c, v) in bagconvert_row(t, m.acc, m.gyro).into_iter().enumerate() {
-                p.cols[c][i] = v;
-            }
-            p.times[i] = t.as_nanos();
-        })
-        .ok()?;
-    }
-    if times.windows(2).any(|w| w[1] < w[0]) {
-        return None;
-    }
-    let mut notes = bag.notes().to_vec();
-    notes.extend(sel.note.iter().cloned());
-    Some(Converted {
-        data: DataImu { columns },
-        topic: sel.topic.clone(),
+        data: into_data_imu(s, TimeColumn::Record),
+        topic,
         notes,
     })
 }
@@ -207,6 +180,106 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
     }
 }
 
+/// What the `bag2mat` conversion runs with.
+#[derive(Debug, Clone)]
+pub struct Config {
+    /// Input (any accepted kind).
+    pub bag: PathBuf,
+    /// Topics to convert.
+    pub topics: TopicSelector,
+    /// Output file for one topic, or output directory for several (default: beside the bag).
+    pub output: Option<PathBuf>,
+    /// Output format.
+    pub format: Format,
+    /// The `t` column: record time (bagconvert) or `header.stamp`.
+    pub time: TimeColumn,
+    /// No progress bar, no log lines.
+    pub quiet: bool,
+}
+
+/// Where each topic's file goes: with one topic, bagconvert's path (or `-o FILE`); with
+/// several, `<dir>/<topic folder>/<stem>.<ext>` where `<dir>` is `-o` or the bag's directory.
+pub fn output_paths(cfg: &Config, topics: &[&str]) -> Vec<PathBuf> {
+    if topics.len() == 1 && !cfg.topics.all_imu {
+        return vec![
+            cfg.output
+                .clone()
+                .unwrap_or_else(|| default_output(&cfg.bag, cfg.format)),
+        ];
+    }
+    let file = default_output(&cfg.bag, cfg.format);
+    let name = file
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    let dir = cfg
+        .output
+        .clone()
+        .unwrap_or_else(|| match cfg.bag.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        });
+    topic_folder_names(topics)
+        .into_iter()
+        .map(|f| dir.join(f).join(&name))
+        .collect()
+}
+
+/// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet. Returns each
+/// output path with its number of rows.
+pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
+    let log = |s: &str| {
+        if !cfg.quiet {
+            eprintln!("{s}");
+        }
+    };
+    log(&format!("BAG Path is: {}", cfg.bag.display()));
+    let single = cfg.topics.topics.len() == 1 && !cfg.topics.all_imu;
+    if single {
+        let out = output_paths(cfg, &[cfg.topics.topics[0].as_str()]).remove(0);
+        log(&format!(
+            "{} Path is: {}",
+            cfg.format.extension().to_uppercase(),
+            out.display()
+        ));
+    }
+    log("Reading in rosbag file...");
+    let read = read_imu_topics(&cfg.bag, &cfg.topics, &ReadOptions { quiet: cfg.quiet })?;
+    let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
+    let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+    let outs = output_paths(cfg, &names);
+    let mut written = Vec::new();
+    for (s, out) in read.series.into_iter().zip(outs) {
+        for n in &s.notes {
+            eprintln!("warning: {n}");
+        }
+        let topic = s.topic.clone();
+        if !single {
+            log(&format!(
+                "{} Path is: {}",
+                cfg.format.extension().to_uppercase(),
+                out.display()
+            ));
+        }
+        let data = into_data_imu(s, cfg.time);
+        log(&format!(
+            "Done processing bag: {} messages on '{}'",
+            data.rows(),
+            topic
+        ));
+        if let Some(dir) = out.parent()
+            && !single
+            && !dir.as_os_str().is_empty()
+        {
+            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        }
+        write(&out, &data, cfg.format)?;
+        written.push((out, data.rows()));
+    }
+    log("Done processing IMU data");
+    Ok(written)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,52 +299,32 @@ mod tests {
             PathBuf::from("dir/x.csv")
         );
     }
-}
 
-/// What the `bag2mat` command runs with.
-#[derive(Debug, Clone)]
-pub struct Config {
-    /// Input bag.
-    pub bag: PathBuf,
-    /// Imu topic.
-    pub topic: String,
-    /// Output file (default: beside the bag, see [`default_output`]).
-    pub output: Option<PathBuf>,
-    /// Output format.
-    pub format: Format,
-    /// No progress bar, no log lines.
-    pub quiet: bool,
-}
-
-/// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet. Returns the
-/// output path and the number of rows written.
-pub fn run(cfg: &Config) -> Result<(PathBuf, usize), Error> {
-    let out = cfg
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&cfg.bag, cfg.format));
-    let log = |s: &str| {
-        if !cfg.quiet {
-            eprintln!("{s}");
-        }
-    };
-    log(&format!("BAG Path is: {}", cfg.bag.display()));
-    log(&format!(
-        "{} Path is: {}",
-        cfg.format.extension().to_uppercase(),
-        out.display()
-    ));
-    log("Reading in rosbag file...");
-    let conv = bag_to_data_imu(&cfg.bag, &cfg.topic, cfg.quiet)?;
-    for n in &conv.notes {
-        eprintln!("warning: {n}");
+    #[test]
+    fn several_topics_get_a_folder_each() {
+        let cfg = Config {
+            bag: PathBuf::from("/d/rig.mcap"),
+            topics: TopicSelector {
+                topics: vec!["/imu0".into(), "/imu1".into()],
+                all_imu: false,
+            },
+            output: None,
+            format: Format::Mat,
+            time: TimeColumn::Record,
+            quiet: true,
+        };
+        assert_eq!(
+            output_paths(&cfg, &["/imu0", "/imu1"]),
+            vec![
+                PathBuf::from("/d/imu0/rig.mat"),
+                PathBuf::from("/d/imu1/rig.mat")
+            ]
+        );
+        let one = Config {
+            topics: TopicSelector::one("/imu0"),
+            output: Some("x.csv".into()),
+            ..cfg
+        };
+        assert_eq!(output_paths(&one, &["/imu0"]), vec![PathBuf::from("x.csv")]);
     }
-    log(&format!(
-        "Done processing bag: {} messages on '{}'",
-        conv.data.rows(),
-        conv.topic
-    ));
-    write(&out, &conv.data, cfg.format)?;
-    log("Done processing IMU data");
-    Ok((out, conv.data.rows()))
 }

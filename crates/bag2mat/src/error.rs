@@ -27,12 +27,20 @@ pub enum Error {
         /// The cause.
         cause: std::io::Error,
     },
-    /// The file does not start with `#ROSBAG V2.0`.
-    #[error("{path}: not a ROS 1 bag (version 2.0): {what}")]
+    /// The input is none of the accepted kinds (see [`crate::source::ACCEPTED`]).
+    #[error("{path}: not a bag this tool reads: {what}")]
     NotABag {
         /// The file.
         path: PathBuf,
         /// What was found instead.
+        what: String,
+    },
+    /// A storage file (sqlite3, metadata.yaml) could not be read.
+    #[error("{path}: {what}")]
+    Storage {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
         what: String,
     },
     /// A record or chunk could not be parsed.
@@ -53,9 +61,15 @@ pub enum Error {
         /// Every topic in the bag.
         available: Vec<TopicSummary>,
     },
-    /// The topic exists but does not carry `sensor_msgs/Imu` with the right md5.
+    /// `--all-imu-topics` found no topic carrying `sensor_msgs/Imu`.
+    #[error("{}", no_imu_topic(.available))]
+    NoImuTopic {
+        /// Every topic in the bag.
+        available: Vec<TopicSummary>,
+    },
+    /// The topic exists but does not carry `sensor_msgs/Imu` (with the right md5 for ROS 1).
     #[error(
-        "topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}]",
+        "topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
         crate::imu_msg::MD5
     )]
     WrongType {
@@ -90,8 +104,19 @@ pub enum Error {
     },
 }
 
+fn no_imu_topic(available: &[TopicSummary]) -> String {
+    let mut s = "no topic carries sensor_msgs/Imu".to_string();
+    list_topics(&mut s, available);
+    s
+}
+
 fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
     let mut s = format!("no sensor_msgs/Imu topic '{topic}' in the bag");
+    list_topics(&mut s, available);
+    s
+}
+
+fn list_topics(s: &mut String, available: &[TopicSummary]) {
     if available.is_empty() {
         s.push_str(" (the bag has no topics at all)");
     } else {
@@ -103,7 +128,6 @@ fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
             ));
         }
     }
-    s
 }
 
 impl Error {

@@ -1,34 +1,50 @@
-//! ROS 1 bag I/O, the `sensor_msgs/Imu` codec and MAT files, without ROS.
+//! The workspace's I/O crate: every file format the tools read or write, without ROS.
 //!
-//! This crate owns every file format of the workspace, so no other crate encodes a record:
+//! No other crate encodes a record:
 //!
-//! * [`bag`]: bag format 2.0 — [`bag::BagReader`] (index or scan, parallel chunk decoding,
-//!   `none`/`bz2`/`lz4`) and [`bag::BagWriter`] (files `rosbag info/check` accept).
-//! * [`imu_msg`]: the `sensor_msgs/Imu` layout, md5 and 2571-byte definition.
-//! * [`read_imu_series`]: one Imu topic as columns in record-time order, with the topic
-//!   rules both analysers share (exact name, else the other slash form; a missing topic
-//!   lists the bag's topics).
-//! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written.
-//! * [`convert`]: the bagconvert rules (rows, output path) and the csv/npy alternatives.
-//! * [`cfmt`]: C `printf` number layouts (`%g`, `%.16e`) for upstream-compatible text.
-//! * [`output`], [`progress`], [`plot`]: atomic output files, progress bars and the embedded
-//!   plot font, shared by every binary of the workspace.
+//! * [`source`]: one interface over every input — a ROS 1 bag, a ROS 2 bag directory, an
+//!   `.mcap`, a `.db3`, a zstd-compressed storage file — recognised from its content.
+//! * [`series`]: the one read path: Imu topics as columns in record-time order, with the
+//!   topic rules every tool shares (exact name, else the other slash form; a missing topic
+//!   lists the input's topics), parallel decode, sorting and the accounting of what the
+//!   container promised against what was delivered.
+//! * [`bag`]: ROS 1 bag format 2.0 — [`bag::BagReader`] (index or scan, `none`/`bz2`/`lz4`)
+//!   and [`bag::BagWriter`] (files `rosbag info/check` accept).
+//! * [`mcap`]: MCAP, our own record-level reader (with or without summary, recovery of files
+//!   cut short) and writer.
+//! * [`rosbag2`]: ROS 2 bag directories, `metadata.yaml`, the sqlite3 storage and rosbag2's
+//!   FILE/MESSAGE zstd compression; [`rosbag2::Ros2BagWriter`].
+//! * [`imu_msg`]: the ROS 1 `sensor_msgs/Imu` layout, md5 and 2571-byte definition;
+//!   [`cdr`]: `sensor_msgs/msg/Imu` in CDR (ROS 2).
+//! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
+//!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
+//! * [`info`]: what an input holds (`bag2mat info`).
+//! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font,
+//!   C `printf` formats.
 //!
 //! Units: times are [`RosTime`] (UNIX epoch); accelerations m/s², angular rates rad/s.
 
 #![deny(missing_docs)]
 
 pub mod bag;
-pub mod cfmt;
+pub mod cdr;
 pub mod convert;
 mod error;
 pub mod imu_msg;
+pub mod info;
 pub mod mat;
-pub mod output;
-pub mod plot;
-pub mod progress;
-mod series;
+pub mod mcap;
+pub mod rosbag2;
+pub mod series;
+pub mod shared;
+pub mod source;
+#[doc(hidden)]
+pub mod test_tools;
+pub mod zstd;
 
 pub use bag::{Compression, RosTime};
 pub use error::{Error, TopicSummary};
-pub use series::{ImuSeries, ReadOptions, permute, read_imu_series};
+pub use series::{
+    ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, permute,
+    read_imu_series, read_imu_topics,
+};

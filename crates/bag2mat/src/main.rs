@@ -1,43 +1,128 @@
-//! `bag2mat BAG TOPIC [-o OUT] [--format mat|csv|npy]`: a ROS bag's Imu topic to the N×7
-//! `data_imu` matrix kalibr_allan's `bagconvert` writes, without ROS or MATLAB.
+//! `bag2mat BAG [TOPIC] [--topic T]… [--all-imu-topics] [-o OUT] [--format mat|csv|npy]
+//! [--time record|header]`: Imu topics of a ROS 1 or ROS 2 bag to the N×7 `data_imu`
+//! matrix kalibr_allan's `bagconvert` writes; `bag2mat info BAG`: what a bag holds.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use bag2mat::convert::{Config, Format, run};
-use clap::Parser;
+use bag2mat::{TimeColumn, TopicSelector};
+use clap::{Parser, Subcommand, ValueEnum};
 
-/// Convert a ROS 1 bag's sensor_msgs/Imu topic to a MATLAB .mat (kalibr_allan's bagconvert layout:
-/// variable data_imu, N×7, columns t ax ay az wx wy wz, t = bag record time in seconds).
+/// Convert sensor_msgs/Imu topics of a bag to a MATLAB .mat (kalibr_allan's bagconvert layout:
+/// variable data_imu, N×7, columns t ax ay az wx wy wz, t = record time in seconds).
+///
+/// Reads ROS 1 bags, ROS 2 bag directories (sqlite3 or MCAP, split, zstd-compressed), bare
+/// .mcap and .db3 files, recognised from their content. `bag2mat info BAG` lists what a bag
+/// holds.
 #[derive(Parser, Debug)]
-#[command(version, about)]
+#[command(version, about, args_conflicts_with_subcommands = true)]
 struct Args {
-    /// The bag (format 2.0; chunks none, bz2 or lz4).
-    bag: PathBuf,
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// The input: a ROS 1 bag, a ROS 2 bag directory, an .mcap or a .db3.
+    bag: Option<PathBuf>,
     /// The Imu topic (`imu` and `/imu` are tried in that order if the exact name is missing).
-    topic: String,
-    /// Output file [default: beside the bag, <stem>.<format>].
+    topic: Option<String>,
+    /// Another Imu topic (repeatable); each topic gets its own output folder.
+    #[arg(long = "topic", value_name = "TOPIC")]
+    topics: Vec<String>,
+    /// Every topic that carries sensor_msgs/Imu, each into its own folder.
+    #[arg(long)]
+    all_imu_topics: bool,
+    /// Output file for one topic; output directory for several [default: beside the bag,
+    /// <stem>.<format>, or <topic>/<stem>.<format> per topic].
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = Format::Mat)]
-    format: Format,
+    #[arg(long, value_enum, default_value_t = FormatArg::Mat)]
+    format: FormatArg,
+    /// The time in column t: the record (receive) time, as bagconvert, or header.stamp.
+    #[arg(long, value_enum, default_value_t = TimeArg::Record)]
+    time: TimeArg,
     /// No progress bar and no log lines.
     #[arg(short, long)]
     quiet: bool,
 }
 
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Every topic of a bag (any format) with its type, message count, mean rate, rate
+    /// jitter, time span and gaps; the Imu topics are flagged.
+    Info {
+        /// The input.
+        bag: PathBuf,
+        /// No progress bar.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+}
+
+/// Output file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FormatArg {
+    /// MATLAB Level-5 .mat with the variable data_imu (what kalibr_allan loads).
+    Mat,
+    /// Comma-separated text with a header line.
+    Csv,
+    /// NumPy .npy, float64, shape (N, 7).
+    Npy,
+}
+
+/// The time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TimeArg {
+    /// Record (receive) time: bagconvert's rule.
+    Record,
+    /// header.stamp.
+    Header,
+}
+
 fn main() -> ExitCode {
     let a = Args::parse();
-    let cfg = Config {
-        bag: a.bag,
-        topic: a.topic,
-        output: a.output,
-        format: a.format,
-        quiet: a.quiet,
+    let result = match a.command {
+        Some(Command::Info { bag, quiet }) => bag2mat::info::info(&bag, quiet).map(|r| {
+            print!("{}", r.text(&bag));
+        }),
+        None => {
+            let Some(bag) = a.bag else {
+                eprintln!(
+                    "bag2mat: error: no input given (bag2mat BAG TOPIC, or bag2mat info BAG)"
+                );
+                return ExitCode::from(2);
+            };
+            let mut topics: Vec<String> = a.topic.into_iter().collect();
+            topics.extend(a.topics);
+            if topics.is_empty() && !a.all_imu_topics {
+                eprintln!(
+                    "bag2mat: error: name a topic (TOPIC, --topic) or pass --all-imu-topics; `bag2mat info {}` lists them",
+                    bag.display()
+                );
+                return ExitCode::from(2);
+            }
+            let cfg = Config {
+                bag,
+                topics: TopicSelector {
+                    topics,
+                    all_imu: a.all_imu_topics,
+                },
+                output: a.output,
+                format: match a.format {
+                    FormatArg::Mat => Format::Mat,
+                    FormatArg::Csv => Format::Csv,
+                    FormatArg::Npy => Format::Npy,
+                },
+                time: match a.time {
+                    TimeArg::Record => TimeColumn::Record,
+                    TimeArg::Header => TimeColumn::Header,
+                },
+                quiet: a.quiet,
+            };
+            run(&cfg).map(|_| ())
+        }
     };
-    match run(&cfg) {
-        Ok(_) => ExitCode::SUCCESS,
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("bag2mat: error: {e}");
             ExitCode::FAILURE

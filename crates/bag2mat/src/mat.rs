@@ -11,7 +11,7 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::error::Error;
-use crate::output::write_atomic;
+use crate::shared::output::write_atomic;
 
 /// The variable name bagconvert writes.
 pub const VAR_NAME: &str = "data_imu";

@@ -81,7 +81,7 @@ fn bad_inputs_fail_cleanly() {
         ),
         (
             vec![junk.display().to_string(), "imu".into()],
-            "not a ROS 1 bag",
+            "not a bag this tool reads",
         ),
         (
             vec![dir.path().display().to_string(), "imu".into()],

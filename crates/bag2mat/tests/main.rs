@@ -5,5 +5,6 @@
 mod cli;
 mod real_tools;
 mod reference;
+mod ros2;
 mod roundtrip;
 mod util;

@@ -6,7 +6,7 @@ use std::process::Command;
 
 use bag2mat::Compression;
 use bag2mat::convert::{Format, data_imu_from_series, write};
-use bag2mat::{ReadOptions, read_imu_series};
+use bag2mat::{ReadOptions, TimeColumn, read_imu_series};
 
 use crate::util::{run, synthetic, write_synthetic};
 
@@ -91,7 +91,7 @@ fn octave_and_scipy_load_our_mat() {
     let bag = dir.path().join("m.bag");
     write_synthetic(&bag, "imu", 777, Compression::Lz4, false);
     let s = read_imu_series(&bag, "imu", &ReadOptions { quiet: true }).unwrap();
-    let d = data_imu_from_series(&s);
+    let d = data_imu_from_series(&s, TimeColumn::Record);
     let mat = dir.path().join("m.mat");
     write(&mat, &d, Format::Mat).unwrap();
     // Octave prints the size, the first time at full precision, and the sum of each column.

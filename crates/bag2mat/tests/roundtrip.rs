@@ -255,15 +255,16 @@ fn unfinished_writer_leaves_nothing_behind() {
     );
 }
 
-/// The parallel chunk path of `bag_to_data_imu` and the streaming path agree exactly, and an
-/// out-of-order bag falls back to the streaming path, which sorts.
+/// `bag_to_data_imu` (which consumes the series column by column) and the row-by-row
+/// conversion of the same series agree exactly, and an out-of-order bag comes out sorted.
 #[test]
-fn planned_and_streamed_matrices_agree() {
+fn matrix_routes_agree_and_sort() {
     use bag2mat::convert::{bag_to_data_imu, data_imu_from_series};
     let p2 = crate::util::case_bag("p2_medium_100hz");
     let planned = bag_to_data_imu(&p2, "/imu/data", true).unwrap().data;
     let streamed = data_imu_from_series(
         &read_imu_series(&p2, "/imu/data", &ReadOptions { quiet: true }).unwrap(),
+        bag2mat::TimeColumn::Record,
     );
     assert_eq!(planned, streamed);
 

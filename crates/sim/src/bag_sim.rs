@@ -17,6 +17,8 @@ use crate::rotation::quat_from_matrix;
 use bag2mat::bag::BagWriter;
 use bag2mat::bag::write::ConnId;
 use bag2mat::imu_msg::Imu;
+use bag2mat::mcap::ChunkCompression;
+use bag2mat::rosbag2::{Ros2BagWriter, Storage, TopicId};
 use bag2mat::{Compression, RosTime};
 use std::path::PathBuf;
 
@@ -41,10 +43,41 @@ pub struct BagConfig {
     pub frame_id: String,
     /// Motion model.
     pub motion: Motion,
-    /// Chunk compression.
+    /// Chunk compression (ROS 1 bags).
     pub compression: Compression,
+    /// Container: a ROS 1 bag (upstream), or a ROS 2 bag directory (Imu as CDR).
+    pub format: BagFormat,
     /// No progress bar.
     pub quiet: bool,
+}
+
+/// What `sim bag` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BagFormat {
+    /// A ROS 1 bag (format 2.0), as upstream.
+    #[default]
+    Ros1,
+    /// A ROS 2 bag directory with one MCAP file, chunks compressed as given.
+    Mcap(ChunkCompression),
+    /// A ROS 2 bag directory with one sqlite3 `.db3`.
+    Sqlite3,
+}
+
+impl BagFormat {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            BagFormat::Ros1 => "ros1",
+            BagFormat::Mcap(_) => "mcap",
+            BagFormat::Sqlite3 => "sqlite3",
+        }
+    }
+}
+
+/// The writer behind [`ImuBagSink`].
+enum SinkWriter {
+    Ros1(BagWriter, ConnId),
+    Ros2(Box<Ros2BagWriter>, TopicId),
 }
 
 /// What was written.
@@ -60,8 +93,7 @@ pub struct BagSummary {
 
 /// Streams Imu messages into a bag, reusing one message value (no per-message allocation).
 pub struct ImuBagSink {
-    writer: BagWriter,
-    conn: ConnId,
+    writer: SinkWriter,
     imu: Imu,
     count: u64,
     first: Option<RosTime>,
@@ -76,8 +108,34 @@ impl ImuBagSink {
         topic: &str,
         frame_id: &str,
     ) -> Result<Self> {
-        let mut writer = BagWriter::create(path, compression)?;
-        let conn = writer.add_imu_connection(topic);
+        Self::create_format(path, BagFormat::Ros1, compression, topic, frame_id)
+    }
+
+    /// Create a bag of the given format (a ROS 2 bag is a directory) with one Imu topic.
+    pub fn create_format(
+        path: &std::path::Path,
+        format: BagFormat,
+        compression: Compression,
+        topic: &str,
+        frame_id: &str,
+    ) -> Result<Self> {
+        let writer = match format {
+            BagFormat::Ros1 => {
+                let mut w = BagWriter::create(path, compression)?;
+                let c = w.add_imu_connection(topic);
+                SinkWriter::Ros1(w, c)
+            }
+            BagFormat::Mcap(c) => {
+                let mut w = Ros2BagWriter::create(path, Storage::Mcap(c))?;
+                let t = w.add_imu_topic(topic)?;
+                SinkWriter::Ros2(Box::new(w), t)
+            }
+            BagFormat::Sqlite3 => {
+                let mut w = Ros2BagWriter::create(path, Storage::Sqlite3)?;
+                let t = w.add_imu_topic(topic)?;
+                SinkWriter::Ros2(Box::new(w), t)
+            }
+        };
         // `header.seq` stays 0 and the covariances zero, as upstream's default-constructed
         // message (quirk_03, spec §4).
         let imu = Imu {
@@ -86,7 +144,6 @@ impl ImuBagSink {
         };
         Ok(Self {
             writer,
-            conn,
             imu,
             count: 0,
             first: None,
@@ -107,7 +164,10 @@ impl ImuBagSink {
         self.imu.orientation = q_xyzw;
         self.imu.angular_velocity = gyro;
         self.imu.linear_acceleration = acc;
-        self.writer.write_imu(self.conn, stamp, &self.imu)?;
+        match &mut self.writer {
+            SinkWriter::Ros1(w, c) => w.write_imu(*c, stamp, &self.imu)?,
+            SinkWriter::Ros2(w, t) => w.write_imu(*t, stamp.as_nanos(), &self.imu)?,
+        }
         self.first.get_or_insert(stamp);
         self.last = stamp;
         self.count += 1;
@@ -116,7 +176,10 @@ impl ImuBagSink {
 
     /// Write the index and move the file into place.
     pub fn finish(self) -> Result<BagSummary> {
-        self.writer.finish()?;
+        match self.writer {
+            SinkWriter::Ros1(w, _) => w.finish()?,
+            SinkWriter::Ros2(w, _) => w.finish()?,
+        }
         Ok(BagSummary {
             messages: self.count,
             first: self.first.unwrap_or_default(),
@@ -147,6 +210,12 @@ pub fn validate(cfg: &BagConfig) -> Result<()> {
             "--topic must not be empty".into(),
         ));
     }
+    if cfg.format != BagFormat::Ros1 && cfg.compression != Compression::None {
+        return Err(SimError::InvalidArgument(format!(
+            "--compression {} is for ROS 1 bags; --format mcap takes --compression none, zstd or lz4, sqlite3 none",
+            cfg.compression.name()
+        )));
+    }
     let end = cfg.start_ns as f64 + cfg.duration * 1e9;
     if end > MAX_ROS_NS as f64 {
         return Err(SimError::InvalidArgument(
@@ -165,9 +234,15 @@ pub fn message_count(rate: f64, duration: f64) -> u64 {
 pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
     validate(cfg)?;
     let n = message_count(cfg.rate, cfg.duration);
-    let pb = bag2mat::progress::bar(n, cfg.quiet, "msgs");
+    let pb = bag2mat::shared::progress::bar(n, cfg.quiet, "msgs");
     pb.set_message("writing");
-    let mut sink = ImuBagSink::create(&cfg.out, cfg.compression, &cfg.topic, &cfg.frame_id)?;
+    let mut sink = ImuBagSink::create_format(
+        &cfg.out,
+        cfg.format,
+        cfg.compression,
+        &cfg.topic,
+        &cfg.frame_id,
+    )?;
     let mut noise = NoiseGenerator::new(cfg.noise.discretize(1.0 / cfg.rate), cfg.seed);
     // The static model does not depend on t (upstream calls MotionModel(0)): compute it once.
     let fixed = (cfg.motion == Motion::Static).then(|| cfg.motion.sample(0.0));

@@ -182,16 +182,52 @@ pub enum CompressionArg {
     Bz2,
     /// LZ4 frames.
     Lz4,
+    /// zstd (MCAP chunks only).
+    Zstd,
 }
 
 impl From<CompressionArg> for Compression {
     fn from(c: CompressionArg) -> Self {
         match c {
-            CompressionArg::None => Compression::None,
+            CompressionArg::None | CompressionArg::Zstd => Compression::None,
             CompressionArg::Bz2 => Compression::Bz2,
             CompressionArg::Lz4 => Compression::Lz4,
         }
     }
+}
+
+/// `sim bag --format`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BagFormatArg {
+    /// ROS 1 bag (format 2.0), as upstream.
+    Ros1,
+    /// ROS 2 bag directory with an MCAP file (Imu as CDR).
+    Mcap,
+    /// ROS 2 bag directory with a sqlite3 .db3 file (Imu as CDR).
+    Sqlite3,
+}
+
+/// The container and compression of `sim bag`, checked together.
+fn bag_format(f: BagFormatArg, c: CompressionArg) -> Result<crate::bag_sim::BagFormat> {
+    use crate::bag_sim::BagFormat;
+    use bag2mat::mcap::ChunkCompression;
+    Ok(match (f, c) {
+        (BagFormatArg::Ros1, CompressionArg::Zstd) => {
+            return Err(SimError::InvalidArgument(
+                "--compression zstd is for --format mcap (ROS 1 bags take none, bz2 or lz4)".into(),
+            ));
+        }
+        (BagFormatArg::Ros1, _) => BagFormat::Ros1,
+        (BagFormatArg::Mcap, CompressionArg::None) => BagFormat::Mcap(ChunkCompression::None),
+        (BagFormatArg::Mcap, CompressionArg::Zstd) => BagFormat::Mcap(ChunkCompression::Zstd),
+        (BagFormatArg::Mcap, CompressionArg::Lz4) => BagFormat::Mcap(ChunkCompression::Lz4),
+        (BagFormatArg::Sqlite3, CompressionArg::None) => BagFormat::Sqlite3,
+        (f, c) => {
+            return Err(SimError::InvalidArgument(format!(
+                "--compression {c:?} does not apply to --format {f:?} (mcap: none, zstd, lz4; sqlite3: none)"
+            )));
+        }
+    })
 }
 
 /// Time grids.
@@ -215,9 +251,12 @@ impl From<GridArg> for Grid {
 /// `sim bag`.
 #[derive(Debug, Clone, Args)]
 pub struct BagArgs {
-    /// Output bag.
-    #[arg(short, long, default_value = "imu.bag")]
-    pub output: PathBuf,
+    /// Output bag (a directory for ROS 2 formats) [default: imu.bag, or imu for ROS 2].
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Container: ROS 1 bag, or a ROS 2 bag directory holding an MCAP or sqlite3 file.
+    #[arg(long, value_enum, default_value_t = BagFormatArg::Ros1)]
+    pub format: BagFormatArg,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub noise: NoiseArgs,
@@ -240,7 +279,7 @@ pub struct BagArgs {
     /// Motion model.
     #[arg(long, value_enum, default_value_t = MotionArg::Static)]
     pub motion: MotionArg,
-    /// Chunk compression.
+    /// Chunk compression (ROS 1: none, bz2, lz4; MCAP: none, zstd, lz4).
     #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     pub compression: CompressionArg,
     /// No progress bar and no parameter report (errors are still printed)
@@ -255,8 +294,16 @@ impl TryFrom<BagArgs> for BagConfig {
             Some(s) => parse_start_time(s)?,
             None => now_ns(),
         };
+        let format = bag_format(a.format, a.compression)?;
+        let out = a.output.unwrap_or_else(|| {
+            PathBuf::from(if format == crate::bag_sim::BagFormat::Ros1 {
+                "imu.bag"
+            } else {
+                "imu"
+            })
+        });
         let cfg = BagConfig {
-            out: a.output,
+            out,
             noise: a.noise.resolve(PresetArg::Medium)?,
             rate: a.rate,
             duration: a.duration,
@@ -268,7 +315,12 @@ impl TryFrom<BagArgs> for BagConfig {
                 MotionArg::Static => Motion::Static,
                 MotionArg::Ellipse => Motion::Ellipse,
             },
-            compression: a.compression.into(),
+            compression: if format == crate::bag_sim::BagFormat::Ros1 {
+                a.compression.into()
+            } else {
+                Compression::None
+            },
+            format,
             quiet: a.quiet,
         };
         crate::bag_sim::validate(&cfg)?;

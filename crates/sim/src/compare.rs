@@ -104,7 +104,7 @@ pub fn run(cfg: &CompareConfig) -> Result<bool> {
     let c = compare(cfg)?;
     let md = markdown(&c);
     print!("{md}");
-    bag2mat::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
     eprintln!("wrote {}", cfg.output.display());
     for f in crate::compare_plot::plot(cfg)? {
         eprintln!("wrote {}", f.display());

@@ -195,7 +195,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
             cfg.rate, cfg.duration
         );
         let png = cfg.root.join(format!("compare_{sensor}.png"));
-        bag2mat::plot::png_atomic(&png, SIZE, |area| draw(area, &title, unit, &curves))?;
+        bag2mat::shared::plot::png_atomic(&png, SIZE, |area| draw(area, &title, unit, &curves))?;
         files.push(png);
         let svg = cfg.root.join(format!("compare_{sensor}.svg"));
         let mut text = String::new();
@@ -209,7 +209,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
             path: svg.clone(),
             msg,
         })?;
-        bag2mat::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
+        bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
         files.push(svg);
     }
     Ok(files)

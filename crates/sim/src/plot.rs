@@ -219,14 +219,14 @@ pub fn plot_integration(
     truth: &[PoseRow],
     tracks: &[Track],
 ) -> Result<()> {
-    bag2mat::plot::register_font();
+    bag2mat::shared::plot::register_font();
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
     let perr = |p: &Path, msg: String| SimError::Plot {
         path: p.into(),
         msg,
     };
-    bag2mat::plot::png_atomic(&png, SIZE, |area| draw(area, title, truth, tracks))?;
+    bag2mat::shared::plot::png_atomic(&png, SIZE, |area| draw(area, title, truth, tracks))?;
     let mut s = String::new();
     draw(
         SVGBackend::with_string(&mut s, SIZE).into_drawing_area(),

@@ -12,7 +12,7 @@ use std::fmt::Write;
 pub fn bag_header(c: &BagConfig) -> String {
     let n = crate::bag_sim::message_count(c.rate, c.duration);
     format!(
-        "sim bag: {} motion, {} Hz, {} s -> {} messages on topic '{}' (frame_id '{}'), start {}.{:09}, compression {}, seed {}\n{}",
+        "sim bag: {} motion, {} Hz, {} s -> {} messages on topic '{}' (frame_id '{}'), start {}.{:09}, format {}, compression {}, seed {}\n{}",
         match c.motion {
             crate::motion::Motion::Static => "static",
             crate::motion::Motion::Ellipse => "ellipse",
@@ -24,7 +24,11 @@ pub fn bag_header(c: &BagConfig) -> String {
         c.frame_id,
         c.start_ns / 1_000_000_000,
         c.start_ns % 1_000_000_000,
-        c.compression.name(),
+        c.format.name(),
+        match c.format {
+            crate::bag_sim::BagFormat::Mcap(m) if !m.name().is_empty() => m.name(),
+            _ => c.compression.name(),
+        },
         c.seed,
         c.noise.describe(c.rate)
     )

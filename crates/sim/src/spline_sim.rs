@@ -213,7 +213,7 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
         None if t_start >= 1_000_000_000_000_000_000 => 0,
         None => now_ns() as i64 - t_start,
     };
-    let pb = bag2mat::progress::bar(noisy.len() as u64, cfg.quiet, "msgs");
+    let pb = bag2mat::shared::progress::bar(noisy.len() as u64, cfg.quiet, "msgs");
     let mut sink = ImuBagSink::create(&bag_path, cfg.compression, &cfg.topic, &cfg.frame_id)?;
     for (i, r) in noisy.iter().enumerate() {
         let t_ns = t_start + (i as f64 * 1e9 / cfg.rate).round() as i64 + offset;

@@ -1,11 +1,11 @@
 //! The upstream text layouts (vio_data_simulation.md §5), read and written. Writers go
-//! through bag2mat's atomic file helper; numbers use [`bag2mat::cfmt`] for upstream parity
+//! through bag2mat's atomic file helper; numbers use [`bag2mat::shared::cfmt`] for upstream parity
 //! (`%g`, 6 significant digits) or the shortest round-trip form for full precision.
 
 use crate::error::{Result, SimError};
 use crate::rotation::matrix_from_quat;
 use crate::spline::Pose;
-use bag2mat::cfmt::push_g;
+use bag2mat::shared::cfmt::push_g;
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -52,7 +52,7 @@ impl PoseRow {
 
 /// Write a file atomically from a string.
 pub fn write_string(path: &Path, s: &str) -> Result<()> {
-    bag2mat::output::write_atomic(path, |w| w.write_all(s.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(path, |w| w.write_all(s.as_bytes()))?;
     Ok(())
 }
 

@@ -16,7 +16,7 @@ use crate::motion::{Mode, ellipse_with};
 use crate::noise::{ContinuousNoise, NoiseGenerator};
 use crate::rotation::quat_from_matrix;
 use crate::textio::{NumFormat, PoseRow, format_pose_rows, format_tum, write_string};
-use bag2mat::cfmt::push_g;
+use bag2mat::shared::cfmt::push_g;
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 

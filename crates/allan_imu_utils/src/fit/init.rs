@@ -109,7 +109,7 @@ pub fn start_coefficients(sigma2: &[f64], taus: &[f64]) -> [f64; 5] {
 /// Eigen's default print of a 1×5 row after `C `: each entry `%g`-6, right-aligned to the
 /// widest entry, one space between (imu_utils.md §4.2).
 pub fn c_line(c: &[f64; 5]) -> String {
-    let items: Vec<String> = c.iter().map(|&v| bag2mat::cfmt::g6(v)).collect();
+    let items: Vec<String> = c.iter().map(|&v| bag2mat::shared::cfmt::g6(v)).collect();
     let width = items.iter().map(|s| s.len()).max().unwrap_or(0);
     let cells: Vec<String> = items.iter().map(|s| format!("{s:>width$}")).collect();
     format!("C {}", cells.join(" "))

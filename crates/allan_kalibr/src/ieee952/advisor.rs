@@ -56,7 +56,8 @@ const Z95: f64 = 1.959_963_984_540_054;
 
 /// Advice for a term of a record of `record` seconds.
 fn term_advice(t: &Term, record: f64) -> TermAdvice {
-    if t.verdict != Verdict::Resolved || !super::fit::is_positive(t.value) || !t.std_err.is_finite() {
+    if t.verdict != Verdict::Resolved || !super::fit::is_positive(t.value) || !t.std_err.is_finite()
+    {
         return TermAdvice::none();
     }
     let p = Z95 * t.std_err / t.value;

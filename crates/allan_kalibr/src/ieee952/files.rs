@@ -150,7 +150,7 @@ pub fn write_outputs(
     let mut files = Vec::new();
     let mut put = |name: &str, text: String| -> Result<(), bag2mat::Error> {
         let p = dir.join(format!("{prefix}{name}"));
-        bag2mat::output::write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
+        bag2mat::shared::output::write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
         files.push(p);
         Ok(())
     };

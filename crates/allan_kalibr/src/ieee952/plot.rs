@@ -40,7 +40,7 @@ pub fn write_chart(
     dir: &Path,
     prefix: &str,
 ) -> Result<[PathBuf; 2], bag2mat::Error> {
-    bag2mat::plot::register_font();
+    bag2mat::shared::plot::register_font();
     let cols = 3u32;
     let rows = a.axes.len().div_ceil(3).max(1) as u32;
     let size = (PANEL.0 * cols, PANEL.1 * rows + 40);
@@ -56,12 +56,12 @@ pub fn write_chart(
         draw(a, title, truth, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
         root.present().map_err(|e| plot_err(&svg, e.to_string()))?;
     }
-    bag2mat::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
+    bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
     let psize = (
         (size.0 as f64 * PNG_SCALE) as u32,
         (size.1 as f64 * PNG_SCALE) as u32,
     );
-    bag2mat::plot::png_atomic(&png, psize, |root| {
+    bag2mat::shared::plot::png_atomic(&png, psize, |root| {
         draw(a, title, truth, &root, PNG_SCALE)?;
         root.present().map_err(|e| e.to_string())
     })?;

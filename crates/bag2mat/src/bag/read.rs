@@ -4,8 +4,8 @@
 //! infos). When the index is missing or unreadable — a writer that never finished leaves
 //! `index_pos = 0`, a truncated copy loses the index at the end — the chunk section is
 //! scanned record by record instead, every complete chunk is used, and the notes say how
-//! many bytes at the end were lost. Chunks are read with positioned reads and decompressed
-//! in parallel batches, so memory stays at a few chunks beyond what the caller keeps.
+//! many bytes at the end were lost. Each chunk is one [`Part`] of the [`Source`] interface,
+//! read with positioned reads and decompressed by whichever thread reads it.
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -13,20 +13,15 @@ use std::io::Read;
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-use rayon::prelude::*;
-
 use super::record::{self, ChunkInfo, Connection, Header, MAGIC, Op};
 use super::{Compression, RosTime};
 use crate::error::{Error, TopicSummary};
-use crate::imu_msg::{self, ImuSample};
+use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
 
 thread_local! {
     /// Per-thread (raw, decompressed) chunk buffers, reused across chunks.
     static BUFFERS: std::cell::RefCell<(Vec<u8>, Vec<u8>)> = const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
-
-/// Chunks decoded in parallel per batch (about 48 MiB of uncompressed body).
-const BATCH_CHUNKS: usize = 64;
 
 /// Where a chunk is, and (when the bag is indexed) what it holds.
 #[derive(Debug, Clone)]
@@ -34,6 +29,8 @@ struct ChunkLoc {
     pos: u64,
     /// `(connection, count)` from the chunk info; empty when scanned.
     counts: Vec<(u32, u32)>,
+    /// Time span from the chunk info.
+    span: Option<(RosTime, RosTime)>,
 }
 
 /// What the bag holds: its connections and the number of messages on each.
@@ -52,31 +49,6 @@ pub struct BagIndex {
 /// One topic of a bag as [`BagReader::topics`] lists it.
 pub type ConnectionSummary = TopicSummary;
 
-/// Which connections to read, decided by [`BagReader::select_imu_topic`].
-#[derive(Debug, Clone)]
-pub struct TopicSelection {
-    /// The topic as it is in the bag.
-    pub topic: String,
-    /// Its connection ids.
-    pub conns: Vec<u32>,
-    /// Messages expected (from the index).
-    pub expected: u64,
-    /// Set when the other slash form was used.
-    pub note: Option<String>,
-}
-
-/// What a read returned besides the samples.
-#[derive(Debug, Clone, Default)]
-pub struct StreamReport {
-    /// When the messages were not in record-time order in the file: the stable order by
-    /// record time (indices into the delivery order). `None` means already in order.
-    pub order: Option<Vec<usize>>,
-    /// Things to tell the user (lost chunks, unindexed bag, topic fallback).
-    pub notes: Vec<String>,
-    /// Messages delivered.
-    pub delivered: u64,
-}
-
 /// An open bag.
 pub struct BagReader {
     path: PathBuf,
@@ -85,6 +57,9 @@ pub struct BagReader {
     chunks: Vec<ChunkLoc>,
     index: BagIndex,
     notes: Vec<String>,
+    losses: Vec<Loss>,
+    channels: Vec<source::Channel>,
+    parts: Vec<Part>,
 }
 
 impl BagReader {
@@ -135,6 +110,9 @@ impl BagReader {
                 indexed: false,
             },
             notes: Vec::new(),
+            losses: Vec::new(),
+            channels: Vec::new(),
+            parts: Vec::new(),
         };
         let indexed = index_pos >= first
             && index_pos < len
@@ -147,12 +125,37 @@ impl BagReader {
             });
             reader.scan(first)?;
         }
+        reader.build_interface();
         Ok(reader)
     }
 
-    /// Notes gathered while opening (unindexed or truncated bag).
-    pub fn notes(&self) -> &[String] {
-        &self.notes
+    /// The channels and parts of the [`Source`] interface.
+    fn build_interface(&mut self) {
+        self.channels = self
+            .index
+            .connections
+            .iter()
+            .map(|c| source::Channel {
+                id: c.id,
+                topic: c.topic.clone(),
+                msg_type: c.msg_type.clone(),
+                encoding: Encoding::Ros1,
+                md5sum: Some(c.md5sum.clone()),
+                count: Some(self.index.counts.get(&c.id).copied().unwrap_or(0)),
+            })
+            .collect();
+        self.parts = self
+            .chunks
+            .iter()
+            .map(|c| Part {
+                label: format!("chunk at byte {}", c.pos),
+                span: c.span.map(|(a, b)| (a.as_nanos(), b.as_nanos())),
+                counts: self
+                    .index
+                    .indexed
+                    .then(|| c.counts.iter().map(|&(conn, n)| (conn, n as u64)).collect()),
+            })
+            .collect();
     }
 
     /// Connections and counts.
@@ -225,6 +228,7 @@ impl BagReader {
             .map(|i| ChunkLoc {
                 pos: i.chunk_pos,
                 counts: i.counts,
+                span: Some((i.start_time, i.end_time)),
             })
             .collect();
         self.index.indexed = true;
@@ -237,10 +241,14 @@ impl BagReader {
         let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
         while pos < self.len {
             let Some((h_bytes, data_pos, data_len)) = self.record_at(pos) else {
-                self.notes.push(format!(
-                    "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
-                    self.len - pos
-                ));
+                self.losses.push(Loss {
+                    what: format!(
+                        "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
+                        self.len - pos
+                    ),
+                    messages: None,
+                    span: None,
+                });
                 break;
             };
             let h = Header::parse(&h_bytes).map_err(|w| self.corrupt(pos, w))?;
@@ -282,11 +290,14 @@ impl BagReader {
                             self.chunks.push(ChunkLoc {
                                 pos,
                                 counts: Vec::new(),
+                                span: None,
                             });
                         }
-                        Err(e) => self.notes.push(format!(
-                            "chunk at byte {pos} is unreadable and was skipped: {e}"
-                        )),
+                        Err(e) => self.losses.push(Loss {
+                            what: format!("chunk at byte {pos} is unreadable and was skipped: {e}"),
+                            messages: None,
+                            span: None,
+                        }),
                     }
                 }
                 Op::Connection => {
@@ -392,158 +403,17 @@ impl BagReader {
         Ok(compression)
     }
 
-    /// Resolves `topic` to its `sensor_msgs/Imu` connections: the exact name first, else the
-    /// other slash form (`imu` ↔ `/imu`, with a note); errors list every topic of the bag.
-    pub fn select_imu_topic(&self, topic: &str) -> Result<TopicSelection, Error> {
-        let matching = |t: &str| -> Vec<&Connection> {
-            self.index
-                .connections
-                .iter()
-                .filter(|c| c.topic == t)
-                .collect()
-        };
-        let mut chosen = topic.to_string();
-        let mut conns = matching(topic);
-        let mut note = None;
-        if conns.is_empty() {
-            let other = match topic.strip_prefix('/') {
-                Some(rest) => rest.to_string(),
-                None => format!("/{topic}"),
-            };
-            let alt = matching(&other);
-            if !alt.is_empty() {
-                note = Some(format!(
-                    "topic '{topic}' is not in the bag; using '{other}'"
-                ));
-                chosen = other;
-                conns = alt;
-            }
-        }
-        if conns.is_empty() {
-            return Err(Error::TopicNotFound {
-                topic: topic.to_string(),
-                available: self.topics(),
-            });
-        }
-        if let Some(bad) = conns
-            .iter()
-            .find(|c| c.msg_type != imu_msg::TYPE || c.md5sum != imu_msg::MD5)
-        {
-            return Err(Error::WrongType {
-                topic: chosen,
-                msg_type: bad.msg_type.clone(),
-                md5sum: bad.md5sum.clone(),
-            });
-        }
-        let ids: Vec<u32> = conns.iter().map(|c| c.id).collect();
-        let expected = ids
-            .iter()
-            .map(|id| self.index.counts.get(id).copied().unwrap_or(0))
-            .sum();
-        Ok(TopicSelection {
-            topic: chosen,
-            conns: ids,
-            expected,
-            note,
-        })
-    }
-
-    /// Streams every Imu sample of the selection to `sink` as `(record time, sample)`, in file
-    /// order, reading and decoding chunks in parallel batches. A chunk that cannot be read is
-    /// skipped with a note counting its lost messages. The report carries the record-time
-    /// order when the file order differs from it.
-    pub fn stream_imu(
-        &self,
-        sel: &TopicSelection,
-        quiet: bool,
-        sink: &mut dyn FnMut(RosTime, &ImuSample),
-    ) -> Result<StreamReport, Error> {
-        let mut report = StreamReport::default();
-        report.notes.extend(self.notes.iter().cloned());
-        report.notes.extend(sel.note.iter().cloned());
-        let wanted = |conn: u32| sel.conns.contains(&conn);
-        let chunks: Vec<&ChunkLoc> = self
-            .chunks
-            .iter()
-            .filter(|c| {
-                c.counts.is_empty() || c.counts.iter().any(|(conn, n)| wanted(*conn) && *n > 0)
-            })
-            .collect();
-        let pb = crate::progress::bar(sel.expected.max(1), quiet, "msgs");
-        pb.set_message("reading");
-        let mut times: Vec<u64> = Vec::with_capacity(sel.expected as usize);
-        let mut sorted = true;
-        let mut last = 0u64;
-        let mut lost = 0u64;
-        for batch in chunks.chunks(BATCH_CHUNKS) {
-            let decoded: Vec<Result<Vec<(RosTime, ImuSample)>, String>> = batch
-                .par_iter()
-                .map(|c| self.decode_chunk(c.pos, &sel.conns))
-                .collect();
-            for (loc, res) in batch.iter().zip(decoded) {
-                match res {
-                    Ok(samples) => {
-                        for (t, s) in &samples {
-                            let ns = t.as_nanos();
-                            sorted &= ns >= last;
-                            last = ns;
-                            times.push(ns);
-                            sink(*t, s);
-                        }
-                        pb.inc(samples.len() as u64);
-                    }
-                    Err(e) => {
-                        let n: u64 = loc
-                            .counts
-                            .iter()
-                            .filter(|(c, _)| wanted(*c))
-                            .map(|(_, n)| *n as u64)
-                            .sum();
-                        lost += n;
-                        report.notes.push(format!(
-                            "chunk at byte {} is unreadable ({e}); {n} messages of the topic lost",
-                            loc.pos
-                        ));
-                    }
-                }
-            }
-        }
-        pb.finish_and_clear();
-        if lost > 0 {
-            report.notes.push(format!(
-                "{lost} of {} messages were lost to unreadable chunks",
-                sel.expected
-            ));
-        }
-        report.delivered = times.len() as u64;
-        if !sorted {
-            let mut order: Vec<usize> = (0..times.len()).collect();
-            order.sort_by_key(|&i| times[i]);
-            report.notes.push(
-                "messages were not stored in record-time order; sorted as rosbag::View does"
-                    .to_string(),
-            );
-            report.order = Some(order);
-        }
-        Ok(report)
-    }
-
-    fn decode_chunk(&self, pos: u64, conns: &[u32]) -> Result<Vec<(RosTime, ImuSample)>, String> {
-        let mut out = Vec::new();
-        self.for_each_in_chunk(pos, conns, |t, s| out.push((t, *s)))?;
-        Ok(out)
-    }
-
-    /// Calls `f(record time, sample)` for each selected Imu message of the chunk at `pos`, in
-    /// body order; returns how many there were.
+    /// Calls `f(connection, record time, data)` for each message record of the chunk at
+    /// `pos` whose connection `want` accepts, in body order. Returns how many it delivered
+    /// and, when the body could not be read to its end, why.
     fn for_each_in_chunk(
         &self,
         pos: u64,
-        conns: &[u32],
-        mut f: impl FnMut(RosTime, &ImuSample),
-    ) -> Result<usize, String> {
-        self.with_chunk_body(pos, |body| {
-            let mut n = 0;
+        want: &dyn Fn(u32) -> bool,
+        f: &mut MessageSink<'_>,
+    ) -> PartRead {
+        let mut out = PartRead::default();
+        let r = self.with_chunk_body(pos, |body| {
             let mut bpos = 0;
             while bpos < body.len() {
                 let rec = record::raw_record(body, bpos)
@@ -551,95 +421,18 @@ impl BagReader {
                 let (op, conn, time) = record::op_conn_time(rec.header)?;
                 if op == Some(Op::MessageData as u8) {
                     let conn = conn.ok_or("message record without 'conn'")?;
-                    if conns.contains(&conn) {
+                    if want(conn) {
                         let t = time.ok_or("message record without 'time'")?;
-                        f(t, &ImuSample::decode(rec.data).map_err(|e| e.to_string())?);
-                        n += 1;
+                        f(conn, t.as_nanos(), rec.data);
+                        out.delivered += 1;
                     }
                 }
                 bpos = rec.end;
             }
-            Ok(n)
-        })
-    }
-
-    /// For an indexed bag: the chunks holding the selection, in file order, with the number
-    /// of selected messages in each (from the chunk infos). `None` for a scanned bag.
-    pub fn chunk_plan(&self, sel: &TopicSelection) -> Option<Vec<(u64, usize)>> {
-        if !self.index.indexed {
-            return None;
-        }
-        Some(
-            self.chunks
-                .iter()
-                .map(|c| {
-                    (
-                        c.pos,
-                        c.counts
-                            .iter()
-                            .filter(|(conn, _)| sel.conns.contains(conn))
-                            .map(|(_, n)| *n as usize)
-                            .sum(),
-                    )
-                })
-                .filter(|(_, n)| *n > 0)
-                .collect(),
-        )
-    }
-
-    /// Splits a column of the whole selection into one slice per planned chunk.
-    pub fn split_rows<'a, T>(column: &'a mut [T], plan: &[(u64, usize)]) -> Vec<&'a mut [T]> {
-        let mut rest = column;
-        plan.iter()
-            .map(|&(_, k)| {
-                let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
-                rest = tail;
-                head
-            })
-            .collect()
-    }
-
-    /// Decodes the planned chunks in parallel, each into its own `part` (the caller splits
-    /// its output so that part `i` holds exactly the rows of chunk `i` of `plan`):
-    /// `put(part, row within the chunk, record time, sample)`. Fails — and the caller falls
-    /// back to [`BagReader::stream_imu`] — when a chunk is unreadable or holds a different
-    /// number of messages than its chunk info says.
-    pub fn decode_planned<P: Send>(
-        &self,
-        sel: &TopicSelection,
-        plan: &[(u64, usize)],
-        parts: &mut [P],
-        quiet: bool,
-        put: impl Fn(&mut P, usize, RosTime, &ImuSample) + Sync,
-    ) -> Result<(), String> {
-        if plan.len() != parts.len() {
-            return Err("plan and parts differ in length".into());
-        }
-        let total: u64 = plan.iter().map(|(_, k)| *k as u64).sum();
-        let pb = crate::progress::bar(total.max(1), quiet, "msgs");
-        pb.set_message("reading");
-        let r =
-            parts
-                .par_iter_mut()
-                .zip(plan.par_iter())
-                .try_for_each(|(part, &(pos, expected))| {
-                    let mut k = 0;
-                    let got = self.for_each_in_chunk(pos, &sel.conns, |t, s| {
-                        if k < expected {
-                            put(part, k, t, s);
-                        }
-                        k += 1;
-                    })?;
-                    if got != expected {
-                        return Err(format!(
-                            "chunk at byte {pos} holds {got} messages, its index says {expected}"
-                        ));
-                    }
-                    pb.inc(expected as u64);
-                    Ok(())
-                });
-        pb.finish_and_clear();
-        r
+            Ok(())
+        });
+        out.error = r.err();
+        out
     }
 
     /// The path this reader was opened on.
@@ -650,6 +443,38 @@ impl BagReader {
     /// File size in bytes.
     pub fn file_len(&self) -> u64 {
         self.len
+    }
+}
+
+impl Source for BagReader {
+    fn kind(&self) -> InputKind {
+        InputKind::Ros1Bag
+    }
+    fn channels(&self) -> &[source::Channel] {
+        &self.channels
+    }
+    fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+    fn notes(&self) -> &[String] {
+        &self.notes
+    }
+    fn losses(&self) -> &[Loss] {
+        &self.losses
+    }
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut MessageSink<'_>,
+    ) -> PartRead {
+        match self.chunks.get(part) {
+            Some(c) => self.for_each_in_chunk(c.pos, want, sink),
+            None => PartRead {
+                error: Some("no such chunk".into()),
+                ..PartRead::default()
+            },
+        }
     }
 }
 

@@ -17,7 +17,7 @@ use super::record::{self, ChunkInfo, Connection, MAGIC};
 use super::{Compression, RosTime};
 use crate::error::Error;
 use crate::imu_msg::{self, Imu};
-use crate::output::AtomicFile;
+use crate::shared::output::AtomicFile;
 
 /// rosbag's default chunk threshold: a chunk is closed once its body reaches 768 KiB.
 pub const DEFAULT_CHUNK_THRESHOLD: usize = 768 * 1024;

@@ -84,6 +84,78 @@ where
     f.commit()
 }
 
+/// A directory being filled under a temporary name beside the target (`.<name>.<pid>.tmp`);
+/// [`AtomicDir::commit`] renames it into place. Dropped without a commit, it is removed
+/// with everything in it. The target must not exist (a bag directory is never merged into
+/// or replaced, as `ros2 bag record` refuses an existing one).
+pub struct AtomicDir {
+    tmp: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl AtomicDir {
+    /// Creates the temporary directory; fails when `target` already exists.
+    pub fn create(target: &Path) -> Result<AtomicDir, Error> {
+        if target.exists() {
+            return Err(Error::io(
+                target,
+                std::io::Error::new(
+                    std::io::ErrorKind::AlreadyExists,
+                    "already exists (remove it or choose another output)",
+                ),
+            ));
+        }
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = target.file_name().ok_or_else(|| {
+            Error::io(
+                target,
+                std::io::Error::other("output path has no file name"),
+            )
+        })?;
+        let tmp = dir.join(format!(
+            ".{}.{}.tmp",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        Ok(AtomicDir {
+            tmp,
+            target: target.to_path_buf(),
+            committed: false,
+        })
+    }
+
+    /// Where to write the files now.
+    pub fn path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// The final path.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Renames the directory into place.
+    pub fn commit(mut self) -> Result<(), Error> {
+        std::fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for AtomicDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.tmp);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

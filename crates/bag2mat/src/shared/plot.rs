@@ -3,7 +3,7 @@
 
 use std::sync::Once;
 
-static FONT: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../../assets/DejaVuSans.ttf");
 
 /// Registers the embedded font as "sans-serif" (all styles). Call before drawing; idempotent.
 pub fn register_font() {

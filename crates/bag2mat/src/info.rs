@@ -1,0 +1,220 @@
+//! `bag2mat info BAG`: what an input holds, for any format — every topic with its type,
+//! encoding, message count, mean rate, rate jitter, time span and gaps (from the record
+//! times of every message), the Imu topics flagged, and what the container reports lost.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use rayon::prelude::*;
+
+use crate::bag::RosTime;
+use crate::error::Error;
+use crate::series::is_imu;
+use crate::source::{self, InputKind, Loss};
+
+/// An interval longer than this many median periods counts as a gap.
+pub const GAP_FACTOR: f64 = 3.0;
+
+/// One topic (and type) of an input.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicInfo {
+    /// Topic name.
+    pub topic: String,
+    /// Message type.
+    pub msg_type: String,
+    /// Encoding (`ros1`, `cdr`, …).
+    pub encoding: String,
+    /// Whether the tools can read it as Imu.
+    pub imu: bool,
+    /// Messages read.
+    pub count: u64,
+    /// Messages the container promises, when it keeps a count.
+    pub promised: Option<u64>,
+    /// First and last record time, ns.
+    pub span: Option<(u64, u64)>,
+    /// `(count − 1) / span`, Hz.
+    pub mean_rate: Option<f64>,
+    /// Median interval between consecutive messages, s.
+    pub median_period: Option<f64>,
+    /// Standard deviation of the intervals over their mean (relative jitter).
+    pub jitter: Option<f64>,
+    /// Intervals longer than [`GAP_FACTOR`] median periods.
+    pub gaps: u64,
+    /// The longest interval, s.
+    pub longest_gap: Option<f64>,
+}
+
+/// What `bag2mat info` prints.
+#[derive(Debug, Clone)]
+pub struct InfoReport {
+    /// What the input is.
+    pub kind: InputKind,
+    /// Every topic, sorted by name.
+    pub topics: Vec<TopicInfo>,
+    /// Notes from opening.
+    pub notes: Vec<String>,
+    /// Data the container reports lost, and parts that could not be read.
+    pub losses: Vec<Loss>,
+}
+
+fn stats(t: &mut [u64]) -> (Option<f64>, Option<f64>, Option<f64>, u64, Option<f64>) {
+    t.sort_unstable();
+    if t.len() < 2 {
+        return (None, None, None, 0, None);
+    }
+    let span = (t[t.len() - 1] - t[0]) as f64 * 1e-9;
+    let mean_rate = (span > 0.0).then(|| (t.len() - 1) as f64 / span);
+    let mut d: Vec<f64> = t.windows(2).map(|w| (w[1] - w[0]) as f64 * 1e-9).collect();
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / d.len() as f64;
+    let jitter = (mean > 0.0).then(|| var.sqrt() / mean);
+    let longest = d.iter().cloned().fold(0.0, f64::max);
+    d.sort_by(|a, b| a.total_cmp(b));
+    let median = d[d.len() / 2];
+    let gaps = if median > 0.0 {
+        d.iter().filter(|&&x| x > GAP_FACTOR * median).count() as u64
+    } else {
+        0
+    };
+    (mean_rate, Some(median), jitter, gaps, Some(longest))
+}
+
+/// Reads every message's record time of `path` and summarises each topic.
+pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
+    let src = source::open(path)?;
+    let parts = src.parts();
+    let pb = crate::shared::progress::bar(parts.len().max(1) as u64, quiet, "parts");
+    pb.set_message("reading");
+    let per_part: Vec<(BTreeMap<u32, Vec<u64>>, source::PartRead)> = (0..parts.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut m: BTreeMap<u32, Vec<u64>> = BTreeMap::new();
+            let r = src.read_part(i, &|_| true, &mut |c, t, _| m.entry(c).or_default().push(t));
+            pb.inc(1);
+            (m, r)
+        })
+        .collect();
+    pb.finish_and_clear();
+    let mut losses: Vec<Loss> = src.losses().to_vec();
+    let mut times: BTreeMap<u32, Vec<u64>> = BTreeMap::new();
+    for (i, (m, r)) in per_part.into_iter().enumerate() {
+        if let Some(e) = r.error.or(r.skip_reason) {
+            losses.push(Loss {
+                what: format!("{}: {e}", parts[i].label),
+                messages: None,
+                span: parts[i].span,
+            });
+        }
+        for (c, v) in m {
+            times.entry(c).or_default().extend(v);
+        }
+    }
+    let mut by: BTreeMap<(String, String), TopicInfo> = BTreeMap::new();
+    let mut topic_times: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
+    for c in src.channels() {
+        let key = (c.topic.clone(), c.msg_type.clone());
+        let e = by.entry(key.clone()).or_insert_with(|| TopicInfo {
+            topic: c.topic.clone(),
+            msg_type: c.msg_type.clone(),
+            encoding: c.encoding.name().to_string(),
+            imu: true,
+            count: 0,
+            promised: Some(0),
+            span: None,
+            mean_rate: None,
+            median_period: None,
+            jitter: None,
+            gaps: 0,
+            longest_gap: None,
+        });
+        e.imu &= is_imu(c);
+        e.promised = e.promised.zip(c.count).map(|(a, b)| a + b);
+        topic_times
+            .entry(key)
+            .or_default()
+            .extend(times.remove(&c.id).unwrap_or_default());
+    }
+    for (key, mut t) in topic_times {
+        let e = by.get_mut(&key).expect("same keys");
+        e.count = t.len() as u64;
+        let (rate, median, jitter, gaps, longest) = stats(&mut t);
+        e.span = t.first().zip(t.last()).map(|(a, b)| (*a, *b));
+        e.mean_rate = rate;
+        e.median_period = median;
+        e.jitter = jitter;
+        e.gaps = gaps;
+        e.longest_gap = longest;
+    }
+    Ok(InfoReport {
+        kind: src.kind(),
+        topics: by.into_values().collect(),
+        notes: src.notes().to_vec(),
+        losses,
+    })
+}
+
+impl InfoReport {
+    /// The printed report.
+    pub fn text(&self, path: &Path) -> String {
+        let mut s = format!(
+            "path:      {}\nformat:    {}\n",
+            path.display(),
+            self.kind.describe()
+        );
+        let spans: Vec<(u64, u64)> = self.topics.iter().filter_map(|t| t.span).collect();
+        if let (Some(a), Some(b)) = (
+            spans.iter().map(|x| x.0).min(),
+            spans.iter().map(|x| x.1).max(),
+        ) {
+            s.push_str(&format!(
+                "start:     {}\nend:       {}\nduration:  {:.3} s\n",
+                RosTime::from_nanos(a),
+                RosTime::from_nanos(b),
+                (b - a) as f64 * 1e-9
+            ));
+        }
+        let total: u64 = self.topics.iter().map(|t| t.count).sum();
+        s.push_str(&format!(
+            "messages:  {total}\ntopics:    {}   (* = sensor_msgs/Imu, read by the tools)\n",
+            self.topics.len()
+        ));
+        s.push_str(&format!(
+            "  {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>10}\n",
+            "topic", "type", "enc", "msgs", "rate Hz", "jitter", "span s", "gaps", "longest s"
+        ));
+        let opt =
+            |v: Option<f64>, p: usize| v.map(|x| format!("{x:.p$}")).unwrap_or_else(|| "-".into());
+        for t in &self.topics {
+            s.push_str(&format!(
+                "{} {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>10}\n",
+                if t.imu { "*" } else { " " },
+                t.topic,
+                t.msg_type,
+                t.encoding,
+                t.count,
+                opt(t.mean_rate, 3),
+                t.jitter
+                    .map(|j| format!("{:.2}%", j * 100.0))
+                    .unwrap_or_else(|| "-".into()),
+                opt(t.span.map(|(a, b)| (b - a) as f64 * 1e-9), 3),
+                t.gaps,
+                opt(t.longest_gap, 4),
+            ));
+            if let Some(p) = t.promised
+                && p != t.count
+            {
+                s.push_str(&format!(
+                    "    the container promises {p} messages on this topic, {} were read\n",
+                    t.count
+                ));
+            }
+        }
+        for n in &self.notes {
+            s.push_str(&format!("note: {n}\n"));
+        }
+        for l in &self.losses {
+            s.push_str(&format!("lost: {l}\n"));
+        }
+        s
+    }
+}

@@ -1,0 +1,461 @@
+//! ROS 2 bags (rosbag2): a directory with `metadata.yaml` and one or more storage files
+//! (`.db3` sqlite3 or `.mcap`), split files read in order, and rosbag2's compression: FILE
+//! mode (each storage file one `.zstd` file) and MESSAGE mode (each payload one zstd frame).
+//!
+//! * [`metadata`]: `metadata.yaml`, read and written.
+//! * [`sqlite`]: the `.db3` storage, read and written.
+//! * [`BagDir`]: a bag directory (or a bare FILE-compressed file) as one
+//!   [`crate::source::Source`], with channels merged across files by topic and type.
+//! * [`Ros2BagWriter`]: a bag directory with one storage file, Imu as CDR.
+
+pub mod metadata;
+pub mod sqlite;
+
+pub use sqlite::{Sqlite3Reader, Sqlite3Writer};
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::cdr;
+use crate::error::Error;
+use crate::imu_msg::Imu;
+use crate::mcap::{ChunkCompression, McapReader, McapWriter};
+use crate::shared::output::AtomicDir;
+use crate::source::{
+    self, Channel, Decompressed, InputKind, Loss, MessageSink, Part, PartRead, Source,
+};
+use metadata::{BagInfo, OFFERED_QOS_PROFILES, WrittenBag, WrittenTopic};
+
+thread_local! {
+    /// Per-thread buffer for MESSAGE-mode decompression.
+    static PAYLOAD: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Largest decompressed message accepted in MESSAGE mode (a damaged frame cannot make the
+/// reader allocate more).
+const MAX_MESSAGE_BYTES: u64 = 1 << 30;
+
+struct FileSource {
+    src: Box<dyn Source>,
+    /// Channel id in this file → id in the bag.
+    ids: BTreeMap<u32, u32>,
+    _tmp: Option<Decompressed>,
+}
+
+/// A ROS 2 bag directory, read as one source.
+pub struct BagDir {
+    files: Vec<FileSource>,
+    channels: Vec<Channel>,
+    /// Part in the bag → (file, part in the file).
+    part_map: Vec<(usize, usize)>,
+    parts: Vec<Part>,
+    message_zstd: bool,
+    notes: Vec<String>,
+    losses: Vec<Loss>,
+    /// The parsed `metadata.yaml`, when there is one.
+    pub info: Option<BagInfo>,
+}
+
+fn open_storage(path: &Path) -> Result<(Box<dyn Source>, Option<Decompressed>), Error> {
+    let (inner, tmp) = match source::detect(path)? {
+        InputKind::Zstd => {
+            let d = source::decompress_zstd_file(path)?;
+            (d.path.clone(), Some(d))
+        }
+        _ => (path.to_path_buf(), None),
+    };
+    let src: Box<dyn Source> = match source::detect(&inner)? {
+        InputKind::Mcap => Box::new(McapReader::open(&inner)?),
+        InputKind::Sqlite3 => Box::new(Sqlite3Reader::open(&inner)?),
+        other => {
+            return Err(Error::NotABag {
+                path: path.to_path_buf(),
+                what: format!(
+                    "a {} where a rosbag2 storage file (.db3 or .mcap) was expected",
+                    other.describe()
+                ),
+            });
+        }
+    };
+    Ok((src, tmp))
+}
+
+impl BagDir {
+    /// Opens the bag directory `dir` (its `metadata.yaml` lists the storage files).
+    pub fn open(dir: &Path) -> Result<BagDir, Error> {
+        let meta_path = dir.join("metadata.yaml");
+        let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
+        let info = BagInfo::parse(&text).map_err(|e| Error::Storage {
+            path: meta_path.clone(),
+            what: format!("not a rosbag2 metadata.yaml: {e}"),
+        })?;
+        let mut notes = Vec::new();
+        let mut losses = Vec::new();
+        let mut paths: Vec<PathBuf> = info
+            .relative_file_paths
+            .iter()
+            .map(|r| dir.join(r))
+            .collect();
+        if paths.is_empty() {
+            // Some tools leave the list empty; take the storage files in name order.
+            let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+                .map_err(|e| Error::io(dir, e))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    let n = p.to_string_lossy();
+                    [".db3", ".mcap", ".db3.zstd", ".mcap.zstd"]
+                        .iter()
+                        .any(|x| n.ends_with(x))
+                })
+                .collect();
+            found.sort();
+            notes.push(format!(
+                "metadata.yaml lists no storage files; reading the {} found in the directory",
+                found.len()
+            ));
+            paths = found;
+        }
+        let mut files = Vec::new();
+        for p in &paths {
+            if !p.exists() {
+                losses.push(Loss {
+                    what: format!("{} is listed in metadata.yaml but missing", p.display()),
+                    messages: None,
+                    span: None,
+                });
+                continue;
+            }
+            let (src, tmp) = open_storage(p)?;
+            files.push((src, tmp));
+        }
+        if files.is_empty() {
+            return Err(Error::Storage {
+                path: meta_path,
+                what: "the bag directory holds none of its storage files".into(),
+            });
+        }
+        let message_zstd = info.compression_mode() == "message";
+        if message_zstd && info.compression_format() != "zstd" {
+            return Err(Error::Storage {
+                path: meta_path,
+                what: format!(
+                    "unsupported message compression '{}' (zstd is)",
+                    info.compression_format()
+                ),
+            });
+        }
+        Ok(Self::assemble(
+            files,
+            Some(info),
+            message_zstd,
+            notes,
+            losses,
+        ))
+    }
+
+    /// Opens a bare FILE-mode compressed storage file (`.mcap.zstd`, `.db3.zstd`).
+    pub fn open_compressed_file(path: &Path) -> Result<BagDir, Error> {
+        let (src, tmp) = open_storage(path)?;
+        Ok(Self::assemble(
+            vec![(src, tmp)],
+            None,
+            false,
+            Vec::new(),
+            Vec::new(),
+        ))
+    }
+
+    fn assemble(
+        files: Vec<(Box<dyn Source>, Option<Decompressed>)>,
+        info: Option<BagInfo>,
+        message_zstd: bool,
+        mut notes: Vec<String>,
+        mut losses: Vec<Loss>,
+    ) -> BagDir {
+        let mut channels: Vec<Channel> = Vec::new();
+        let mut out_files = Vec::new();
+        let mut part_map = Vec::new();
+        let mut parts = Vec::new();
+        let multi = files.len() > 1;
+        for (fi, (src, tmp)) in files.into_iter().enumerate() {
+            let mut ids = BTreeMap::new();
+            for c in src.channels() {
+                let found = channels.iter_mut().find(|g| {
+                    g.topic == c.topic && g.msg_type == c.msg_type && g.encoding == c.encoding
+                });
+                let gid = match found {
+                    Some(g) => {
+                        g.count = g.count.zip(c.count).map(|(a, b)| a + b);
+                        g.id
+                    }
+                    None => {
+                        let id = channels.len() as u32 + 1;
+                        channels.push(Channel { id, ..c.clone() });
+                        id
+                    }
+                };
+                ids.insert(c.id, gid);
+            }
+            for (pi, p) in src.parts().iter().enumerate() {
+                part_map.push((fi, pi));
+                let mut p = p.clone();
+                if multi {
+                    p.label = format!("file {}: {}", fi + 1, p.label);
+                }
+                p.counts = p.counts.map(|v| {
+                    v.into_iter()
+                        .filter_map(|(c, n)| ids.get(&c).map(|g| (*g, n)))
+                        .collect()
+                });
+                parts.push(p);
+            }
+            notes.extend(src.notes().iter().cloned());
+            losses.extend(src.losses().iter().cloned());
+            out_files.push(FileSource {
+                src,
+                ids,
+                _tmp: tmp,
+            });
+        }
+        // metadata.yaml's counts are what the recorder promised for the whole bag.
+        if let Some(info) = &info {
+            for c in channels.iter_mut() {
+                if let Some(t) = info.topics_with_message_count.iter().find(|t| {
+                    t.topic_metadata.name == c.topic && t.topic_metadata.msg_type == c.msg_type
+                }) {
+                    c.count = Some(t.message_count);
+                }
+            }
+        }
+        BagDir {
+            files: out_files,
+            channels,
+            part_map,
+            parts,
+            message_zstd,
+            notes,
+            losses,
+            info,
+        }
+    }
+}
+
+impl Source for BagDir {
+    fn kind(&self) -> InputKind {
+        if self.info.is_some() {
+            InputKind::Rosbag2Dir
+        } else {
+            InputKind::Zstd
+        }
+    }
+    fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+    fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+    fn notes(&self) -> &[String] {
+        &self.notes
+    }
+    fn losses(&self) -> &[Loss] {
+        &self.losses
+    }
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut MessageSink<'_>,
+    ) -> PartRead {
+        let Some(&(fi, pi)) = self.part_map.get(part) else {
+            return PartRead {
+                error: Some("no such part".into()),
+                ..PartRead::default()
+            };
+        };
+        let f = &self.files[fi];
+        let local_want = |c: u32| f.ids.get(&c).is_some_and(|g| want(*g));
+        let mut skipped = 0;
+        let mut skip_reason = None;
+        let mut r = f.src.read_part(pi, &local_want, &mut |c, t, data| {
+            let g = f.ids[&c];
+            if !self.message_zstd {
+                sink(g, t, data);
+                return;
+            }
+            PAYLOAD.with(|cell| {
+                let mut buf = cell.borrow_mut();
+                match crate::zstd::decompress_into(data, &mut buf, MAX_MESSAGE_BYTES) {
+                    Ok(()) => sink(g, t, &buf),
+                    Err(e) => {
+                        skipped += 1;
+                        skip_reason.get_or_insert(e);
+                    }
+                }
+            });
+        });
+        r.delivered -= skipped;
+        r.skipped += skipped;
+        if r.skip_reason.is_none() {
+            r.skip_reason = skip_reason;
+        }
+        r
+    }
+}
+
+/// The storage of a bag [`Ros2BagWriter`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Storage {
+    /// One `.db3`.
+    Sqlite3,
+    /// One `.mcap`, chunks compressed as given.
+    Mcap(ChunkCompression),
+}
+
+enum StorageWriter {
+    Sqlite3(Sqlite3Writer),
+    Mcap(Box<McapWriter>),
+}
+
+/// A topic handle of [`Ros2BagWriter`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TopicId(usize);
+
+/// Writes a ROS 2 bag directory: `metadata.yaml` plus one storage file named after the
+/// directory (`<name>_0.db3` or `<name>_0.mcap`), the way `ros2 bag record` lays it out.
+pub struct Ros2BagWriter {
+    dir: AtomicDir,
+    storage: StorageWriter,
+    file: String,
+    topics: Vec<(WrittenTopic, i64)>,
+    span: Option<(u64, u64)>,
+    scratch: Vec<u8>,
+}
+
+impl Ros2BagWriter {
+    /// Starts the bag directory `dir` (which must not exist yet).
+    pub fn create(dir: &Path, storage: Storage) -> Result<Ros2BagWriter, Error> {
+        let d = AtomicDir::create(dir)?;
+        let stem = dir
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "bag".into());
+        let (file, storage) = match storage {
+            Storage::Sqlite3 => {
+                let f = format!("{stem}_0.db3");
+                let w = Sqlite3Writer::create(&d.path().join(&f))?;
+                (f, StorageWriter::Sqlite3(w))
+            }
+            Storage::Mcap(c) => {
+                let f = format!("{stem}_0.mcap");
+                let w = McapWriter::create(&d.path().join(&f), "ros2", c)?;
+                (f, StorageWriter::Mcap(Box::new(w)))
+            }
+        };
+        Ok(Ros2BagWriter {
+            dir: d,
+            storage,
+            file,
+            topics: Vec::new(),
+            span: None,
+            scratch: Vec::with_capacity(512),
+        })
+    }
+
+    /// Declares a topic of any type with its `ros2msg` definition and type hash.
+    pub fn add_topic(
+        &mut self,
+        name: &str,
+        msg_type: &str,
+        definition: &str,
+        type_hash: &str,
+    ) -> Result<TopicId, Error> {
+        let id = match &mut self.storage {
+            StorageWriter::Sqlite3(w) => {
+                w.add_topic(name, msg_type, definition, type_hash, OFFERED_QOS_PROFILES)?
+            }
+            StorageWriter::Mcap(w) => {
+                let s = w.add_schema(msg_type, cdr::SCHEMA_ENCODING, definition.as_bytes())?;
+                w.add_channel(
+                    s,
+                    name,
+                    cdr::ENCODING,
+                    &[(
+                        "offered_qos_profiles".to_string(),
+                        OFFERED_QOS_PROFILES.to_string(),
+                    )],
+                )? as i64
+            }
+        };
+        self.topics.push((
+            WrittenTopic {
+                name: name.to_string(),
+                msg_type: msg_type.to_string(),
+                type_hash: type_hash.to_string(),
+                count: 0,
+            },
+            id,
+        ));
+        Ok(TopicId(self.topics.len() - 1))
+    }
+
+    /// Declares a `sensor_msgs/msg/Imu` topic.
+    pub fn add_imu_topic(&mut self, name: &str) -> Result<TopicId, Error> {
+        self.add_topic(name, cdr::TYPE, &cdr::definition(), cdr::TYPE_HASH)
+    }
+
+    /// Appends one Imu message (CDR, little-endian) with its record time (ns).
+    pub fn write_imu(&mut self, topic: TopicId, time_ns: u64, imu: &Imu) -> Result<(), Error> {
+        let mut buf = std::mem::take(&mut self.scratch);
+        buf.clear();
+        let r = cdr::encode(imu, cdr::Endian::Little, &mut buf)
+            .and_then(|_| self.write_raw(topic, time_ns, &buf));
+        self.scratch = buf;
+        r
+    }
+
+    /// Appends one already-serialized (CDR) message with its record time (ns).
+    pub fn write_raw(&mut self, topic: TopicId, time_ns: u64, data: &[u8]) -> Result<(), Error> {
+        let (t, id) = self
+            .topics
+            .get_mut(topic.0)
+            .ok_or_else(|| Error::BadMessage {
+                what: format!("unknown topic {}", topic.0),
+            })?;
+        match &mut self.storage {
+            StorageWriter::Sqlite3(w) => w.write(*id, time_ns, data)?,
+            StorageWriter::Mcap(w) => {
+                let seq = t.count as u32;
+                w.write(*id as u16, seq, time_ns, time_ns, data)?
+            }
+        }
+        t.count += 1;
+        self.span = Some(match self.span {
+            None => (time_ns, time_ns),
+            Some((a, b)) => (a.min(time_ns), b.max(time_ns)),
+        });
+        Ok(())
+    }
+
+    /// Finishes the storage file, writes `metadata.yaml` and renames the directory into
+    /// place.
+    pub fn finish(self) -> Result<(), Error> {
+        let bag = WrittenBag {
+            storage: match self.storage {
+                StorageWriter::Sqlite3(_) => "sqlite3",
+                StorageWriter::Mcap(_) => "mcap",
+            },
+            file: self.file.clone(),
+            topics: self.topics.iter().map(|(t, _)| t.clone()).collect(),
+            span: self.span,
+        };
+        let yaml = metadata::write_yaml(&bag);
+        match self.storage {
+            StorageWriter::Sqlite3(w) => w.finish(&yaml)?,
+            StorageWriter::Mcap(w) => w.finish()?,
+        }
+        crate::shared::output::write_atomic(&self.dir.path().join("metadata.yaml"), |w| {
+            w.write_all(yaml.as_bytes())
+        })?;
+        self.dir.commit()
+    }
+}

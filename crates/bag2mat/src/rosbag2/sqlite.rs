@@ -1,0 +1,307 @@
+//! rosbag2's sqlite3 storage (`.db3`), read and written with `rusqlite` (bundled SQLite).
+//!
+//! Every schema version from Foxy to today shares what the reader needs: `topics(id, name,
+//! type, serialization_format, …)` and `messages(id INTEGER PRIMARY KEY, topic_id,
+//! timestamp, data)`, where `timestamp` is the receive time in ns (the record time). Later
+//! versions add `offered_qos_profiles`, `type_description_hash`, and the `schema`,
+//! `metadata` and `message_definitions` tables, which the reader does not need. Parts are
+//! ranges of message ids, read in parallel, each on its own connection from a small pool.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use rusqlite::{Connection, OpenFlags, params};
+
+use crate::error::Error;
+use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
+
+/// Message ids per part.
+const ROWS_PER_PART: i64 = 65_536;
+
+/// An open `.db3`.
+pub struct Sqlite3Reader {
+    path: PathBuf,
+    pool: Mutex<Vec<Connection>>,
+    channels: Vec<source::Channel>,
+    ranges: Vec<(i64, i64)>,
+    parts: Vec<Part>,
+    notes: Vec<String>,
+    losses: Vec<Loss>,
+    /// The `schema` table's version, when the file has one (ROS 2 Iron and later).
+    pub schema_version: Option<i64>,
+}
+
+fn sql_err(path: &Path, e: rusqlite::Error) -> Error {
+    Error::Storage {
+        path: path.to_path_buf(),
+        what: format!("sqlite3: {e}"),
+    }
+}
+
+fn connect(path: &Path) -> Result<Connection, rusqlite::Error> {
+    Connection::open_with_flags(
+        path,
+        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+    )
+}
+
+impl Sqlite3Reader {
+    /// Opens a rosbag2 `.db3` read-only and lists its topics.
+    pub fn open(path: &Path) -> Result<Sqlite3Reader, Error> {
+        let conn = connect(path).map_err(|e| sql_err(path, e))?;
+        let tables: Vec<String> = conn
+            .prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
+            .and_then(|mut s| {
+                s.query_map([], |r| r.get::<_, String>(0))?
+                    .collect::<Result<_, _>>()
+            })
+            .map_err(|e| sql_err(path, e))?;
+        for t in ["topics", "messages"] {
+            if !tables.iter().any(|x| x == t) {
+                return Err(Error::NotABag {
+                    path: path.to_path_buf(),
+                    what: format!(
+                        "an SQLite database without the rosbag2 '{t}' table. Accepted: {}",
+                        source::ACCEPTED
+                    ),
+                });
+            }
+        }
+        let schema_version = if tables.iter().any(|x| x == "schema") {
+            conn.query_row("SELECT max(schema_version) FROM schema", [], |r| {
+                r.get::<_, Option<i64>>(0)
+            })
+            .ok()
+            .flatten()
+        } else {
+            None
+        };
+        let channels = conn
+            .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
+            .and_then(|mut s| {
+                s.query_map([], |r| {
+                    Ok(source::Channel {
+                        id: r.get::<_, i64>(0)? as u32,
+                        topic: r.get(1)?,
+                        msg_type: r.get(2)?,
+                        encoding: Encoding::from_name(&r.get::<_, String>(3)?),
+                        md5sum: None,
+                        count: None,
+                    })
+                })?
+                .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(|e| sql_err(path, e))?;
+        let (lo, hi): (Option<i64>, Option<i64>) = conn
+            .query_row("SELECT min(id), max(id) FROM messages", [], |r| {
+                Ok((r.get(0)?, r.get(1)?))
+            })
+            .map_err(|e| sql_err(path, e))?;
+        let mut ranges = Vec::new();
+        if let (Some(lo), Some(hi)) = (lo, hi) {
+            let mut a = lo;
+            while a <= hi {
+                let b = a.saturating_add(ROWS_PER_PART).min(hi.saturating_add(1));
+                ranges.push((a, b));
+                if b <= a {
+                    break;
+                }
+                a = b;
+            }
+        }
+        let parts = ranges
+            .iter()
+            .map(|(a, b)| Part {
+                label: format!("message rows {a}..{}", b - 1),
+                span: None,
+                counts: None,
+            })
+            .collect();
+        Ok(Sqlite3Reader {
+            path: path.to_path_buf(),
+            pool: Mutex::new(vec![conn]),
+            channels,
+            ranges,
+            parts,
+            notes: Vec::new(),
+            losses: Vec::new(),
+            schema_version,
+        })
+    }
+
+    /// Counts the messages of every topic (a full pass over the table).
+    pub fn count_messages(&self) -> Result<Vec<(u32, u64)>, Error> {
+        let conn = self.take()?;
+        let r = conn
+            .prepare("SELECT topic_id, count(*) FROM messages GROUP BY topic_id")
+            .and_then(|mut s| {
+                s.query_map([], |r| {
+                    Ok((r.get::<_, i64>(0)? as u32, r.get::<_, i64>(1)? as u64))
+                })?
+                .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(|e| sql_err(&self.path, e));
+        self.give(conn);
+        r
+    }
+
+    fn take(&self) -> Result<Connection, Error> {
+        let c = self.pool.lock().ok().and_then(|mut p| p.pop());
+        match c {
+            Some(c) => Ok(c),
+            None => connect(&self.path).map_err(|e| sql_err(&self.path, e)),
+        }
+    }
+
+    fn give(&self, c: Connection) {
+        if let Ok(mut p) = self.pool.lock() {
+            p.push(c);
+        }
+    }
+}
+
+impl Source for Sqlite3Reader {
+    fn kind(&self) -> InputKind {
+        InputKind::Sqlite3
+    }
+    fn channels(&self) -> &[source::Channel] {
+        &self.channels
+    }
+    fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+    fn notes(&self) -> &[String] {
+        &self.notes
+    }
+    fn losses(&self) -> &[Loss] {
+        &self.losses
+    }
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut MessageSink<'_>,
+    ) -> PartRead {
+        let mut out = PartRead::default();
+        let Some(&(a, b)) = self.ranges.get(part) else {
+            out.error = Some("no such part".into());
+            return out;
+        };
+        let conn = match self.take() {
+            Ok(c) => c,
+            Err(e) => {
+                out.error = Some(e.to_string());
+                return out;
+            }
+        };
+        let r = (|| -> Result<(), rusqlite::Error> {
+            let mut st = conn.prepare_cached(
+                "SELECT topic_id, timestamp, data FROM messages WHERE id >= ?1 AND id < ?2",
+            )?;
+            let mut rows = st.query(params![a, b])?;
+            while let Some(row) = rows.next()? {
+                let topic = row.get::<_, i64>(0)? as u32;
+                if !want(topic) {
+                    continue;
+                }
+                let t = row.get::<_, i64>(1)?.max(0) as u64;
+                let data = row.get_ref(2)?.as_blob()?;
+                sink(topic, t, data);
+                out.delivered += 1;
+            }
+            Ok(())
+        })();
+        if let Err(e) = r {
+            out.error = Some(format!("sqlite3: {e}"));
+        }
+        self.give(conn);
+        out
+    }
+}
+
+/// Writes a rosbag2 `.db3` in the current schema (version 4: `schema`, `metadata`,
+/// `topics` with QoS and type hash, `message_definitions`, `messages`).
+pub struct Sqlite3Writer {
+    path: PathBuf,
+    conn: Connection,
+}
+
+impl Sqlite3Writer {
+    /// Creates the database with its tables, in one transaction until [`Self::finish`].
+    pub fn create(path: &Path) -> Result<Sqlite3Writer, Error> {
+        let conn = Connection::open(path).map_err(|e| sql_err(path, e))?;
+        conn.execute_batch(
+            "PRAGMA journal_mode = MEMORY;
+             PRAGMA synchronous = OFF;
+             CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);
+             INSERT INTO schema VALUES (4, '');
+             CREATE TABLE metadata(id INTEGER PRIMARY KEY, metadata_version INTEGER NOT NULL, metadata TEXT NOT NULL);
+             CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL, type_description_hash TEXT NOT NULL);
+             CREATE TABLE message_definitions(id INTEGER PRIMARY KEY, topic_type TEXT NOT NULL, encoding TEXT NOT NULL, encoded_message_definition TEXT NOT NULL, type_description_hash TEXT NOT NULL);
+             CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);
+             BEGIN;",
+        )
+        .map_err(|e| sql_err(path, e))?;
+        Ok(Sqlite3Writer {
+            path: path.to_path_buf(),
+            conn,
+        })
+    }
+
+    /// Declares a topic (and its type's definition); returns its id.
+    pub fn add_topic(
+        &mut self,
+        name: &str,
+        msg_type: &str,
+        definition: &str,
+        type_hash: &str,
+        qos: &str,
+    ) -> Result<i64, Error> {
+        let r = (|| {
+            self.conn.execute(
+                "INSERT INTO topics (name, type, serialization_format, offered_qos_profiles, type_description_hash) VALUES (?1, ?2, 'cdr', ?3, ?4)",
+                params![name, msg_type, qos, type_hash],
+            )?;
+            let id = self.conn.last_insert_rowid();
+            let known: i64 = self.conn.query_row(
+                "SELECT count(*) FROM message_definitions WHERE topic_type = ?1",
+                params![msg_type],
+                |r| r.get(0),
+            )?;
+            if known == 0 {
+                self.conn.execute(
+                    "INSERT INTO message_definitions (topic_type, encoding, encoded_message_definition, type_description_hash) VALUES (?1, 'ros2msg', ?2, ?3)",
+                    params![msg_type, definition, type_hash],
+                )?;
+            }
+            Ok(id)
+        })();
+        r.map_err(|e| sql_err(&self.path, e))
+    }
+
+    /// Appends one message with its receive time (ns).
+    pub fn write(&mut self, topic: i64, time_ns: u64, data: &[u8]) -> Result<(), Error> {
+        let t = i64::try_from(time_ns).map_err(|_| Error::BadMessage {
+            what: format!("record time {time_ns} ns does not fit rosbag2's int64"),
+        })?;
+        self.conn
+            .prepare_cached("INSERT INTO messages (topic_id, timestamp, data) VALUES (?1, ?2, ?3)")
+            .and_then(|mut s| s.execute(params![topic, t, data]))
+            .map(|_| ())
+            .map_err(|e| sql_err(&self.path, e))
+    }
+
+    /// Stores the bag's metadata, builds the timestamp index and commits.
+    pub fn finish(self, metadata_yaml: &str) -> Result<(), Error> {
+        let r = (|| {
+            self.conn.execute(
+                "INSERT INTO metadata (metadata_version, metadata) VALUES (8, ?1)",
+                params![metadata_yaml],
+            )?;
+            self.conn
+                .execute_batch("CREATE INDEX timestamp_idx ON messages (timestamp ASC); COMMIT;")
+        })();
+        r.map_err(|e| sql_err(&self.path, e))?;
+        self.conn.close().map_err(|(_, e)| sql_err(&self.path, e))
+    }
+}

@@ -1,0 +1,298 @@
+//! One interface over every container the workspace reads: ROS 1 bags, MCAP files, rosbag2
+//! sqlite3 files and rosbag2 bag directories (split files, zstd file or message compression).
+//!
+//! [`open`] recognises the input from its content (never its extension) and returns a
+//! [`Source`]: the channels with their type, encoding and the message count the container
+//! promises, the independently readable parts (chunks, row ranges), and what opening found
+//! (notes, and [`Loss`]es: data the container held or promised that cannot be delivered).
+//! Reading a part hands out `(channel, record time, payload)` for the channels asked for and
+//! says how many it delivered and why it stopped early. Decoding, the topic rules, progress
+//! and sorting are written once on top of this, in [`crate::series`].
+
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use crate::error::Error;
+
+/// What an input is, recognised from its first bytes (or `metadata.yaml` for a directory).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// `#ROSBAG V2.0\n`.
+    Ros1Bag,
+    /// `\x89MCAP0\r\n`.
+    Mcap,
+    /// `SQLite format 3\0`: a rosbag2 `.db3`.
+    Sqlite3,
+    /// A directory holding `metadata.yaml` and its storage files.
+    Rosbag2Dir,
+    /// A zstd frame: a FILE-mode compressed `.mcap.zstd` or `.db3.zstd`.
+    Zstd,
+}
+
+impl InputKind {
+    /// How the kind is named in messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            InputKind::Ros1Bag => "ROS 1 bag",
+            InputKind::Mcap => "MCAP file",
+            InputKind::Sqlite3 => "rosbag2 sqlite3 file",
+            InputKind::Rosbag2Dir => "ROS 2 bag directory",
+            InputKind::Zstd => "zstd-compressed file",
+        }
+    }
+}
+
+/// Every kind of input accepted, for error messages.
+pub const ACCEPTED: &str = "a ROS 1 bag (format 2.0), a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files), an .mcap file, a rosbag2 .db3 (sqlite3) file, or a zstd-compressed .mcap/.db3";
+
+/// The magic line of a ROS 1 bag.
+pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+/// The first 16 bytes of every SQLite 3 database.
+pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
+/// The magic number of a zstd frame.
+pub const ZSTD_MAGIC: &[u8] = &[0x28, 0xB5, 0x2F, 0xFD];
+
+/// How a channel's payloads are serialized.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Encoding {
+    /// ROS 1 serialization (ROS 1 bags, MCAP `ros1` channels).
+    Ros1,
+    /// CDR (ROS 2).
+    Cdr,
+    /// Anything else, named as the container names it.
+    Other(String),
+}
+
+impl Encoding {
+    /// From a container's encoding name (`ros1`, `cdr`, …).
+    pub fn from_name(name: &str) -> Encoding {
+        match name {
+            "ros1" => Encoding::Ros1,
+            "cdr" => Encoding::Cdr,
+            other => Encoding::Other(other.to_string()),
+        }
+    }
+    /// The name.
+    pub fn name(&self) -> &str {
+        match self {
+            Encoding::Ros1 => "ros1",
+            Encoding::Cdr => "cdr",
+            Encoding::Other(s) => s,
+        }
+    }
+}
+
+/// A stream of messages of one type on one topic (a ROS 1 connection, an MCAP channel, a
+/// rosbag2 topic). Several channels may share a topic.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Channel {
+    /// Id, unique within the source.
+    pub id: u32,
+    /// Topic name as recorded.
+    pub topic: String,
+    /// Message type as recorded (`sensor_msgs/Imu`, `sensor_msgs/msg/Imu`).
+    pub msg_type: String,
+    /// Payload serialization.
+    pub encoding: Encoding,
+    /// The ROS 1 md5 of the type, when the container records it.
+    pub md5sum: Option<String>,
+    /// Messages the container's index or summary promises; `None` when it keeps no count.
+    pub count: Option<u64>,
+}
+
+/// An independently readable piece of a source (a chunk, a range of rows).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Part {
+    /// Where it is, for messages ("chunk at byte 4117").
+    pub label: String,
+    /// Record-time span (ns) the container states for it, if any.
+    pub span: Option<(u64, u64)>,
+    /// Messages per channel the container promises in it, if it says.
+    pub counts: Option<Vec<(u32, u64)>>,
+}
+
+/// Data that the container held or promised and that cannot be delivered.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Loss {
+    /// What was lost and why.
+    pub what: String,
+    /// Messages lost, when known.
+    pub messages: Option<u64>,
+    /// Record-time span (ns) of the lost data, when known.
+    pub span: Option<(u64, u64)>,
+}
+
+impl std::fmt::Display for Loss {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.what)?;
+        if let Some(n) = self.messages {
+            write!(f, "; {n} messages lost")?;
+        }
+        if let Some((a, b)) = self.span {
+            write!(
+                f,
+                " (record time {} .. {})",
+                crate::RosTime::from_nanos(a),
+                crate::RosTime::from_nanos(b)
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// What reading one part delivered.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct PartRead {
+    /// Messages of the wanted channels handed to the callback.
+    pub delivered: u64,
+    /// Why the part stopped before its end (the messages before it were delivered).
+    pub error: Option<String>,
+    /// Messages of wanted channels found but not handed out (e.g. a payload that does not
+    /// decompress), and why the first of them was skipped.
+    pub skipped: u64,
+    /// Why the first skipped message was skipped.
+    pub skip_reason: Option<String>,
+}
+
+/// The callback of [`Source::read_part`]: `(channel id, record time in ns, payload)`.
+pub type MessageSink<'a> = dyn FnMut(u32, u64, &[u8]) + 'a;
+
+/// A container opened for reading.
+pub trait Source: Sync {
+    /// What it is.
+    fn kind(&self) -> InputKind;
+    /// Its channels.
+    fn channels(&self) -> &[Channel];
+    /// Its parts, in storage order.
+    fn parts(&self) -> &[Part];
+    /// What opening found (unindexed, truncated, scanned, …).
+    fn notes(&self) -> &[String];
+    /// What opening found lost (incomplete records, unreadable index entries, …).
+    fn losses(&self) -> &[Loss];
+    /// Reads part `part`, calling `sink` for each message of a channel `want` accepts, in
+    /// storage order.
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut MessageSink<'_>,
+    ) -> PartRead;
+}
+
+/// Recognises `path` from its content.
+pub fn detect(path: &Path) -> Result<InputKind, Error> {
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        if path.join("metadata.yaml").is_file() {
+            return Ok(InputKind::Rosbag2Dir);
+        }
+        return Err(Error::NotABag {
+            path: path.to_path_buf(),
+            what: format!("a directory without metadata.yaml. Accepted: {ACCEPTED}"),
+        });
+    }
+    let mut head = [0u8; 16];
+    let mut f = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut got = 0;
+    while got < head.len() {
+        match f.read(&mut head[got..]) {
+            Ok(0) => break,
+            Ok(n) => got += n,
+            Err(e) => return Err(Error::io(path, e)),
+        }
+    }
+    let head = &head[..got];
+    if head.starts_with(ROS1_MAGIC) {
+        return Ok(InputKind::Ros1Bag);
+    }
+    if head.starts_with(crate::mcap::MAGIC) {
+        return Ok(InputKind::Mcap);
+    }
+    if head.starts_with(SQLITE_MAGIC) {
+        return Ok(InputKind::Sqlite3);
+    }
+    if head.starts_with(ZSTD_MAGIC) {
+        return Ok(InputKind::Zstd);
+    }
+    let what = if head.is_empty() {
+        "the file is empty".to_string()
+    } else if head.starts_with(b"#ROSBAG V") {
+        let line = head.split(|&b| b == b'\n').next().unwrap_or(head);
+        format!(
+            "unsupported ROS bag version line {:?} (only 2.0 is read)",
+            String::from_utf8_lossy(line)
+        )
+    } else if head.starts_with(b"\x89MCAP") {
+        format!(
+            "MCAP major version {:?} is not supported (only 0)",
+            head.get(5).map(|&b| b as char)
+        )
+    } else if head.starts_with(b"rosbag2_bagfile_information") {
+        "a metadata.yaml file: pass its directory".to_string()
+    } else {
+        format!(
+            "it starts with {:?}",
+            String::from_utf8_lossy(&head[..head.len().min(12)])
+        )
+    };
+    Err(Error::NotABag {
+        path: path.to_path_buf(),
+        what: format!("{what}. Accepted: {ACCEPTED}"),
+    })
+}
+
+/// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
+pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
+    if path.file_name().is_some_and(|n| n == "metadata.yaml")
+        && path.is_file()
+        && let Some(dir) = path.parent()
+    {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        return Ok(Box::new(crate::rosbag2::BagDir::open(dir)?));
+    }
+    Ok(match detect(path)? {
+        InputKind::Ros1Bag => Box::new(crate::bag::BagReader::open(path)?),
+        InputKind::Mcap => Box::new(crate::mcap::McapReader::open(path)?),
+        InputKind::Sqlite3 => Box::new(crate::rosbag2::Sqlite3Reader::open(path)?),
+        InputKind::Rosbag2Dir => Box::new(crate::rosbag2::BagDir::open(path)?),
+        InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
+    })
+}
+
+/// A file decompressed from a zstd FILE-mode input into a private temporary file, removed
+/// when dropped.
+pub struct Decompressed {
+    /// Where the decompressed bytes are.
+    pub path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+/// Decompresses every zstd frame of `src` into a temporary file (FILE-mode rosbag2
+/// compression stores each storage file as one `.zstd` file).
+pub fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
+    let dir = tempfile::Builder::new()
+        .prefix("bag2mat-zstd.")
+        .tempdir()
+        .map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let name = src
+        .file_stem()
+        .map(|s| s.to_os_string())
+        .unwrap_or_else(|| "decompressed".into());
+    let path = dir.path().join(name);
+    let input = File::open(src).map_err(|e| Error::io(src, e))?;
+    let mut out = std::io::BufWriter::new(File::create(&path).map_err(|e| Error::io(&path, e))?);
+    crate::zstd::decompress_stream(std::io::BufReader::new(input), &mut out).map_err(|e| {
+        Error::Corrupt {
+            path: src.to_path_buf(),
+            offset: 0,
+            what: format!("zstd: {e}"),
+        }
+    })?;
+    std::io::Write::flush(&mut out).map_err(|e| Error::io(&path, e))?;
+    Ok(Decompressed { path, _dir: dir })
+}

@@ -1,0 +1,112 @@
+//! Test support shared by every crate's tests (not part of the tools): where the Python
+//! virtual environment with the independent ROS 2 implementations is (`rosbags`, Foxglove's
+//! `mcap` + `mcap-ros2-support`, installed by `scripts/test.sh`), and running them. A test
+//! that needs them fails, never skips, when they are missing.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The workspace root.
+pub fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The virtual environment `scripts/test.sh` installs.
+pub fn venv() -> PathBuf {
+    workspace().join("target/py-venv")
+}
+
+/// The venv's Python interpreter; panics (failing the test) when it is missing.
+pub fn venv_python() -> PathBuf {
+    let p = venv().join("bin/python");
+    assert!(
+        p.exists(),
+        "{} is missing: run scripts/test.sh, which installs rosbags, mcap and mcap-ros2-support",
+        p.display()
+    );
+    p
+}
+
+/// Runs a command; panics with its output when it fails. Returns stdout.
+pub fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e} (scripts/test.sh installs it)"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `rosbags-convert --src SRC… --dst DST EXTRA…` from the venv.
+pub fn rosbags_convert(src: &[&Path], dst: &Path, extra: &[&str]) {
+    let _ = venv_python();
+    let mut c = Command::new(venv().join("bin/rosbags-convert"));
+    c.arg("--src").args(src).arg("--dst").arg(dst).args(extra);
+    run_ok(&mut c);
+}
+
+/// The rosbags-convert options of each ROS 2 destination the tests check: storage, and
+/// compression mode (zstd) when compressed.
+pub const ROS2_MODES: [(&str, &[&str]); 7] = [
+    ("sqlite3", &["--dst-storage", "sqlite3"]),
+    ("mcap", &["--dst-storage", "mcap"]),
+    (
+        "sqlite3_zstd_file",
+        &[
+            "--dst-storage",
+            "sqlite3",
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "file",
+        ],
+    ),
+    (
+        "sqlite3_zstd_message",
+        &[
+            "--dst-storage",
+            "sqlite3",
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "message",
+        ],
+    ),
+    (
+        "mcap_zstd_file",
+        &[
+            "--dst-storage",
+            "mcap",
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "file",
+        ],
+    ),
+    (
+        "mcap_zstd_message",
+        &[
+            "--dst-storage",
+            "mcap",
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "message",
+        ],
+    ),
+    (
+        "mcap_zstd_storage",
+        &[
+            "--dst-storage",
+            "mcap",
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "storage",
+        ],
+    ),
+];

@@ -1,0 +1,72 @@
+//! zstd in pure Rust (`ruzstd`): MCAP chunk and rosbag2 message/file compression.
+
+use std::io::{Read, Write};
+
+/// Decompresses one or more concatenated zstd frames from `input` into `out`.
+pub fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std::io::Result<u64> {
+    let mut input = std::io::BufReader::new(input);
+    let mut total = 0u64;
+    loop {
+        // Stop cleanly at the end of the input, between frames.
+        if std::io::BufRead::fill_buf(&mut input)?.is_empty() {
+            return Ok(total);
+        }
+        let mut dec = ruzstd::decoding::StreamingDecoder::new(&mut input)
+            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        total += std::io::copy(&mut dec, out)?;
+    }
+}
+
+/// Decompresses `data` (whole zstd frames) into `out`, which is cleared first. At most
+/// `limit` bytes are accepted (a damaged size field cannot make it allocate more).
+pub fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Result<(), String> {
+    out.clear();
+    let mut w = LimitedWriter { out, limit };
+    decompress_stream(data, &mut w).map_err(|e| format!("zstd: {e}"))?;
+    Ok(())
+}
+
+struct LimitedWriter<'a> {
+    out: &'a mut Vec<u8>,
+    limit: u64,
+}
+
+impl Write for LimitedWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.out.len() as u64 + buf.len() as u64 > self.limit {
+            return Err(std::io::Error::other(format!(
+                "decompressed data exceeds the {} bytes announced",
+                self.limit
+            )));
+        }
+        self.out.extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Compresses `data` as one zstd frame (ruzstd's fastest level, about zstd level 1).
+pub fn compress(data: &[u8], out: &mut Vec<u8>) {
+    out.clear();
+    ruzstd::encoding::compress(data, &mut *out, ruzstd::encoding::CompressionLevel::Fastest);
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn round_trip_and_limit() {
+        let data: Vec<u8> = (0..200_000u32)
+            .flat_map(|i| (i % 251).to_le_bytes())
+            .collect();
+        let mut z = Vec::new();
+        super::compress(&data, &mut z);
+        assert!(z.len() < data.len() / 2);
+        let mut back = Vec::new();
+        super::decompress_into(&z, &mut back, data.len() as u64).unwrap();
+        assert_eq!(back, data);
+        assert!(super::decompress_into(&z, &mut back, 1000).is_err());
+        assert!(super::decompress_into(&z[..z.len() / 2], &mut back, u64::MAX).is_err());
+    }
+}
