@@ -36,10 +36,35 @@ pub const DIRECT_MAX: usize = 4096;
 /// Half-width (in terms) of the exactly summed windows around the singular points.
 pub const WINDOW: usize = 64;
 
+/// Entries kept by the memo of [`greenhall_edf`] before it is cleared.
+const MEMO_MAX: usize = 1 << 16;
+
 /// Greenhall EDF of the Allan variance at cluster size `m` from `n_phase` phase points
 /// (= rate samples + 1) for power-law noise `alpha` ∈ −2..=2. `None` for another α or when
-/// there is no second difference.
+/// there is no second difference. Memoised: the axes of an IMU share their grid and length,
+/// and the declared-fit check asks for the same points again.
 pub fn greenhall_edf(alpha: i32, m: usize, n_phase: usize, kind: Overlap) -> Option<f64> {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    type Key = (i32, usize, usize, bool);
+    static MEMO: OnceLock<Mutex<HashMap<Key, Option<f64>>>> = OnceLock::new();
+    let key = (alpha, m, n_phase, kind == Overlap::Normal);
+    let memo = MEMO.get_or_init(|| Mutex::new(HashMap::new()));
+    if let Some(v) = memo.lock().ok().and_then(|g| g.get(&key).copied()) {
+        return v;
+    }
+    let v = greenhall_edf_uncached(alpha, m, n_phase, kind);
+    if let Ok(mut g) = memo.lock() {
+        if g.len() >= MEMO_MAX {
+            g.clear();
+        }
+        g.insert(key, v);
+    }
+    v
+}
+
+/// [`greenhall_edf`] without the memo.
+fn greenhall_edf_uncached(alpha: i32, m: usize, n_phase: usize, kind: Overlap) -> Option<f64> {
     if !(-2..=2).contains(&alpha) || m == 0 {
         return None;
     }

@@ -169,18 +169,18 @@ impl CurveData {
             return Err(Ieee952Error::TooShort { n: y.len(), min });
         }
         let phase = Phase::from_rate(y, tau0);
-        let points = ms
+        let avars = phase.avar_curve(&ms);
+        let points = avars
             .par_iter()
-            .filter_map(|&m| {
-                let p = phase.avar(m, Overlap::Overlapping)?;
-                let id = noise_id::identify(&phase, m);
-                Some(CurvePoint {
+            .map(|p| {
+                let id = noise_id::identify(&phase, p.m);
+                CurvePoint {
                     m: p.m,
                     tau: p.tau,
                     avar: p.avar,
                     id: id.alpha,
                     id_method: id.method,
-                })
+                }
             })
             .collect();
         Ok(CurveData {

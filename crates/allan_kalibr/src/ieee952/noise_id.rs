@@ -44,10 +44,10 @@ pub struct NoiseId {
 }
 
 /// Decimated points the lag-1 method looks at, at most: the middle stretch of that length
-/// (α is a property of the noise, not of the record length; 2¹⁶ points give r1 to ±0.004,
-/// far inside the decision steps of 0.25 in δ). Keeps the identification O(2¹⁶) per τ
+/// (α is a property of the noise, not of the record length; 2¹⁴ points give r1 to ±0.008,
+/// far inside the decision steps of 0.25 in δ). Keeps the identification O(2¹⁴) per τ
 /// instead of O(n/m).
-pub const MAX_ID_POINTS: usize = 1 << 16;
+pub const MAX_ID_POINTS: usize = 1 << 14;
 
 /// Identifies the dominant power-law noise at cluster size m.
 pub fn identify(phase: &Phase, m: usize) -> NoiseId {

@@ -186,16 +186,23 @@ impl StartStats {
         })
     }
 
-    /// From the samples.
+    /// From the samples (window sums taken directly, no copy of the record).
     pub fn from_samples(y: &[f64], tau0: f64) -> Option<StartStats> {
-        let mut cum = Vec::with_capacity(y.len() + 1);
-        cum.push(0.0);
-        let mut s = 0.0;
-        for v in y {
-            s += v;
-            cum.push(s);
+        let n = y.len();
+        let window = ((n / 200).max(10)).min(n / 6);
+        if window == 0 || n < 60 {
+            return None;
         }
-        StartStats::from_cumsum(y.len(), tau0, |k| cum[k])
+        let mean = |a: usize, b: usize| y[a..b].iter().sum::<f64>() / (b - a) as f64;
+        Some(StartStats {
+            window,
+            tau0,
+            n,
+            means: (0..(n / 3) / window)
+                .map(|j| mean(j * window, (j + 1) * window))
+                .collect(),
+            reference: mean(n / 2, n),
+        })
     }
 }
 
