@@ -127,38 +127,29 @@ fn curves<'a>(an: &'a Analysis, name: &str, base: usize) -> Curves<'a> {
     }
 }
 
-/// Draws one file: PNG through bag2mat's atomic PNG helper, SVG rendered to a string and
-/// written atomically.
-fn render(path: &Path, c: &Curves<'_>, svg: bool) -> Result<(), Error> {
-    if !svg {
-        return bag2mat::shared::plot::png_atomic(path, SIZE, |root| draw(&root, c))
-            .map_err(Error::from);
-    }
-    let mut text = String::new();
+impl bag2mat::shared::plot::Figure for Curves<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
     {
-        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(&root, c).map_err(|what| Error::Plot {
-            path: path.to_path_buf(),
-            what,
-        })?;
+        draw(root, self)
     }
-    crate::report::write_text(path, &text)
 }
 
-/// Writes the four plot files into `dir`; returns their paths.
+/// Writes the four plot files into `dir` (the workspace's PNG+SVG writer, the two sensors in
+/// parallel); returns their paths.
 pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    bag2mat::shared::plot::register_font();
     use rayon::prelude::*;
-    let jobs = [
-        ("allan_gyr", 0, "png"),
-        ("allan_gyr", 0, "svg"),
-        ("allan_acc", 3, "png"),
-        ("allan_acc", 3, "svg"),
-    ];
-    jobs.par_iter()
-        .map(|&(stem, base, ext)| {
-            let p = dir.join(format!("{stem}.{ext}"));
-            render(&p, &curves(an, name, base), ext == "svg").map(|()| p)
+    let jobs = [("allan_gyr", 0), ("allan_acc", 3)];
+    let files: Vec<[PathBuf; 2]> = jobs
+        .par_iter()
+        .map(|&(stem, base)| {
+            bag2mat::shared::plot::write_png_svg(&curves(an, name, base), dir, stem, SIZE, SIZE)
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    Ok(files.into_iter().flatten().collect())
 }

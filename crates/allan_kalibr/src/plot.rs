@@ -44,32 +44,24 @@ pub struct Chart<'a> {
     pub fit: &'a ChartFit,
 }
 
-/// Draws `chart` into `<stem>.png` and `<stem>.svg` under `dir`; returns the two paths.
+/// Draws `chart` into `<stem>.png` and `<stem>.svg` under `dir` (the workspace's PNG+SVG
+/// writer); returns the two paths.
 pub fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2], Error> {
-    bag2mat::shared::plot::register_font();
-    let png = dir.join(format!("{stem}.png"));
-    let svg = dir.join(format!("{stem}.svg"));
-
-    // SVG: drawn into a string, then written atomically.
-    let mut svg_text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg_text, SVG_SIZE).into_drawing_area();
-        draw(chart, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
-        root.present().map_err(|e| plot_err(&svg, e))?;
-    }
-    bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
-
-    bag2mat::shared::plot::png_atomic(&png, PNG_SIZE, |root| {
-        draw(chart, &root, PNG_SIZE.0 as f64 / SVG_SIZE.0 as f64).map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())
-    })?;
-    Ok([png, svg])
+    Ok(bag2mat::shared::plot::write_png_svg(
+        chart, dir, stem, SVG_SIZE, PNG_SIZE,
+    )?)
 }
 
-fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Plot {
-        path: path.to_path_buf(),
-        what: e.to_string(),
+impl bag2mat::shared::plot::Figure for Chart<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(self, root, scale).map_err(|e| e.to_string())
     }
 }
 

@@ -168,6 +168,26 @@ where
     root.present().map_err(|x| e(&x))
 }
 
+/// What one comparison chart draws.
+struct Compare<'a> {
+    title: &'a str,
+    unit: &'a str,
+    curves: &'a [Curves],
+}
+
+impl bag2mat::shared::plot::Figure for Compare<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _scale: f64,
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root.clone(), self.title, self.unit, self.curves)
+    }
+}
+
 /// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison root.
 pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
@@ -194,23 +214,17 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
             "{sensor}: {} Hz, {} s — kalibr_allan, IEEE 952 and the truth",
             cfg.rate, cfg.duration
         );
-        let png = cfg.root.join(format!("compare_{sensor}.png"));
-        bag2mat::shared::plot::png_atomic(&png, SIZE, |area| draw(area, &title, unit, &curves))?;
-        files.push(png);
-        let svg = cfg.root.join(format!("compare_{sensor}.svg"));
-        let mut text = String::new();
-        draw(
-            SVGBackend::with_string(&mut text, SIZE).into_drawing_area(),
-            &title,
-            unit,
-            &curves,
-        )
-        .map_err(|msg| SimError::Plot {
-            path: svg.clone(),
-            msg,
-        })?;
-        bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
-        files.push(svg);
+        files.extend(bag2mat::shared::plot::write_png_svg(
+            &Compare {
+                title: &title,
+                unit,
+                curves: &curves,
+            },
+            &cfg.root,
+            &format!("compare_{sensor}"),
+            SIZE,
+            SIZE,
+        )?);
     }
     Ok(files)
 }

@@ -1,7 +1,7 @@
 //! Plots of `sim integrate`: ground truth and the integrated trajectories (top view, z over
 //! time, position error over time), PNG and SVG, with bag2mat's embedded font.
 
-use crate::error::{Result, SimError};
+use crate::error::Result;
 use crate::integrate::State;
 use crate::textio::PoseRow;
 use plotters::coord::Shift;
@@ -212,28 +212,51 @@ where
     Ok(())
 }
 
-/// Draw `stem.png` and `stem.svg` (written atomically).
+/// Draw `stem.png` and `stem.svg` (the workspace's PNG+SVG writer, atomically).
 pub fn plot_integration(
     stem: &Path,
     title: &str,
     truth: &[PoseRow],
     tracks: &[Track],
 ) -> Result<()> {
-    bag2mat::shared::plot::register_font();
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
-    let perr = |p: &Path, msg: String| SimError::Plot {
-        path: p.into(),
-        msg,
+    let dir = match stem.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     };
-    bag2mat::shared::plot::png_atomic(&png, SIZE, |area| draw(area, title, truth, tracks))?;
-    let mut s = String::new();
-    draw(
-        SVGBackend::with_string(&mut s, SIZE).into_drawing_area(),
-        title,
-        truth,
-        tracks,
-    )
-    .map_err(|m| perr(&svg, m))?;
-    crate::textio::write_string(&svg, &s)
+    let name = stem
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    bag2mat::shared::plot::write_png_svg(
+        &Integration {
+            title,
+            truth,
+            tracks,
+        },
+        dir,
+        &name,
+        SIZE,
+        SIZE,
+    )?;
+    Ok(())
+}
+
+/// What [`plot_integration`] draws.
+struct Integration<'a> {
+    title: &'a str,
+    truth: &'a [PoseRow],
+    tracks: &'a [Track<'a>],
+}
+
+impl bag2mat::shared::plot::Figure for Integration<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _scale: f64,
+    ) -> std::result::Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root.clone(), self.title, self.truth, self.tracks)
+    }
 }

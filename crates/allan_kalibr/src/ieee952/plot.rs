@@ -32,7 +32,8 @@ const TERM_COLORS: [RGBColor; 5] = [
 /// A truth curve per axis, in the order of [`ImuAnalysis::axes`]: (τ s, σ).
 pub type Truth = Vec<Vec<(f64, f64)>>;
 
-/// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}`; returns the two paths.
+/// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}` (the workspace's PNG+SVG
+/// writer); returns the two paths.
 pub fn write_chart(
     a: &ImuAnalysis,
     title: &str,
@@ -40,32 +41,39 @@ pub fn write_chart(
     dir: &Path,
     prefix: &str,
 ) -> Result<[PathBuf; 2], bag2mat::Error> {
-    bag2mat::shared::plot::register_font();
-    let cols = 3u32;
     let rows = a.axes.len().div_ceil(3).max(1) as u32;
-    let size = (PANEL.0 * cols, PANEL.1 * rows + 40);
-    let png = dir.join(format!("{prefix}{STEM}.png"));
-    let svg = dir.join(format!("{prefix}{STEM}.svg"));
-    let plot_err = |p: &Path, e: String| bag2mat::Error::Plot {
-        path: p.to_path_buf(),
-        what: e,
-    };
-    let mut svg_text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg_text, size).into_drawing_area();
-        draw(a, title, truth, &root, 1.0).map_err(|e| plot_err(&svg, e))?;
-        root.present().map_err(|e| plot_err(&svg, e.to_string()))?;
-    }
-    bag2mat::shared::output::write_atomic(&svg, |w| w.write_all(svg_text.as_bytes()))?;
+    let size = (PANEL.0 * 3, PANEL.1 * rows + 40);
     let psize = (
         (size.0 as f64 * PNG_SCALE) as u32,
         (size.1 as f64 * PNG_SCALE) as u32,
     );
-    bag2mat::shared::plot::png_atomic(&png, psize, |root| {
-        draw(a, title, truth, &root, PNG_SCALE)?;
-        root.present().map_err(|e| e.to_string())
-    })?;
-    Ok([png, svg])
+    bag2mat::shared::plot::write_png_svg(
+        &Chart { a, title, truth },
+        dir,
+        &format!("{prefix}{STEM}"),
+        size,
+        psize,
+    )
+}
+
+/// What the chart shows.
+struct Chart<'a> {
+    a: &'a ImuAnalysis,
+    title: &'a str,
+    truth: Option<&'a Truth>,
+}
+
+impl bag2mat::shared::plot::Figure for Chart<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(self.a, self.title, self.truth, root, scale)
+    }
 }
 
 fn draw<DB: DrawingBackend>(

@@ -1,5 +1,8 @@
-//! Plot setup shared by every binary that draws: the lean `plotters` build has no system
-//! fonts, so the DejaVu Sans font shipped in `assets/` is embedded and registered here.
+//! Plot output shared by every binary that draws: the lean `plotters` build has no system
+//! fonts, so the DejaVu Sans font shipped in `assets/` is embedded and registered here; and
+//! the one PNG+SVG writer ([`write_png_svg`]) every chart of the workspace goes through — a
+//! chart implements [`Figure`] (drawing on any plotters backend) and gets both files,
+//! written atomically.
 
 use std::sync::Once;
 
@@ -21,6 +24,51 @@ pub fn register_font() {
             let _ = plotters::style::register_font("sans-serif", style, FONT);
         }
     });
+}
+
+/// A chart drawn the same way on any plotters backend (the SVG and the PNG of one figure).
+pub trait Figure {
+    /// Draws onto `root`. `scale` multiplies every size in pixels: 1 for the SVG (its user
+    /// units), the PNG's width over the SVG's for the PNG.
+    fn draw<DB: plotters::prelude::DrawingBackend>(
+        &self,
+        root: &plotters::drawing::DrawingArea<DB, plotters::coord::Shift>,
+        scale: f64,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Writes `<dir>/<stem>.png` (`png_size` pixels) and `<dir>/<stem>.svg` (`svg_size` user
+/// units) of `fig`, each atomically; returns `[png, svg]`.
+pub fn write_png_svg(
+    fig: &impl Figure,
+    dir: &std::path::Path,
+    stem: &str,
+    svg_size: (u32, u32),
+    png_size: (u32, u32),
+) -> Result<[std::path::PathBuf; 2], crate::Error> {
+    use plotters::prelude::{IntoDrawingArea, SVGBackend};
+    register_font();
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, svg_size).into_drawing_area();
+        fig.draw(&root, 1.0)
+            .and_then(|()| root.present().map_err(|e| e.to_string()))
+            .map_err(|what| crate::Error::Plot {
+                path: svg.clone(),
+                what,
+            })?;
+    }
+    crate::shared::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
+    let scale = png_size.0 as f64 / svg_size.0.max(1) as f64;
+    png_atomic(&png, png_size, |root| {
+        fig.draw(&root, scale)?;
+        root.present().map_err(|e| e.to_string())
+    })?;
+    Ok([png, svg])
 }
 
 /// Draws a PNG atomically. plotters' bitmap backend writes to a path and picks the encoder
