@@ -15,12 +15,13 @@
 //! * [`rosbag2`]: ROS 2 bag directories, `metadata.yaml`, the sqlite3 storage and rosbag2's
 //!   FILE/MESSAGE zstd compression; [`rosbag2::Ros2BagWriter`].
 //! * [`imu_msg`]: the ROS 1 `sensor_msgs/Imu` layout, md5 and 2571-byte definition;
-//!   [`cdr`]: `sensor_msgs/msg/Imu` in CDR (ROS 2).
+//!   [`cdr`]: `sensor_msgs/msg/Imu` in CDR (ROS 2); [`Sensor`]: its two sensors and their
+//!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
 //! * [`info`]: what an input holds (`bag2mat info`).
-//! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font,
-//!   C `printf` formats.
+//! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
+//!   and the PNG+SVG chart writer, C `printf` formats.
 //!
 //! Units: times are [`RosTime`] (UNIX epoch); accelerations m/s², angular rates rad/s.
 
@@ -35,6 +36,7 @@ pub mod info;
 pub mod mat;
 pub mod mcap;
 pub mod rosbag2;
+pub mod sensor;
 pub mod series;
 pub mod shared;
 pub mod source;
@@ -44,6 +46,7 @@ pub mod zstd;
 
 pub use bag::{Compression, RosTime};
 pub use error::{Error, TopicSummary};
+pub use sensor::Sensor;
 pub use series::{
     ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, permute,
     read_imu_series, read_imu_topics,

@@ -18,14 +18,8 @@ use crate::noise::{
     white_to_continuous, white_to_discrete,
 };
 
-/// The two sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Sensor {
-    /// Gyroscope (rad/s).
-    Gyro,
-    /// Accelerometer (m/s²).
-    Acc,
-}
+/// The two sensors (the workspace's one sensor type).
+pub use bag2mat::Sensor;
 
 /// The two quantities users need.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

@@ -17,14 +17,10 @@ pub const IMU_UTILS_BIAS_FACTOR: f64 = 0.6642824703;
 /// `findMinNum` / `findMinIndex` start their running minimum here (quirk 3).
 pub const IMU_UTILS_MIN_START: f64 = 1000.0;
 
-/// Which of upstream's two twin fit classes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sensor {
-    /// `FitAllanGyr`: values in pseudo-deg/h, no point filter.
-    Gyro,
-    /// `FitAllanAcc`: values in m/s², `checkData` filter.
-    Acc,
-}
+/// Which of upstream's two twin fit classes: `FitAllanGyr` (`Sensor::Gyro`: values in
+/// pseudo-deg/h, no point filter) or `FitAllanAcc` (`Sensor::Acc`: values in m/s², the
+/// `checkData` filter) — the workspace's one sensor type.
+pub use bag2mat::Sensor;
 
 /// Mirrors imu_utils `2cdda91` `FitAllanAcc::checkData` (imu_utils.md §4.1, quirk 6): among
 /// τ < 1 s points, each one that sets a new running maximum of σ² (starting from 0) is
