@@ -36,6 +36,8 @@ pub enum Command {
     Spline(SplineArgs),
     /// Tabulate the analysers' figures (written by scripts/compare.sh) against the truth.
     Compare(CompareArgs),
+    /// List the sensor profiles of `sim bag --sensor` with their figures and sources.
+    Sensors(crate::cli_model::SensorsArgs),
 }
 
 /// `sim compare` arguments.
@@ -246,6 +248,9 @@ pub struct BagArgs {
     /// No progress bar and no parameter report (errors are still printed)
     #[arg(short, long)]
     pub quiet: bool,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub model: crate::cli_model::ModelArgs,
 }
 
 impl TryFrom<BagArgs> for BagConfig {
@@ -255,9 +260,10 @@ impl TryFrom<BagArgs> for BagConfig {
             Some(s) => parse_start_time(s)?,
             None => now_ns(),
         };
+        crate::bag_sim::validate_rate(a.rate)?;
         let cfg = BagConfig {
             out: a.output,
-            noise: a.noise.resolve(PresetArg::Medium)?,
+            model: a.model.resolve(&a.noise, a.rate)?,
             rate: a.rate,
             duration: a.duration,
             seed: a.noise.seed,
@@ -599,7 +605,7 @@ mod tests {
             (c.rate, c.duration, c.topic.as_str(), c.frame_id.as_str()),
             (200.0, 14400.0, "imu", "base_link")
         );
-        assert_eq!(c.noise, Preset::Medium.params());
+        assert_eq!(c.model.legacy(200.0), Some(Preset::Medium.params()));
         assert_eq!(c.motion, Motion::Static);
         assert_eq!(c.compression, Compression::None);
         assert_eq!(c.start_ns, 1_700_000_000_000_000_000);
@@ -615,8 +621,9 @@ mod tests {
             panic!()
         };
         let c = BagConfig::try_from(a).unwrap();
-        assert_eq!(c.noise.acc_noise, 0.5);
-        assert_eq!(c.noise.gyro_noise, 0.03);
+        let n = c.model.legacy(200.0).unwrap();
+        assert_eq!(n.acc_noise, 0.5);
+        assert_eq!(n.gyro_noise, 0.03);
     }
 
     #[test]

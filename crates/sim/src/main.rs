@@ -56,6 +56,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 return Ok(ExitCode::FAILURE);
             }
         }
+        Command::Sensors(a) => {
+            if a.spec_example {
+                print!("{}", sim::cli_model::SPEC_EXAMPLE);
+            } else {
+                sim::bag_sim::validate_rate(a.rate)?;
+                print!("{}", sim::noise::profiles::listing(a.rate));
+            }
+        }
         Command::Spline(a) => {
             if a.self_check {
                 let (text, pass) = sim::report::spline_self_check(a.pose_rate)?;
