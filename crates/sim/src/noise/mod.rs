@@ -46,6 +46,9 @@ pub mod spec;
 pub mod truth;
 pub mod truth_file;
 
+#[cfg(test)]
+mod tests_stat;
+
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};

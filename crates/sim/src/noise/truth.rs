@@ -254,6 +254,21 @@ pub fn warmup_avar(amplitude: f64, beta: f64, m: usize, n: usize) -> f64 {
     amplitude * amplitude / (2.0 * big_m * mf * mf) * f * f * geo
 }
 
+/// The cross term (1/M)·Σ_k d_ramp·d_warm,k of a ramp (its second difference is the constant
+/// `ramp_tau` = R·τ) and a warm-up A·w^n in the overlapping estimator:
+/// R·τ·(−A/m)·((1−w^m)²/(1−w))·(1−w^M)/((1−w)·M).
+pub fn ramp_warmup_cross(ramp_tau: f64, amplitude: f64, beta: f64, m: usize, n: usize) -> f64 {
+    if 2 * m > n {
+        return f64::NAN;
+    }
+    let big_m = (n + 1 - 2 * m) as f64;
+    let mf = m as f64;
+    let one_minus_wm = -(-mf * beta).exp_m1();
+    let one_minus_w = -(-beta).exp_m1();
+    let geo = -(-big_m * beta).exp_m1() / one_minus_w;
+    ramp_tau * (-amplitude / mf) * one_minus_wm * one_minus_wm / one_minus_w * geo / big_m
+}
+
 /// Autocovariance of filtered, decimated white noise at the output (lags 0..), and the Allan
 /// variance from it.
 #[derive(Debug, Clone, PartialEq)]
@@ -322,6 +337,51 @@ impl FilteredWhite {
     }
 }
 
+impl FilteredWhite {
+    /// Exact equivalent degrees of freedom of the overlapping Allan variance estimate at
+    /// cluster size m from `n` samples, for this Gaussian sequence plus independent white
+    /// noise of variance `extra_white` (e.g. the LSB rounding): with d_k the second
+    /// difference of m-sample sums and ρ(l) its autocovariance,
+    /// ν = 2·E[Â]²/Var(Â) = M²ρ(0)² / Σ_{|l|<M} (M − |l|)·ρ(l)², M = n − 2m + 1.
+    /// ρ(l) = Σ_j g(|j|)·R(l − j) has support 2m + (filter lags), so this costs O(m²).
+    pub fn edf(&self, m: usize, n: usize, extra_white: f64) -> f64 {
+        if 2 * m > n {
+            return f64::NAN;
+        }
+        let mf = m as f64;
+        let r = |k: usize| -> f64 {
+            let base = self.r.get(k).copied().unwrap_or(0.0);
+            if k == 0 { base + extra_white } else { base }
+        };
+        let g = |k: usize| -> f64 {
+            if k <= m {
+                2.0 * mf - 3.0 * k as f64
+            } else if k <= 2 * m {
+                -(2.0 * mf - k as f64)
+            } else {
+                0.0
+            }
+        };
+        let support = 2 * m + self.r.len();
+        let big_m = n + 1 - 2 * m;
+        let rho = |l: usize| -> f64 {
+            let mut s = 0.0;
+            for j in -(2 * m as i64)..=(2 * m as i64) {
+                let k = (l as i64 - j).unsigned_abs() as usize;
+                s += g(j.unsigned_abs() as usize) * r(k);
+            }
+            s
+        };
+        let rho0 = rho(0);
+        let mut sum = big_m as f64 * rho0 * rho0;
+        for l in 1..support.min(big_m) {
+            let v = rho(l);
+            sum += 2.0 * (big_m - l) as f64 * v * v;
+        }
+        (big_m as f64).powi(2) * rho0 * rho0 / sum
+    }
+}
+
 /// The terms' Allan variances at one cluster size (U²).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct TermAvar {
@@ -341,6 +401,9 @@ pub struct TermAvar {
     pub rate_ramp: f64,
     /// Warm-up.
     pub warmup: f64,
+    /// Cross term of the two deterministic terms (ramp × warm-up): deterministic signals are
+    /// not independent, so their Allan variances do not simply add. May be negative.
+    pub deterministic_cross: f64,
 }
 
 /// Term names in [`TermAvar`] order (file columns).
@@ -372,12 +435,12 @@ impl TermAvar {
 
     /// Sum of all terms.
     pub fn total(&self) -> f64 {
-        self.values().iter().sum()
+        self.values().iter().sum::<f64>() + self.deterministic_cross
     }
 
-    /// Sum of the deterministic terms (ramp, warm-up).
+    /// The deterministic part (ramp, warm-up and their cross term).
     pub fn deterministic(&self) -> f64 {
-        self.rate_ramp + self.warmup
+        self.rate_ramp + self.warmup + self.deterministic_cross
     }
 }
 
@@ -427,6 +490,11 @@ impl AxisTruth {
         &self.white
     }
 
+    /// Variance of the LSB rounding error (white), U².
+    pub fn resolution_variance(&self) -> f64 {
+        self.lsb_var
+    }
+
     /// Every term at cluster size m.
     pub fn terms(&self, m: usize) -> TermAvar {
         let tau = m as f64 * self.dt;
@@ -443,6 +511,12 @@ impl AxisTruth {
                 .warmup
                 .map(|(a, b)| warmup_avar(a, b, m, self.n))
                 .unwrap_or(0.0),
+            deterministic_cross: match self.warmup {
+                Some((a, b)) if self.ramp != 0.0 => {
+                    ramp_warmup_cross(self.ramp * tau, a, b, m, self.n)
+                }
+                _ => 0.0,
+            },
         }
     }
 
