@@ -64,22 +64,22 @@ pub struct ModelArgs {
     #[arg(long, value_name = "HZ")]
     pub acc_lpf: Option<f64>,
     /// Gyro bias instability B [rad/s] (flicker noise; Allan floor 0.664·B).
-    #[arg(long, value_name = "B")]
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
     pub gyro_bias_instability: Option<f64>,
     /// Accelerometer bias instability B [m/s²].
-    #[arg(long, value_name = "B")]
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
     pub acc_bias_instability: Option<f64>,
     /// Corner times of the gyro flicker floor [s] (default 1,1000 when B is new).
-    #[arg(long, value_name = "LO,HI", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "LO,HI", value_delimiter = ',')]
     pub gyro_bi_taus: Option<Vec<f64>>,
     /// Corner times of the accelerometer flicker floor [s].
-    #[arg(long, value_name = "LO,HI", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "LO,HI", value_delimiter = ',')]
     pub acc_bi_taus: Option<Vec<f64>>,
     /// Gyro first-order Gauss–Markov bias: σ [rad/s], correlation time [s] (replaces the base's).
-    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',')]
     pub gyro_gm: Option<Vec<f64>>,
     /// Accelerometer Gauss–Markov bias: σ [m/s²], correlation time [s].
-    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',')]
     pub acc_gm: Option<Vec<f64>>,
     /// Gyro rate ramp R [rad/s²] (deterministic).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
@@ -88,16 +88,16 @@ pub struct ModelArgs {
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub acc_ramp: Option<f64>,
     /// Gyro quantization Q [rad] (IEEE 952: the integrated angle in steps of √12·Q).
-    #[arg(long, value_name = "Q")]
+    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
     pub gyro_quantization: Option<f64>,
     /// Accelerometer quantization Q [m/s] (integrated velocity).
-    #[arg(long, value_name = "Q")]
+    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
     pub acc_quantization: Option<f64>,
     /// Gyro output LSB [rad/s]: values rounded to counts of it; 0 = none.
-    #[arg(long, value_name = "LSB")]
+    #[arg(long, value_name = "LSB", allow_negative_numbers = true)]
     pub gyro_resolution: Option<f64>,
     /// Accelerometer output LSB [m/s²].
-    #[arg(long, value_name = "LSB")]
+    #[arg(long, value_name = "LSB", allow_negative_numbers = true)]
     pub acc_resolution: Option<f64>,
     /// Gyro warm-up: bias A·exp(−t/T) after power-on; A [rad/s], T [s].
     #[arg(
@@ -198,6 +198,17 @@ impl ModelArgs {
         ];
         for (s, b, taus, gm, ramp, q, lsb, warm) in per_sensor {
             let flag = |name: &str| format!("--{}-{name}", s.short());
+            for (name, v) in [("bi-taus", taus), ("gm", gm), ("warmup", warm)] {
+                if let Some(v) = v
+                    && v.len() != 2
+                {
+                    return Err(SimError::InvalidArgument(format!(
+                        "{} takes two comma-separated numbers, got {}",
+                        flag(name),
+                        v.len()
+                    )));
+                }
+            }
             for (name, v) in [
                 ("quantization", q),
                 ("resolution", lsb),

@@ -64,12 +64,26 @@ fn sensor_truths(info: &TruthInfo<'_>, s: Sensor) -> Result<(ResolvedChain, Vec<
     Ok((chain, t))
 }
 
-fn g(v: f64) -> String {
+/// Shortest representation that reads back to the same f64 (the model round-trips exactly),
+/// spelled so that YAML 1.1 parsers (PyYAML) see a float too: a '.' in the mantissa and a
+/// signed exponent (`2.0e+2`, not `2e2`).
+pub fn g(v: f64) -> String {
     if v == 0.0 {
-        "0.0".to_string()
-    } else {
-        format!("{v:.10e}")
+        return "0.0".to_string();
     }
+    let s = format!("{v:e}");
+    let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
+    let mant = if mant.contains('.') {
+        mant.to_string()
+    } else {
+        format!("{mant}.0")
+    };
+    let exp = if exp.starts_with('-') {
+        exp.to_string()
+    } else {
+        format!("+{exp}")
+    };
+    format!("{mant}e{exp}")
 }
 
 fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
@@ -510,4 +524,21 @@ pub fn read_model(path: &Path) -> Result<ImuModel> {
     let mut m = super::spec::apply(&spec, Some(super::spec::zero_model("truth")), path)?;
     m.label = format!("truth {}", path.display());
     Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn floats_are_yaml_1_1_floats_and_round_trip() {
+        for (v, s) in [
+            (200.0, "2.0e+2"),
+            (4e-7, "4.0e-7"),
+            (9.69627362219072e-6, "9.69627362219072e-6"),
+            (0.0, "0.0"),
+            (-1.5, "-1.5e+0"),
+        ] {
+            assert_eq!(super::g(v), s);
+            assert_eq!(s.parse::<f64>().unwrap(), v);
+        }
+    }
 }
