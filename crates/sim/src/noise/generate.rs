@@ -197,13 +197,18 @@ impl Quantizer {
     }
 }
 
-/// The real-sensor noise of a whole IMU, sample by sample, generated in parallel blocks.
+/// The real-sensor noise of a whole IMU, sample by sample. A worker thread generates the
+/// next blocks (the six axes in parallel) while the caller consumes the current one, so the
+/// generation overlaps the bag writing.
 pub struct ImuNoise {
-    axes: Vec<AxisGenerator>,
     quant: Vec<Quantizer>,
+    rx: std::sync::mpsc::Receiver<Vec<Vec<f64>>>,
     buf: Vec<Vec<f64>>,
     pos: usize,
 }
+
+/// Blocks generated ahead of the consumer.
+const BLOCKS_AHEAD: usize = 2;
 
 impl ImuNoise {
     /// The generator of `model` at `rate` Hz, seeded with `seed`.
@@ -222,27 +227,32 @@ impl ImuNoise {
                 axes.push(g);
             }
         }
+        let (tx, rx) = std::sync::mpsc::sync_channel(BLOCKS_AHEAD);
+        std::thread::spawn(move || {
+            loop {
+                let mut buf = vec![vec![0.0; BLOCK]; 6];
+                axes.par_iter_mut()
+                    .zip(buf.par_iter_mut())
+                    .for_each(|(g, b)| g.fill(b));
+                if tx.send(buf).is_err() {
+                    break; // the consumer is gone
+                }
+            }
+        });
         Ok(ImuNoise {
-            axes,
             quant,
-            buf: vec![vec![0.0; BLOCK]; 6],
+            rx,
+            buf: Vec::new(),
             pos: BLOCK,
         })
-    }
-
-    fn refill(&mut self) {
-        self.axes
-            .par_iter_mut()
-            .zip(self.buf.par_iter_mut())
-            .for_each(|(g, b)| g.fill(b));
-        self.pos = 0;
     }
 
     /// Add the noise of the next sample to the clean `gyro` and `acc` and quantise.
     #[inline]
     pub fn apply(&mut self, gyro: &mut [f64; 3], acc: &mut [f64; 3]) {
         if self.pos == BLOCK {
-            self.refill();
+            self.buf = self.rx.recv().expect("noise worker stopped");
+            self.pos = 0;
         }
         let p = self.pos;
         for i in 0..3 {
