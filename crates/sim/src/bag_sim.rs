@@ -183,7 +183,10 @@ pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
     let mut sink = ImuBagSink::create(&cfg.out, cfg.compression, &cfg.topic, &cfg.frame_id)?;
     // The presets' model is vio_data_simulation's: keep its generator (byte-identical bags).
     let mut noise = match cfg.model.legacy(cfg.rate) {
-        Some(c) => Noise::Legacy(NoiseGenerator::new(c.discretize(1.0 / cfg.rate), cfg.seed)),
+        Some(c) => Noise::Legacy(Box::new(NoiseGenerator::new(
+            c.discretize(1.0 / cfg.rate),
+            cfg.seed,
+        ))),
         None => Noise::Real(Box::new(ImuNoise::new(&cfg.model, cfg.rate, cfg.seed)?)),
     };
     // The static model does not depend on t (upstream calls MotionModel(0)): compute it once.
@@ -231,7 +234,7 @@ pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
 
 /// The two noise generators behind `sim bag`.
 enum Noise {
-    Legacy(NoiseGenerator),
+    Legacy(Box<NoiseGenerator>),
     Real(Box<ImuNoise>),
 }
 

@@ -27,7 +27,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Write a simulated IMU bag (default: vio_data_simulation ros_version's 4 h static bag).
-    Bag(BagArgs),
+    Bag(Box<BagArgs>),
     /// Write the upstream text files of the 20 s ellipse trajectory.
     Traj(TrajArgs),
     /// Integrate IMU samples (Euler vs midpoint) and report the errors.
@@ -600,7 +600,7 @@ mod tests {
         else {
             panic!("not bag")
         };
-        let c = BagConfig::try_from(a).unwrap();
+        let c = BagConfig::try_from(*a).unwrap();
         assert_eq!(
             (c.rate, c.duration, c.topic.as_str(), c.frame_id.as_str()),
             (200.0, 14400.0, "imu", "base_link")
@@ -620,7 +620,7 @@ mod tests {
         else {
             panic!()
         };
-        let c = BagConfig::try_from(a).unwrap();
+        let c = BagConfig::try_from(*a).unwrap();
         let n = c.model.legacy(200.0).unwrap();
         assert_eq!(n.acc_noise, 0.5);
         assert_eq!(n.gyro_noise, 0.03);
@@ -639,7 +639,7 @@ mod tests {
                 panic!()
             };
             assert!(
-                BagConfig::try_from(a).is_err(),
+                BagConfig::try_from(*a).is_err(),
                 "{args:?} should be rejected"
             );
         }

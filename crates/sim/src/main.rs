@@ -18,7 +18,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Bag(a) => {
-            let cfg = sim::bag_sim::BagConfig::try_from(a)?;
+            let cfg = sim::bag_sim::BagConfig::try_from(*a)?;
             if !cfg.quiet {
                 eprintln!("{}", sim::report::bag_header(&cfg));
             }

@@ -5,11 +5,11 @@
 //!    low-pass filter; the output keeps the last of the D filtered samples (for the averaging
 //!    filter, the mean of the D samples, drawn directly as one normal of σ_w/√D — the same
 //!    distribution; without a filter the D − 1 discarded samples are not drawn);
-//! 2. + bias random walk b_n (applied before its update, as vio_data_simulation does),
+//! 2. plus the bias random walk b_n, applied before its update (as vio_data_simulation does):
 //!    b_{n+1} = b_n + K√Δt·e;
-//! 3. + each AR(1) component (flicker components, then Gauss–Markov biases):
-//!    x_{n+1} = a·x_n + σ√(1 − a²)·e, a = e^(−Δt/T), started from its stationary law;
-//! 4. + ramp R·nΔt + warm-up A·e^(−nΔt/T).
+//! 3. plus each AR(1) component (flicker components, then Gauss–Markov biases), started from
+//!    its stationary law: x_{n+1} = a·x_n + σ√(1 − a²)·e, a = e^(−Δt/T);
+//! 4. plus the ramp R·nΔt and the warm-up A·e^(−nΔt/T).
 //!
 //! Then, in [`ImuNoise::apply`], the motion signal is added and the sum is quantised:
 //! the integrated angle/velocity with step q = √12·Q (the rate is the difference of the

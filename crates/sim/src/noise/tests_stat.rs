@@ -86,6 +86,7 @@ fn edf(tr: &AxisTruth, a: &AxisModel, t: &TermAvar, m: usize, n: usize, dt: f64)
 }
 
 /// Checks one generated series against its truth at octave m; returns (points, misses).
+#[allow(clippy::too_many_arguments)]
 fn check_series(
     model: &ImuModel,
     s: Sensor,
