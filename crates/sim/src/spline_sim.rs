@@ -234,7 +234,11 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
     pb.finish_and_clear();
     // The truth beside the bag: the noise model (zero with --no-noise) and its Allan deviation.
     let model = crate::noise::model::ImuModel::from_continuous(
-        if cfg.noise.is_some() { "spline" } else { "spline (no noise)" },
+        if cfg.noise.is_some() {
+            "spline"
+        } else {
+            "spline (no noise)"
+        },
         &cfg.noise.unwrap_or(ContinuousNoise::ZERO),
     );
     let truth = crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {

@@ -11,7 +11,7 @@
 //! | `gauss_markov` | first-order Gauss–Markov bias (σ, T) | U, s | bump near τ ≈ 1.9·T |
 //! | `rate_ramp` | deterministic ramp R | U/s | R·τ/√2 |
 //! | `quantization` | IEEE 952 Q, on the integrated angle/velocity | U·s | √3·Q/τ |
-//! | `resolution` | output LSB: values rounded to counts | U | white, r/√(12·f·τ)·… |
+//! | `resolution` | output LSB: values rounded to counts | U | white: AVAR r²/(12·m), m = τ·f |
 //! | `warmup` | exponential bias settling after power-on | U, s | deterministic |
 //!
 //! Where each term enters the chain (and so what the truth in [`super::truth`] computes):

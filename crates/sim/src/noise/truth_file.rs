@@ -9,7 +9,8 @@
 //!
 //! CSV columns: `m` (cluster size), `tau_s`, then `gyro_x … acc_z` (total Allan deviation,
 //! rad/s and m/s²), then `<sensor>_<axis>_<term>` for every term that is on for that sensor
-//! (its own Allan deviation; the totals are the root-sum-square of these).
+//! (its own Allan deviation; the totals are the root-sum-square of these, plus the ramp ×
+//! warm-up cross term when both deterministic terms are on).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
