@@ -21,6 +21,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             let cfg = sim::bag_sim::BagConfig::try_from(*a)?;
             if !cfg.quiet {
                 eprintln!("{}", sim::report::bag_header(&cfg));
+                let n = sim::bag_sim::message_count(cfg.rate, cfg.duration) as usize;
+                for w in sim::noise::truth_file::widrow_warnings(&cfg.model, cfg.rate, n)? {
+                    eprintln!("warning: {w}");
+                }
             }
             let s = sim::bag_sim::run(&cfg)
                 .with_context(|| format!("writing {}", cfg.out.display()))?;

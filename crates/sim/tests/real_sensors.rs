@@ -204,3 +204,36 @@ fn sensors_lists_every_profile_with_figures_and_the_spec_example_parses() {
     std::fs::write(d.path().join("ex.yaml"), &ex).unwrap();
     bag(d.path(), "ex.bag", &["--noise-spec", "ex.yaml"]);
 }
+
+#[test]
+fn sensor_preset_equals_preset_byte_for_byte_and_coarse_quantization_is_flagged() {
+    let d = tempfile::tempdir().unwrap();
+    bag(d.path(), "p.bag", &["--preset", "high"]);
+    bag(d.path(), "s.bag", &["--sensor", "high"]);
+    assert!(
+        std::fs::read(d.path().join("p.bag")).unwrap()
+            == std::fs::read(d.path().join("s.bag")).unwrap(),
+        "--sensor high must be the --preset high bag"
+    );
+    // Q far above the noise's motion of the integrated angle: warned (not an error).
+    let (_, err) = ok(
+        d.path(),
+        &[
+            "bag",
+            "-o",
+            "q.bag",
+            "--duration",
+            "5",
+            "--start-time",
+            START,
+            "--preset",
+            "low",
+            "--gyro-quantization",
+            "1e-2",
+        ],
+    );
+    assert!(
+        err.contains("warning: gyroscope x: the quantization step"),
+        "{err}"
+    );
+}

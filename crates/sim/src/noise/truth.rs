@@ -525,6 +525,40 @@ impl AxisTruth {
         self.terms(m).total()
     }
 
+    /// Widrow ratio of the output LSB: sd of the change of the value per sample (all other
+    /// terms) over the LSB; `None` without an LSB.
+    pub fn widrow_resolution(&self) -> Option<f64> {
+        if self.lsb_var == 0.0 {
+            return None;
+        }
+        let t1 = self.terms(1);
+        let change_var = 2.0 * (t1.total() - t1.quantization - t1.resolution);
+        Some(widrow_ratio(
+            change_var.max(0.0).sqrt(),
+            (12.0 * self.lsb_var).sqrt(),
+        ))
+    }
+
+    /// Widrow ratio of the IEEE 952 quantization: sd of the increment of the integrated value
+    /// per sample (the stationary random terms) over the step √12·Q; `None` without Q.
+    pub fn widrow_quantization(&self) -> Option<f64> {
+        if self.quantization == 0.0 {
+            return None;
+        }
+        let others = self.white.variance()
+            + self
+                .flicker
+                .iter()
+                .chain(&self.gm)
+                .map(|v| v.0)
+                .sum::<f64>()
+            + self.rw_step * self.rw_step;
+        Some(widrow_ratio(
+            others.sqrt() * self.dt,
+            super::quantization_step(self.quantization),
+        ))
+    }
+
     /// Per-sample variance of the random part of the output (white, LSB, quantization,
     /// flicker, Gauss–Markov; the random walk and deterministic terms are not stationary).
     pub fn stationary_variance(&self) -> f64 {
@@ -539,6 +573,9 @@ impl AxisTruth {
                 .sum::<f64>()
     }
 }
+
+/// Below this Widrow ratio `sim bag` warns that a rounding term's truth is approximate.
+pub const WIDROW_MIN: f64 = 0.5;
 
 /// Widrow's condition for a rounding error to be uniform and white: the standard deviation of
 /// the quantised quantity's change per sample over the step. The uniform-white approximation

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use super::filter::{Biquad, autocorrelation, enbw, impulse_response};
 use super::model::{AXES, AxisModel, Filter, ImuModel, ResolvedChain, Sensor, Warmup};
-use super::truth::{AxisTruth, TERM_NAMES, TermAvar, tau_grid, widrow_ratio};
+use super::truth::{AxisTruth, TERM_NAMES, TermAvar, WIDROW_MIN, tau_grid};
 use crate::error::{Result, SimError};
 
 /// What the truth describes.
@@ -348,28 +348,18 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
                 );
             }
             // Widrow ratios: how well the rounding errors are uniform and white.
-            let t1 = t.terms(1);
-            let change_var = 2.0 * (t1.total() - t1.quantization - t1.resolution);
-            let rand_sd = (t.stationary_variance()
-                - a.resolution * a.resolution / 12.0
-                - 2.0 * a.quantization * a.quantization / (dt * dt))
-                .max(0.0)
-                .sqrt();
-            if a.resolution > 0.0 {
+            if let Some(r) = t.widrow_resolution() {
                 let _ = writeln!(
                     o,
                     "        widrow_ratio_resolution: {}   # sd of the change per sample / LSB; >= 1: rounding error white (truth exact)",
-                    g(widrow_ratio(change_var.max(0.0).sqrt(), a.resolution))
+                    g(r)
                 );
             }
-            if a.quantization > 0.0 {
+            if let Some(r) = t.widrow_quantization() {
                 let _ = writeln!(
                     o,
-                    "        widrow_ratio_quantization: {}   # sd of the increment per sample / step",
-                    g(widrow_ratio(
-                        rand_sd * dt,
-                        super::quantization_step(a.quantization)
-                    ))
+                    "        widrow_ratio_quantization: {}   # sd of the increment of the integrated value per sample / step",
+                    g(r)
                 );
             }
             let m1 = (info.rate.round() as usize).max(1);
@@ -441,6 +431,34 @@ pub fn csv_text(info: &TruthInfo<'_>) -> Result<String> {
         o.push('\n');
     }
     Ok(o)
+}
+
+/// One line per axis whose quantization or LSB rounding is too coarse for its noise
+/// (Widrow ratio below [`WIDROW_MIN`]): there the rounding error is not white and the
+/// truth's Q/LSB rows are only approximate.
+pub fn widrow_warnings(model: &ImuModel, rate: f64, samples: usize) -> Result<Vec<String>> {
+    let mut out = Vec::new();
+    let dt = 1.0 / rate;
+    for s in Sensor::BOTH {
+        let chain = model.sensor(s).chain.resolve(s, rate)?;
+        for (axis, a) in AXES.iter().zip(&model.sensor(s).axes) {
+            let t = AxisTruth::new(a, &chain, dt, samples);
+            for (what, r) in [
+                ("output LSB", t.widrow_resolution()),
+                ("quantization step (sqrt(12)*Q)", t.widrow_quantization()),
+            ] {
+                if let Some(r) = r
+                    && r < WIDROW_MIN
+                {
+                    out.push(format!(
+                        "{} {axis}: the {what} is coarse for the noise that moves the value (Widrow ratio {r:.2} < {WIDROW_MIN}): the rounding error is not white and the truth's term for it is approximate",
+                        s.name()
+                    ));
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Writes both files atomically beside the bag; returns their paths.
