@@ -49,9 +49,10 @@ pub struct ModelArgs {
     /// Sensor profile from datasheet figures (see `sim sensors`); replaces --preset.
     #[arg(long, value_enum, value_name = "NAME", conflicts_with = "preset")]
     pub sensor: Option<SensorArg>,
-    /// YAML noise model: every term, per sensor, optionally per axis (format in `sim sensors
-    /// --help`); applied on top of --sensor/--preset when given, else on its own `base:` or on
-    /// nothing. A `<bag>.truth.yaml` works too. The flags below override it.
+    /// YAML noise model: every term, per sensor, optionally per axis (`sim sensors
+    /// --spec-example` prints every key with its unit); applied on top of --sensor/--preset
+    /// when given, else on its own `base:` or on nothing. A `<bag>.truth.yaml` works too. The
+    /// flags below override it.
     #[arg(long, value_name = "FILE.yaml")]
     pub noise_spec: Option<PathBuf>,
     /// Internal sample rate of both sensors [Hz]; an integer multiple of --rate.
