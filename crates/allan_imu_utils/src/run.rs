@@ -236,10 +236,11 @@ fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Ve
     let prefix = format!("{}_", config.name);
     let mut out = files::write_outputs(an, &config.out_dir, &prefix, rostopic)?;
     if config.plots {
+        let truth = allan_kalibr::ieee952::plot::find_truth(&config.bag, an);
         out.extend(allan_kalibr::ieee952::plot::write_chart(
             an,
             &config.name,
-            None,
+            truth.as_ref(),
             &config.out_dir,
             &prefix,
         )?);

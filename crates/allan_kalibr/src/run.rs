@@ -259,8 +259,13 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     written.extend(write_plots(&analysis, &title, dir)?);
     if let Some(an) = &ieee {
         written.extend(crate::ieee952::files::write_outputs(an, dir, "", &topic)?);
+        let truth = crate::ieee952::plot::find_truth(&config.input, an);
         written.extend(crate::ieee952::plot::write_chart(
-            an, &title, None, dir, "",
+            an,
+            &title,
+            truth.as_ref(),
+            dir,
+            "",
         )?);
     }
     let timings = Timings {

@@ -257,6 +257,20 @@ fn quad(s: &[f64; 10], c: &[f64; TERM_COUNT]) -> f64 {
     v
 }
 
+/// The bilinear form of a ten-entry basis with different coefficients on each side (the
+/// covariance between two points whose effective coefficients differ).
+fn bilinear(s: &[f64; 10], ci: &[f64; TERM_COUNT], cj: &[f64; TERM_COUNT]) -> f64 {
+    let mut v = 0.0;
+    for (k, &(t, u)) in PAIRS.iter().enumerate() {
+        v += if t == u {
+            ci[t] * cj[u] * s[k]
+        } else {
+            (ci[t] * cj[u] + ci[u] * cj[t]) * s[k]
+        };
+    }
+    v
+}
+
 /// The covariance of the Allan variance estimates at a fixed set of cluster sizes, as a
 /// quadratic form in the model coefficients (see the module docs).
 #[derive(Clone, Debug)]
@@ -318,11 +332,24 @@ impl CovBasis {
 
     /// Covariance matrix of the points `idx` (indices into [`CovBasis::ms`]) for `c`.
     pub fn cov(&self, idx: &[usize], c: &[f64; TERM_COUNT]) -> Vec<Vec<f64>> {
+        let per: Vec<[f64; TERM_COUNT]> = vec![*c; idx.len()];
+        self.cov_pointwise(idx, &per)
+    }
+
+    /// Covariance matrix of the points `idx` when point a has the effective coefficients
+    /// `c[a]` (a component standing in for one of another shape, see the fit's Gauss–Markov
+    /// term): Cov_ab = Σ_{t,u} c_a,t c_b,u S_ab^{tu}.
+    pub fn cov_pointwise(&self, idx: &[usize], c: &[[f64; TERM_COUNT]]) -> Vec<Vec<f64>> {
         let k = idx.len();
         let mut out = vec![vec![0.0; k]; k];
         for a in 0..k {
             for b in a..k {
-                let v = quad(&self.sums[self.tri(idx[a], idx[b])], c);
+                let s = &self.sums[self.tri(idx[a], idx[b])];
+                let v = if c[a] == c[b] {
+                    quad(s, &c[a])
+                } else {
+                    bilinear(s, &c[a], &c[b])
+                };
                 out[a][b] = v;
                 out[b][a] = v;
             }
@@ -334,7 +361,8 @@ impl CovBasis {
                 .collect();
             let v: Vec<f64> = idx
                 .iter()
-                .map(|&i| self.var(i, c).max(0.0).sqrt())
+                .zip(c)
+                .map(|(&i, ci)| self.var(i, ci).max(0.0).sqrt())
                 .collect();
             for a in 0..k {
                 for b in 0..k {
@@ -388,11 +416,11 @@ mod tests {
     const MC_CORR_ABS_TOL: f64 = 0.05;
     const RNG_SEED: u64 = 0xC0_7A12;
 
-    fn model_avar(m: usize, tau0: f64, c: &[f64; 5]) -> f64 {
+    fn model_avar(m: usize, tau0: f64, c: &[f64; 6]) -> f64 {
         (0..5).map(|j| c[j] * basis(j, m as f64 * tau0)).sum()
     }
 
-    fn one(ms: &[usize], n: usize, tau0: f64, c: &[f64; 5]) -> Vec<Vec<f64>> {
+    fn one(ms: &[usize], n: usize, tau0: f64, c: &[f64; 6]) -> Vec<Vec<f64>> {
         let b = CovBasis::new(ms, n, tau0, Overlap::Overlapping);
         let idx: Vec<usize> = (0..ms.len()).collect();
         b.cov(&idx, c)
@@ -403,10 +431,10 @@ mod tests {
         let n = 100_000;
         let tau0 = 0.01;
         for (alpha, c) in [
-            (0, [0.0, 1e-4, 0.0, 0.0, 0.0]),
-            (-2, [0.0, 0.0, 0.0, 1e-6, 0.0]),
-            (2, [1e-6, 0.0, 0.0, 0.0, 0.0]),
-            (-1, [0.0, 0.0, 1e-6, 0.0, 0.0]),
+            (0, [0.0, 1e-4, 0.0, 0.0, 0.0, 0.0]),
+            (-2, [0.0, 0.0, 0.0, 1e-6, 0.0, 0.0]),
+            (2, [1e-6, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            (-1, [0.0, 0.0, 1e-6, 0.0, 0.0, 0.0]),
         ] {
             // (white FM at m = 16 differs by 5 %: Greenhall's kernel is continuous-time, ours exact for
             // sampled white noise — the Monte-Carlo test below confirms ours)
@@ -428,9 +456,9 @@ mod tests {
         let n = 100_000;
         let tau0 = 0.01;
         for (alpha, c) in [
-            (0, [0.0, 1e-4, 0.0, 0.0, 0.0]),
-            (-2, [0.0, 0.0, 0.0, 1e-6, 0.0]),
-            (-1, [0.0, 0.0, 1e-6, 0.0, 0.0]),
+            (0, [0.0, 1e-4, 0.0, 0.0, 0.0, 0.0]),
+            (-2, [0.0, 0.0, 0.0, 1e-6, 0.0, 0.0]),
+            (-1, [0.0, 0.0, 1e-6, 0.0, 0.0, 0.0]),
         ] {
             for m in [100usize, 1000] {
                 let b = CovBasis::new(&[m], n, tau0, Overlap::Normal);
@@ -450,7 +478,7 @@ mod tests {
     fn matches_monte_carlo_on_white_plus_random_walk() {
         let (n, tau0, reps) = (400usize, 0.1f64, 4000usize);
         let (nd, kd) = (0.2f64, 0.05f64);
-        let c = [0.0, nd * nd, 0.0, kd * kd, 0.0];
+        let c = [0.0, nd * nd, 0.0, kd * kd, 0.0, 0.0];
         let ms = [2usize, 3, 8, 40];
         let mut rng = StdRng::seed_from_u64(RNG_SEED);
         let mut samples: Vec<[f64; 4]> = Vec::with_capacity(reps);
@@ -512,11 +540,11 @@ mod tests {
         let n = 1_000_000;
         let tau0 = 0.01;
         let cs = [
-            [1e-8, 1e-4, 1e-6, 1e-8, 0.0],
-            [0.0, 1e-4, 0.0, 0.0, 0.0],
-            [0.0, 0.0, 1e-6, 0.0, 0.0],
-            [0.0, 0.0, 0.0, 1e-8, 0.0],
-            [1e-6, 0.0, 0.0, 0.0, 0.0],
+            [1e-8, 1e-4, 1e-6, 1e-8, 0.0, 0.0],
+            [0.0, 1e-4, 0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 1e-6, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 1e-8, 0.0, 0.0],
+            [1e-6, 0.0, 0.0, 0.0, 0.0, 0.0],
         ];
         for (mi, mj) in [
             (1usize, 1usize),

@@ -44,7 +44,8 @@ pub const COL_VERDICT: &str = "verdict";
 pub const COL_UNIT: &str = "unit";
 /// `fit` or `region` (IEEE 952 region reading: no reliable fit).
 pub const COL_SOURCE: &str = "source";
-/// The axis' fit: `fits`, `fits_range` (part of the curve) or `no_reliable_fit`.
+/// The axis' fit: `fits`, `fits_range` (part of the curve), `fits_approximately` (the model
+/// misses the curve beyond its statistics; see `AxisVerdict::Fits`) or `no_reliable_fit`.
 pub const COL_FIT: &str = "fit";
 /// First τ of the fitted range, s.
 pub const COL_FIT_TAU_LO: &str = "fit_tau_lo";
@@ -165,6 +166,10 @@ pub fn write_outputs(
 fn fit_code(v: &AxisVerdict) -> &'static str {
     match v {
         AxisVerdict::Fits {
+            approximate: Some(_),
+            ..
+        } => "fits_approximately",
+        AxisVerdict::Fits {
             short_cut: false,
             long_cut: false,
             ..
@@ -179,7 +184,7 @@ fn fit_code(v: &AxisVerdict) -> &'static str {
 /// reads back to the same double.
 pub fn terms_csv(a: &ImuAnalysis) -> String {
     let mut s = String::from(
-        "# IEEE 952 terms per axis, continuous time (N: noise density, K: random walk, B: bias instability, Q: quantization, R: ramp)\n",
+        "# IEEE 952 terms per axis, continuous time (N: noise density, K: random walk, B: bias instability, Q: quantization, R: ramp; G: Gauss-Markov bias sigma, GT its correlation time; BT: the bias-instability floor's lower corner, 0 for a flat floor)\n",
     );
     if let Some(x) = a.axes.first() {
         let _ = writeln!(
@@ -207,7 +212,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
             record_25: f64::NAN,
         };
         let adv = ax.advice;
-        let rows: [(&str, &Term, &str, Option<super::region::Reading>, _); 5] = [
+        let rows: [(&str, &Term, &str, Option<super::region::Reading>, _); 6] = [
             ("Q", &an.terms.q, sensor.q_unit(), None, nan_adv),
             (
                 "N",
@@ -231,6 +236,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
                 adv.map_or(nan_adv, |v| v.k),
             ),
             ("R", &an.terms.r, sensor.r_unit(), None, nan_adv),
+            ("G", &an.terms.g, sensor.unit(), None, nan_adv),
         ];
         for (name, t, unit, reg, adv) in rows {
             let source = if an.verdict.fits() { "fit" } else { "region" };
@@ -250,6 +256,22 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
                 adv.precision,
                 adv.record_10,
                 adv.record_25
+            );
+        }
+        // the shape parameters, as rows of their own: the Gauss–Markov correlation time
+        // and the flicker floor's lower corner
+        for (name, value, t) in [
+            ("GT", an.terms.g_time, &an.terms.g),
+            ("BT", an.terms.b_corner, &an.terms.b),
+        ] {
+            let _ = writeln!(
+                s,
+                "{},{axis},{name},{value},NaN,NaN,NaN,{},{:?},s,{},{},{lo_t},{hi_t},{chi},{delta},NaN,NaN,NaN,NaN,NaN,NaN",
+                sensor.name(),
+                t.reported().is_some(),
+                t.verdict,
+                if an.verdict.fits() { "fit" } else { "region" },
+                fit_code(&an.verdict),
             );
         }
     }

@@ -45,32 +45,195 @@
 //! the others enter when they lower χ² (under the full model's discrepancy) by more than
 //! [`SELECT_CHI2`]; fitting terms the data do not have costs the others precision (B and R
 //! trade off against K at long τ). Non-negativity: every subset of terms is solved
-//! unconstrained and the cheapest feasible one kept — with five unknowns this enumeration
+//! unconstrained and the cheapest feasible one kept — with six unknowns this enumeration
 //! of active sets is the exact NNLS optimum. Intervals by test inversion
 //! ([`inverted_interval`]).
+//!
+//! Two shapes that are not power laws, so that they are not read as one (issue 10: "handle
+//! flicker floors, Gauss–Markov bumps and quantization without inventing terms"):
+//! * a Gauss–Markov (exponentially correlated) bias, IEEE 952 Annex C ([`gm_basis`]):
+//!   its bump would otherwise be fitted as bias instability or random walk. It enters only
+//!   where the data locate its correlation time (an interior best time, at least
+//!   [`GM_MIN_T`]) and lower χ² by [`SELECT_CHI2_GM`]; a B or K that a bump explains as
+//!   well is not "resolved" ([`FitResult::ambiguous`]).
+//! * a lower corner of the flicker floor ([`flicker_band`]): a 1/f spectrum that stops at a
+//!   shortest correlation time rolls off slowly below it, and a flat floor trades the missing
+//!   flicker for white noise. The corner enters like a term; where the data cannot tell
+//!   (the usual case) every plausible corner widens the intervals
+//!   ([`FitResult::alternatives`]).
+//!
+//! Their covariance: the shaped terms' AVAR is given, point by point, to the power law of
+//! its local slope (`effective_coef`).
 
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
 use super::avar_cov::CovBasis;
 
-/// The five IEEE 952 terms, in coefficient order.
-pub const TERM_COUNT: usize = 5;
+/// The model's coefficients: the five IEEE 952 terms, then the exponentially correlated
+/// (Gauss–Markov) bias of IEEE 952 Annex C.
+pub const TERM_COUNT: usize = 6;
+/// The five IEEE 952 power-law terms (the first five coefficients).
+pub const IEEE_TERMS: usize = 5;
+/// Index of the Gauss–Markov coefficient σ².
+pub const GM: usize = 5;
 /// Term names in coefficient order.
-pub const TERM_NAMES: [&str; TERM_COUNT] = ["Q", "N", "B", "K", "R"];
-/// Power-law α of the AVAR of each term (R, a deterministic ramp, is given RW FM's).
-pub const TERM_ALPHA: [i32; TERM_COUNT] = [2, 0, -1, -2, -2];
+pub const TERM_NAMES: [&str; TERM_COUNT] = ["Q", "N", "B", "K", "R", "G"];
+/// Power-law α of the AVAR of each term (R, a deterministic ramp, is given RW FM's; the
+/// Gauss–Markov bias, flat around its peak, flicker FM's).
+pub const TERM_ALPHA: [i32; TERM_COUNT] = [2, 0, -1, -2, -2, -1];
+/// 2 ln2/π: the AVAR of bias instability B is this times B².
+pub const FLICKER_AVAR: f64 = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI;
 
-/// Basis function g_j(τ) of coefficient j: AVAR = Σ c_j g_j(τ).
+/// Basis function g_j(τ) of coefficient j of the IEEE 952 terms: AVAR = Σ c_j g_j(τ)
+/// (0 for the Gauss–Markov coefficient, whose shape needs its correlation time: [`basis_at`]).
 pub fn basis(j: usize, tau: f64) -> f64 {
     match j {
         0 => 3.0 / (tau * tau),
         1 => 1.0 / tau,
-        2 => 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI,
+        2 => FLICKER_AVAR,
         3 => tau / 3.0,
-        _ => tau * tau / 2.0,
+        4 => tau * tau / 2.0,
+        _ => 0.0,
     }
 }
+
+/// Allan variance of a first-order Gauss–Markov bias of unit variance and correlation time
+/// `t` (IEEE 952 Annex C, exponentially correlated noise, with q_c² = 2σ²/T):
+/// (2T/τ)·[1 − (T/2τ)(3 − 4e^(−τ/T) + e^(−2τ/T))] — a random walk (2τ/3T) for τ ≪ T, white
+/// noise (2T/τ) for τ ≫ T, a bump of 0.38·σ² at τ ≈ 1.9T in between. 0 for a NaN `t`.
+pub fn gm_basis(tau: f64, t: f64) -> f64 {
+    if !is_positive(t) {
+        return 0.0;
+    }
+    let x = tau / t;
+    if x < 1e-3 {
+        // the series, where the bracket cancels: 2x/3 − x²/2 + …
+        return 2.0 * x / 3.0 - x * x / 2.0;
+    }
+    (2.0 / x) * (1.0 - (3.0 - 4.0 * (-x).exp() + (-2.0 * x).exp()) / (2.0 * x))
+}
+
+/// Share of the flicker floor reached at τ = x·T_lo by a flicker bias whose 1/f spectrum
+/// stops at a shortest correlation time T_lo: a sum of Gauss–Markov biases with
+/// correlation times spread uniformly in log T from T_lo up (A. van der Ziel's construction
+/// of 1/f noise, which is also how `sim` generates it). Its Allan variance is
+/// (B²/π)·∫_{T_lo}^∞ g(τ/T) d ln T with g = [`gm_basis`]; the integral over all T is 2 ln 2, the
+/// flat floor (2 ln2/π)·B², so
+///
+/// ```text
+/// ψ(x) = (1/2 ln2)·∫_0^x g(s) ds/s  →  x/(3 ln2) for x ≪ 1 (a random walk),
+///                                       1 − 1/(x·ln2) for x ≫ 1 (a slow roll-off)
+/// ```
+///
+/// The roll-off towards short τ is slow (2 % below the floor at x = 40): where the floor
+/// meets white noise, a flat-floor fit of such a curve trades the missing flicker for
+/// white noise and reports N low by about a percent (measured on `sim`'s STIM300-like
+/// accelerometer, its floor corner at 20 s). Tabulated once, Simpson on ln s.
+pub fn flicker_band(x: f64) -> f64 {
+    use std::sync::OnceLock;
+    static TABLE: OnceLock<Vec<f64>> = OnceLock::new();
+    if !is_positive(x) {
+        return 0.0;
+    }
+    if x < BAND_TABLE.0 {
+        // the series of the integral: 2x/3 − x²/4 + O(x³)
+        return (2.0 * x / 3.0 - x * x / 4.0) / (2.0 * std::f64::consts::LN_2);
+    }
+    if x >= BAND_TABLE.1 {
+        // ∫_x^∞ g(s) ds/s = 2/x − 3/(2x²) + O(e^(−x)/x)
+        return 1.0 - (2.0 / x - 1.5 / (x * x)) / (2.0 * std::f64::consts::LN_2);
+    }
+    let (l0, l1) = (BAND_TABLE.0.ln(), BAND_TABLE.1.ln());
+    let h = (l1 - l0) / BAND_TABLE_CELLS as f64;
+    let table = TABLE.get_or_init(|| {
+        let f = |l: f64| gm_basis(l.exp(), 1.0);
+        let mut v = Vec::with_capacity(BAND_TABLE_CELLS + 1);
+        let x0 = BAND_TABLE.0;
+        let mut acc = 2.0 * x0 / 3.0 - x0 * x0 / 4.0;
+        v.push(acc);
+        for i in 0..BAND_TABLE_CELLS {
+            let a = l0 + i as f64 * h;
+            acc += h / 6.0 * (f(a) + 4.0 * f(a + 0.5 * h) + f(a + h));
+            v.push(acc);
+        }
+        v.iter()
+            .map(|a| a / (2.0 * std::f64::consts::LN_2))
+            .collect()
+    });
+    let u = (x.ln() - l0) / h;
+    let i = (u.floor() as usize).min(BAND_TABLE_CELLS - 1);
+    let w = u - i as f64;
+    table[i] * (1.0 - w) + table[i + 1] * w
+}
+
+/// x range of the [`flicker_band`] table (outside it, two-term series accurate to 1e-7).
+const BAND_TABLE: (f64, f64) = (1e-2, 10.0);
+/// Cells of the table: linear interpolation in ln x errs by < 2e-6.
+const BAND_TABLE_CELLS: usize = 2048;
+
+/// The shape parameters of the non-power-law terms: the Gauss–Markov correlation time and
+/// the flicker floor's lower corner (see [`flicker_band`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shapes {
+    /// Correlation time of the Gauss–Markov bias, s (NaN: not in the model).
+    pub gm_t: f64,
+    /// Shortest correlation time of the flicker floor, s (0: a flat floor, IEEE 952's B).
+    pub b_lo: f64,
+}
+
+impl Shapes {
+    /// The IEEE 952 power laws alone.
+    pub const FLAT: Shapes = Shapes {
+        gm_t: f64::NAN,
+        b_lo: 0.0,
+    };
+}
+
+/// Basis function j at τ with the shapes `s`.
+pub fn basis_at(j: usize, tau: f64, s: &Shapes) -> f64 {
+    match j {
+        GM => gm_basis(tau, s.gm_t),
+        2 if s.b_lo > 0.0 => FLICKER_AVAR * flicker_band(tau / s.b_lo),
+        _ => basis(j, tau),
+    }
+}
+
+/// The coefficients of the power laws that stand in, at τ, for the shaped terms in the
+/// covariance of the AVAR points: each shaped term's AVAR goes to the power law of its
+/// local slope there (a random walk where it rises like one, white noise where it falls,
+/// flicker in between). [`super::avar_cov`] has covariances of power laws only; the EDF of
+/// a bump's shoulder is that of the power law it resembles.
+fn effective_coef(c: &[f64; TERM_COUNT], s: &Shapes, tau: f64) -> [f64; TERM_COUNT] {
+    let mut e = *c;
+    e[GM] = 0.0;
+    let spread = |e: &mut [f64; TERM_COUNT], a: f64, shape: &dyn Fn(f64) -> f64| {
+        let slope = ((shape(tau * SLOPE_STEP) / shape(tau / SLOPE_STEP)).ln()
+            / (2.0 * SLOPE_STEP.ln()))
+        .clamp(-1.0, 1.0);
+        let j = if slope >= 0.5 {
+            3
+        } else if slope <= -0.5 {
+            1
+        } else {
+            2
+        };
+        e[j] += a / basis(j, tau);
+    };
+    if s.b_lo > 0.0 && c[2] != 0.0 {
+        e[2] = 0.0;
+        let a = c[2] * basis_at(2, tau, s);
+        spread(&mut e, a, &|t| basis_at(2, t, s));
+    }
+    if c[GM] != 0.0 && s.gm_t > 0.0 {
+        let a = c[GM] * gm_basis(tau, s.gm_t);
+        spread(&mut e, a, &|t| gm_basis(t, s.gm_t));
+    }
+    e
+}
+
+/// Half-width (as a factor) of the local-slope difference in [`effective_coef`].
+const SLOPE_STEP: f64 = 1.1;
 
 /// `v > 0` (false for NaN), spelled out so that NaN handling is visible at the call sites.
 pub(super) fn is_positive(v: f64) -> bool {
@@ -101,6 +264,8 @@ pub struct FitConfig {
     pub trim: bool,
     /// Allow a negative 1/τ² coefficient (the low-pass correction; module docs).
     pub band_limit: bool,
+    /// Allow the flicker floor a lower corner ([`flicker_band`]).
+    pub flicker_corner: bool,
 }
 
 impl Default for FitConfig {
@@ -113,6 +278,7 @@ impl Default for FitConfig {
             discrepancy: true,
             trim: true,
             band_limit: true,
+            flicker_corner: true,
         }
     }
 }
@@ -193,16 +359,49 @@ pub struct FitResult {
     pub delta: f64,
     /// Degrees of freedom (points − free terms).
     pub dof: usize,
-    /// Largest share of the measured Allan variance each term's own line has at a used point:
-    /// ≈ 1 where it alone makes the curve, ≥ 0.64 where its line comes within 20 % of the data.
+    /// Shapes of the Gauss–Markov term and of the flicker floor.
+    pub shapes: Shapes,
+    /// Other flicker-floor corners the data do not reject (χ² within [`PROFILE_CHI2_95`] of
+    /// the best, the terms unchanged): how the coefficients move with the floor's unresolved
+    /// shape. A term's interval spans theirs — a profile-likelihood interval over the corner
+    /// (a long record of a white + flicker sensor cannot tell a flat floor from one with a
+    /// corner where the two meet, and N follows the choice by about a percent).
+    pub alternatives: Vec<ShapeAlternative>,
+    /// Terms in the model that a Gauss–Markov bias explains as well (see [`fit`]): B or K
+    /// whose floor or rise is a bump's shoulder or tail; not "resolved".
+    pub ambiguous: [bool; TERM_COUNT],
+    /// Largest share of the model's Allan variance each term's own line has at a used point:
+    /// ≈ 1 where it alone makes the curve, ≥ 0.64 where its line comes within 20 % of it.
     pub max_share: [f64; TERM_COUNT],
 }
+
+/// The fit with other shape parameters (see [`FitResult::alternatives`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeAlternative {
+    /// The shapes.
+    pub shapes: Shapes,
+    /// Coefficients with them.
+    pub coef: [f64; TERM_COUNT],
+    /// Their standard errors.
+    pub std_err: [f64; TERM_COUNT],
+}
+
+/// χ²(1) quantile at 0.95: a shape is plausible while its χ² is within this of the best.
+pub const PROFILE_CHI2_95: f64 = 3.841_458_820_694_124;
 
 impl FitResult {
     /// Model AVAR at τ.
     pub fn predict(&self, tau: f64) -> f64 {
-        (0..TERM_COUNT).map(|j| self.coef[j] * basis(j, tau)).sum()
+        predict(&self.coef, &self.shapes, tau)
     }
+}
+
+/// Model AVAR at τ for coefficients `coef` and shapes `shapes`.
+pub fn predict(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> f64 {
+    (0..TERM_COUNT)
+        .filter(|&j| coef[j] != 0.0)
+        .map(|j| coef[j] * basis_at(j, tau, shapes))
+        .sum()
 }
 
 /// A short-τ point is dropped when it raises χ² by more than this many times the χ² per
@@ -210,7 +409,8 @@ impl FitResult {
 /// 10⁴ wrongly dropped on data the model describes; a band-limited point raises χ² by
 /// 10²–10⁶).
 pub const TRIM_CHI2: f64 = 15.136_705_226_623_606;
-/// Nuisance terms [`FitConfig::select`] adds only when the data ask for them: Q, B, R.
+/// Nuisance terms [`FitConfig::select`] adds only when the data ask for them: Q, B, R (and
+/// the Gauss–Markov bias, with its own threshold [`SELECT_CHI2_GM`]).
 const NUISANCE: [usize; 3] = [0, 2, 4];
 /// χ²(1) quantile at 0.99: a nuisance term enters when it lowers the fit's χ² by more than
 /// this (a 1 % chance of adding a term the data do not have).
@@ -254,13 +454,14 @@ struct Problem<'d, 'a> {
     sel: Vec<usize>,
     g: Vec<[f64; TERM_COUNT]>,
     a: Vec<f64>,
+    shapes: Shapes,
 }
 
 impl<'d, 'a> Problem<'d, 'a> {
-    fn new(data: &'d FitData<'a>, sel: &[usize]) -> Self {
+    fn new(data: &'d FitData<'a>, sel: &[usize], shapes: Shapes) -> Self {
         let g = sel
             .iter()
-            .map(|&i| std::array::from_fn(|j| basis(j, data.points[i].tau)))
+            .map(|&i| std::array::from_fn(|j| basis_at(j, data.points[i].tau, &shapes)))
             .collect();
         let a = sel.iter().map(|&i| data.points[i].avar).collect();
         Problem {
@@ -268,6 +469,7 @@ impl<'d, 'a> Problem<'d, 'a> {
             sel: sel.to_vec(),
             g,
             a,
+            shapes,
         }
     }
 
@@ -284,7 +486,16 @@ impl<'d, 'a> Problem<'d, 'a> {
         let mut cp = *c;
         cp[0] = cp[0].max(0.0);
         let idx: Vec<usize> = self.sel.iter().map(|&i| self.data.basis_index[i]).collect();
-        Some(b.cov(&idx, &cp))
+        let shaped = (cp[2] != 0.0 && self.shapes.b_lo > 0.0) || cp[GM] != 0.0;
+        if !shaped {
+            return Some(b.cov(&idx, &cp));
+        }
+        let per: Vec<[f64; TERM_COUNT]> = self
+            .sel
+            .iter()
+            .map(|&i| effective_coef(&cp, &self.shapes, self.data.points[i].tau))
+            .collect();
+        Some(b.cov_pointwise(&idx, &per))
     }
 
     /// V = Σ + δ²·diag(A²) with A the measured AVAR; without a basis, diag(A²) alone (δ
@@ -347,6 +558,7 @@ fn solve_delta(sigma: &[Vec<f64>], a: &[f64], r: &[f64], dof: usize) -> f64 {
 }
 
 /// GLS of the terms `enabled` (those in `signed` may be negative) on the points `sel`.
+#[allow(clippy::too_many_arguments)]
 fn gls(
     data: &FitData,
     sel: &[usize],
@@ -354,8 +566,9 @@ fn gls(
     signed: [bool; TERM_COUNT],
     delta_mode: Delta,
     max_iter: usize,
+    shapes: Shapes,
 ) -> Option<Solve> {
-    let p = Problem::new(data, sel);
+    let p = Problem::new(data, sel, shapes);
     let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
     if terms.is_empty() || sel.len() < terms.len() + 1 {
         return None;
@@ -458,7 +671,9 @@ fn gls(
 /// the coefficients `at` and discrepancy `delta` (no re-weighting): the χ² of nested models
 /// under one covariance, so that their difference is a likelihood-ratio statistic (with the
 /// covariance re-evaluated per model, a model could lower its χ² by inflating its own
-/// variances). Returns the coefficients, χ² and the whitened residuals.
+/// variances). Returns the coefficients, χ², the whitened residuals and the coefficients'
+/// covariance.
+#[allow(clippy::too_many_arguments)]
 fn fixed_ls(
     data: &FitData,
     sel: &[usize],
@@ -466,8 +681,9 @@ fn fixed_ls(
     signed: [bool; TERM_COUNT],
     at: &[f64; TERM_COUNT],
     delta: f64,
-) -> Option<([f64; TERM_COUNT], f64, Vec<f64>)> {
-    let p = Problem::new(data, sel);
+    shapes: Shapes,
+) -> Option<FixedLs> {
+    let p = Problem::new(data, sel, shapes);
     let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
     if terms.is_empty() || sel.len() < terms.len() + 1 {
         return None;
@@ -486,8 +702,22 @@ fn fixed_ls(
         } else {
             1.0
         };
-    Some((c, chi2, rw))
+    let free: Vec<usize> = terms.iter().copied().filter(|&j| c[j] != 0.0).collect();
+    let cov = if free.is_empty() {
+        [[0.0; TERM_COUNT]; TERM_COUNT]
+    } else {
+        covariance(&gw, &ones, &free)?
+    };
+    Some((c, chi2, rw, cov))
 }
+
+/// What [`fixed_ls`] returns: coefficients, χ², whitened residuals, covariance.
+type FixedLs = (
+    [f64; TERM_COUNT],
+    f64,
+    Vec<f64>,
+    [[f64; TERM_COUNT]; TERM_COUNT],
+);
 
 /// Median of χ²(1): a robust scale is median(e²)/this.
 const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
@@ -510,7 +740,14 @@ fn robust_scale(resid_w: &[f64]) -> f64 {
 }
 
 fn signed_terms(cfg: &FitConfig) -> [bool; TERM_COUNT] {
-    [cfg.band_limit, false, false, false, false]
+    [cfg.band_limit, false, false, false, false, false]
+}
+
+/// The IEEE 952 terms of `cfg` (the Gauss–Markov one off).
+fn ieee_only(terms: [bool; TERM_COUNT]) -> [bool; TERM_COUNT] {
+    let mut t = terms;
+    t[GM] = false;
+    t
 }
 
 /// First position of the fitted range on `data` (see the module docs): 0 unless
@@ -550,13 +787,14 @@ pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
     while n - s > MIN_FIT_POINTS {
         let rest: Vec<usize> = (s + 1..n).collect();
         let all: Vec<usize> = (s..n).collect();
-        let Some(base) = gls(data, &rest, cfg.terms, signed, mode, cfg.max_iter) else {
+        let terms = ieee_only(cfg.terms);
+        let Some(base) = gls(data, &rest, terms, signed, mode, cfg.max_iter, Shapes::FLAT) else {
             break;
         };
         // both fits under the covariance of the fit without the point
-        let (Some((_, chi_without, rw)), Some((_, chi_with, _))) = (
-            fixed_ls(data, &rest, cfg.terms, signed, &base.coef, delta),
-            fixed_ls(data, &all, cfg.terms, signed, &base.coef, delta),
+        let (Some((_, chi_without, rw, _)), Some((_, chi_with, _, _))) = (
+            fixed_ls(data, &rest, terms, signed, &base.coef, delta, Shapes::FLAT),
+            fixed_ls(data, &all, terms, signed, &base.coef, delta, Shapes::FLAT),
         ) else {
             break;
         };
@@ -581,10 +819,13 @@ pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
 
 /// Fits the model on the contiguous positions `used` of `data`. With
 /// [`FitConfig::select`], forward selection: start from the enabled ones of N and K, then
-/// repeatedly add the enabled nuisance term (Q, B, R) that lowers χ² most (with the full
-/// model's discrepancy δ held fixed), while it lowers it by more than [`SELECT_CHI2`]; the
-/// chosen model is then refitted with its own δ. Terms left out are reported at 0 with the
-/// upper bound of the all-terms fit.
+/// repeatedly make the enabled step that lowers χ² most (with the full model's discrepancy
+/// δ held fixed), while it lowers it by more than its threshold: add a nuisance term (Q, B,
+/// R: [`SELECT_CHI2`]), add a Gauss–Markov bias at its best correlation time
+/// ([`SELECT_CHI2_GM`]), or, once B is in, give the flicker floor a lower corner at its best
+/// place ([`SELECT_CHI2`]: one parameter; [`flicker_band`]). The chosen model is then
+/// refitted with its own δ. Terms left out are reported at 0 with the upper bound of the
+/// all-terms fit.
 pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
     let signed = signed_terms(cfg);
     let est = if cfg.discrepancy {
@@ -592,8 +833,10 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
     } else {
         Delta::Zero
     };
-    let full = gls(data, used, cfg.terms, signed, est, cfg.max_iter);
-    let mut terms = cfg.terms;
+    let ieee = ieee_only(cfg.terms);
+    let full = gls(data, used, ieee, signed, est, cfg.max_iter, Shapes::FLAT);
+    let mut terms = ieee;
+    let mut shapes = Shapes::FLAT;
     if cfg.select {
         let mut t = [false; TERM_COUNT];
         t[1] = cfg.terms[1];
@@ -606,39 +849,81 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
                 _ if data.basis.is_none() => 1.0,
                 _ => 0.0,
             };
-            let dmode = if data.basis.is_none() {
-                Delta::Fixed(1.0)
+            let dmode = Delta::Fixed(d);
+            let grid = shape_grid(data, used, GM_GRID);
+            let corners = if cfg.flicker_corner {
+                shape_grid(data, used, CORNER_GRID)
             } else {
-                Delta::Fixed(d)
+                Vec::new()
             };
             loop {
-                let base = gls(data, used, t, signed, dmode, cfg.max_iter)?;
-                let chi = |tt: [bool; TERM_COUNT]| {
-                    fixed_ls(data, used, tt, signed, &base.coef, d).map(|x| x.1)
+                let base = gls(data, used, t, signed, dmode, cfg.max_iter, shapes)?;
+                let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
+                    fixed_ls(data, used, tt, signed, &base.coef, d, sh).map(|x| x.1)
                 };
-                let cur = chi(t)?;
-                let best = NUISANCE
-                    .iter()
-                    .copied()
-                    .filter(|&j| cfg.terms[j] && !t[j])
-                    .filter_map(|j| {
+                let cur = chi(t, shapes)?;
+                // (term added or none, χ² drop beyond its threshold, shapes)
+                let mut best: Option<(Option<usize>, f64, Shapes)> = None;
+                let mut consider = |j: Option<usize>, excess: f64, sh: Shapes| {
+                    if best.is_none_or(|b| excess > b.1) {
+                        best = Some((j, excess, sh));
+                    }
+                };
+                for j in NUISANCE {
+                    if cfg.terms[j] && !t[j] {
                         let mut tt = t;
                         tt[j] = true;
-                        Some((j, cur - chi(tt)?))
-                    })
-                    .max_by(|x, y| x.1.total_cmp(&y.1));
+                        if let Some(c) = chi(tt, shapes) {
+                            consider(Some(j), cur - c - SELECT_CHI2, shapes);
+                        }
+                    }
+                }
+                if cfg.terms[GM] && !t[GM] {
+                    let mut tt = t;
+                    tt[GM] = true;
+                    // the best correlation time; a bump only where the data locate it (a
+                    // best time at either end of the search is a trend the power laws
+                    // miss, not a bump)
+                    let best_t = grid
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(i, &tg)| {
+                            let sh = Shapes { gm_t: tg, ..shapes };
+                            chi(tt, sh).map(|c| (i, c, sh))
+                        })
+                        .min_by(|a, b| a.1.total_cmp(&b.1));
+                    if let Some((i, c, sh)) = best_t
+                        && i > 0
+                        && i + 1 < grid.len()
+                    {
+                        consider(Some(GM), cur - c - SELECT_CHI2_GM, sh);
+                    }
+                }
+                if t[2] && shapes.b_lo == 0.0 {
+                    for &lo in &corners {
+                        let sh = Shapes { b_lo: lo, ..shapes };
+                        if let Some(c) = chi(t, sh) {
+                            consider(None, cur - c - SELECT_CHI2, sh);
+                        }
+                    }
+                }
                 match best {
-                    Some((j, drop)) if drop > SELECT_CHI2 => t[j] = true,
+                    Some((j, excess, sh)) if excess > 0.0 => {
+                        if let Some(j) = j {
+                            t[j] = true;
+                        }
+                        shapes = sh;
+                    }
                     _ => break,
                 }
             }
             terms = t;
         }
     }
-    let mut s = if terms == cfg.terms {
+    let mut s = if terms == ieee && shapes == Shapes::FLAT {
         full.clone()?
     } else {
-        gls(data, used, terms, signed, est, cfg.max_iter)?
+        gls(data, used, terms, signed, est, cfg.max_iter, shapes)?
     };
     if !cfg.discrepancy && data.basis.is_some() {
         // plain GLS: standard errors scaled against misfit
@@ -659,11 +944,82 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
             cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
         }
     }
+    if coef[GM] == 0.0 {
+        shapes.gm_t = f64::NAN;
+    }
+    if coef[2] == 0.0 {
+        shapes.b_lo = 0.0;
+    }
+    // B or K only where no Gauss–Markov bias explains the data as well: the model with the
+    // term swapped for a bump (its best correlation time) must fit worse, under the final
+    // model's covariance, by Akaike's measure (the bump has one more parameter).
+    let mut ambiguous = [false; TERM_COUNT];
+    if cfg.select && cfg.terms[GM] {
+        let d = if data.basis.is_none() { 1.0 } else { s.delta };
+        let grid = shape_grid(data, used, GM_GRID);
+        let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
+            fixed_ls(data, used, tt, signed, &s.coef, d, sh).map(|x| x.1)
+        };
+        if let Some(cur) = chi(terms, shapes) {
+            for j in [2, 3] {
+                if !terms[j] || coef[j] == 0.0 {
+                    continue;
+                }
+                let mut tt = terms;
+                tt[j] = false;
+                tt[GM] = true;
+                let times: Vec<f64> = if terms[GM] {
+                    vec![shapes.gm_t]
+                } else {
+                    grid.clone()
+                };
+                let alt = times
+                    .iter()
+                    .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }))
+                    .fold(f64::INFINITY, f64::min);
+                ambiguous[j] = alt + SWAP_PENALTY <= cur;
+            }
+        }
+    }
+    // the flicker floor's shape as the data leave it: every corner (and the flat floor)
+    // whose fit is within the 95 % profile-likelihood bound of the best one, under the
+    // final model's covariance — the terms' intervals span theirs (see [`FitResult`])
+    let mut alternatives = Vec::new();
+    if terms[2] && coef[2] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
+        let cands: Vec<f64> = std::iter::once(0.0)
+            .chain(shape_grid(data, used, CORNER_GRID))
+            .collect();
+        let fits: Vec<(f64, FixedLs)> = cands
+            .iter()
+            .filter_map(|&lo| {
+                let sh = Shapes { b_lo: lo, ..shapes };
+                fixed_ls(data, used, terms, signed, &s.coef, s.delta, sh).map(|f| (lo, f))
+            })
+            .collect();
+        let best = fits.iter().map(|f| f.1.1).fold(f64::INFINITY, f64::min);
+        for (lo, (c, chi, _, cv)) in fits {
+            if lo != shapes.b_lo && chi - best <= PROFILE_CHI2_95 {
+                alternatives.push(ShapeAlternative {
+                    shapes: Shapes { b_lo: lo, ..shapes },
+                    coef: c,
+                    std_err: std::array::from_fn(|j| cv[j][j].max(0.0).sqrt()),
+                });
+            }
+        }
+    }
+    // each term's largest share of the model's Allan variance at a used point (the model
+    // rather than the measured points: their scatter at long τ would make a term dominant,
+    // or not, by chance)
     let max_share = std::array::from_fn(|j| {
         used.iter()
             .map(|&i| {
-                let p = &data.points[i];
-                (coef[j] * basis(j, p.tau) / p.avar).max(0.0)
+                let tau = data.points[i].tau;
+                let total = predict(&coef, &shapes, tau);
+                if total > 0.0 {
+                    (coef[j] * basis_at(j, tau, &shapes) / total).max(0.0)
+                } else {
+                    0.0
+                }
             })
             .fold(0.0, f64::max)
     });
@@ -682,14 +1038,85 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
             f64::NAN
         },
         dof: s.dof,
+        shapes,
+        alternatives,
+        ambiguous,
         max_share,
     })
 }
 
+/// Akaike's penalty for the swapped model's extra parameter (the bump's correlation time):
+/// a random walk is a bump whose turn-over lies in the last, noisiest octaves, and with its
+/// time free the bump fits such data about as well by chance.
+const SWAP_PENALTY: f64 = 2.0;
+
+/// χ²(2) quantile at 0.999: the Gauss–Markov bias enters with two parameters, its σ and a
+/// correlation time searched over `GM_GRID`, so it must lower χ² by more than this.
+pub const SELECT_CHI2_GM: f64 = 13.815_510_557_964_274;
+/// Where a shape parameter is searched on a fitted range, relative to its first and last τ,
+/// and how finely.
+#[derive(Clone, Copy, Debug)]
+struct ShapeGrid {
+    /// Lowest candidate over the range's first τ.
+    from_first: f64,
+    /// Lowest candidate at all, s.
+    floor: f64,
+    /// Highest candidate over the range's last τ.
+    to_last: f64,
+    /// Candidates per octave.
+    per_octave: f64,
+}
+
+/// Shortest Gauss–Markov correlation time, s. IEEE 952 reads the white noise N on the −½
+/// line at τ = 1 s; a Gauss–Markov bias of T ≪ 1 s is white noise there (its Allan variance
+/// 2σ²T/τ for τ ≫ T: low-passed white noise), so a bump below 1 s would split N into two
+/// and report only the part above 1/(2πT) Hz. Measured on the heavily filtered real
+/// accelerometers of `testdata/real_curves`: bumps at 0.2–1 s took up to 20 % of N.
+pub const GM_MIN_T: f64 = 1.0;
+
+/// Gauss–Markov correlation times: from 4× the first τ (and [`GM_MIN_T`]) (the rise must be seen) to 1/8 of
+/// the last (and the turn-down after the bump; a longer T is a random walk over the
+/// record), two per octave.
+const GM_GRID: ShapeGrid = ShapeGrid {
+    from_first: 4.0,
+    floor: GM_MIN_T,
+    to_last: 1.0 / 8.0,
+    per_octave: 2.0,
+};
+/// Flicker-floor corners: from 1/16 of the first τ (the floor there is still 9 % short,
+/// ψ(16) = 0.91) to 1/4 of the last (ψ(4) = 0.67: a floor hardly reached within the range),
+/// two per octave.
+const CORNER_GRID: ShapeGrid = ShapeGrid {
+    from_first: 1.0 / 16.0,
+    floor: 0.0,
+    to_last: 1.0 / 4.0,
+    per_octave: 2.0,
+};
+
+/// Candidate values of a shape parameter on the range `used` (empty for short ranges).
+fn shape_grid(data: &FitData, used: &[usize], g: ShapeGrid) -> Vec<f64> {
+    let (Some(&a), Some(&b)) = (used.first(), used.last()) else {
+        return Vec::new();
+    };
+    let (lo, hi) = (
+        (g.from_first * data.points[a].tau).max(g.floor),
+        g.to_last * data.points[b].tau,
+    );
+    let mut out = Vec::new();
+    let mut t = lo;
+    while t <= hi {
+        out.push(t);
+        t *= 2f64.powf(1.0 / g.per_octave);
+    }
+    out
+}
+
 /// The model term contributing most AVAR at τ.
-pub fn dominant_term(coef: &[f64; TERM_COUNT], tau: f64) -> usize {
+pub fn dominant_term(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> usize {
     (0..TERM_COUNT)
-        .max_by(|&x, &y| (coef[x] * basis(x, tau)).total_cmp(&(coef[y] * basis(y, tau))))
+        .max_by(|&x, &y| {
+            (coef[x] * basis_at(x, tau, shapes)).total_cmp(&(coef[y] * basis_at(y, tau, shapes)))
+        })
         .unwrap_or(1)
 }
 
@@ -717,7 +1144,7 @@ pub fn inverted_interval(
         return plain;
     }
     let free: Vec<usize> = (0..TERM_COUNT).filter(|&t| res.free[t] || t == j).collect();
-    let p = Problem::new(data, &res.used);
+    let p = Problem::new(data, &res.used, res.shapes);
     let misfit = if cfg.discrepancy {
         1.0
     } else {
@@ -1152,16 +1579,94 @@ mod tests {
     }
 
     #[test]
+    fn flicker_band_matches_a_sum_of_gauss_markov_biases() {
+        // the slow version: the construction itself, a sum of unit Gauss–Markov AVARs with
+        // correlation times 64 per octave from T_lo to 10⁸·T_lo, each weighted by its share
+        // of ln T, over the integral of all of them (2 ln2)
+        const STEPS_PER_OCTAVE: f64 = 64.0;
+        // the sum's own quadrature error (midpoint rule in ln T, cut at 10⁸·T_lo: 1e-8)
+        const SUM_REL_TOL: f64 = 1e-4;
+        let slow = |x: f64| {
+            let h = std::f64::consts::LN_2 / STEPS_PER_OCTAVE;
+            let steps = (1e8f64.ln() / h) as usize;
+            let s: f64 = (0..steps)
+                .map(|i| gm_basis(x, ((i as f64 + 0.5) * h).exp()) * h)
+                .sum();
+            s / (2.0 * std::f64::consts::LN_2)
+        };
+        for x in [1e-3, 0.01, 0.05, 0.3, 1.0, 3.0, 9.9, 10.0, 40.0, 1e3] {
+            let (a, b) = (flicker_band(x), slow(x));
+            assert!((a / b - 1.0).abs() < SUM_REL_TOL, "x {x}: {a} vs {b}");
+        }
+        assert_eq!(flicker_band(0.0), 0.0);
+    }
+
+    #[test]
+    fn finds_the_flicker_floor_corner() {
+        // noise-free white + flicker with a lower corner at 5 s + random walk (white meets
+        // the floor at 57 s, the floor meets the random walk at 5000 s): the corner must be
+        // found (on the 2-per-octave grid: within a factor √2) and N, B not traded
+        let (n2, b2, k2, lo) = (1e-6, 4e-8, 1e-11, 5.0);
+        let ms: Vec<usize> = (0..22).map(|k| 1usize << k).collect();
+        let tau0 = 0.005;
+        let b = CovBasis::new(&ms, 16_000_000, tau0, Overlap::Overlapping);
+        let mut d = data_for([0.0; 5], &ms, tau0, Some(&b));
+        let shapes = Shapes {
+            gm_t: f64::NAN,
+            b_lo: lo,
+        };
+        for p in d.points.iter_mut() {
+            p.avar = predict(&[0.0, n2, b2, k2, 0.0, 0.0], &shapes, p.tau);
+        }
+        let used: Vec<usize> = (0..ms.len()).collect();
+        let r = fit(&d, &used, &FitConfig::default()).unwrap();
+        assert!(
+            r.shapes.b_lo > lo / 2f64.sqrt() && r.shapes.b_lo < lo * 2f64.sqrt(),
+            "corner {} s for {lo} s",
+            r.shapes.b_lo
+        );
+        // the grid step leaves a little shape error: measured N 0.1 %, B 1 %
+        const N_GRID_REL_TOL: f64 = 0.01;
+        const B_GRID_REL_TOL: f64 = 0.05;
+        assert!(
+            (r.coef[1] / n2).sqrt() - 1.0 < N_GRID_REL_TOL,
+            "{:e}",
+            r.coef[1]
+        );
+        assert!(
+            ((r.coef[2] / b2).sqrt() - 1.0).abs() < B_GRID_REL_TOL,
+            "{:e}",
+            r.coef[2]
+        );
+        // the flat-floor model misses it: N low
+        let flat = fit(
+            &d,
+            &used,
+            &FitConfig {
+                flicker_corner: false,
+                ..FitConfig::default()
+            },
+        )
+        .unwrap();
+        assert!(
+            flat.coef[1] < r.coef[1],
+            "{:e} vs {:e}",
+            flat.coef[1],
+            r.coef[1]
+        );
+    }
+
+    #[test]
     fn nnls_subsets_matches_brute_force_grid() {
         // a 2-term case where the unconstrained solution is negative: y = 1/τ data with a dip
-        let g: Vec<[f64; 5]> = (1..20)
+        let g: Vec<[f64; TERM_COUNT]> = (1..20)
             .map(|k| std::array::from_fn(|j| basis(j, k as f64)))
             .collect();
         let a: Vec<f64> = (1..20)
             .map(|k| 1.0 / k as f64 - 0.01 * k as f64 / 3.0)
             .collect();
         let w = vec![1.0; g.len()];
-        let c = nnls_subsets(&g, &a, &w, &[1, 3], &[false; 5], &|_| true).unwrap();
+        let c = nnls_subsets(&g, &a, &w, &[1, 3], &[false; TERM_COUNT], &|_| true).unwrap();
         assert_eq!(c[3], 0.0, "K must be clamped at 0");
         // with K = 0, N² is the 1-D LS solution
         let num: f64 = g.iter().zip(&a).map(|(gi, ai)| gi[1] * ai).sum();

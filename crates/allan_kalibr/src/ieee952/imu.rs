@@ -18,6 +18,10 @@ use super::{
     short,
 };
 
+/// τ/T_lo from which a flicker floor with lower corner T_lo is within 2 % of 0.664·B in
+/// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
+const BAND_FLOOR_X: f64 = 40.0;
+
 pub use bag2mat::Sensor;
 
 /// One analysed axis.
@@ -157,13 +161,8 @@ pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: 
         else {
             continue;
         };
-        let coef = f.coef;
-        let model = move |tau: f64| {
-            (0..super::fit::TERM_COUNT)
-                .map(|j| coef[j] * super::fit::basis(j, tau))
-                .sum::<f64>()
-                .max(0.0)
-        };
+        let f = f.clone();
+        let model = move |tau: f64| f.predict(tau).max(0.0);
         ax.warmup = stationarity::warmup(st, &model);
     }
     an.timing = t.map(stationarity::timing);
@@ -350,6 +349,15 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
                 term_text(b, sensor.unit())
             );
         }
+        if an.terms.b_corner > 0.0 && an.terms.b.verdict != Verdict::NotFitted {
+            let _ = writeln!(
+                s,
+                "{:<7} B's floor has a lower corner: within 2 % of 0.664*B from tau = {} s on (1/f spectrum down to a correlation time of {} s)",
+                "",
+                short(BAND_FLOOR_X * an.terms.b_corner),
+                short(an.terms.b_corner)
+            );
+        }
         for (name, t, unit) in [
             ("quantiz. Q", &an.terms.q, sensor.q_unit()),
             ("rate ramp R", &an.terms.r, sensor.r_unit()),
@@ -357,6 +365,15 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
             if t.verdict == Verdict::Resolved {
                 let _ = writeln!(s, "{:<7} {name:<11}= {}", "", term_text(t, unit));
             }
+        }
+        if an.terms.g.verdict != Verdict::NotFitted {
+            let _ = writeln!(
+                s,
+                "{:<7} Gauss–Markov bias σ = {}, correlation time {} s (a bump: exponentially correlated noise, not B or K)",
+                "",
+                term_text(&an.terms.g, sensor.unit()),
+                short(an.terms.g_time)
+            );
         }
         if an.verdict.fits() {
             let r = &an.region;

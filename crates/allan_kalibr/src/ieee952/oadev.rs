@@ -296,7 +296,7 @@ fn second_diff_sum_slices(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
 
 /// `Σ_k ((x[k+2m] − 2x[k+m]) + x[k])²` over every k with k + 2m < x.len() (0 when there is
 /// none): the fully overlapping second-difference sum of both analysers. Each squared term is
-/// bit-identical to imu_utils' (its expression order); the sum uses [`LANES`] accumulators
+/// bit-identical to imu_utils' (its expression order); the sum uses `LANES` accumulators
 /// and AVX-512 or AVX2 when the CPU has them (chosen at run time), which differs from a
 /// sequential sum by rounding only (~1e-13 relative).
 pub fn second_diff_sum(x: &[f64], m: usize) -> f64 {

@@ -9,7 +9,6 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::imu::{AxisResult, ImuAnalysis};
-use super::region::B_FLOOR_FACTOR;
 
 /// Panel size in SVG user units (the PNG is drawn at [`PNG_SCALE`]).
 const PANEL: (u32, u32) = (560, 420);
@@ -31,6 +30,47 @@ const TERM_COLORS: [RGBColor; 5] = [
 
 /// A truth curve per axis, in the order of [`ImuAnalysis::axes`]: (τ s, σ).
 pub type Truth = Vec<Vec<(f64, f64)>>;
+
+/// The truth `sim` wrote beside the input: `<input>.truth.csv`, or for a `.mat` converted
+/// from a sim bag, `<stem>.bag.truth.csv`. Columns `tau_s` and `gyro_x` … `acc_z` (the total
+/// Allan deviation of each axis); `None` when there is no such file or it does not read.
+pub fn find_truth(input: &Path, a: &ImuAnalysis) -> Option<Truth> {
+    let mut candidates = vec![PathBuf::from(format!("{}.truth.csv", input.display()))];
+    if input.extension().is_some_and(|e| e == "mat") {
+        candidates.push(input.with_extension("bag.truth.csv"));
+    }
+    let path = candidates.into_iter().find(|p| p.is_file())?;
+    read_truth(&std::fs::read_to_string(path).ok()?, a)
+}
+
+/// Parses a `sim` truth CSV for the axes of `a`.
+pub fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let tau_c = col("tau_s")?;
+    let cols: Vec<usize> = a
+        .axes
+        .iter()
+        .map(|ax| {
+            col(&format!(
+                "{}_{}",
+                ax.sensor.short(),
+                ["x", "y", "z"][ax.axis]
+            ))
+        })
+        .collect::<Option<_>>()?;
+    let mut out: Truth = vec![Vec::new(); cols.len()];
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let tau: f64 = f.get(tau_c)?.parse().ok()?;
+        for (k, &c) in cols.iter().enumerate() {
+            let v: f64 = f.get(c)?.parse().ok()?;
+            out[k].push((tau, v));
+        }
+    }
+    Some(out)
+}
 
 /// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}` (the workspace's PNG+SVG
 /// writer); returns the two paths.
@@ -102,16 +142,6 @@ where
         panel(ax, t, &panels[i], scale).map_err(|e| e.to_string())?;
     }
     Ok(())
-}
-
-fn term_line(j: usize, v: f64, tau: f64) -> f64 {
-    match j {
-        0 => 3f64.sqrt() * v / tau,
-        1 => v / tau.sqrt(),
-        2 => B_FLOOR_FACTOR * v,
-        3 => v * (tau / 3.0).sqrt(),
-        _ => v * tau / 2f64.sqrt(),
-    }
 }
 
 fn panel<DB: DrawingBackend>(
@@ -235,7 +265,7 @@ where
         let coef = f.coef;
         // each fitted term's line, over the whole τ axis
         let terms = an.terms.as_array();
-        for j in 0..5 {
+        for j in 0..super::fit::IEEE_TERMS {
             let v = terms[j].value;
             if !super::fit::is_positive(v) || coef[j] <= 0.0 {
                 continue;
@@ -243,7 +273,9 @@ where
             let c = TERM_COLORS[j];
             let name = super::fit::TERM_NAMES[j];
             ctx.draw_series(DashedLineSeries::new(
-                line_over(x0, x1, &|t| term_line(j, v, t)),
+                line_over(x0, x1, &|t| {
+                    v * super::fit::basis_at(j, t, &f.shapes).sqrt()
+                }),
                 px(5.0),
                 px(4.0),
                 c.stroke_width(px(1.0).max(1)),
@@ -251,13 +283,19 @@ where
             .label(format!("{name} = {v:.2e}"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
         }
-        let model = |t: f64| {
-            (0..5)
-                .map(|j| coef[j] * super::fit::basis(j, t))
-                .sum::<f64>()
-                .max(0.0)
-                .sqrt()
-        };
+        if coef[super::fit::GM] > 0.0 {
+            let (sigma, tg) = (an.terms.g.value, f.shapes.gm_t);
+            let c = TERM_COLORS[2];
+            ctx.draw_series(DashedLineSeries::new(
+                line_over(x0, x1, &|t| sigma * super::fit::gm_basis(t, tg).sqrt()),
+                px(2.0),
+                px(4.0),
+                c.stroke_width(px(1.0).max(1)),
+            ))?
+            .label(format!("Gauss–Markov σ = {sigma:.2e}, T = {tg:.3} s"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+        }
+        let model = |t: f64| f.predict(t).max(0.0).sqrt();
         ctx.draw_series(LineSeries::new(
             line_over(lo, hi, &model),
             BLACK.stroke_width(px(2.0)),

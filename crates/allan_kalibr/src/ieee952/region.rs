@@ -4,9 +4,10 @@
 //!
 //! Rules (on the points of the usable range, local slopes from log-log central differences
 //! on the 2-per-octave fit grid):
-//! * **N** — the −½ line at τ = 1 s. The white-noise region is the points whose local slope is
-//!   within [`SLOPE_TOL`] of −½ left of the curve's minimum; the line of slope −½ fitted to them (least squares in log:
-//!   the geometric mean of σ(τ)·√τ) is read at τ = 1 s. Its 95 % interval is that of the
+//! * **N** — the −½ line at τ = 1 s. The white-noise points are those whose local slope is
+//!   within [`SLOPE_TOL`] of −½, within an octave of the one nearest 1 s
+//!   ([`white_near_1s`]); the line of slope −½ fitted to them (least squares in log: the
+//!   geometric mean of σ(τ)·√τ) is read at τ = 1 s. Its 95 % interval is that of the
 //!   region's most precise point, scaled to the line (neighbouring overlapping points are
 //!   strongly correlated, so averaging them narrows it little). Every term adds to the Allan
 //!   variance, so this reading is biased high by whatever else contributes there.
@@ -78,6 +79,26 @@ pub fn local_slopes(tau: &[f64], adev: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The white-noise points the N reading uses: those whose local slope is within
+/// [`SLOPE_TOL`] of −½ (`is_white`) within [`N_WINDOW`] of the one nearest τ = 1 s. Near 1 s,
+/// not all of them: a curve can fall like white noise again beyond a Gauss–Markov bump, and
+/// a long run that bends slowly (a filtered sensor) would be read at its middle rather than
+/// at 1 s.
+pub fn white_near_1s(tau: &[f64], is_white: &[bool]) -> Vec<usize> {
+    let Some(centre) = (0..tau.len())
+        .filter(|&i| is_white[i])
+        .min_by(|&a, &b| tau[a].ln().abs().total_cmp(&tau[b].ln().abs()))
+    else {
+        return Vec::new();
+    };
+    (0..tau.len())
+        .filter(|&i| is_white[i] && (tau[i] / tau[centre]).ln().abs() <= N_WINDOW.ln() + 1e-9)
+        .collect()
+}
+
+/// Half-width (a factor of τ) of the window of white-noise points the N reading averages.
+pub const N_WINDOW: f64 = 2.0;
+
 /// Readings from `points` (the usable range of one curve, ascending τ, on the fit grid) with
 /// their 95 % bounds `lo95`/`hi95` (NaN when the sample count is unknown: then the readings
 /// carry no interval).
@@ -116,13 +137,12 @@ pub fn read(points: &[Point]) -> Readings {
             kind: ReadingKind::UpperBound,
         })
     };
-    // N: the −½ line through the white region (left of the minimum), read at 1 s
     let imin = (0..pts.len())
         .min_by(|&a, &b| adev[a].total_cmp(&adev[b]))
         .unwrap_or(0);
-    let white: Vec<usize> = (0..imin)
-        .filter(|&i| (slope[i] + 0.5).abs() <= SLOPE_TOL)
-        .collect();
+    // N: the −½ line through the white points near 1 s, read at 1 s
+    let is_white: Vec<bool> = slope.iter().map(|s| (s + 0.5).abs() <= SLOPE_TOL).collect();
+    let white = white_near_1s(&tau, &is_white);
     let n = if white.is_empty() {
         bound(&|t: f64| t.sqrt())
     } else {

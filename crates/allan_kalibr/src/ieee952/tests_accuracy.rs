@@ -291,7 +291,7 @@ fn accuracy_methods() {
         (
             "N+K only",
             with(FitConfig {
-                terms: [false, true, false, true, false],
+                terms: [false, true, false, true, false, false],
                 ..FitConfig::default()
             }),
         ),

@@ -43,7 +43,7 @@ pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Analysis) {
         })
     };
     println!(
-        "{imu:6} {:4} {}: {} | range {:?} chi2/dof {:.3} delta {:.4} misfit {:.3} pts {}\n      N {}\n      B {}\n      K {}\n      Q {}  R {}\n      region N {}  B {}  K {}",
+        "{imu:6} {:4} {}: {} | range {:?} chi2/dof {:.3} delta {:.4} misfit {:.3} pts {}\n      N {}\n      B {}\n      K {}\n      Q {}  R {}\n      region N {}  B {}  K {}\n      G {} T {:.3} s, BT {:.3} s, N/reading {:+.1} %",
         sensor.name(),
         ["x", "y", "z"][axis],
         a.verdict,
@@ -60,17 +60,26 @@ pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Analysis) {
         r(a.region.n),
         r(a.region.b),
         r(a.region.k),
+        t(&a.terms.g),
+        a.terms.g_time,
+        a.terms.b_corner,
+        a.verdict.range().map_or(f64::NAN, |(lo, hi)| 100.0
+            * (a.terms.n.value / n_reading_at_1s(a, lo, hi) - 1.0)),
     );
 }
 
 #[test]
 #[ignore = "development table; --ignored --nocapture"]
 fn real_curves_table() {
+    let mut cfg = Config::default();
+    if std::env::var("NO_GM").is_ok() {
+        cfg.fit.terms[super::fit::GM] = false;
+    }
+    if std::env::var("NO_CORNER").is_ok() {
+        cfg.fit.flicker_corner = false;
+    }
     for (name, d) in IMUS {
-        for (i, (s, a)) in analyse_imu_dir(name, d, &Config::default())
-            .iter()
-            .enumerate()
-        {
+        for (i, (s, a)) in analyse_imu_dir(name, d, &cfg).iter().enumerate() {
             print_row(name, *s, i % 3, a);
         }
     }
@@ -141,28 +150,34 @@ const B_FLOOR_TOL: f64 = 0.20;
 /// Issue 10: at least this share of the axes fit over a range with τ = 1 s and two decades.
 const MIN_FITTING_SHARE: f64 = 0.90;
 
-/// The −½-line reading at τ = 1 s (IEEE 952): the line of slope −½ fitted to the white-noise
-/// region — the curve points of [`tau_lo`, `tau_hi`] left of its minimum whose local log-log
-/// slope is within 0.1 of −½ — read at 1 s (least squares in log: the geometric mean of
-/// σ(τ)·√τ over the region).
+/// The −½-line reading at τ = 1 s (IEEE 952), on the full curve (the product reads it on the
+/// fit grid, `region::read`): the line of slope −½ fitted to the white-noise points near
+/// 1 s — the curve points of [`tau_lo`, `tau_hi`] whose local log-log slope is within 0.1 of
+/// −½, within an octave of the one nearest 1 s — read at 1 s (least squares in log: the
+/// geometric mean of σ(τ)·√τ over them).
 pub(super) fn n_reading_at_1s(a: &Analysis, tau_lo: f64, tau_hi: f64) -> f64 {
+    const SLOPE_TOL: f64 = 0.1;
+    const WINDOW: f64 = 2.0;
     let c: Vec<_> = a
         .curve
         .iter()
         .filter(|p| p.tau >= tau_lo && p.tau <= tau_hi)
         .collect();
-    let imin = (0..c.len())
-        .min_by(|&i, &j| c[i].adev.total_cmp(&c[j].adev))
-        .unwrap_or(0);
-    let c = &c[..=imin];
-    let mut logs = Vec::new();
-    for i in 1..c.len().saturating_sub(1) {
-        let s = (c[i + 1].adev / c[i - 1].adev).ln() / (c[i + 1].tau / c[i - 1].tau).ln();
-        if (s + 0.5).abs() <= 0.1 {
-            logs.push((c[i].adev * c[i].tau.sqrt()).ln());
-        }
-    }
-    assert!(!logs.is_empty(), "no white-noise region");
+    let white: Vec<usize> = (1..c.len().saturating_sub(1))
+        .filter(|&i| {
+            let s = (c[i + 1].adev / c[i - 1].adev).ln() / (c[i + 1].tau / c[i - 1].tau).ln();
+            (s + 0.5).abs() <= SLOPE_TOL
+        })
+        .collect();
+    let centre = *white
+        .iter()
+        .min_by(|&&x, &&y| c[x].tau.ln().abs().total_cmp(&c[y].tau.ln().abs()))
+        .expect("no white-noise region");
+    let logs: Vec<f64> = white
+        .iter()
+        .filter(|&&i| c[i].tau / c[centre].tau <= WINDOW && c[centre].tau / c[i].tau <= WINDOW)
+        .map(|&i| (c[i].adev * c[i].tau.sqrt()).ln())
+        .collect();
     (logs.iter().sum::<f64>() / logs.len() as f64).exp()
 }
 
@@ -176,7 +191,16 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
         );
         return (false, format!("{label}: {why}"));
     };
-    let wide = lo <= 1.0 && hi >= 1.0 && hi / lo >= 100.0;
+    // a fit declared "approximately" is one of "the others, with a verdict saying why": the
+    // model stays within the tolerance (checked below) but its terms are not claimed
+    let approximate = matches!(
+        a.verdict,
+        super::AxisVerdict::Fits {
+            approximate: Some(_),
+            ..
+        }
+    );
+    let wide = lo <= 1.0 && hi >= 1.0 && hi / lo >= 100.0 && !approximate;
     let reading = n_reading_at_1s(a, lo, hi);
     for p in a.curve.iter().filter(|p| p.in_range) {
         let mis = p.model / p.adev - 1.0;
@@ -193,7 +217,7 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
     }
     let n = a.terms.n.value;
     assert!(
-        (n / reading - 1.0).abs() <= N_READING_TOL,
+        approximate || (n / reading - 1.0).abs() <= N_READING_TOL,
         "{label}: N {n:e} vs the −½-line reading {reading:e} at 1 s, tol {N_READING_TOL}"
     );
     let floor = a
@@ -203,7 +227,7 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
         .map(|p| p.adev)
         .fold(f64::INFINITY, f64::min);
     let b = a.terms.b;
-    if b.verdict == super::Verdict::Resolved {
+    if b.verdict == super::Verdict::Resolved && !approximate {
         let f = super::region::B_FLOOR_FACTOR * b.value;
         assert!(
             (f / floor - 1.0).abs() <= B_FLOOR_TOL,
@@ -229,7 +253,8 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
     (
         wide,
         format!(
-            "{label}: {} – {} s, χ²/dof {:.2}, δ {:.1} % | N {} | B {} | K {} | region N {} B {} K {} | N/reading {:+.1} %",
+            "{label}: {}{} – {} s, χ²/dof {:.2}, δ {:.1} % | N {} | B {} | K {} | region N {} B {} K {} | N/reading {:+.1} %",
+            if approximate { "(approximately) " } else { "" },
             super::short(lo),
             super::short(hi),
             f.chi2_per_dof,
