@@ -69,6 +69,8 @@ pub mod tau_grid;
 #[cfg(test)]
 mod tests_accuracy;
 #[cfg(test)]
+mod tests_bandlimited;
+#[cfg(test)]
 mod tests_profiles;
 #[cfg(test)]
 mod tests_real;
