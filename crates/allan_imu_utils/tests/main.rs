@@ -1,6 +1,7 @@
 //! Integration tests of allan_imu_utils: parity with the upstream reference outputs in
 //! `testdata/` (fit_reference.rs: the fit alone on upstream's variances; reference.rs: whole
-//! runs on the four bags) and the command line as a user runs it (cli.rs).
+//! runs on the four bags), the command line as a user runs it (cli.rs) and on other tools'
+//! Allan curves (curves.rs).
 
 // `!(err <= tol)` is deliberate: it also fails on NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -8,6 +9,7 @@
 
 mod cli;
 mod common;
+mod curves;
 mod fit_reference;
 mod reference;
 mod ros2;

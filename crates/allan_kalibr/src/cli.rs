@@ -55,8 +55,9 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = TimeArg::Record)]
     pub time: TimeArg,
     /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
-    /// from the timestamps.
-    #[arg(long, value_name = "HZ")]
+    /// from the timestamps. With --curves (also as --rate): the rate of a plain CSV whose τ
+    /// do not start at one sample.
+    #[arg(long, value_name = "HZ", visible_alias = "rate")]
     pub update_rate: Option<f64>,
     /// Chart title prefix (upstream's titlestr) [default: the input's file stem].
     #[arg(

@@ -1,7 +1,9 @@
 //! Integration tests of allan_kalibr: parity with the real kalibr_allan outputs in
-//! `testdata/` (reference.rs) and the binary run as a user would (cli.rs).
+//! `testdata/` (reference.rs), the binary run as a user would (cli.rs) and its IEEE 952 side:
+//! other tools' curves, warm-up and gap checks (ieee952.rs).
 
 mod cli;
 mod common;
 mod consumers;
+mod ieee952;
 mod reference;

@@ -318,7 +318,10 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     let _ = writeln!(
         s,
         "\n=> IEEE 952 noise terms (overlapping Allan deviation, Greenhall EDF, GLS fit with model discrepancy), continuous time, {} Hz",
-        a.rate
+        // the rate as measured (or implied by another tool's grid), to 4 decimals
+        format!("{:.4}", a.rate)
+            .trim_end_matches('0')
+            .trim_end_matches('.')
     );
     for n in &a.notes {
         let _ = writeln!(s, "   note: {n}");

@@ -5,7 +5,10 @@
 //!   part of the record is compared with the mean of the second half. Under the fitted noise
 //!   model the difference has variance ≈ σ²(w) + σ²(T/2) + 2σ²(Δ) (σ² the model's Allan
 //!   variance, w the window, Δ the distance to the reference: the two means' own noise and
-//!   how far the bias may wander in between). A first window beyond [`WARMUP_Z`] of that is
+//!   how far the bias may wander in between). A warm-up raises the whole record's long-τ
+//!   Allan variance too, and the fit takes it for random walk; so at long τ σ² is the
+//!   smaller of the model's and the second half's own (measured on its window means,
+//!   extrapolated as a random walk). A first window beyond [`WARMUP_Z`] of that is
 //!   reported, with its size and how long the excess lasts; `--skip-start` drops it.
 //! * **Gaps and rate changes** ([`timing`]): steps of the time stamps longer than
 //!   [`GAP_FACTOR`] times the median step of their block, and blocks of samples whose median
@@ -163,6 +166,8 @@ pub struct StartStats {
     pub means: Vec<f64>,
     /// Mean of the second half.
     pub reference: f64,
+    /// Means of the windows of the second half (its own noise, see [`warmup`]).
+    pub tail: Vec<f64>,
 }
 
 impl StartStats {
@@ -183,6 +188,9 @@ impl StartStats {
                 .map(|j| mean(j * window, (j + 1) * window))
                 .collect(),
             reference: mean(n / 2, n),
+            tail: (0..(n - n / 2) / window)
+                .map(|j| mean(n / 2 + j * window, n / 2 + (j + 1) * window))
+                .collect(),
         })
     }
 
@@ -202,6 +210,9 @@ impl StartStats {
                 .map(|j| mean(j * window, (j + 1) * window))
                 .collect(),
             reference: mean(n / 2, n),
+            tail: (0..(n - n / 2) / window)
+                .map(|j| mean(n / 2 + j * window, n / 2 + (j + 1) * window))
+                .collect(),
         })
     }
 }
@@ -212,10 +223,17 @@ pub fn warmup(st: &StartStats, model: &dyn Fn(f64) -> f64) -> Option<Warmup> {
     let total = st.n as f64 * st.tau0;
     let wt = st.window as f64 * st.tau0;
     let ref_center = 0.75 * total;
+    let tail = tail_avar(st);
+    // the fitted model, or the second half's own noise where that is smaller (a warm-up
+    // raises the whole record's long-τ Allan variance, and a fit absorbs it as random walk)
+    let noise = |tau: f64| match tail {
+        Some((tau_t, v)) if tau >= tau_t => model(tau).min(v * tau / tau_t),
+        _ => model(tau),
+    };
     let z_of = |j: usize| -> (f64, f64) {
         let d = st.means[j] - st.reference;
         let center = (j as f64 + 0.5) * wt;
-        let var = model(wt) + model(total / 2.0) + 2.0 * model(ref_center - center);
+        let var = noise(wt) + noise(total / 2.0) + 2.0 * noise(ref_center - center);
         (d, d / var.max(f64::MIN_POSITIVE).sqrt())
     };
     let (d0, z0) = z_of(0);
@@ -236,6 +254,28 @@ pub fn warmup(st: &StartStats, model: &dyn Fn(f64) -> f64) -> Option<Warmup> {
         sigmas: z0.abs(),
         duration: (last + 1) as f64 * wt,
     })
+}
+
+/// Clusters the second half's own Allan variance is taken over at least (non-overlapping,
+/// of window means): its EDF is then ≈ 9 for random walk, so it is rarely half the truth.
+const TAIL_CLUSTERS: usize = 10;
+
+/// The second half's non-overlapping Allan variance at its longest τ with
+/// [`TAIL_CLUSTERS`] clusters: (τ, AVAR). [`warmup`] extrapolates it linearly in τ (a
+/// random walk, the steepest ordinary growth: conservative for white and flicker noise).
+fn tail_avar(st: &StartStats) -> Option<(f64, f64)> {
+    let k = st.tail.len() / TAIL_CLUSTERS;
+    if k == 0 {
+        return None;
+    }
+    let means: Vec<f64> = st
+        .tail
+        .chunks_exact(k)
+        .map(|c| c.iter().sum::<f64>() / k as f64)
+        .collect();
+    let avar = means.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>()
+        / (2.0 * (means.len() - 1) as f64);
+    Some((k as f64 * st.window as f64 * st.tau0, avar))
 }
 
 /// Index of the first sample at or after `t[0] + seconds` (the `--skip-start` cut).
@@ -301,5 +341,44 @@ mod tests {
         let w = warmup(&st(&y), &model).expect("warm-up");
         assert!(w.size > 0.03 && w.sigmas > WARMUP_Z, "{w:?}");
         assert!(w.duration > 60.0 && w.duration < 600.0, "{w:?}");
+    }
+
+    /// White noise + random walk, per-sample σ `sd` and walk step `k`.
+    fn white_and_walk(rng: &mut StdRng, n: usize, sd: f64, k: f64) -> Vec<f64> {
+        let mut w = 0.0;
+        (0..n)
+            .map(|_| {
+                let (a, b): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+                w += k * b;
+                sd * a + w
+            })
+            .collect()
+    }
+
+    #[test]
+    fn warmup_seen_through_a_fit_that_absorbed_it() {
+        // a fit that took the warm-up for random walk (K six times the truth) must not hide
+        // it; a clean record against the same inflated model stays quiet, and so do clean
+        // records against their true model (no false alarm from the second half's noise)
+        let (n, tau0, sd, k) = (100_000usize, 0.02, 0.1, 2e-3);
+        let model_of = |kk: f64| move |tau: f64| sd * sd * tau0 / tau + kk * kk / tau0 * tau / 3.0;
+        let mut rng = StdRng::seed_from_u64(RNG_SEED + 1);
+        for rep in 0..20 {
+            let y = white_and_walk(&mut rng, n, sd, k);
+            let st = StartStats::from_samples(&y, tau0).unwrap();
+            assert_eq!(warmup(&st, &model_of(k)), None, "clean record {rep}");
+            if rep == 0 {
+                let warm: Vec<f64> = y
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| v + 2.0 * (-(i as f64 * tau0) / 100.0).exp())
+                    .collect();
+                let st = StartStats::from_samples(&warm, tau0).unwrap();
+                assert!(
+                    warmup(&st, &model_of(6.0 * k)).is_some(),
+                    "warm-up hidden by the inflated fit"
+                );
+            }
+        }
     }
 }
