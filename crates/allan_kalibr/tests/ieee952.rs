@@ -59,10 +59,10 @@ fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> D
     let mut walk = [0.0; 6];
     for i in 0..n {
         let mut t = i as f64 / RATE;
-        if let Some((at, len)) = gap {
-            if t >= at {
-                t += len;
-            }
+        if let Some((at, len)) = gap
+            && t >= at
+        {
+            t += len;
         }
         let mut row = [t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         for c in 0..6 {
