@@ -33,6 +33,13 @@ fi
 
 cargo test --workspace "$@"
 
+# Issue 10's accuracy studies of the IEEE 952 estimator (ignored by a plain `cargo test`;
+# about a minute on two cores in the optimised test build just made): every sim profile ×
+# 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
+# → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
+cargo test -p allan_kalibr --lib -- --ignored --exact \
+  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study
+
 # The seed's comparison, short enough for CI (30 min at 100 Hz, three presets), with the
 # tolerances `sim compare --check` states for that length, on the binaries cargo test built.
 target_dir=$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')
