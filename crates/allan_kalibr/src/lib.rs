@@ -2,7 +2,8 @@
 //!
 //! Reproduces the MATLAB half of rpng/kalibr_allan (`9d38ea9`: `SCRIPT_allan_matparallel.m`,
 //! `allan.m`, `SCRIPT_process_results.m`, `gen_chart.m`) in seconds instead of hours, and adds
-//! what users ask for: Kalibr's `imu.yaml`, the curves as CSV, and readable plots.
+//! what users ask for: Kalibr's `imu.yaml`, the curves as CSV, readable plots, and an IEEE
+//! Std 952 analysis with intervals and verdicts ([`ieee952`]).
 //! The behaviour contract is `shared/specs/kalibr_allan.md`.
 //!
 //! ## Brief overview
@@ -12,7 +13,20 @@
 //! * [`fit`]: gen_chart's fixed-slope fits and read-offs.
 //! * [`report`]: the exact printed text; [`yaml`]: Kalibr imu.yaml; [`curves`]: the CSV;
 //!   [`plot`]: the two charts.
-//! * [`input`]: `.mat`/`.bag` loading and the update-rate check; [`run`]: the whole job.
+//! * [`input`]: `.mat`/`.bag` loading and the update-rate check; [`run`](mod@run): the whole
+//!   job.
+//! * [`ieee952`]: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
+//!   run after their upstream-compatible output, unless `--compat-only`: overlapping Allan
+//!   deviation with Greenhall-EDF intervals ([`ieee952::oadev`], [`ieee952::edf`],
+//!   [`ieee952::ci`], [`ieee952::noise_id`]); the 5-term model (plus a Gauss–Markov bump and
+//!   a flicker floor's corner) fitted by GLS under the points' covariance
+//!   ([`ieee952::avar_cov`]) with a model-discrepancy component, on the τ range the model
+//!   can describe ([`ieee952::fit`]); per-axis verdicts and per-term 95 % intervals, the IEEE
+//!   952 region readings as cross-check and fallback ([`ieee952::region`]); record-length
+//!   advice ([`ieee952::advisor`]); warm-up, gap and rate checks ([`ieee952::stationarity`]);
+//!   other tools' Allan curves (`--curves`, [`ieee952::curves_in`]); the section's text
+//!   ([`ieee952::imu`]), its files (terms and curves CSV, Kalibr/VINS/ORB-SLAM3 yaml, with
+//!   named columns `sim compare` reads: [`ieee952::files`]) and chart ([`ieee952::plot`]).
 //!
 //! ## Units and conventions
 //! Accelerometer in m/s², gyroscope in rad/s, as in the bag. The four numbers are

@@ -367,6 +367,13 @@ fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
                 failed.join(", ")
             ));
         }
+        let approx = a.approximate_axes(s);
+        if !approx.is_empty() {
+            comments.push(format!(
+                "APPROXIMATE FIT on {}: the model misses the curve beyond its statistics there; those values are approximate.",
+                approx.join(", ")
+            ));
+        }
     }
     for (name, x) in names.iter().zip([v.acc_n, v.acc_w, v.gyr_n, v.gyr_w]) {
         comments.extend(note(name, x));

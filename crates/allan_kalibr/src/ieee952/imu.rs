@@ -259,6 +259,23 @@ impl ImuAnalysis {
             .map(|a| a.sensor.axis_label(a.axis))
             .collect()
     }
+
+    /// Axes of one sensor whose fit is declared only approximately (see
+    /// [`AxisVerdict::Fits`]), by label.
+    pub fn approximate_axes(&self, s: Sensor) -> Vec<&'static str> {
+        self.sensor_axes(s)
+            .filter(|a| {
+                matches!(
+                    a.analysis.verdict,
+                    AxisVerdict::Fits {
+                        approximate: Some(_),
+                        ..
+                    }
+                )
+            })
+            .map(|a| a.sensor.axis_label(a.axis))
+            .collect()
+    }
 }
 
 fn term_text(t: &Term, unit: &str) -> String {
@@ -366,7 +383,7 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
             ("rate ramp R", &an.terms.r, sensor.r_unit()),
         ] {
             if t.verdict == Verdict::Resolved {
-                let _ = writeln!(s, "{:<7} {name:<11}= {}", "", term_text(t, unit));
+                let _ = writeln!(s, "{:<7} {name:<15}= {}", "", term_text(t, unit));
             }
         }
         if an.terms.g.verdict != Verdict::NotFitted {

@@ -1,5 +1,6 @@
-//! The corrected estimator shared by both analysers: fully overlapping Allan deviation on a
-//! log grid of distinct cluster sizes, Greenhall EDF confidence intervals, power-law noise
+//! The corrected estimator shared by both analysers: overlapping Allan deviation on a log
+//! grid of distinct cluster sizes (fully overlapping up to m = 256, every m/16-th start
+//! above: statistically the same estimate, [`oadev`]), Greenhall EDF confidence intervals, power-law noise
 //! identification, and a fit of the IEEE Std 952 terms that holds on real sensors — a τ range
 //! the model can describe, weights that survive model error, a goodness of fit and a verdict
 //! per axis, a 95 % interval and a verdict per term, and the classic region readings as a
@@ -42,7 +43,16 @@
 //! Allan variance) — a bias instability only where there is a floor, not at the V where the
 //! white-noise and random-walk lines cross. Where the data leave the flicker
 //! floor's shape open (a flat floor or one with a lower corner, [`fit::flicker_band`]), each
-//! interval spans every plausible shape ([`fit::FitResult::alternatives`]).
+//! interval spans every plausible shape ([`fit::FitResult::alternatives`]). A fit whose
+//! model misses the curve beyond its statistics by more than [`APPROX_DELTA`] is declared
+//! "approximately" (its terms lean on the model's shape).
+//!
+//! Without a reliable fit the terms are IEEE 952's region readings ([`region`]: N from the
+//! −½ line at τ = 1 s, B from the flat floor / 0.664, K from the +½ line at τ = 3 s), each
+//! with its own interval or, where its region is absent, a 95 % upper bound — stated as such
+//! in the text, the terms file (`source` = `region`) and the yaml files. The yaml files never
+//! carry a term as if it were measured when it is not: an unresolved term is written as its
+//! 95 % upper bound and marked so in a comment ([`files`]).
 //!
 //! # How good can K be?
 //! For white noise N plus random walk K over T seconds no unbiased estimator beats
