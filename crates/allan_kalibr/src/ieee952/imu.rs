@@ -469,9 +469,11 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
         let Some(adv) = ax.advice else { continue };
         let one = |name: &str, t: &advisor::TermAdvice, term: &Term| -> String {
             if t.precision.is_finite() {
+                // one decimal below 10 % (a white noise is often known to a few tenths), whole percent above
+                let pct = 100.0 * t.precision;
+                let d = if pct < 10.0 { 1 } else { 0 };
                 format!(
-                    "{name} ±{:.0} % ({} / {})",
-                    100.0 * t.precision,
+                    "{name} ±{pct:.d$} % ({} / {})",
                     advisor::duration_text(t.record_25),
                     advisor::duration_text(t.record_10)
                 )

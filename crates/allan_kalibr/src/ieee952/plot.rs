@@ -280,7 +280,14 @@ where
                 px(4.0),
                 c.stroke_width(px(1.0).max(1)),
             ))?
-            .label(format!("{name} = {v:.2e}"))
+            .label(format!(
+                "{name} = {v:.2e}{}",
+                if terms[j].verdict == super::Verdict::Resolved {
+                    ""
+                } else {
+                    " (not resolved)"
+                }
+            ))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
         }
         if coef[super::fit::GM] > 0.0 {
