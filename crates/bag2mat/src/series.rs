@@ -307,12 +307,50 @@ struct Row {
     s: ImuSample,
 }
 
-/// What one part delivered, per selected topic.
+/// What one part delivered, per selected topic: the messages written straight into its
+/// slice of the columns, and those beyond it (or all, without a promised count) as rows.
 struct PartOut {
+    written: Vec<usize>,
     rows: Vec<Vec<Row>>,
     bad: Vec<u64>,
     first_bad: Vec<Option<String>>,
     read: source::PartRead,
+}
+
+/// One part's slice of one topic's columns.
+struct Slices<'a> {
+    record_time: &'a mut [RosTime],
+    stamp: &'a mut [RosTime],
+    seq: &'a mut [u32],
+    acc: &'a mut [[f64; 3]],
+    gyro: &'a mut [[f64; 3]],
+}
+
+impl Slices<'_> {
+    fn len(&self) -> usize {
+        self.record_time.len()
+    }
+
+    fn set(&mut self, i: usize, t: u64, s: &ImuSample) {
+        self.record_time[i] = RosTime::from_nanos(t);
+        self.stamp[i] = s.stamp;
+        self.seq[i] = s.seq;
+        self.acc[i] = s.acc;
+        self.gyro[i] = s.gyro;
+    }
+}
+
+/// Splits a column into one slice per part, of the given lengths.
+fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
+    let mut rest = column;
+    sizes
+        .iter()
+        .map(|&k| {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            rest = tail;
+            head
+        })
+        .collect()
 }
 
 /// Reads the selected Imu topics of `path` (any accepted input) in one pass.
@@ -359,26 +397,87 @@ pub fn read_from(
         if per_part_unit { "parts" } else { "msgs" },
     );
     pb.set_message("reading");
-    let outs: Vec<PartOut> = (0..parts.len())
-        .into_par_iter()
-        .map(|i| {
-            let mut rows: Vec<Vec<Row>> = (0..n_sel)
+    // Each part's promised count of each topic. Where every part states one, the topic's
+    // columns are allocated once at their final size and each part decodes straight into
+    // its own slice of them: the read holds one copy of the data, not rows and columns.
+    let expect: Vec<Vec<Option<usize>>> = parts
+        .iter()
+        .map(|p| {
+            (0..n_sel)
                 .map(|k| {
-                    let cap: u64 = parts[i]
-                        .counts
-                        .iter()
-                        .flatten()
-                        .filter(|(c, _)| selected[k].channels.iter().any(|(id, _)| id == c))
-                        .map(|(_, n)| *n)
-                        .sum();
-                    Vec::with_capacity(cap.min(1 << 20) as usize)
+                    p.counts.as_ref().map(|v| {
+                        v.iter()
+                            .filter(|(c, _)| selected[k].channels.iter().any(|(id, _)| id == c))
+                            .map(|(_, n)| *n as usize)
+                            .sum()
+                    })
                 })
-                .collect();
+                .collect()
+        })
+        .collect();
+    let direct: Vec<bool> = (0..n_sel)
+        .map(|k| expect.iter().all(|e| e[k].is_some()))
+        .collect();
+    let mut cols: Vec<ImuSeries> = (0..n_sel)
+        .map(|k| {
+            let n = if direct[k] {
+                expect.iter().map(|e| e[k].unwrap_or(0)).sum()
+            } else {
+                0
+            };
+            ImuSeries {
+                record_time: vec![RosTime::default(); n],
+                stamp: vec![RosTime::default(); n],
+                seq: vec![0; n],
+                acc: vec![[0.0; 3]; n],
+                gyro: vec![[0.0; 3]; n],
+                ..ImuSeries::default()
+            }
+        })
+        .collect();
+    let sizes: Vec<Vec<usize>> = (0..n_sel)
+        .map(|k| {
+            expect
+                .iter()
+                .map(|e| if direct[k] { e[k].unwrap_or(0) } else { 0 })
+                .collect()
+        })
+        .collect();
+    let mut dests: Vec<Vec<Slices>> = (0..parts.len())
+        .map(|_| Vec::with_capacity(n_sel))
+        .collect();
+    for (c, sz) in cols.iter_mut().zip(&sizes) {
+        let sl = split_rows(&mut c.record_time, sz)
+            .into_iter()
+            .zip(split_rows(&mut c.stamp, sz))
+            .zip(split_rows(&mut c.seq, sz))
+            .zip(split_rows(&mut c.acc, sz))
+            .zip(split_rows(&mut c.gyro, sz));
+        for (d, ((((record_time, stamp), seq), acc), gyro)) in dests.iter_mut().zip(sl) {
+            d.push(Slices {
+                record_time,
+                stamp,
+                seq,
+                acc,
+                gyro,
+            });
+        }
+    }
+    let outs: Vec<PartOut> = dests
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, mut dst)| {
+            let mut written = vec![0usize; n_sel];
+            let mut rows: Vec<Vec<Row>> = vec![Vec::new(); n_sel];
             let mut bad = vec![0u64; n_sel];
             let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
             let read = src.read_part(i, &want, &mut |c, t, data| {
                 if let Some(Some((k, codec))) = lookup.get(c as usize) {
                     match decode(*codec, data) {
+                        Ok(s) if written[*k] < dst[*k].len() => {
+                            dst[*k].set(written[*k], t, &s);
+                            written[*k] += 1;
+                        }
                         Ok(s) => rows[*k].push(Row { t, s }),
                         Err(e) => {
                             bad[*k] += 1;
@@ -389,6 +488,7 @@ pub fn read_from(
             });
             pb.inc(if per_part_unit { 1 } else { read.delivered });
             PartOut {
+                written,
                 rows,
                 bad,
                 first_bad,
@@ -399,8 +499,12 @@ pub fn read_from(
     pb.finish_and_clear();
 
     let mut series = Vec::with_capacity(n_sel);
-    for (k, s) in selected.into_iter().enumerate() {
-        let mut out = assemble(&outs, k);
+    for ((k, s), cols_k) in selected.into_iter().enumerate().zip(cols) {
+        let got_of: Vec<u64> = outs
+            .iter()
+            .map(|o| (o.written[k] + o.rows[k].len()) as u64)
+            .collect();
+        let mut out = assemble(cols_k, &sizes[k], &outs, k);
         out.topic = s.topic.clone();
         out.msg_type = s.msg_type.clone();
         let r = &mut out.report;
@@ -420,7 +524,7 @@ pub fn read_from(
                     .map(|(_, n)| *n)
                     .sum()
             });
-            let got = o.rows[k].len() as u64 + o.bad[k];
+            let got = got_of[i] + o.bad[k];
             let reason = match (&o.read.error, o.read.skipped) {
                 (Some(e), _) => Some(e.clone()),
                 (None, n) if n > 0 => o.read.skip_reason.clone(),
@@ -504,70 +608,49 @@ pub fn read_from(
 const SORTED_NOTE: &str =
     "messages were not stored in record-time order; sorted as rosbag::View does";
 
-/// Splits a column into one slice per part, of the given lengths.
-fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
-    let mut rest = column;
-    sizes
+/// Topic `k`'s columns: `cols` as the parts filled their slices (of `sizes`), when each
+/// delivered exactly what it promised; otherwise (no promise, fewer or more messages) the
+/// parts' slices and rows gathered in part order. Then sorted by record time when the
+/// storage order differs from it.
+fn assemble(cols: ImuSeries, sizes: &[usize], outs: &[PartOut], k: usize) -> ImuSeries {
+    let exact = outs
         .iter()
-        .map(|&k| {
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
-            rest = tail;
-            head
-        })
-        .collect()
-}
-
-/// One part's rows of every column.
-struct Slices<'a> {
-    record_time: &'a mut [RosTime],
-    stamp: &'a mut [RosTime],
-    seq: &'a mut [u32],
-    acc: &'a mut [[f64; 3]],
-    gyro: &'a mut [[f64; 3]],
-}
-
-/// Gathers topic `k`'s rows of every part into columns (in parallel, each part into its
-/// own rows), then sorts by record time when the storage order differs from it.
-fn assemble(outs: &[PartOut], k: usize) -> ImuSeries {
-    let sizes: Vec<usize> = outs.iter().map(|o| o.rows[k].len()).collect();
-    let n: usize = sizes.iter().sum();
-    let mut s = ImuSeries {
-        record_time: vec![RosTime::default(); n],
-        stamp: vec![RosTime::default(); n],
-        seq: vec![0; n],
-        acc: vec![[0.0; 3]; n],
-        gyro: vec![[0.0; 3]; n],
-        ..ImuSeries::default()
+        .zip(sizes)
+        .all(|(o, &n)| o.written[k] == n && o.rows[k].is_empty());
+    let mut s = if exact {
+        cols
+    } else {
+        let n: usize = outs.iter().map(|o| o.written[k] + o.rows[k].len()).sum();
+        let mut s = ImuSeries {
+            record_time: Vec::with_capacity(n),
+            stamp: Vec::with_capacity(n),
+            seq: Vec::with_capacity(n),
+            acc: Vec::with_capacity(n),
+            gyro: Vec::with_capacity(n),
+            ..ImuSeries::default()
+        };
+        let mut off = 0;
+        for (o, &size) in outs.iter().zip(sizes) {
+            let r = off..off + o.written[k];
+            s.record_time
+                .extend_from_slice(&cols.record_time[r.clone()]);
+            s.stamp.extend_from_slice(&cols.stamp[r.clone()]);
+            s.seq.extend_from_slice(&cols.seq[r.clone()]);
+            s.acc.extend_from_slice(&cols.acc[r.clone()]);
+            s.gyro.extend_from_slice(&cols.gyro[r]);
+            let rows = &o.rows[k];
+            s.record_time
+                .extend(rows.iter().map(|r| RosTime::from_nanos(r.t)));
+            s.stamp.extend(rows.iter().map(|r| r.s.stamp));
+            s.seq.extend(rows.iter().map(|r| r.s.seq));
+            s.acc.extend(rows.iter().map(|r| r.s.acc));
+            s.gyro.extend(rows.iter().map(|r| r.s.gyro));
+            off += size;
+        }
+        s
     };
-    {
-        let slices: Vec<Slices> = split_rows(&mut s.record_time, &sizes)
-            .into_iter()
-            .zip(split_rows(&mut s.stamp, &sizes))
-            .zip(split_rows(&mut s.seq, &sizes))
-            .zip(split_rows(&mut s.acc, &sizes))
-            .zip(split_rows(&mut s.gyro, &sizes))
-            .map(|((((record_time, stamp), seq), acc), gyro)| Slices {
-                record_time,
-                stamp,
-                seq,
-                acc,
-                gyro,
-            })
-            .collect();
-        slices
-            .into_par_iter()
-            .zip(outs.par_iter())
-            .for_each(|(p, o)| {
-                for (i, r) in o.rows[k].iter().enumerate() {
-                    p.record_time[i] = RosTime::from_nanos(r.t);
-                    p.stamp[i] = r.s.stamp;
-                    p.seq[i] = r.s.seq;
-                    p.acc[i] = r.s.acc;
-                    p.gyro[i] = r.s.gyro;
-                }
-            });
-    }
     if s.record_time.windows(2).any(|w| w[1] < w[0]) {
+        let n = s.record_time.len();
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by_key(|&i| s.record_time[i]);
         s.record_time = permute(&s.record_time, &order);
@@ -627,6 +710,82 @@ pub fn permute<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn sample(i: u32) -> ImuSample {
+        ImuSample {
+            seq: i,
+            stamp: RosTime::from_nanos(1000 * i as u64),
+            gyro: [i as f64; 3],
+            acc: [-(i as f64); 3],
+        }
+    }
+
+    fn part(written: usize, rows: Vec<Row>) -> PartOut {
+        PartOut {
+            written: vec![written],
+            rows: vec![rows],
+            bad: vec![0],
+            first_bad: vec![None],
+            read: source::PartRead::default(),
+        }
+    }
+
+    /// Columns as the parts filled them: three parts promised 2 + 2 + 2 messages; the first
+    /// delivered them, the second one short, the third one more (a row).
+    fn filled() -> (ImuSeries, Vec<usize>) {
+        let mut s = ImuSeries {
+            record_time: vec![RosTime::default(); 6],
+            stamp: vec![RosTime::default(); 6],
+            seq: vec![0; 6],
+            acc: vec![[0.0; 3]; 6],
+            gyro: vec![[0.0; 3]; 6],
+            ..ImuSeries::default()
+        };
+        for (slot, i) in [(0usize, 0u32), (1, 1), (2, 2), (4, 3), (5, 4)] {
+            s.record_time[slot] = RosTime::from_nanos(10 * i as u64);
+            s.stamp[slot] = sample(i).stamp;
+            s.seq[slot] = i;
+            s.acc[slot] = sample(i).acc;
+            s.gyro[slot] = sample(i).gyro;
+        }
+        (s, vec![2, 2, 2])
+    }
+
+    #[test]
+    fn assemble_keeps_exact_parts_and_gathers_the_rest_in_part_order() {
+        // every part as promised: the columns as they are (the same buffers)
+        let (mut cols, sizes) = filled();
+        cols.record_time[3] = RosTime::from_nanos(25);
+        cols.seq[3] = 9;
+        let before = cols.seq.as_ptr();
+        let exact = [part(2, vec![]), part(2, vec![]), part(2, vec![])];
+        let got = assemble(cols, &sizes, &exact, 0);
+        assert_eq!(got.seq, vec![0, 1, 2, 9, 3, 4]);
+        assert_eq!(got.seq.as_ptr(), before, "no copy");
+        let (cols, sizes) = filled();
+        // a short part and a part with one more: its slice, then its row, in part order
+        let uneven = [
+            part(2, vec![]),
+            part(1, vec![]),
+            part(
+                2,
+                vec![Row {
+                    t: 50,
+                    s: sample(5),
+                }],
+            ),
+        ];
+        let got = assemble(cols, &sizes, &uneven, 0);
+        assert_eq!(got.seq, vec![0, 1, 2, 3, 4, 5]);
+        assert_eq!(
+            got.record_time,
+            (0..6)
+                .map(|i| RosTime::from_nanos(10 * i))
+                .collect::<Vec<_>>()
+        );
+        assert_eq!(got.acc[5], [-5.0; 3]);
+        assert!(got.notes.is_empty(), "already in record-time order");
+    }
 
     #[test]
     fn folder_names_are_unique_and_flat() {
