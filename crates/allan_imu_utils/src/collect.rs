@@ -69,22 +69,19 @@ impl Collected<'_> {
 
     /// The pushed gyro values of axis `k` (0–2: x, y, z) in pseudo-deg/h, in message order.
     pub fn gyro_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
-        self.series.gyro[..self.len()]
+        self.series.gyro[k][..self.len()]
             .iter()
-            .map(move |w| w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
+            .map(move |w| w * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
     }
 
     /// The pushed gyro values of axis `k` (0–2) in rad/s, as the bag holds them.
     pub fn gyro_rad_s(&self, k: usize) -> Vec<f64> {
-        self.series.gyro[..self.len()]
-            .iter()
-            .map(|w| w[k])
-            .collect()
+        self.series.gyro[k][..self.len()].to_vec()
     }
 
     /// The pushed accelerations of axis `k` (0–2: x, y, z) in m/s², in message order.
     pub fn acc_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
-        self.series.acc[..self.len()].iter().map(move |a| a[k])
+        self.series.acc[k][..self.len()].iter().copied()
     }
 
     /// The error for a non-finite value of accumulator `axis` at message `index`.
@@ -133,8 +130,8 @@ mod tests {
             record_time: stamp.clone(),
             stamp,
             seq: (0..n as u32).collect(),
-            acc: vec![[0.0, 0.0, 9.81]; n],
-            gyro: vec![[0.001, 0.0, 0.0]; n],
+            acc: [vec![0.0; n], vec![0.0; n], vec![9.81; n]],
+            gyro: [vec![0.001; n], vec![0.0; n], vec![0.0; n]],
             ..Default::default()
         }
     }

@@ -73,15 +73,17 @@ pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f
 
 /// The matrix of one Imu series with the chosen time column.
 pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
-    let mut d = DataImu::with_capacity(s.len());
-    for ((t, a), g) in s.time(time).iter().zip(&s.acc).zip(&s.gyro) {
-        d.push(bagconvert_row(*t, *a, *g));
+    let t = s.time(time).iter().map(|r| r.to_sec()).collect();
+    let [ax, ay, az] = s.acc.clone();
+    let [wx, wy, wz] = s.gyro.clone();
+    DataImu {
+        columns: [t, ax, ay, az, wx, wy, wz],
     }
-    d
 }
 
-/// The matrix of one Imu series, consuming it column by column so that the samples are
-/// never held twice in full (peak memory stays near the size of the matrix).
+/// The matrix of one Imu series, consuming it: the six value columns are moved, not copied,
+/// and only the time column is computed (peak memory stays near the size of the matrix).
+/// The values are bagconvert's row ([`bagconvert_row`]) column by column.
 pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
     let ImuSeries {
         record_time,
@@ -102,11 +104,8 @@ pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
     };
     let t: Vec<f64> = t_src.iter().map(|r| r.to_sec()).collect();
     drop(t_src);
-    let split = |v: Vec<[f64; 3]>| -> [Vec<f64>; 3] {
-        std::array::from_fn(|c| v.iter().map(|x| x[c]).collect())
-    };
-    let [ax, ay, az] = split(acc);
-    let [wx, wy, wz] = split(gyro);
+    let [ax, ay, az] = acc;
+    let [wx, wy, wz] = gyro;
     DataImu {
         columns: [t, ax, ay, az, wx, wy, wz],
     }

@@ -103,6 +103,7 @@ pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
                 what: format!("{}: {e}", parts[i].label),
                 messages: None,
                 span: parts[i].span,
+                channel: None,
             });
         }
         for (c, v) in m {

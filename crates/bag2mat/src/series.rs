@@ -91,10 +91,10 @@ pub struct ImuSeries {
     pub stamp: Vec<RosTime>,
     /// `header.seq` of each message (0 for ROS 2, which has none).
     pub seq: Vec<u32>,
-    /// Linear acceleration `[x, y, z]`, m/s².
-    pub acc: Vec<[f64; 3]>,
-    /// Angular velocity `[x, y, z]`, rad/s.
-    pub gyro: Vec<[f64; 3]>,
+    /// Linear acceleration, one column per axis x, y, z, m/s².
+    pub acc: [Vec<f64>; 3],
+    /// Angular velocity, one column per axis x, y, z, rad/s.
+    pub gyro: [Vec<f64>; 3],
     /// Things the binary should tell the user on stderr (topic fallback, lost chunks, …).
     pub notes: Vec<String>,
     /// Promised against delivered.
@@ -110,6 +110,16 @@ impl ImuSeries {
     /// True when there are no samples.
     pub fn is_empty(&self) -> bool {
         self.record_time.is_empty()
+    }
+
+    /// Angular velocity `[x, y, z]` of sample `i`, rad/s.
+    pub fn gyro_at(&self, i: usize) -> [f64; 3] {
+        std::array::from_fn(|c| self.gyro[c][i])
+    }
+
+    /// Linear acceleration `[x, y, z]` of sample `i`, m/s².
+    pub fn acc_at(&self, i: usize) -> [f64; 3] {
+        std::array::from_fn(|c| self.acc[c][i])
     }
 
     /// The chosen time column.
@@ -300,16 +310,176 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
     Ok(out)
 }
 
-/// One decoded message.
-#[derive(Clone, Copy)]
-struct Row {
-    t: u64,
-    s: ImuSample,
+/// The smallest payload a decodable `sensor_msgs/Imu` has (ROS 1: 16 header bytes and 37
+/// doubles; CDR: 4 encapsulation bytes, the stamp, an empty frame_id and 37 aligned doubles):
+/// a part of `bytes` bytes holds at most `bytes / MIN_IMU_PAYLOAD` rows, whatever its index
+/// says.
+pub const MIN_IMU_PAYLOAD: u64 = 16 + 37 * 8;
+
+/// Parts decoded at once when the container does not say how many rows each holds: their
+/// rows are buffered, then appended in order, so memory stays near the size of the result.
+const WINDOW_PARTS_PER_THREAD: usize = 4;
+
+/// The columns of one topic's rows.
+#[derive(Debug, Clone, Default)]
+struct Rows {
+    record_time: Vec<RosTime>,
+    stamp: Vec<RosTime>,
+    seq: Vec<u32>,
+    acc: [Vec<f64>; 3],
+    gyro: [Vec<f64>; 3],
 }
 
-/// What one part delivered, per selected topic.
+impl Rows {
+    fn zeroed(n: usize) -> Rows {
+        Rows {
+            record_time: vec![RosTime::default(); n],
+            stamp: vec![RosTime::default(); n],
+            seq: vec![0; n],
+            acc: std::array::from_fn(|_| vec![0.0; n]),
+            gyro: std::array::from_fn(|_| vec![0.0; n]),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.record_time.len()
+    }
+
+    fn push(&mut self, t: u64, s: &ImuSample) {
+        self.record_time.push(RosTime::from_nanos(t));
+        self.stamp.push(s.stamp);
+        self.seq.push(s.seq);
+        for c in 0..3 {
+            self.acc[c].push(s.acc[c]);
+            self.gyro[c].push(s.gyro[c]);
+        }
+    }
+
+    /// Appends rows `..n` of `slot`.
+    fn extend_from(&mut self, slot: &RowsMut<'_>, n: usize) {
+        self.record_time.extend_from_slice(&slot.record_time[..n]);
+        self.stamp.extend_from_slice(&slot.stamp[..n]);
+        self.seq.extend_from_slice(&slot.seq[..n]);
+        for c in 0..3 {
+            self.acc[c].extend_from_slice(&slot.acc[c][..n]);
+            self.gyro[c].extend_from_slice(&slot.gyro[c][..n]);
+        }
+    }
+
+    fn append(&mut self, other: &Rows) {
+        self.record_time.extend_from_slice(&other.record_time);
+        self.stamp.extend_from_slice(&other.stamp);
+        self.seq.extend_from_slice(&other.seq);
+        for c in 0..3 {
+            self.acc[c].extend_from_slice(&other.acc[c]);
+            self.gyro[c].extend_from_slice(&other.gyro[c]);
+        }
+    }
+
+    /// One mutable slot per part, of the given lengths.
+    fn split(&mut self, sizes: &[usize]) -> Vec<RowsMut<'_>> {
+        let mut rt = split_rows(&mut self.record_time, sizes).into_iter();
+        let mut st = split_rows(&mut self.stamp, sizes).into_iter();
+        let mut sq = split_rows(&mut self.seq, sizes).into_iter();
+        let [a0, a1, a2] = &mut self.acc;
+        let [g0, g1, g2] = &mut self.gyro;
+        let mut cols: [std::vec::IntoIter<&mut [f64]>; 6] = [
+            split_rows(a0, sizes).into_iter(),
+            split_rows(a1, sizes).into_iter(),
+            split_rows(a2, sizes).into_iter(),
+            split_rows(g0, sizes).into_iter(),
+            split_rows(g1, sizes).into_iter(),
+            split_rows(g2, sizes).into_iter(),
+        ];
+        (0..sizes.len())
+            .map(|_| {
+                let mut col = |j: usize| cols[j].next().unwrap_or_default();
+                RowsMut {
+                    acc: [col(0), col(1), col(2)],
+                    gyro: [col(3), col(4), col(5)],
+                    record_time: rt.next().unwrap_or_default(),
+                    stamp: st.next().unwrap_or_default(),
+                    seq: sq.next().unwrap_or_default(),
+                }
+            })
+            .collect()
+    }
+
+    /// Sorts by record time (stable) when the storage order differs from it; true if it did.
+    fn sort_by_record_time(&mut self) -> bool {
+        if !self.record_time.windows(2).any(|w| w[1] < w[0]) {
+            return false;
+        }
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        order.sort_by_key(|&i| self.record_time[i]);
+        self.record_time = permute(&self.record_time, &order);
+        self.stamp = permute(&self.stamp, &order);
+        self.seq = permute(&self.seq, &order);
+        for c in 0..3 {
+            self.acc[c] = permute(&self.acc[c], &order);
+            self.gyro[c] = permute(&self.gyro[c], &order);
+        }
+        true
+    }
+}
+
+/// One part's rows of every column of one topic.
+#[derive(Default)]
+struct RowsMut<'a> {
+    record_time: &'a mut [RosTime],
+    stamp: &'a mut [RosTime],
+    seq: &'a mut [u32],
+    acc: [&'a mut [f64]; 3],
+    gyro: [&'a mut [f64]; 3],
+}
+
+impl RowsMut<'_> {
+    fn cap(&self) -> usize {
+        self.record_time.len()
+    }
+
+    fn set(&mut self, i: usize, t: u64, s: &ImuSample) {
+        self.record_time[i] = RosTime::from_nanos(t);
+        self.stamp[i] = s.stamp;
+        self.seq[i] = s.seq;
+        for c in 0..3 {
+            self.acc[c][i] = s.acc[c];
+            self.gyro[c][i] = s.gyro[c];
+        }
+    }
+}
+
+/// Where one part's rows of one topic go: its planned slot, then (past the plan) a buffer.
+#[derive(Default)]
+struct Target<'a> {
+    slot: RowsMut<'a>,
+    filled: usize,
+    overflow: Rows,
+}
+
+impl Target<'_> {
+    fn put(&mut self, t: u64, s: &ImuSample) {
+        if self.filled < self.slot.cap() {
+            self.slot.set(self.filled, t, s);
+            self.filled += 1;
+        } else {
+            self.overflow.push(t, s);
+        }
+    }
+
+    fn rows(&self) -> usize {
+        self.filled + self.overflow.len()
+    }
+
+    /// True when the part delivered exactly what its slot was sized for.
+    fn exact(&self) -> bool {
+        self.filled == self.slot.cap() && self.overflow.len() == 0
+    }
+}
+
+/// What one part delivered, per selected topic (the rows themselves are in the targets).
 struct PartOut {
-    rows: Vec<Vec<Row>>,
+    rows: Vec<u64>,
     bad: Vec<u64>,
     first_bad: Vec<Option<String>>,
     read: source::PartRead,
@@ -325,6 +495,158 @@ pub fn read_imu_topics(
     read_from(src.as_ref(), sel, opts)
 }
 
+/// How part `i` routes a selected channel's messages: channel id → (topic, codec).
+type Lookup = Vec<Option<(usize, Codec)>>;
+
+/// Reads part `i` into `targets` (one per selected topic).
+fn decode_part(
+    src: &dyn Source,
+    i: usize,
+    lookup: &Lookup,
+    targets: &mut [Target<'_>],
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> PartOut {
+    let n_sel = targets.len();
+    let mut bad = vec![0u64; n_sel];
+    let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
+    let want = |c: u32| lookup.get(c as usize).is_some_and(|x| x.is_some());
+    let read = src.read_part(i, &want, &mut |c, t, data| {
+        if let Some(Some((k, codec))) = lookup.get(c as usize) {
+            match decode(*codec, data) {
+                Ok(s) => targets[*k].put(t, &s),
+                Err(e) => {
+                    bad[*k] += 1;
+                    first_bad[*k].get_or_insert_with(|| e.to_string());
+                }
+            }
+        }
+    });
+    pb.inc(if per_part_unit { 1 } else { read.delivered });
+    PartOut {
+        rows: targets.iter().map(|t| t.rows() as u64).collect(),
+        bad,
+        first_bad,
+        read,
+    }
+}
+
+/// Decodes every part into one [`Rows`] per selected topic, in storage order.
+///
+/// When every part says how many messages of each topic it holds, the columns are allocated
+/// once and each part is decoded in parallel straight into its own rows (no copy). A part
+/// that holds more or fewer than it said is still read whole (its extra rows are buffered)
+/// and the columns are then rebuilt in order. Without counts, parts are decoded a window at
+/// a time and appended, so memory stays near the size of the result. Slots are sized by the
+/// counts bounded by what the part's bytes can hold ([`MIN_IMU_PAYLOAD`]).
+fn decode_all(
+    src: &dyn Source,
+    lookup: &Lookup,
+    selected: &[Selected],
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> (Vec<Rows>, Vec<PartOut>) {
+    let parts = src.parts();
+    let n_sel = selected.len();
+    let planned: Option<Vec<Vec<usize>>> = parts
+        .iter()
+        .map(|p| {
+            let counts = p.counts.as_ref()?;
+            let bound = p.bytes / MIN_IMU_PAYLOAD;
+            Some(
+                selected
+                    .iter()
+                    .map(|s| {
+                        let n: u64 = counts
+                            .iter()
+                            .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                            .map(|(_, n)| *n)
+                            .fold(0u64, |a, b| a.saturating_add(b));
+                        n.min(bound) as usize
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    match planned {
+        Some(plan) => {
+            let mut columns: Vec<Rows> = (0..n_sel)
+                .map(|k| Rows::zeroed(plan.iter().map(|p| p[k]).sum()))
+                .collect();
+            let outs: Vec<PartOut>;
+            let mut rebuilt: Option<Vec<Rows>> = None;
+            {
+                // slots[k][i]: topic k's rows of part i.
+                let mut slots: Vec<std::vec::IntoIter<RowsMut>> = columns
+                    .iter_mut()
+                    .enumerate()
+                    .map(|(k, c)| {
+                        let sizes: Vec<usize> = plan.iter().map(|p| p[k]).collect();
+                        c.split(&sizes).into_iter()
+                    })
+                    .collect();
+                let mut per_part: Vec<Vec<Target>> = (0..parts.len())
+                    .map(|_| {
+                        slots
+                            .iter_mut()
+                            .map(|it| Target {
+                                slot: it.next().unwrap_or_default(),
+                                ..Target::default()
+                            })
+                            .collect()
+                    })
+                    .collect();
+                outs = per_part
+                    .par_iter_mut()
+                    .enumerate()
+                    .map(|(i, targets)| decode_part(src, i, lookup, targets, pb, per_part_unit))
+                    .collect();
+                if per_part.iter().flatten().any(|t| !t.exact()) {
+                    // Some part disagreed with its count: gather the rows in order.
+                    let mut r: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+                    for targets in &per_part {
+                        for (k, t) in targets.iter().enumerate() {
+                            r[k].extend_from(&t.slot, t.filled);
+                            r[k].append(&t.overflow);
+                        }
+                    }
+                    rebuilt = Some(r);
+                }
+            }
+            if let Some(r) = rebuilt {
+                columns = r;
+            }
+            (columns, outs)
+        }
+        None => {
+            let mut columns: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+            let mut outs = Vec::with_capacity(parts.len());
+            let window = (rayon::current_num_threads() * WINDOW_PARTS_PER_THREAD).max(1);
+            let mut start = 0;
+            while start < parts.len() {
+                let end = (start + window).min(parts.len());
+                let done: Vec<(Vec<Target>, PartOut)> = (start..end)
+                    .into_par_iter()
+                    .map(|i| {
+                        let mut targets: Vec<Target> =
+                            (0..n_sel).map(|_| Target::default()).collect();
+                        let o = decode_part(src, i, lookup, &mut targets, pb, per_part_unit);
+                        (targets, o)
+                    })
+                    .collect();
+                for (targets, o) in done {
+                    for (k, t) in targets.iter().enumerate() {
+                        columns[k].append(&t.overflow);
+                    }
+                    outs.push(o);
+                }
+                start = end;
+            }
+            (columns, outs)
+        }
+    }
+}
+
 /// [`read_imu_topics`] on an open source.
 pub fn read_from(
     src: &dyn Source,
@@ -332,16 +654,14 @@ pub fn read_from(
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
     let selected = select(src, sel)?;
-    let n_sel = selected.len();
     // Channel id → (selected topic, codec); a dense table for the usual small ids.
     let max_id = src.channels().iter().map(|c| c.id).max().unwrap_or(0) as usize;
-    let mut lookup: Vec<Option<(usize, Codec)>> = vec![None; max_id + 1];
+    let mut lookup: Lookup = vec![None; max_id + 1];
     for (k, s) in selected.iter().enumerate() {
         for &(id, codec) in &s.channels {
             lookup[id as usize] = Some((k, codec));
         }
     }
-    let want = |c: u32| lookup.get(c as usize).is_some_and(|x| x.is_some());
     let promised_of = |ids: &[(u32, Codec)]| -> Option<u64> {
         ids.iter()
             .map(|(id, _)| src.channels().iter().find(|c| c.id == *id)?.count)
@@ -359,50 +679,29 @@ pub fn read_from(
         if per_part_unit { "parts" } else { "msgs" },
     );
     pb.set_message("reading");
-    let outs: Vec<PartOut> = (0..parts.len())
-        .into_par_iter()
-        .map(|i| {
-            let mut rows: Vec<Vec<Row>> = (0..n_sel)
-                .map(|k| {
-                    let cap: u64 = parts[i]
-                        .counts
-                        .iter()
-                        .flatten()
-                        .filter(|(c, _)| selected[k].channels.iter().any(|(id, _)| id == c))
-                        .map(|(_, n)| *n)
-                        .sum();
-                    Vec::with_capacity(cap.min(1 << 20) as usize)
-                })
-                .collect();
-            let mut bad = vec![0u64; n_sel];
-            let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
-            let read = src.read_part(i, &want, &mut |c, t, data| {
-                if let Some(Some((k, codec))) = lookup.get(c as usize) {
-                    match decode(*codec, data) {
-                        Ok(s) => rows[*k].push(Row { t, s }),
-                        Err(e) => {
-                            bad[*k] += 1;
-                            first_bad[*k].get_or_insert_with(|| e.to_string());
-                        }
-                    }
-                }
-            });
-            pb.inc(if per_part_unit { 1 } else { read.delivered });
-            PartOut {
-                rows,
-                bad,
-                first_bad,
-                read,
-            }
-        })
-        .collect();
+    let (columns, outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
     pb.finish_and_clear();
 
-    let mut series = Vec::with_capacity(n_sel);
-    for (k, s) in selected.into_iter().enumerate() {
-        let mut out = assemble(&outs, k);
-        out.topic = s.topic.clone();
-        out.msg_type = s.msg_type.clone();
+    let mut series = Vec::with_capacity(selected.len());
+    for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
+        let sorted = rows.sort_by_record_time();
+        let Rows {
+            record_time,
+            stamp,
+            seq,
+            acc,
+            gyro,
+        } = rows;
+        let mut out = ImuSeries {
+            topic: s.topic.clone(),
+            msg_type: s.msg_type.clone(),
+            record_time,
+            stamp,
+            seq,
+            acc,
+            gyro,
+            ..ImuSeries::default()
+        };
         let r = &mut out.report;
         r.promised = promised[k];
         r.delivered = out.record_time.len() as u64;
@@ -420,7 +719,7 @@ pub fn read_from(
                     .map(|(_, n)| *n)
                     .sum()
             });
-            let got = o.rows[k].len() as u64 + o.bad[k];
+            let got = o.rows[k] + o.bad[k];
             let reason = match (&o.read.error, o.read.skipped) {
                 (Some(e), _) => Some(e.clone()),
                 (None, n) if n > 0 => o.read.skip_reason.clone(),
@@ -435,6 +734,7 @@ pub fn read_from(
                     what: format!("{}: {reason}", p.label),
                     messages: mine.map(|m| m.saturating_sub(got)),
                     span: p.span,
+                    channel: None,
                 });
             } else if short {
                 r.losses.push(Loss {
@@ -446,6 +746,7 @@ pub fn read_from(
                     ),
                     messages: mine.map(|m| m - got),
                     span: p.span,
+                    channel: None,
                 });
             }
         }
@@ -468,7 +769,7 @@ pub fn read_from(
                 r.first_error.as_deref().unwrap_or("?")
             ));
         }
-        if out.notes.iter().any(|n| n == SORTED_NOTE) {
+        if sorted {
             notes.push(SORTED_NOTE.to_string());
         }
         out.notes = notes;
@@ -515,69 +816,6 @@ fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
             head
         })
         .collect()
-}
-
-/// One part's rows of every column.
-struct Slices<'a> {
-    record_time: &'a mut [RosTime],
-    stamp: &'a mut [RosTime],
-    seq: &'a mut [u32],
-    acc: &'a mut [[f64; 3]],
-    gyro: &'a mut [[f64; 3]],
-}
-
-/// Gathers topic `k`'s rows of every part into columns (in parallel, each part into its
-/// own rows), then sorts by record time when the storage order differs from it.
-fn assemble(outs: &[PartOut], k: usize) -> ImuSeries {
-    let sizes: Vec<usize> = outs.iter().map(|o| o.rows[k].len()).collect();
-    let n: usize = sizes.iter().sum();
-    let mut s = ImuSeries {
-        record_time: vec![RosTime::default(); n],
-        stamp: vec![RosTime::default(); n],
-        seq: vec![0; n],
-        acc: vec![[0.0; 3]; n],
-        gyro: vec![[0.0; 3]; n],
-        ..ImuSeries::default()
-    };
-    {
-        let slices: Vec<Slices> = split_rows(&mut s.record_time, &sizes)
-            .into_iter()
-            .zip(split_rows(&mut s.stamp, &sizes))
-            .zip(split_rows(&mut s.seq, &sizes))
-            .zip(split_rows(&mut s.acc, &sizes))
-            .zip(split_rows(&mut s.gyro, &sizes))
-            .map(|((((record_time, stamp), seq), acc), gyro)| Slices {
-                record_time,
-                stamp,
-                seq,
-                acc,
-                gyro,
-            })
-            .collect();
-        slices
-            .into_par_iter()
-            .zip(outs.par_iter())
-            .for_each(|(p, o)| {
-                for (i, r) in o.rows[k].iter().enumerate() {
-                    p.record_time[i] = RosTime::from_nanos(r.t);
-                    p.stamp[i] = r.s.stamp;
-                    p.seq[i] = r.s.seq;
-                    p.acc[i] = r.s.acc;
-                    p.gyro[i] = r.s.gyro;
-                }
-            });
-    }
-    if s.record_time.windows(2).any(|w| w[1] < w[0]) {
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by_key(|&i| s.record_time[i]);
-        s.record_time = permute(&s.record_time, &order);
-        s.stamp = permute(&s.stamp, &order);
-        s.seq = permute(&s.seq, &order);
-        s.acc = permute(&s.acc, &order);
-        s.gyro = permute(&s.gyro, &order);
-        s.notes.push(SORTED_NOTE.to_string());
-    }
-    s
 }
 
 /// A folder name for each topic, for tools that write one output folder per topic: the

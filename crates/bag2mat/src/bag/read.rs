@@ -144,10 +144,21 @@ impl BagReader {
                 count: Some(self.index.counts.get(&c.id).copied().unwrap_or(0)),
             })
             .collect();
+        let ends: Vec<u64> = self
+            .chunks
+            .iter()
+            .skip(1)
+            .map(|c| c.pos)
+            .chain([self.len])
+            .collect();
         self.parts = self
             .chunks
             .iter()
-            .map(|c| Part {
+            .zip(ends)
+            .map(|(c, end)| Part {
+                bytes: end
+                    .saturating_sub(c.pos)
+                    .saturating_mul(source::MAX_EXPANSION),
                 label: format!("chunk at byte {}", c.pos),
                 span: c.span.map(|(a, b)| (a.as_nanos(), b.as_nanos())),
                 counts: self
@@ -248,6 +259,7 @@ impl BagReader {
                     ),
                     messages: None,
                     span: None,
+                    channel: None,
                 });
                 break;
             };
@@ -297,6 +309,7 @@ impl BagReader {
                             what: format!("chunk at byte {pos} is unreadable and was skipped: {e}"),
                             messages: None,
                             span: None,
+                            channel: None,
                         }),
                     }
                 }

@@ -333,6 +333,9 @@ impl McapReader {
                                 compression: h.compression.clone(),
                             });
                             self.parts.push(Part {
+                                bytes: h.uncompressed_size.min(
+                                    h.compressed_size.saturating_mul(source::MAX_EXPANSION),
+                                ),
                                 label: format!("chunk at byte {pos}"),
                                 span: Some((h.message_start_time, h.message_end_time)),
                                 counts: None,
@@ -347,11 +350,13 @@ impl McapReader {
                             ),
                             messages: None,
                             span: Some((h.message_start_time, h.message_end_time)),
+                            channel: None,
                         }),
                         Err(e) => self.losses.push(Loss {
                             what: format!("chunk at byte {pos} has an unreadable header ({e}); skipped"),
                             messages: None,
                             span: None,
+                            channel: None,
                         }),
                     }
                 }
@@ -406,6 +411,7 @@ impl McapReader {
             && end - *start <= LOOSE_PART_BYTES
         {
             *e = end;
+            p.bytes = end - *start;
             if let Some(t) = t {
                 p.span = Some(match p.span {
                     Some((a, b)) => (a.min(t), b.max(t)),
@@ -416,6 +422,7 @@ impl McapReader {
         }
         self.locs.push(Loc::Loose { start: pos, end });
         self.parts.push(Part {
+            bytes: end - pos,
             label: format!("unchunked messages from byte {pos}"),
             span: t.map(|t| (t, t)),
             counts: None,
@@ -447,6 +454,7 @@ impl McapReader {
             what,
             messages,
             span,
+            channel: None,
         });
     }
 
@@ -499,6 +507,7 @@ impl McapReader {
                     ),
                     messages: None,
                     span: Some((ci.message_start_time, ci.message_end_time)),
+                    channel: None,
                 });
             }
         }

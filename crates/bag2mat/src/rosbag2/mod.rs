@@ -122,6 +122,7 @@ impl BagDir {
                     what: format!("{} is listed in metadata.yaml but missing", p.display()),
                     messages: None,
                     span: None,
+                    channel: None,
                 });
                 continue;
             }

@@ -112,6 +112,8 @@ impl Sqlite3Reader {
         let parts = ranges
             .iter()
             .map(|(a, b)| Part {
+                // Rows hold no count; the bound is never used to size memory.
+                bytes: u64::MAX,
                 label: format!("message rows {a}..{}", b - 1),
                 span: None,
                 counts: None,
