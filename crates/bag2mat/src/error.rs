@@ -80,6 +80,15 @@ pub enum Error {
         /// Its md5.
         md5sum: String,
     },
+    /// A topic the user asked for yielded no row at all (every message lost or undecodable,
+    /// or none recorded): an error, never an empty matrix.
+    #[error("{}", nothing_read(.topic, .why))]
+    NothingRead {
+        /// The topic.
+        topic: String,
+        /// What the reader found (losses, notes).
+        why: Vec<String>,
+    },
     /// A message's bytes do not decode as the expected type.
     #[error("bad message: {what}")]
     BadMessage {
@@ -102,6 +111,18 @@ pub enum Error {
         /// What is wrong.
         what: String,
     },
+}
+
+fn nothing_read(topic: &str, why: &[String]) -> String {
+    if why.is_empty() {
+        return format!("topic '{topic}' holds no message");
+    }
+    let mut s = format!("no message of topic '{topic}' could be read:");
+    for w in why {
+        s.push_str("\n  ");
+        s.push_str(w);
+    }
+    s
 }
 
 fn no_imu_topic(available: &[TopicSummary]) -> String {

@@ -227,6 +227,8 @@ struct Selected {
     msg_type: String,
     channels: Vec<(u32, Codec)>,
     note: Option<String>,
+    /// Named by the user (not only found by `all_imu`).
+    named: bool,
 }
 
 fn other_slash_form(topic: &str) -> String {
@@ -240,7 +242,7 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
     let chans = src.channels();
     let on = |t: &str| chans.iter().filter(|c| c.topic == t).collect::<Vec<_>>();
     let mut out: Vec<Selected> = Vec::new();
-    let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note| {
+    let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note, named: bool| {
         if out.iter().any(|s| s.topic == topic) {
             return Ok(());
         }
@@ -265,13 +267,14 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             msg_type: cs[0].msg_type.clone(),
             channels,
             note,
+            named,
         });
         Ok(())
     };
     for t in &sel.topics {
         let cs = on(t);
         if !cs.is_empty() {
-            push(&mut out, t.clone(), cs, None)?;
+            push(&mut out, t.clone(), cs, None, true)?;
             continue;
         }
         let other = other_slash_form(t);
@@ -283,7 +286,7 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             });
         }
         let note = format!("topic '{t}' is not in the bag; using '{other}'");
-        push(&mut out, other, cs, Some(note))?;
+        push(&mut out, other, cs, Some(note), true)?;
     }
     if sel.all_imu {
         let mut topics: Vec<&str> = chans
@@ -298,7 +301,7 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             // A topic that mixes Imu with another type is not "an Imu topic".
             let cs = on(t);
             if cs.iter().all(|c| is_imu(c)) {
-                push(&mut out, t.to_string(), cs, None)?;
+                push(&mut out, t.to_string(), cs, None, false)?;
             }
         }
         if out.is_empty() && before == 0 {
@@ -682,7 +685,9 @@ pub fn read_from(
     let (columns, outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
     pb.finish_and_clear();
 
-    let mut series = Vec::with_capacity(selected.len());
+    let n_sel = selected.len();
+    let mut series = Vec::with_capacity(n_sel);
+    let mut dropped: Vec<String> = Vec::new();
     for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
         let sorted = rows.sort_by_record_time();
         let Rows {
@@ -711,32 +716,45 @@ pub fn read_from(
                 r.first_error = o.first_bad[k].clone();
             }
         }
+        let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
         for (i, o) in outs.iter().enumerate() {
             let p = &parts[i];
             let mine: Option<u64> = p.counts.as_ref().map(|v| {
                 v.iter()
-                    .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                    .filter(|(c, _)| mine_ch(c))
                     .map(|(_, n)| *n)
-                    .sum()
+                    .fold(0u64, |a, b| a.saturating_add(b))
             });
             let got = o.rows[k] + o.bad[k];
+            // What the part itself found lost on this topic (or on no particular channel).
+            let mut known = 0u64;
+            for l in &o.read.lost {
+                match l.channel {
+                    Some(c) if mine_ch(&c) => {
+                        known += l.messages.unwrap_or(0);
+                        r.losses.push(l.clone());
+                    }
+                    None if mine != Some(0) => r.losses.push(l.clone()),
+                    _ => {}
+                }
+            }
             let reason = match (&o.read.error, o.read.skipped) {
                 (Some(e), _) => Some(e.clone()),
                 (None, n) if n > 0 => o.read.skip_reason.clone(),
                 _ => None,
             };
-            let short = mine.is_some_and(|m| got < m);
+            let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
             if let Some(reason) = reason {
                 if mine == Some(0) {
                     continue;
                 }
                 r.losses.push(Loss {
                     what: format!("{}: {reason}", p.label),
-                    messages: mine.map(|m| m.saturating_sub(got)),
+                    messages: rest,
                     span: p.span,
                     channel: None,
                 });
-            } else if short {
+            } else if rest.is_some_and(|n| n > 0) {
                 r.losses.push(Loss {
                     what: format!(
                         "{} holds {got} messages of '{}', its index says {}",
@@ -744,7 +762,7 @@ pub fn read_from(
                         s.topic,
                         mine.unwrap_or(0)
                     ),
-                    messages: mine.map(|m| m - got),
+                    messages: rest,
                     span: p.span,
                     channel: None,
                 });
@@ -757,8 +775,9 @@ pub fn read_from(
         let lost: u64 = r.losses.iter().filter_map(|l| l.messages).sum();
         if lost > 0 {
             notes.push(format!(
-                "{lost} of {} messages were lost to unreadable chunks",
-                r.promised.unwrap_or(r.delivered + lost)
+                "{lost} of {} messages on '{}' were lost (see above)",
+                r.promised.unwrap_or(r.delivered + lost),
+                s.topic
             ));
         }
         if r.undecodable > 0 {
@@ -773,7 +792,25 @@ pub fn read_from(
             notes.push(SORTED_NOTE.to_string());
         }
         out.notes = notes;
+        if out.is_empty() {
+            // Nothing to convert is an error for a topic the user named; an Imu topic that
+            // --all-imu-topics found empty is left out, and said so.
+            if s.named || series.is_empty() && k + 1 == n_sel && dropped.len() + 1 == n_sel {
+                return Err(Error::NothingRead {
+                    topic: s.topic.clone(),
+                    why: out.notes.clone(),
+                });
+            }
+            dropped.push(format!(
+                "Imu topic '{}' holds no readable message and was left out",
+                s.topic
+            ));
+            continue;
+        }
         series.push(out);
+    }
+    for s in series.iter_mut() {
+        s.notes.extend(dropped.iter().cloned());
     }
     let read_ids: std::collections::BTreeSet<u32> = lookup
         .iter()

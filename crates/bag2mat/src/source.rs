@@ -150,7 +150,7 @@ impl std::fmt::Display for Loss {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.what)?;
         if let Some(n) = self.messages {
-            write!(f, "; {n} messages lost")?;
+            write!(f, "; {n} message{} lost", if n == 1 { "" } else { "s" })?;
         }
         if let Some((a, b)) = self.span {
             write!(
