@@ -80,6 +80,12 @@ pub enum Error {
         /// Its md5.
         md5sum: String,
     },
+    /// The input holds no topic at all (empty, or cut short before any complete chunk).
+    #[error("{}", no_topics(.why))]
+    NoTopics {
+        /// What the reader found (truncation, damage).
+        why: Vec<String>,
+    },
     /// A topic the user asked for yielded no row at all (every message lost or undecodable,
     /// or none recorded): an error, never an empty matrix.
     #[error("{}", nothing_read(.topic, .why))]
@@ -111,6 +117,18 @@ pub enum Error {
         /// What is wrong.
         what: String,
     },
+}
+
+fn no_topics(why: &[String]) -> String {
+    if why.is_empty() {
+        return "the input holds no topic at all".to_string();
+    }
+    let mut s = "the input holds no readable topic:".to_string();
+    for w in why {
+        s.push_str("\n  ");
+        s.push_str(w);
+    }
+    s
 }
 
 fn nothing_read(topic: &str, why: &[String]) -> String {

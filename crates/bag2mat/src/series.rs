@@ -240,6 +240,12 @@ fn other_slash_form(topic: &str) -> String {
 
 fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error> {
     let chans = src.channels();
+    if chans.is_empty() {
+        // Say why there is nothing (truncated, damaged) rather than "no topics".
+        let mut why: Vec<String> = src.notes().to_vec();
+        why.extend(src.losses().iter().map(|l| l.to_string()));
+        return Err(Error::NoTopics { why });
+    }
     let on = |t: &str| chans.iter().filter(|c| c.topic == t).collect::<Vec<_>>();
     let mut out: Vec<Selected> = Vec::new();
     let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note, named: bool| {
@@ -772,12 +778,22 @@ pub fn read_from(
         notes.extend(src.losses().iter().map(|l| l.to_string()));
         notes.extend(s.note.iter().cloned());
         notes.extend(r.losses.iter().map(|l| l.to_string()));
+        // Whatever the parts said, the container's own promise is checked as a whole.
         let lost: u64 = r.losses.iter().filter_map(|l| l.messages).sum();
-        if lost > 0 {
+        let missing = r
+            .promised
+            .map(|p| p.saturating_sub(r.delivered + r.undecodable))
+            .unwrap_or(lost);
+        if missing > 0 {
             notes.push(format!(
-                "{lost} of {} messages on '{}' were lost (see above)",
-                r.promised.unwrap_or(r.delivered + lost),
-                s.topic
+                "{missing} of {} messages on '{}' were lost{}",
+                r.promised.unwrap_or(r.delivered + missing),
+                s.topic,
+                if r.losses.is_empty() && src.losses().is_empty() {
+                    " (the container promises them; none of its parts could say where)"
+                } else {
+                    " (see above)"
+                }
             ));
         }
         if r.undecodable > 0 {

@@ -141,22 +141,37 @@ impl BagReader {
             offset,
             what,
         };
-        let rec = record::raw_record(&head, MAGIC.len()).ok_or_else(|| {
-            corrupt(
-                13,
-                format!(
-                    "the bag header record is incomplete (the file is {len} bytes: truncated, no complete chunk)"
-                ),
-            )
-        })?;
-        let h = Header::parse(rec.header).map_err(|w| corrupt(13, w))?;
-        if h.op().map_err(|w| corrupt(13, w))? != Op::BagHeader {
-            return Err(corrupt(13, "first record is not the bag header".into()));
-        }
-        // A damaged index_pos or chunk_count is worked around, not fatal.
-        let index_pos = h.u64("index_pos").unwrap_or(0);
-        let chunk_count = h.u32("chunk_count").ok();
-        let first = rec.end as u64;
+        // The bag header names the index; when it is damaged, the chunks after its usual
+        // 4104 bytes are walked as for a bag without an index.
+        let header = record::raw_record(&head, MAGIC.len())
+            .ok_or_else(|| "the bag header record is incomplete".to_string())
+            .and_then(|rec| {
+                let h = Header::parse(rec.header)?;
+                if h.op()? != Op::BagHeader {
+                    return Err("the first record is not the bag header".into());
+                }
+                Ok((
+                    h.u64("index_pos").unwrap_or(0),
+                    h.u32("chunk_count").ok(),
+                    rec.end as u64,
+                ))
+            });
+        let mut header_damage = None;
+        let (index_pos, chunk_count, first) = match header {
+            Ok(h) => h,
+            Err(e) if len > record::FIRST_RECORD_POS => {
+                header_damage = Some(e);
+                (0, None, record::FIRST_RECORD_POS)
+            }
+            Err(_) => {
+                return Err(corrupt(
+                    13,
+                    format!(
+                        "the bag header record is incomplete (the file is {len} bytes: truncated, no complete chunk)"
+                    ),
+                ));
+            }
+        };
         let mut reader = BagReader {
             path: path.to_path_buf(),
             file,
@@ -173,15 +188,28 @@ impl BagReader {
             channels: Vec::new(),
             parts: Vec::new(),
         };
+        if let Some(e) = &header_damage {
+            reader.notes.push(format!(
+                "the bag header is damaged ({e}); the chunks after it were walked without the index"
+            ));
+        }
         let index_ok = index_pos >= first && index_pos < len;
         let (index_conns, infos) = if index_ok {
             reader.read_index(index_pos)
         } else {
-            reader.notes.push(if index_pos == 0 {
-                "the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string()
+            if header_damage.is_some() {
+            } else if index_pos == 0 {
+                reader.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
+            } else if index_pos >= len {
+                reader.losses.push(Loss::new(format!(
+                    "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
+                    index_pos - len
+                )));
             } else {
-                format!("the bag's index_pos {index_pos} is outside the file ({len} bytes: truncated?); its chunks were walked")
-            });
+                reader.notes.push(format!(
+                    "the bag's index_pos {index_pos} points into its header; its chunks were walked"
+                ));
+            }
             (Vec::new(), Vec::new())
         };
         let walk_end = if index_ok { index_pos } else { len };

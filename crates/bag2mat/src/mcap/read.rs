@@ -279,11 +279,10 @@ impl McapReader {
                 break;
             };
             if first && op != Op::Header as u8 {
-                return Err(Error::Corrupt {
-                    path: self.path.clone(),
-                    offset: pos,
-                    what: "the first record is not an MCAP Header".into(),
-                });
+                // The Header only names the profile and library: its damage costs nothing.
+                self.notes.push(format!(
+                    "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
+                ));
             }
             let small = |w: &mut Window| -> Result<Option<Vec<u8>>, Error> {
                 if clen > MAX_META_RECORD {
@@ -296,13 +295,9 @@ impl McapReader {
             match Op::from_byte(op) {
                 Some(Op::Header) if first => match small(&mut w)?.map(|b| Header::decode(&b)) {
                     Some(Ok(h)) => self.header = h,
-                    _ => {
-                        return Err(Error::Corrupt {
-                            path: self.path.clone(),
-                            offset: pos,
-                            what: "unreadable MCAP Header record".into(),
-                        });
-                    }
+                    _ => self.notes.push(format!(
+                        "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
+                    )),
                 },
                 Some(Op::Schema) => {
                     if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {

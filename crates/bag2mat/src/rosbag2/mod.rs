@@ -362,6 +362,13 @@ impl Ros2BagWriter {
         })
     }
 
+    /// Sets the MCAP chunk size (bytes of records per chunk; no effect on sqlite3).
+    pub fn set_mcap_chunk_size(&mut self, bytes: usize) {
+        if let StorageWriter::Mcap(w) = &mut self.storage {
+            w.set_chunk_size(bytes);
+        }
+    }
+
     /// Declares a topic of any type with its `ros2msg` definition and type hash.
     pub fn add_topic(
         &mut self,
