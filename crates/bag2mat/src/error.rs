@@ -20,12 +20,20 @@ pub enum Error {
     /// An operating-system error on a path.
     // The cause is part of the message and deliberately not a `source`: anyhow's chained
     // output would print it twice.
-    #[error("{path}: {cause}")]
+    #[error("{}: {}", .path.display(), crate::shared::output::describe(.cause))]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
         cause: std::io::Error,
+    },
+    /// An output that must not be written (an input of the run, a directory, …).
+    #[error("{}: not written: {what}", .path.display())]
+    Output {
+        /// The output path as given.
+        path: PathBuf,
+        /// Why.
+        what: String,
     },
     /// The input is none of the accepted kinds (see [`crate::source::ACCEPTED`]).
     #[error("{path}: not a bag this tool reads: {what}")]

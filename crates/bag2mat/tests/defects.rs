@@ -365,3 +365,246 @@ fn defect_05_counts_never_size_memory() {
         );
     }
 }
+
+/// A small bag and the matrix bag2mat writes from it (for the output tests).
+fn small_bag(dir: &Path) -> (std::path::PathBuf, Vec<u8>) {
+    let bag = dir.join("small.bag");
+    write_synthetic(&bag, "imu", 300, Compression::None, false);
+    let out = dir.join("ref.mat");
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&out).arg("-q"));
+    assert!(ok, "{err}");
+    (bag, std::fs::read(&out).unwrap())
+}
+
+#[test]
+fn defect_06_outputs_write_through_devices_and_links() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bag, want) = small_bag(dir.path());
+    // A FIFO (what /dev/null and /dev/stdout are to a rename: not regular files, which a
+    // rename as root would replace) is written through and stays a FIFO; also behind a
+    // symlink, as /dev/stdout is. The test never touches the real /dev entries.
+    let fifo = dir.path().join("pipe");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo on a fresh path in our temporary directory.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let stdout_like = dir.path().join("stdout");
+    std::os::unix::fs::symlink(&fifo, &stdout_like).unwrap();
+    for o in [&fifo, &stdout_like] {
+        let (tx, rx) = std::sync::mpsc::channel();
+        {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || tx.send(std::fs::read(&fifo).unwrap()));
+        }
+        let (ok, _, err) = run(bag2mat()
+            .arg(&bag)
+            .arg("imu")
+            .arg("-o")
+            .arg(o)
+            .args(["--format", "mat", "-q"]));
+        let got = rx.recv_timeout(std::time::Duration::from_secs(5));
+        if got.is_err() {
+            // Nothing came through the FIFO: release the reader before failing.
+            let _ = std::fs::OpenOptions::new().write(true).open(&fifo);
+        }
+        assert!(ok, "{err}");
+        assert_eq!(
+            got.ok(),
+            Some(want.clone()),
+            "-o {}: the FIFO got nothing",
+            o.display()
+        );
+        let m = std::fs::metadata(&fifo).unwrap();
+        assert!(!m.is_file(), "the FIFO became a regular file");
+    }
+    // "-" writes the matrix to standard output.
+    let out = bag2mat()
+        .arg(&bag)
+        .arg("imu")
+        .args(["-o", "-", "--format", "mat", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert_eq!(out.stdout, want, "-o -: stdout is not the matrix");
+    // A symlink is followed: its target gets the matrix, the link stays a link.
+    let real = dir.path().join("real.mat");
+    std::fs::write(&real, b"old").unwrap();
+    let link = dir.path().join("link.mat");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    let (ok, _, err) = run(bag2mat()
+        .arg(&bag)
+        .arg("imu")
+        .arg("-o")
+        .arg(&link)
+        .arg("-q"));
+    assert!(ok, "{err}");
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink(),
+        "the link was replaced"
+    );
+    assert_eq!(std::fs::read(&real).unwrap(), want);
+}
+
+#[test]
+fn defect_07_the_input_is_never_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bag, _) = small_bag(dir.path());
+    // A bag named .mat: the default output is the input itself.
+    let named_mat = dir.path().join("rec.mat");
+    std::fs::copy(&bag, &named_mat).unwrap();
+    let before = std::fs::read(&named_mat).unwrap();
+    let (ok, _, err) = run(bag2mat().arg(&named_mat).arg("imu"));
+    assert!(!ok, "overwrote its input");
+    assert!(
+        err.contains("bag2mat: error:") && err.contains("input"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&named_mat).unwrap(), before);
+    // -o equal to the input, also through another name (a hard link).
+    let alias = dir.path().join("alias.bag");
+    std::fs::hard_link(&bag, &alias).unwrap();
+    let before = std::fs::read(&bag).unwrap();
+    for o in [&bag, &alias] {
+        let (ok, _, err) = run(bag2mat()
+            .arg(&bag)
+            .arg("imu")
+            .arg("-o")
+            .arg(o)
+            .args(["--format", "mat"]));
+        assert!(!ok, "-o {}: overwrote its input", o.display());
+        assert!(err.contains("input"), "{err}");
+        assert_eq!(std::fs::read(&bag).unwrap(), before);
+    }
+}
+
+/// Hidden temporary files left in `dir`.
+fn temps(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') && n.contains(".tmp"))
+        .collect()
+}
+
+#[test]
+fn defect_08_failed_outputs_leave_no_temp_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bag, _) = small_bag(dir.path());
+    // The output name is a directory.
+    let d = dir.path().join("out.mat");
+    std::fs::create_dir(&d).unwrap();
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&d));
+    assert!(!ok);
+    assert!(
+        err.contains("directory") && !err.contains("os error"),
+        "{err}"
+    );
+    assert_eq!(temps(dir.path()), Vec::<String>::new());
+    // The final rename fails (a directory is in the way of one of two topics' files): no
+    // temp file, and (all or none) no file of the other topic either.
+    let two = dir.path().join("two.bag");
+    {
+        let mut w = bag2mat::bag::BagWriter::create(&two, Compression::None).unwrap();
+        let a = w.add_imu_connection("/imu0");
+        let b = w.add_imu_connection("/imu1");
+        for i in 0..100 {
+            let (t, m) = synthetic(i);
+            w.write_imu(a, t, &m).unwrap();
+            w.write_imu(b, t, &m).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let out = dir.path().join("outs");
+    std::fs::create_dir_all(out.join("imu1/two.mat/x")).unwrap();
+    let (ok, _, err) = run(bag2mat()
+        .arg(&two)
+        .arg("--all-imu-topics")
+        .arg("-o")
+        .arg(&out));
+    assert!(!ok, "{err}");
+    assert!(
+        !out.join("imu0/two.mat").exists(),
+        "half of the outputs written"
+    );
+    for sub in ["imu0", "imu1"] {
+        assert_eq!(temps(&out.join(sub)), Vec::<String>::new(), "{sub}");
+    }
+}
+
+#[test]
+fn defect_09_format_follows_the_extension() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bag, _) = small_bag(dir.path());
+    let csv = dir.path().join("x.csv");
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&csv).arg("-q"));
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("t,ax,ay,az,wx,wy,wz\n"), "not CSV");
+    assert_eq!(text.lines().count(), 301);
+    let npy = dir.path().join("x.npy");
+    let (ok, _, _) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&npy).arg("-q"));
+    assert!(ok);
+    assert!(std::fs::read(&npy).unwrap().starts_with(b"\x93NUMPY"));
+    // A contradiction is a usage error (exit 2), and nothing is written.
+    let bad = dir.path().join("y.csv");
+    let out = bag2mat()
+        .arg(&bag)
+        .arg("imu")
+        .arg("-o")
+        .arg(&bad)
+        .args(["--format", "npy"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .starts_with("bag2mat: error: --format npy contradicts")
+    );
+    assert!(!bad.exists());
+}
+
+/// Exit code, stderr.
+fn status(cmd: &mut Command) -> (Option<i32>, String) {
+    let out = cmd.output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn defect_14_one_error_convention() {
+    let dir = tempfile::tempdir().unwrap();
+    // Failures: exit 1, one line "bag2mat: error: <what>: <cause>", no OS error numbers.
+    let missing = dir.path().join("missing.bag");
+    for args in [
+        vec![missing.display().to_string(), "imu".into()],
+        vec!["info".into(), missing.display().to_string()],
+    ] {
+        let (code, err) = status(bag2mat().args(&args));
+        assert_eq!(code, Some(1), "{args:?}: {err}");
+        let errors: Vec<&str> = err.lines().filter(|l| l.contains("error")).collect();
+        assert_eq!(errors.len(), 1, "{args:?}: {err}");
+        assert!(
+            errors[0].starts_with(&format!(
+                "bag2mat: error: {}: no such file",
+                missing.display()
+            )),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("os error"), "{err}");
+    }
+    // Usage errors: exit 2, same prefix.
+    for args in [
+        vec![],
+        vec!["--no-such-flag".to_string()],
+        vec!["x.bag".into()],
+    ] {
+        let (code, err) = status(bag2mat().args(&args));
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("bag2mat: error: "), "{args:?}: {err}");
+        assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
+    }
+}
