@@ -27,7 +27,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Write a simulated IMU bag (default: vio_data_simulation ros_version's 4 h static bag).
-    Bag(BagArgs),
+    Bag(Box<BagArgs>),
     /// Write the upstream text files of the 20 s ellipse trajectory.
     Traj(TrajArgs),
     /// Integrate IMU samples (Euler vs midpoint) and report the errors.
@@ -36,6 +36,8 @@ pub enum Command {
     Spline(SplineArgs),
     /// Tabulate the analysers' figures (written by scripts/compare.sh) against the truth.
     Compare(CompareArgs),
+    /// List the sensor profiles of `sim bag --sensor` with their figures and sources.
+    Sensors(crate::cli_model::SensorsArgs),
 }
 
 /// `sim compare` arguments.
@@ -285,6 +287,9 @@ pub struct BagArgs {
     /// No progress bar and no parameter report (errors are still printed)
     #[arg(short, long)]
     pub quiet: bool,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub model: crate::cli_model::ModelArgs,
 }
 
 impl TryFrom<BagArgs> for BagConfig {
@@ -294,6 +299,7 @@ impl TryFrom<BagArgs> for BagConfig {
             Some(s) => parse_start_time(s)?,
             None => now_ns(),
         };
+        crate::bag_sim::validate_rate(a.rate)?;
         let format = bag_format(a.format, a.compression)?;
         let out = a.output.unwrap_or_else(|| {
             PathBuf::from(if format == crate::bag_sim::BagFormat::Ros1 {
@@ -304,7 +310,7 @@ impl TryFrom<BagArgs> for BagConfig {
         });
         let cfg = BagConfig {
             out,
-            noise: a.noise.resolve(PresetArg::Medium)?,
+            model: a.model.resolve(&a.noise, a.rate)?,
             rate: a.rate,
             duration: a.duration,
             seed: a.noise.seed,
@@ -646,12 +652,12 @@ mod tests {
         else {
             panic!("not bag")
         };
-        let c = BagConfig::try_from(a).unwrap();
+        let c = BagConfig::try_from(*a).unwrap();
         assert_eq!(
             (c.rate, c.duration, c.topic.as_str(), c.frame_id.as_str()),
             (200.0, 14400.0, "imu", "base_link")
         );
-        assert_eq!(c.noise, Preset::Medium.params());
+        assert_eq!(c.model.legacy(200.0), Some(Preset::Medium.params()));
         assert_eq!(c.motion, Motion::Static);
         assert_eq!(c.compression, Compression::None);
         assert_eq!(c.start_ns, 1_700_000_000_000_000_000);
@@ -666,9 +672,10 @@ mod tests {
         else {
             panic!()
         };
-        let c = BagConfig::try_from(a).unwrap();
-        assert_eq!(c.noise.acc_noise, 0.5);
-        assert_eq!(c.noise.gyro_noise, 0.03);
+        let c = BagConfig::try_from(*a).unwrap();
+        let n = c.model.legacy(200.0).unwrap();
+        assert_eq!(n.acc_noise, 0.5);
+        assert_eq!(n.gyro_noise, 0.03);
     }
 
     #[test]
@@ -684,7 +691,7 @@ mod tests {
                 panic!()
             };
             assert!(
-                BagConfig::try_from(a).is_err(),
+                BagConfig::try_from(*a).is_err(),
                 "{args:?} should be rejected"
             );
         }

@@ -7,6 +7,10 @@
 //! with its ratio to the truth. imu_utils' values are converted as the seed did — `*_n` (a
 //! per-sample σ_d) by ·√Δt, `*_w` (a bias-instability floor) by /√Δt — and the ratio shows
 //! the gap instead of hiding it. All conversions go through [`crate::noise`].
+//!
+//! The truth is what `sim bag` wrote beside each bag (`ROOT/<preset>/imu.bag.truth.yaml`, the
+//! mean of the three axes' N and K; its `.truth.csv` is the curve under the tools' curves in
+//! the plot); a folder without one falls back to the preset's nominal values, with a note.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -18,14 +22,8 @@ use crate::noise::{
     white_to_continuous, white_to_discrete,
 };
 
-/// The two sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Sensor {
-    /// Gyroscope (rad/s).
-    Gyro,
-    /// Accelerometer (m/s²).
-    Acc,
-}
+/// The two sensors (the noise model's type).
+pub use crate::noise::model::Sensor;
 
 /// The two quantities users need.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -131,6 +129,35 @@ pub fn preset_name(p: Preset) -> &'static str {
         Preset::Medium => "medium",
         Preset::High => "high",
     }
+}
+
+/// The truth file `sim bag` wrote for a preset's bag under `root`.
+pub fn truth_yaml(root: &Path, p: Preset) -> PathBuf {
+    crate::noise::truth_file::paths(&root.join(preset_name(p)).join("imu.bag")).0
+}
+
+/// N and K of the truth (mean of the three axes), from the truth file when there is one,
+/// else the preset's nominal values.
+fn truth_values(root: &Path, p: Preset) -> Result<ContinuousNoise> {
+    let path = truth_yaml(root, p);
+    if !path.exists() {
+        eprintln!(
+            "note: {} not found; using the {} preset's nominal values as the truth",
+            path.display(),
+            preset_name(p)
+        );
+        return Ok(p.params());
+    }
+    let m = crate::noise::truth_file::read_model(&path)?;
+    let mean = |s: Sensor, f: fn(&crate::noise::model::AxisModel) -> f64| {
+        m.sensor(s).axes.iter().map(f).sum::<f64>() / 3.0
+    };
+    Ok(ContinuousNoise {
+        gyro_noise: mean(Sensor::Gyro, |a| a.white_noise),
+        gyro_bias_rw: mean(Sensor::Gyro, |a| a.random_walk),
+        acc_noise: mean(Sensor::Acc, |a| a.white_noise),
+        acc_bias_rw: mean(Sensor::Acc, |a| a.random_walk),
+    })
 }
 
 fn truth(n: &ContinuousNoise, s: Sensor, q: Quantity) -> f64 {
@@ -306,7 +333,7 @@ pub fn compare(cfg: &CompareConfig) -> Result<Comparison> {
             read_imu_utils_yaml(&dir.join("imu_utils").join(format!("{name}_imu_param.yaml")))?;
         let ka = read_kalibr_yaml(&dir.join("kalibr").join("imu.yaml"))?;
         let ie = read_ieee_terms(&dir.join("kalibr").join("ieee952_terms.csv"))?;
-        let t = p.params();
+        let t = truth_values(&cfg.root, p)?;
         for s in [Sensor::Gyro, Sensor::Acc] {
             for q in [Quantity::WhiteNoise, Quantity::RandomWalk] {
                 let (iu_key, ka_key) = match (s, q) {

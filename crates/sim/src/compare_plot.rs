@@ -1,6 +1,8 @@
 //! The plot of `sim compare`: per sensor, each preset's Allan deviation as the tools see it —
 //! kalibr_allan's averaged non-overlapping curve, the IEEE 952 overlapping curve (mean of the
-//! three axes) — against the truth's model √(N²/τ + K²τ/3), log-log, PNG and SVG.
+//! three axes) — over the truth: the exact Allan deviation of the simulated sequence that
+//! `sim bag` wrote beside the bag (`imu.bag.truth.csv`, mean of the axes; drawn first, under
+//! the tools' curves), or the model √(N²/τ + K²τ/3) when a folder has no truth file.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +18,7 @@ struct Curves {
     kalibr: Vec<(f64, f64)>,
     ieee: Vec<(f64, f64)>,
     truth: (f64, f64),
+    truth_curve: Option<Vec<(f64, f64)>>,
 }
 
 const COLORS: [RGBColor; 3] = [
@@ -110,6 +113,36 @@ where
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(|x| e(&x))?;
+    // The truth first, under the tools' curves.
+    for (i, c) in curves.iter().enumerate() {
+        let (n, k) = c.truth;
+        let points: Vec<(f64, f64)> = match &c.truth_curve {
+            Some(tc) => tc
+                .iter()
+                .copied()
+                .filter(|&(t, v)| t >= t0 && t <= t1 && v > 0.0)
+                .collect(),
+            None => (0..=200)
+                .map(|j| {
+                    let t = t0 * (t1 / t0).powf(j as f64 / 200.0);
+                    (t, (n * n / t + k * k * t / 3.0).sqrt())
+                })
+                .collect(),
+        };
+        let truth = chart
+            .draw_series(LineSeries::new(points, BLACK.stroke_width(2)))
+            .map_err(|x| e(&x))?;
+        if i == 0 {
+            let label = if c.truth_curve.is_some() {
+                "truth: exact ADEV of the simulated sequence (sim truth.csv)"
+            } else {
+                "truth: sqrt(N²/τ + K²τ/3)"
+            };
+            truth.label(label).legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
+            });
+        }
+    }
     for (i, c) in curves.iter().enumerate() {
         let col = COLORS[i % COLORS.len()];
         chart
@@ -127,19 +160,6 @@ where
             .map_err(|x| e(&x))?
             .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
-        let (n, k) = c.truth;
-        let model = (0..=200).map(|j| {
-            let t = t0 * (t1 / t0).powf(j as f64 / 200.0);
-            (t, (n * n / t + k * k * t / 3.0).sqrt())
-        });
-        let truth = chart
-            .draw_series(LineSeries::new(model, BLACK.stroke_width(1)))
-            .map_err(|x| e(&x))?;
-        if i == 0 {
-            truth.label("truth: sqrt(N²/τ + K²τ/3)").legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
-            });
-        }
     }
     chart
         .configure_series_labels()
@@ -163,6 +183,20 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
         for &p in &cfg.presets {
             let dir = cfg.root.join(preset_name(p)).join("kalibr");
             let t = p.params();
+            let (_, csv) =
+                crate::noise::truth_file::paths(&cfg.root.join(preset_name(p)).join("imu.bag"));
+            let sensor_kind = if sensor == "gyro" {
+                crate::noise::model::Sensor::Gyro
+            } else {
+                crate::noise::model::Sensor::Acc
+            };
+            let truth_curve = if csv.exists() {
+                let tc = crate::noise::truth_file::read_curves(&csv)?;
+                tc.sensor_mean(sensor_kind)
+                    .map(|v| tc.tau.iter().copied().zip(v).collect())
+            } else {
+                None
+            };
             curves.push(Curves {
                 preset: preset_name(p),
                 kalibr: kalibr_curve(&dir.join("allan_curves.csv"), column)?,
@@ -172,6 +206,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
                 } else {
                     (t.acc_noise, t.acc_bias_rw)
                 },
+                truth_curve,
             });
         }
         let title = format!(

@@ -41,6 +41,14 @@ pub enum SimError {
     /// A tool output read by `sim compare` is missing or malformed.
     #[error("comparison input: {0}")]
     Input(String),
+    /// A `--noise-spec` file is malformed.
+    #[error("noise spec {path}: {msg}")]
+    Spec {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        msg: String,
+    },
     /// Writing the bag failed (bag2mat's error).
     #[error(transparent)]
     Bag(#[from] bag2mat::Error),

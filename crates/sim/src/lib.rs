@@ -2,7 +2,8 @@
 //! (`../shared/specs/vio_data_simulation.md`), plus Spline-Fusion IMU synthesis from poses.
 //!
 //! * [`noise`]: continuous ↔ discrete noise parameters (THE place for these conversions in
-//!   the workspace) and the seeded `addIMUnoise` generator.
+//!   the workspace), the seeded `addIMUnoise` generator, and the real-sensor model (every
+//!   IEEE 952 term, the DLPF chain, profiles, spec files) with its exact truth curves.
 //! * [`motion`]: the analytic models (static level IMU, 20 s ellipse).
 //! * [`grid`]: upstream's accumulated time grids.
 //! * [`bag_sim`]: `sim bag` — the `ros_version` static (or ellipse) IMU bag via bag2mat.
@@ -40,6 +41,7 @@
 
 pub mod bag_sim;
 pub mod cli;
+pub mod cli_model;
 pub mod compare;
 pub mod compare_plot;
 pub mod error;

@@ -18,9 +18,13 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Bag(a) => {
-            let cfg = sim::bag_sim::BagConfig::try_from(a)?;
+            let cfg = sim::bag_sim::BagConfig::try_from(*a)?;
             if !cfg.quiet {
                 eprintln!("{}", sim::report::bag_header(&cfg));
+                let n = sim::bag_sim::message_count(cfg.rate, cfg.duration) as usize;
+                for w in sim::noise::truth_file::widrow_warnings(&cfg.model, cfg.rate, n)? {
+                    eprintln!("warning: {w}");
+                }
             }
             let s = sim::bag_sim::run(&cfg)
                 .with_context(|| format!("writing {}", cfg.out.display()))?;
@@ -54,6 +58,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             let cfg = sim::compare::CompareConfig::try_from(a)?;
             if !sim::compare::run(&cfg)? {
                 return Ok(ExitCode::FAILURE);
+            }
+        }
+        Command::Sensors(a) => {
+            if a.spec_example {
+                print!("{}", sim::cli_model::SPEC_EXAMPLE);
+            } else {
+                sim::bag_sim::validate_rate(a.rate)?;
+                print!("{}", sim::noise::profiles::listing(a.rate));
             }
         }
         Command::Spline(a) => {

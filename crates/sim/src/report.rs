@@ -30,20 +30,24 @@ pub fn bag_header(c: &BagConfig) -> String {
             _ => c.compression.name(),
         },
         c.seed,
-        c.noise.describe(c.rate)
+        c.model.describe(c.rate)
     )
 }
 
 /// Printed when `sim bag` is done.
 pub fn bag_done(c: &BagConfig, s: &BagSummary) -> String {
     let t = |r: bag2mat::RosTime| format!("{}.{:09}", r.sec, r.nsec);
-    format!(
+    let mut o = format!(
         "wrote {} ({} messages, {} .. {})",
         c.out.display(),
         s.messages,
         t(s.first),
         t(s.last)
-    )
+    );
+    for f in &s.truth {
+        o.push_str(&format!("\nwrote {}", f.display()));
+    }
+    o
 }
 
 /// `sim spline` summary.

@@ -232,7 +232,25 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
     }
     let bag = sink.finish()?;
     pb.finish_and_clear();
+    // The truth beside the bag: the noise model (zero with --no-noise) and its Allan deviation.
+    let model = crate::noise::model::ImuModel::from_continuous(
+        if cfg.noise.is_some() {
+            "spline"
+        } else {
+            "spline (no noise)"
+        },
+        &cfg.noise.unwrap_or(ContinuousNoise::ZERO),
+    );
+    let truth = crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {
+        bag: &bag_path,
+        model: &model,
+        rate: cfg.rate,
+        samples: noisy.len(),
+        seed: cfg.seed,
+        motion: "spline",
+    })?;
     files.push(bag_path);
+    files.extend(truth);
     Ok(SplineSummary {
         poses: poses.len(),
         knots: knots.poses.len(),

@@ -3,5 +3,6 @@
 //! (scripts/test.sh installs them).
 
 mod cli;
+mod real_sensors;
 mod real_tools;
 mod util;

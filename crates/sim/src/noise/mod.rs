@@ -22,6 +22,32 @@
 //! gyro white (x, y, z), acc white, gyro bias step, acc bias step; initial biases zero.
 //! Unlike upstream (a fresh `std::random_device` per call, not reproducible) one persistent
 //! generator seeded from `--seed` is used, so equal seeds give equal data.
+//!
+//! # Real sensors (issue 9)
+//! The ideal model above is what the presets use, byte for byte. Real sensors have more:
+//! * [`model`]: every IEEE 952 term per axis (N, K, B, Gauss–Markov, R, Q, LSB, warm-up) in
+//!   continuous time, and the sensor's chain (internal rate, low-pass, decimation);
+//! * [`spec`]: the `--noise-spec` YAML file; [`profiles`]: datasheet sensors;
+//! * [`filter`]: the digital low-pass and the per-sample σ it leaves (σ_d² = N²·f_i·Σh²);
+//! * [`flicker`]: 1/f bias noise as log-spaced Gauss–Markov processes;
+//! * [`generate`]: the per-sample chain, per-axis streams, parallel blocks;
+//! * [`truth`]: the exact Allan variance of the generated sequence, term by term;
+//!   [`psd`]: the spectral integrals and closed forms it is checked against;
+//!   [`truth_file`]: `<bag>.truth.yaml` and `<bag>.truth.csv`.
+
+pub mod filter;
+pub mod flicker;
+pub mod generate;
+pub mod model;
+pub mod profiles;
+pub mod psd;
+pub mod quad;
+pub mod spec;
+pub mod truth;
+pub mod truth_file;
+
+#[cfg(test)]
+mod tests_stat;
 
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -52,6 +78,13 @@ pub fn random_walk_to_discrete(sigma_b: f64, dt: f64) -> f64 {
 /// (inverse of [`random_walk_to_discrete`]).
 pub fn random_walk_to_continuous(sigma_bd: f64, dt: f64) -> f64 {
     sigma_bd / dt.sqrt()
+}
+
+/// IEEE 952 quantization Q (U·s) → the step of the integrated angle/velocity, q = √12·Q:
+/// the rounding error of a uniform quantiser has variance q²/12 = Q², which gives the Allan
+/// variance 3Q²/τ².
+pub fn quantization_step(q: f64) -> f64 {
+    q * 12f64.sqrt()
 }
 
 /// Allan deviation of white noise of density `sigma` (unit/√Hz) at averaging time `tau` (s):

@@ -1,0 +1,307 @@
+//! The real-sensor noise flags of `sim bag` (clap derive) and their resolution into an
+//! [`ImuModel`]: profile or preset, then `--noise-spec`, then explicit flags.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use crate::cli::NoiseArgs;
+use crate::error::{Result, SimError};
+use crate::noise::model::{BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup};
+use crate::noise::profiles::Profile;
+
+/// Sensor profiles (`sim sensors` lists their figures and sources).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SensorArg {
+    /// The seed's low preset (white noise + random walk).
+    Low,
+    /// The seed's medium preset (vio_data_simulation ros_version param.h).
+    Medium,
+    /// The seed's high preset.
+    High,
+    /// Bosch BMI088 (consumer MEMS).
+    Bmi088,
+    /// Analog Devices ADIS16470 (industrial MEMS).
+    Adis16470,
+    /// Safran Sensonor STIM300 (tactical grade).
+    Stim300,
+}
+
+impl SensorArg {
+    /// The profile.
+    pub fn profile(self) -> Profile {
+        match self {
+            SensorArg::Low => Profile::Low,
+            SensorArg::Medium => Profile::Medium,
+            SensorArg::High => Profile::High,
+            SensorArg::Bmi088 => Profile::Bmi088,
+            SensorArg::Adis16470 => Profile::Adis16470,
+            SensorArg::Stim300 => Profile::Stim300,
+        }
+    }
+}
+
+/// Real-sensor noise model flags of `sim bag`. Units: gyroscope rad/s-based, accelerometer
+/// m/s²-based; every value applies to the three axes of its sensor.
+#[derive(Debug, Clone, Default, Args)]
+#[command(next_help_heading = "Real-sensor noise model")]
+pub struct ModelArgs {
+    /// Sensor profile from datasheet figures (see `sim sensors`); replaces --preset.
+    #[arg(long, value_enum, value_name = "NAME", conflicts_with = "preset")]
+    pub sensor: Option<SensorArg>,
+    /// YAML noise model: every term, per sensor, optionally per axis (`sim sensors
+    /// --spec-example` prints every key with its unit); applied on top of --sensor/--preset
+    /// when given, else on its own `base:` or on nothing. A `<bag>.truth.yaml` works too. The
+    /// flags below override it.
+    #[arg(long, value_name = "FILE.yaml")]
+    pub noise_spec: Option<PathBuf>,
+    /// Internal sample rate of both sensors [Hz]; an integer multiple of --rate.
+    #[arg(long, value_name = "HZ")]
+    pub internal_rate: Option<f64>,
+    /// Gyro low-pass: 2nd-order Butterworth −3 dB frequency at the internal rate [Hz]; 0 = none.
+    #[arg(long, value_name = "HZ")]
+    pub gyro_lpf: Option<f64>,
+    /// Accelerometer low-pass −3 dB frequency [Hz]; 0 = none.
+    #[arg(long, value_name = "HZ")]
+    pub acc_lpf: Option<f64>,
+    /// Gyro bias instability B [rad/s] (flicker noise; Allan floor 0.664·B).
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
+    pub gyro_bias_instability: Option<f64>,
+    /// Accelerometer bias instability B [m/s²].
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
+    pub acc_bias_instability: Option<f64>,
+    /// Corner times of the gyro flicker floor [s] (default 1,1000 when B is new).
+    #[arg(long, value_name = "LO,HI", value_delimiter = ',')]
+    pub gyro_bi_taus: Option<Vec<f64>>,
+    /// Corner times of the accelerometer flicker floor [s].
+    #[arg(long, value_name = "LO,HI", value_delimiter = ',')]
+    pub acc_bi_taus: Option<Vec<f64>>,
+    /// Gyro first-order Gauss–Markov bias: σ [rad/s], correlation time [s] (replaces the base's).
+    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',')]
+    pub gyro_gm: Option<Vec<f64>>,
+    /// Accelerometer Gauss–Markov bias: σ [m/s²], correlation time [s].
+    #[arg(long, value_name = "SIGMA,TAU", value_delimiter = ',')]
+    pub acc_gm: Option<Vec<f64>>,
+    /// Gyro rate ramp R [rad/s²] (deterministic).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub gyro_ramp: Option<f64>,
+    /// Accelerometer ramp R [m/s³].
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub acc_ramp: Option<f64>,
+    /// Gyro quantization Q [rad] (IEEE 952: the integrated angle in steps of √12·Q).
+    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
+    pub gyro_quantization: Option<f64>,
+    /// Accelerometer quantization Q [m/s] (integrated velocity).
+    #[arg(long, value_name = "Q", allow_negative_numbers = true)]
+    pub acc_quantization: Option<f64>,
+    /// Gyro output LSB [rad/s]: values rounded to counts of it; 0 = none.
+    #[arg(long, value_name = "LSB", allow_negative_numbers = true)]
+    pub gyro_resolution: Option<f64>,
+    /// Accelerometer output LSB [m/s²].
+    #[arg(long, value_name = "LSB", allow_negative_numbers = true)]
+    pub acc_resolution: Option<f64>,
+    /// Gyro warm-up: bias A·exp(−t/T) after power-on; A [rad/s], T [s].
+    #[arg(
+        long,
+        value_name = "A,T",
+        value_delimiter = ',',
+        num_args = 2,
+        allow_negative_numbers = true
+    )]
+    pub gyro_warmup: Option<Vec<f64>>,
+    /// Accelerometer warm-up: A [m/s²], T [s].
+    #[arg(
+        long,
+        value_name = "A,T",
+        value_delimiter = ',',
+        num_args = 2,
+        allow_negative_numbers = true
+    )]
+    pub acc_warmup: Option<Vec<f64>>,
+}
+
+/// Default flicker corner times when B is set by a flag on a model without them, s.
+pub const DEFAULT_BI_TAUS: (f64, f64) = (1.0, 1000.0);
+
+impl ModelArgs {
+    /// The model: base (profile, preset, or medium), spec, then flags; validated at `rate`.
+    pub fn resolve(&self, noise: &NoiseArgs, rate: f64) -> Result<ImuModel> {
+        // Checks the N/K flags the way every subcommand does.
+        noise.resolve(crate::cli::PresetArg::Medium)?;
+        let base = match (self.sensor, noise.preset) {
+            (Some(s), _) => Some(s.profile().model()),
+            (None, Some(p)) => Some(ImuModel::from_continuous(
+                &format!("{p:?}").to_lowercase(),
+                &noise.resolve(p)?,
+            )),
+            (None, None) if self.noise_spec.is_none() => Some(Profile::Medium.model()),
+            (None, None) => None,
+        };
+        let mut m = match &self.noise_spec {
+            Some(path) => {
+                let spec = crate::noise::spec::read(path)?;
+                crate::noise::spec::apply(&spec, base, path)?
+            }
+            None => base.expect("a base without a spec"),
+        };
+        // The existing N/K flags (shared with traj/spline), validated there.
+        for (s, n, k) in [
+            (Sensor::Gyro, noise.gyro_noise, noise.gyro_bias_rw),
+            (Sensor::Acc, noise.acc_noise, noise.acc_bias_rw),
+        ] {
+            for a in m.sensor_mut(s).axes.iter_mut() {
+                if let Some(n) = n {
+                    a.white_noise = n;
+                }
+                if let Some(k) = k {
+                    a.random_walk = k;
+                }
+            }
+        }
+        if let Some(r) = self.internal_rate {
+            m.gyro.chain.internal_rate_hz = Some(r);
+            m.acc.chain.internal_rate_hz = Some(r);
+        }
+        for (s, lpf) in [(Sensor::Gyro, self.gyro_lpf), (Sensor::Acc, self.acc_lpf)] {
+            if let Some(fc) = lpf {
+                let c = &mut m.sensor_mut(s).chain;
+                *c = Chain {
+                    filter: if fc == 0.0 {
+                        Filter::None
+                    } else {
+                        Filter::Butterworth2 { cutoff_hz: fc }
+                    },
+                    ..*c
+                };
+            }
+        }
+        let per_sensor = [
+            (
+                Sensor::Gyro,
+                self.gyro_bias_instability,
+                &self.gyro_bi_taus,
+                &self.gyro_gm,
+                self.gyro_ramp,
+                self.gyro_quantization,
+                self.gyro_resolution,
+                &self.gyro_warmup,
+            ),
+            (
+                Sensor::Acc,
+                self.acc_bias_instability,
+                &self.acc_bi_taus,
+                &self.acc_gm,
+                self.acc_ramp,
+                self.acc_quantization,
+                self.acc_resolution,
+                &self.acc_warmup,
+            ),
+        ];
+        for (s, b, taus, gm, ramp, q, lsb, warm) in per_sensor {
+            let flag = |name: &str| format!("--{}-{name}", s.short());
+            for (name, v) in [("bi-taus", taus), ("gm", gm), ("warmup", warm)] {
+                if let Some(v) = v
+                    && v.len() != 2
+                {
+                    return Err(SimError::InvalidArgument(format!(
+                        "{} takes two comma-separated numbers, got {}",
+                        flag(name),
+                        v.len()
+                    )));
+                }
+            }
+            for (name, v) in [
+                ("quantization", q),
+                ("resolution", lsb),
+                ("bias-instability", b),
+            ] {
+                if let Some(v) = v
+                    && !(v.is_finite() && v >= 0.0)
+                {
+                    return Err(SimError::InvalidArgument(format!(
+                        "{} must be a non-negative number, got {v}",
+                        flag(name)
+                    )));
+                }
+            }
+            for a in m.sensor_mut(s).axes.iter_mut() {
+                if b.is_some() || taus.is_some() {
+                    let old = a.bias_instability;
+                    let (lo, hi) = match (taus, old) {
+                        (Some(t), _) => (t[0], t[1]),
+                        (None, Some(o)) => (o.tau_lo, o.tau_hi),
+                        (None, None) => DEFAULT_BI_TAUS,
+                    };
+                    let bv = b.or(old.map(|o| o.b)).unwrap_or(0.0);
+                    a.bias_instability = (bv != 0.0).then_some(BiasInstability {
+                        b: bv,
+                        tau_lo: lo,
+                        tau_hi: hi,
+                    });
+                }
+                if let Some(g) = gm {
+                    a.gauss_markov = if g[0] == 0.0 {
+                        Vec::new()
+                    } else {
+                        vec![GaussMarkov {
+                            sigma: g[0],
+                            tau: g[1],
+                        }]
+                    };
+                }
+                if let Some(r) = ramp {
+                    a.rate_ramp = r;
+                }
+                if let Some(q) = q {
+                    a.quantization = q;
+                }
+                if let Some(l) = lsb {
+                    a.resolution = l;
+                }
+                if let Some(w) = warm {
+                    a.warmup = (w[0] != 0.0).then_some(Warmup::Exponential {
+                        amplitude: w[0],
+                        tau: w[1],
+                    });
+                }
+            }
+        }
+        m.validate(rate)?;
+        Ok(m)
+    }
+}
+
+/// `sim sensors`.
+#[derive(Debug, Clone, Args)]
+pub struct SensorsArgs {
+    /// Output rate the per-sample figures are given at [Hz].
+    #[arg(long, default_value_t = 200.0)]
+    pub rate: f64,
+    /// Print a commented `--noise-spec` example (every key, with units) instead.
+    #[arg(long)]
+    pub spec_example: bool,
+}
+
+/// The `sim sensors --spec-example` text: every key of a `--noise-spec` file with its unit.
+pub const SPEC_EXAMPLE: &str = "\
+# sim noise spec (sim bag --noise-spec FILE.yaml). Units: gyroscope terms rad/s-based,
+# accelerometer terms m/s^2-based, times in s, rates in Hz. Every key is optional.
+base: bmi088                 # start from a profile (sim sensors); default: every term off
+gyroscope:
+  internal_rate_hz: 2000     # internal sample rate, an integer multiple of the output rate
+  filter: {kind: butterworth2, cutoff_hz: 23}   # or {kind: none}, {kind: average}
+  white_noise: 2.44e-4       # N [rad/s/sqrt(Hz)]
+  random_walk: 4.0e-7        # K [rad/s^2/sqrt(Hz)]
+  bias_instability: {value: 9.7e-6, tau_lo_s: 5, tau_hi_s: 500}   # B [rad/s]; value 0 = off
+  gauss_markov: [{sigma: 3.0e-5, tau_s: 20}]   # first-order Gauss-Markov biases; [] = none
+  rate_ramp: 0.0             # R [rad/s^2]
+  quantization: 0.0          # Q [rad] (integrated angle in steps of sqrt(12)*Q)
+  resolution: 1.065e-3       # output LSB [rad/s]; 0 = none
+  warmup: {temperature_rise_k: 1, tau_s: 300, bias_per_k: 2.6e-4}   # or {amplitude: A, tau_s: T}
+  axes:                      # per-axis overrides, same keys
+    z: {white_noise: 3.0e-4}
+accelerometer:
+  white_noise: 1.57e-3       # N [m/s^2/sqrt(Hz)]
+  random_walk: 1.0e-5        # K [m/s^3/sqrt(Hz)]
+  resolution: 1.8e-3         # LSB [m/s^2]
+";
