@@ -4,39 +4,57 @@
 use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Parser;
 
 use allan_imu_utils::cli::{Args, Config};
+use bag2mat::shared::{cli, output};
+
+const TOOL: &str = "allan_imu_utils";
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("allan_imu_utils: error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn run() -> anyhow::Result<()> {
     let t = std::time::Instant::now();
-    let config = Config::try_from(Args::parse()).context("bad arguments")?;
-    let outcomes = allan_imu_utils::run::run(&config)
-        .with_context(|| format!("analysing {}", config.bag.display()))?;
+    let args = match Args::try_parse() {
+        Ok(a) => a,
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => return cli::usage(TOOL, &e.render().to_string()),
+    };
+    let config = match Config::try_from(args) {
+        Ok(c) => c,
+        Err(e) => return cli::usage(TOOL, &e.to_string()),
+    };
+    output::protect_input(&config.bag);
+    // Every output of the run, or none.
+    let staging = output::Staging::begin();
+    let outcomes = match allan_imu_utils::run::run(&config).map_err(|e| e.to_string()) {
+        Ok(o) => o,
+        Err(e) => return cli::fail(TOOL, &e),
+    };
+    if let Err(e) = staging.commit() {
+        return cli::fail(TOOL, &e);
+    }
     let several = outcomes.len() > 1;
+    let mut out = std::io::stdout().lock();
     for outcome in &outcomes {
-        let mut out = std::io::stdout().lock();
+        let mut text = String::new();
         if several {
-            writeln!(out, "===== topic {} =====", outcome.topic).context("writing stdout")?;
+            text.push_str(&format!("===== topic {} =====\n", outcome.topic));
         }
         for note in &outcome.notes {
-            eprintln!("{note}");
+            if note.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{note}");
+            } else {
+                eprintln!("warning: {note}");
+            }
         }
-        out.write_all(outcome.stdout.as_bytes())
-            .context("writing stdout")?;
+        text.push_str(&outcome.stdout);
         if let Some(t) = &outcome.ieee952_text {
-            out.write_all(t.as_bytes()).context("writing stdout")?;
+            text.push_str(t);
+        }
+        if let Err(e) = out.write_all(text.as_bytes()) {
+            return cli::fail(TOOL, &format!("standard output: {e}"));
         }
         if config.timings {
             for (phase, d) in &outcome.timings {
@@ -47,5 +65,5 @@ fn run() -> anyhow::Result<()> {
     if config.timings {
         eprintln!("timing total {:.3} s", t.elapsed().as_secs_f64());
     }
-    Ok(())
+    ExitCode::SUCCESS
 }

@@ -116,7 +116,7 @@ fn run_series(
     let t2 = Instant::now();
     std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
         path: config.out_dir.clone(),
-        source: e,
+        cause: e,
     })?;
     let mut files = report::write_curve_files(&analysis, &config.name, &config.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {

@@ -290,3 +290,75 @@ fn opencv_reads_both_yaml_files() {
         assert_eq!(n, expected, "{file}: values read by OpenCV:\n{dump}");
     }
 }
+
+#[test]
+fn defect_05_max_cluster_is_validated_against_the_data() {
+    let bag = crate::common::testdata().join("p3_short_61s/p3_short_61s.bag");
+    let dir = tempfile::tempdir().unwrap();
+    for m in ["4294967296", "1000000000", "100000"] {
+        let t = std::time::Instant::now();
+        let out = run(bin()
+            .arg(&bag)
+            .args([
+                "--topic",
+                "imu",
+                "--max-cluster",
+                m,
+                "-q",
+                "--no-plots",
+                "--compat-only",
+            ])
+            .arg("--data-save-path")
+            .arg(dir.path()));
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "--max-cluster {m}: {err}");
+        assert!(
+            err.contains("--max-cluster") && err.contains("samples allow"),
+            "{err}"
+        );
+        assert!(
+            t.elapsed().as_secs() < 30,
+            "--max-cluster {m} ran for {:?}",
+            t.elapsed()
+        );
+    }
+    let out = run(bin().arg(&bag).args(["--max-cluster", "-1"]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("must be positive"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn defect_14_one_error_convention() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.bag");
+    let m = missing.to_str().unwrap();
+    let cases: [(Vec<&str>, i32, String); 3] = [
+        (
+            vec![m],
+            1,
+            format!("allan_imu_utils: error: {m}: no such file or directory"),
+        ),
+        (
+            vec!["--no-such-flag"],
+            2,
+            "allan_imu_utils: error: unexpected argument".into(),
+        ),
+        (
+            vec![m, "--max-time-min", "-5"],
+            2,
+            "allan_imu_utils: error: invalid value '-5'".into(),
+        ),
+    ];
+    for (args, code, start) in cases {
+        let out = run(bin().args(&args));
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.starts_with(&start), "{args:?}: {err}");
+        assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
+        assert!(!err.contains("os error"), "{err}");
+    }
+}

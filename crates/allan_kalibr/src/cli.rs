@@ -14,7 +14,7 @@ use crate::run::Config;
 /// lines as gen_chart.m does, prints upstream's lines and writes imu.yaml,
 /// allan_curves.csv, allan_accel.{png,svg} and allan_gyro.{png,svg}.
 #[derive(Debug, Clone, Parser, PartialEq)]
-#[command(name = "allan_kalibr", version)]
+#[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {
     /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
     pub input: PathBuf,
@@ -31,7 +31,7 @@ pub struct Args {
     pub time: TimeArg,
     /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
     /// from the timestamps.
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", value_parser = rate_hz)]
     pub update_rate: Option<f64>,
     /// Chart title prefix (upstream's titlestr) [default: the input's file stem].
     #[arg(
@@ -51,12 +51,30 @@ pub struct Args {
     /// Output directory (default: the input's directory).
     #[arg(short = 'o', long, value_name = "OUTDIR")]
     pub outdir: Option<PathBuf>,
-    /// No progress bars.
+    /// Only errors and warnings on stderr: no progress bars, no "wrote" lines (the results
+    /// still go to stdout).
     #[arg(short, long)]
     pub quiet: bool,
     /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
     #[arg(long)]
     pub timings: bool,
+}
+
+/// The slowest update rate accepted, Hz: below it a τ grid of seconds-to-hours is meaningless
+/// and the printed numbers run to hundreds of digits.
+pub const MIN_RATE_HZ: f64 = 1e-3;
+/// The fastest update rate accepted, Hz (IMUs sample at 1 Hz to a few tens of kHz).
+pub const MAX_RATE_HZ: f64 = 1e7;
+
+/// `--update-rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
+fn rate_hz(s: &str) -> Result<f64, String> {
+    let v = bag2mat::shared::cli::positive_f64(s)?;
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
+        return Err(format!(
+            "{s} Hz is outside {MIN_RATE_HZ} .. {MAX_RATE_HZ:e} Hz"
+        ));
+    }
+    Ok(v)
 }
 
 /// The time column.

@@ -151,7 +151,8 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
 
 /// [`run`] on samples already in memory.
 pub fn run_on(config: &Config, data: ImuData) -> Result<RunOutput, Error> {
-    let mut notes = data.notes.clone();
+    // What the reader found (losses, fallbacks) is always said, also with --quiet.
+    let mut notes: Vec<String> = data.notes.iter().map(|n| format!("warning: {n}")).collect();
     let data_topic = data.topic.clone();
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
