@@ -77,7 +77,41 @@ fn run_series(
             config.max_time_min
         ));
     }
+    // The Allan variance assumes one constant rate with no gap: a record that is not one
+    // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
+    let mut collected = collected;
+    let tm = bag2mat::timing::analyse(&collected.t);
+    if !tm.is_continuous()
+        && let Some(seg) = tm.longest()
+    {
+        notes.push(format!(
+            "warning: the stamps of '{topic}' are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: messages {}..{} ({} of {})",
+            tm.describe(),
+            seg.start,
+            seg.end,
+            seg.len(),
+            collected.len()
+        ));
+        collected.restrict(seg.start..seg.end);
+    } else if !tm.gaps.is_empty() {
+        notes.push(format!(
+            "warning: the stamps of '{topic}' have small gaps ({}); analysed as one record",
+            tm.describe()
+        ));
+    }
     analysis::check_enough(&collected, config.max_cluster)?;
+    for (k, name) in collect::FIELDS.iter().enumerate() {
+        let col: Vec<f64> = if k < 3 {
+            collected.gyro_rad_s(k)
+        } else {
+            collected.acc_values(k - 3).collect()
+        };
+        match allan_kalibr::input::value_problem(name, &col) {
+            Some((true, what)) => return Err(Error::Config(what)),
+            Some((false, what)) => notes.push(format!("warning: {what}")),
+            None => {}
+        }
+    }
     let t1 = Instant::now();
     let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster)?;
     timings.push(("allan", t1.elapsed()));

@@ -481,3 +481,112 @@ fn defect_07_the_input_is_never_overwritten() {
         "the input bag was overwritten"
     );
 }
+
+/// Writes `t` with seeded white noise as a .mat.
+fn mat_at(path: &Path, t: &[f64], scale: f64) {
+    let mut d = DataImu::with_capacity(t.len());
+    let mut s: u64 = 0xA11A;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for &ti in t {
+        d.push([
+            ti,
+            next() * scale,
+            next() * scale,
+            9.81 + next() * scale,
+            next() * 1e-3,
+            next() * 1e-3,
+            next() * 1e-3,
+        ]);
+    }
+    write_data_imu(path, &d).unwrap();
+}
+
+#[test]
+fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
+    let dir = tempfile::tempdir().unwrap();
+    // 60 s at 100 Hz, a 1 h gap, 30 s more; and the first 60 s alone.
+    let first: Vec<f64> = (0..6000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
+    let mut gapped = first.clone();
+    gapped.extend((0..3000).map(|i| 1.7e9 + 3660.0 + i as f64 * 0.01));
+    let (g, c) = (dir.path().join("gap.mat"), dir.path().join("clean.mat"));
+    mat_at(&g, &gapped, 0.01);
+    mat_at(&c, &first, 0.01);
+    let run_on = |m: &Path, o: &str| {
+        let out = run(&[
+            m.to_str().unwrap(),
+            "--compat-only",
+            "-o",
+            dir.path().join(o).to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+            std::fs::read_to_string(dir.path().join(o).join("imu.yaml")).unwrap(),
+        )
+    };
+    let (err, yaml) = run_on(&g, "g");
+    let (_, clean_yaml) = run_on(&c, "c");
+    assert!(
+        err.contains("update rate: 100 Hz"),
+        "rate not from the median period: {err}"
+    );
+    assert!(
+        err.contains("warning: the timestamps are not one continuous record")
+            && err.contains("1 gap"),
+        "{err}"
+    );
+    // The same numbers (the first line names the input file).
+    let body = |y: &str| y.lines().skip(1).collect::<Vec<_>>().join("\n");
+    assert_eq!(
+        body(&yaml),
+        body(&clean_yaml),
+        "the longest stretch is the first 60 s"
+    );
+}
+
+#[test]
+fn defect_11_degenerate_values_are_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let t: Vec<f64> = (0..3000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
+    // Constant accelerometer axes (scale 0): warned, with the reason for the NaN.
+    let c = dir.path().join("const.mat");
+    mat_at(&c, &t, 0.0);
+    let out = run(&[
+        c.to_str().unwrap(),
+        "--compat-only",
+        "-q",
+        "-o",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: ax is constant") && err.contains("NaN"),
+        "{err}"
+    );
+    // Values of 1e300: an error that says why.
+    let big = dir.path().join("big.mat");
+    mat_at(&big, &t, 1e300);
+    let out = run(&[
+        big.to_str().unwrap(),
+        "--compat-only",
+        "-q",
+        "-o",
+        dir.path().join("p").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("allan_kalibr: error:") && err.contains("overflow"),
+        "{err}"
+    );
+}

@@ -77,7 +77,10 @@ pub enum Error {
     },
     /// The topic exists but does not carry `sensor_msgs/Imu` (with the right md5 for ROS 1).
     #[error(
-        "topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
+        "topic '{}' carries {} [{}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
+        crate::shared::cli::escape(.topic),
+        crate::shared::cli::escape(.msg_type),
+        crate::shared::cli::escape(.md5sum),
         crate::imu_msg::MD5
     )]
     WrongType {
@@ -141,9 +144,15 @@ fn no_topics(why: &[String]) -> String {
 
 fn nothing_read(topic: &str, why: &[String]) -> String {
     if why.is_empty() {
-        return format!("topic '{topic}' holds no message");
+        return format!(
+            "topic '{}' holds no message",
+            crate::shared::cli::escape(topic)
+        );
     }
-    let mut s = format!("no message of topic '{topic}' could be read:");
+    let mut s = format!(
+        "no message of topic '{}' could be read:",
+        crate::shared::cli::escape(topic)
+    );
     for w in why {
         s.push_str("\n  ");
         s.push_str(w);
@@ -158,7 +167,10 @@ fn no_imu_topic(available: &[TopicSummary]) -> String {
 }
 
 fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
-    let mut s = format!("no sensor_msgs/Imu topic '{topic}' in the bag");
+    let mut s = format!(
+        "no sensor_msgs/Imu topic '{}' in the bag",
+        crate::shared::cli::escape(topic)
+    );
     list_topics(&mut s, available);
     s
 }
@@ -169,9 +181,12 @@ fn list_topics(s: &mut String, available: &[TopicSummary]) {
     } else {
         s.push_str("; topics in the bag:");
         for t in available {
+            // Names come from the file: control bytes are escaped.
             s.push_str(&format!(
                 "\n  {:<30} {:>10} msgs : {}",
-                t.topic, t.count, t.msg_type
+                crate::shared::cli::escape(&t.topic),
+                t.count,
+                crate::shared::cli::escape(&t.msg_type)
             ));
         }
     }

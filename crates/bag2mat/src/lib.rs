@@ -18,7 +18,8 @@
 //!   [`cdr`]: `sensor_msgs/msg/Imu` in CDR (ROS 2).
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`).
+//! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
+//!   constant-rate segments of a series of stamps (info and both analysers use it).
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font,
 //!   C `printf` formats.
 //!
@@ -40,6 +41,7 @@ pub mod shared;
 pub mod source;
 #[doc(hidden)]
 pub mod test_tools;
+pub mod timing;
 pub mod zstd;
 
 pub use bag::{Compression, RosTime};

@@ -253,24 +253,62 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             return Ok(());
         }
         let mut channels = Vec::new();
+        let mut others: Vec<&Channel> = Vec::new();
         for c in &cs {
             match imu_codec(c) {
                 Some(k) => channels.push((c.id, k)),
-                None => {
-                    return Err(Error::WrongType {
-                        topic: topic.clone(),
-                        msg_type: c.msg_type.clone(),
-                        md5sum: c
-                            .md5sum
-                            .clone()
-                            .unwrap_or_else(|| format!("encoding {}", c.encoding.name())),
-                    });
-                }
+                None => others.push(c),
             }
         }
+        let Some(first_other) = others.first() else {
+            out.push(Selected {
+                topic,
+                msg_type: cs[0].msg_type.clone(),
+                channels,
+                note,
+                named,
+            });
+            return Ok(());
+        };
+        if channels.is_empty() {
+            return Err(Error::WrongType {
+                topic: topic.clone(),
+                msg_type: first_other.msg_type.clone(),
+                md5sum: first_other
+                    .md5sum
+                    .clone()
+                    .unwrap_or_else(|| format!("encoding {}", first_other.encoding.name())),
+            });
+        }
+        // Imu plus another type on one topic: the Imu connection is converted, as
+        // bagconvert's rosbag::View + instantiate<sensor_msgs::Imu>() skips the others.
+        let other_types: Vec<String> = others
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} ({} messages)",
+                    crate::shared::cli::escape(&c.msg_type),
+                    c.count.map_or("?".to_string(), |n| n.to_string())
+                )
+            })
+            .collect();
+        let mixed = format!(
+            "topic '{}' also carries {}; only its sensor_msgs/Imu connection is converted, as bagconvert does",
+            crate::shared::cli::escape(&topic),
+            other_types.join(", ")
+        );
+        let note = Some(match note {
+            Some(n) => format!("{n}; {mixed}"),
+            None => mixed,
+        });
+        let msg_type = cs
+            .iter()
+            .find(|c| is_imu(c))
+            .map(|c| c.msg_type.clone())
+            .unwrap_or_default();
         out.push(Selected {
             topic,
-            msg_type: cs[0].msg_type.clone(),
+            msg_type,
             channels,
             note,
             named,
@@ -291,7 +329,11 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
                 available: topic_summaries(src),
             });
         }
-        let note = format!("topic '{t}' is not in the bag; using '{other}'");
+        let note = format!(
+            "topic '{}' is not in the bag; using '{}'",
+            crate::shared::cli::escape(t),
+            crate::shared::cli::escape(&other)
+        );
         push(&mut out, other, cs, Some(note), true)?;
     }
     if sel.all_imu {
@@ -304,11 +346,8 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         topics.dedup();
         let before = out.len();
         for t in topics {
-            // A topic that mixes Imu with another type is not "an Imu topic".
-            let cs = on(t);
-            if cs.iter().all(|c| is_imu(c)) {
-                push(&mut out, t.to_string(), cs, None, false)?;
-            }
+            // A topic that mixes Imu with another type gives its Imu connection (with a note).
+            push(&mut out, t.to_string(), on(t), None, false)?;
         }
         if out.is_empty() && before == 0 {
             return Err(Error::NoImuTopic {

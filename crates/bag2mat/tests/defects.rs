@@ -608,3 +608,72 @@ fn defect_14_one_error_convention() {
         assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
     }
 }
+
+#[test]
+fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("mixed.bag");
+    {
+        let mut w = bag2mat::bag::BagWriter::create(&bag, Compression::None).unwrap();
+        let imu = w.add_imu_connection("imu");
+        let other = w.add_connection(
+            "imu",
+            "std_msgs/String",
+            "992ce8a1687cec8c8bd883ec73ca41d1",
+            "string data",
+        );
+        for i in 0..500 {
+            let (t, m) = synthetic(i);
+            w.write_imu(imu, t, &m).unwrap();
+            if i % 50 == 0 {
+                w.write_raw(other, t, &[2, 0, 0, 0, b'h', b'i']).unwrap();
+            }
+        }
+        w.finish().unwrap();
+    }
+    let out = dir.path().join("mixed.csv");
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&out));
+    assert!(ok, "a mixed topic was rejected: {err}");
+    assert!(
+        err.contains("warning: topic 'imu' also carries std_msgs/String (10 messages)"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap().lines().count(), 501);
+}
+
+#[test]
+fn defect_13_messages_a_person_can_act_on() {
+    let dir = tempfile::tempdir().unwrap();
+    // Control bytes in a topic name from the file are escaped.
+    let bag = dir.path().join("esc.bag");
+    write_synthetic(&bag, "/i\x1b[2Jmu", 10, Compression::None, false);
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu"));
+    assert!(!ok);
+    assert!(!err.contains('\x1b'), "raw control byte printed: {err:?}");
+    assert!(err.contains("/i\\u{1b}[2Jmu"), "{err}");
+    // A bag cut short before any complete chunk says so.
+    write_synthetic(&bag, "imu", 3000, Compression::None, false);
+    let full = std::fs::read(&bag).unwrap();
+    let cut = dir.path().join("cut.bag");
+    std::fs::write(&cut, &full[..4117 + 40]).unwrap();
+    let (ok, _, err) = run(bag2mat().arg(&cut).arg("imu"));
+    assert!(!ok);
+    assert!(
+        err.contains("truncated") && !err.contains("no topics at all"),
+        "{err}"
+    );
+    // A file in the way of the output: named as the user named it, no OS error number, no
+    // temporary path.
+    let (ok, _, err) = run(bag2mat()
+        .arg(&bag)
+        .arg("imu")
+        .arg("-o")
+        .arg(dir.path().join("esc.bag/x.mat")));
+    assert!(!ok);
+    assert!(
+        err.contains("esc.bag/x.mat: a component of the path is not a directory")
+            && !err.contains("os error")
+            && !err.contains(".x.mat."),
+        "{err}"
+    );
+}

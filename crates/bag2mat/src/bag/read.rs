@@ -506,8 +506,10 @@ impl BagReader {
                 Some(c) if c.info_counts.is_none() => {
                     unlisted.remove(&info.chunk_pos);
                     let own = c.promised();
-                    let mine: Vec<(u32, u64)> =
+                    let mut mine: Vec<(u32, u64)> =
                         info.counts.iter().map(|&(k, n)| (k, n as u64)).collect();
+                    // rosbag lists a chunk's connections in any order.
+                    mine.sort_unstable();
                     if own.is_some() && own.as_ref() != Some(&mine) {
                         self.notes.push(format!(
                             "the chunk info of the chunk at byte {} lists {:?} messages per connection, the chunk's own index {:?}; the chunk is read whole and its own index is used",
