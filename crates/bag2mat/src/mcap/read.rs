@@ -23,7 +23,7 @@ use crate::error::Error;
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
 
 /// Bytes read at once while walking the top-level records.
-const SCAN_WINDOW: usize = 256 * 1024;
+const SCAN_WINDOW: usize = 64 * 1024;
 /// Unchunked messages are grouped into parts of about this many bytes.
 const LOOSE_PART_BYTES: u64 = 4 << 20;
 /// Largest schema, channel or header record read during the walk (a damaged length must not
