@@ -215,6 +215,7 @@ impl Source for Sqlite3Reader {
         // Rows are read in id order; a damaged page ends the query, and the read resumes at
         // the first id past it that SQLite can read (probed at doubling distances), so one
         // bad page costs its own rows only. What was skipped is reported.
+        let mut stray: Option<(u64, u32)> = None;
         let mut lo = a;
         while lo < b {
             let mut last: Option<i64> = None;
@@ -238,6 +239,11 @@ impl Source for Sqlite3Reader {
                     let fields = (|| -> Result<(), rusqlite::Error> {
                         let topic = row.get::<_, i64>(1)? as u32;
                         if !want(topic) {
+                            if !self.channels.iter().any(|c| c.id == topic) {
+                                // A row naming no topic of the table: its message is lost.
+                                let e = stray.get_or_insert((0u64, topic));
+                                e.0 += 1;
+                            }
                             return Ok(());
                         }
                         let t = row.get::<_, i64>(2)?.max(0) as u64;
@@ -277,6 +283,18 @@ impl Source for Sqlite3Reader {
                 to - 1
             )));
             lo = to;
+        }
+        if let Some((n, id)) = stray {
+            out.lost.push(Loss {
+                what: format!(
+                    "message rows {a}..{}: {n} row(s) name topic id {id}{}, which the topics table does not hold (damaged rows)",
+                    b - 1,
+                    if n > 1 { " or another" } else { "" }
+                ),
+                messages: Some(n),
+                span: None,
+                channel: None,
+            });
         }
         self.give(conn);
         out
