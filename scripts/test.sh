@@ -40,6 +40,12 @@ cargo test --workspace "$@"
 cargo test -p allan_kalibr --lib -- --ignored --exact \
   ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study
 
+# Issue 12's seeded corruption campaign (>= 300 variants per input format through the real
+# bag2mat binary, each under an address-space limit and a timeout); its last line gives the
+# counts per format, and any panic, hang, memory blow-up or silent loss fails the run.
+cargo build -q -p bag2mat --bin bag2mat --example fuzz_campaign
+"$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/debug/examples/fuzz_campaign"
+
 # The seed's comparison, short enough for CI (30 min at 100 Hz, three presets), with the
 # tolerances `sim compare --check` states for that length, on the binaries cargo test built.
 target_dir=$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')

@@ -182,6 +182,15 @@ impl Analysis {
 /// N − 2m > 0, and when the stamps give no positive mean period (upstream would print NaNs).
 pub fn check_enough(c: &Collected<'_>, max_cluster: usize) -> Result<(), Error> {
     let n = c.len();
+    // Cluster sizes are distinct integers m with N > 2m: more than N/2 of them cannot exist,
+    // and a larger request would only size memory and time by a number the data cannot use.
+    // (The shipped default never trips this: a short record gets "too few samples".)
+    let allowed = (n / 2).max(crate::cli::DEFAULT_MAX_CLUSTER);
+    if max_cluster > allowed {
+        return Err(Error::Config(format!(
+            "--max-cluster {max_cluster} exceeds what {n} samples allow (at most {allowed}: cluster sizes m need N > 2m)"
+        )));
+    }
     let valid = if n < 2 {
         0
     } else {

@@ -25,7 +25,7 @@ pub const DEFAULT_MAX_CLUSTER: usize = 100;
 /// advice, warm-up and gap checks, and its files prefixed `<name>_`. With --curves it works on
 /// Allan curves another tool wrote.
 #[derive(Debug, Clone, Parser)]
-#[command(name = "allan_imu_utils", version)]
+#[command(name = "allan_imu_utils", version, allow_negative_numbers = true)]
 pub struct Args {
     /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3.
     #[arg(required_unless_present = "curves")]
@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long, value_name = "UNIT")]
     pub units: Vec<String>,
     /// Length of the record behind --curves, in seconds (for the confidence intervals).
-    #[arg(long, value_name = "SECONDS", conflicts_with = "samples")]
+    #[arg(long, value_name = "SECONDS", conflicts_with = "samples", value_parser = bag2mat::shared::cli::positive_f64)]
     pub duration: Option<f64>,
     /// Number of samples behind --curves (for the confidence intervals).
     #[arg(long, value_name = "N")]
@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
     /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
     /// sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic then
     /// gets its own folder under the output directory [default: imu]
@@ -70,15 +70,15 @@ pub struct Args {
     #[arg(long)]
     pub data_save_path: Option<PathBuf>,
     /// Stop after this many minutes of header time; the message crossing it is kept [default: 120]
-    #[arg(long)]
+    #[arg(long, value_parser = positive_int::<u32>)]
     pub max_time_min: Option<u32>,
-    /// Number of log-spaced cluster sizes requested [default: 100]
-    #[arg(long)]
+    /// Number of log-spaced cluster sizes requested (at most half the samples) [default: 100]
+    #[arg(long, value_parser = positive_int::<usize>)]
     pub max_cluster: Option<usize>,
     /// Take the settings from an imu_utils roslaunch file; explicit flags override it
     #[arg(long, value_name = "FILE.launch")]
     pub launch: Option<PathBuf>,
-    /// No progress bar
+    /// Only errors and warnings on stderr: no progress bar (the report still goes to stdout)
     #[arg(long, short)]
     pub quiet: bool,
     /// Do not draw allan_gyr/allan_acc plots
@@ -141,6 +141,19 @@ pub struct Config {
     pub timings: bool,
     /// Also run the IEEE 952 analysis (allan_kalibr::ieee952) beside the compat outputs.
     pub ieee952: bool,
+}
+
+/// A positive whole number: "must be positive" for 0 and negatives (clap would otherwise
+/// call "-1" an unexpected argument).
+fn positive_int<T: std::str::FromStr + TryFrom<u64>>(s: &str) -> Result<T, String> {
+    let t = s.trim();
+    if t.starts_with('-') || t.parse::<f64>().is_ok_and(|v| v <= 0.0) {
+        return Err(format!("{s} must be positive"));
+    }
+    let v: u64 = t
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number"))?;
+    T::try_from(v).map_err(|_| format!("{s} is too large"))
 }
 
 fn from_launch(lp: Option<&LaunchParams>, param: &str) -> Result<Option<String>, Error> {

@@ -40,6 +40,8 @@ pub const FIELDS: [&str; 6] = [
 #[derive(Debug, Clone)]
 pub struct Collected<'a> {
     series: &'a bag2mat::ImuSeries,
+    /// Index in the series of the first sample used (0 unless restricted to a stretch).
+    offset: usize,
     /// `header.stamp.toSec()` (or the record time, with `--time record`) of each used message.
     pub t: Vec<f64>,
     /// How collection ended.
@@ -50,6 +52,17 @@ impl Collected<'_> {
     /// Number of samples used.
     pub fn len(&self) -> usize {
         self.t.len()
+    }
+
+    /// The samples `range` (indices into the collected ones) only: a continuous stretch
+    /// when the record has gaps or rate changes (see [`bag2mat::timing`]).
+    pub fn restrict(&mut self, range: std::ops::Range<usize>) {
+        self.t = self.t[range.clone()].to_vec();
+        self.offset += range.start;
+    }
+
+    fn used(&self) -> std::ops::Range<usize> {
+        self.offset..self.offset + self.len()
     }
 
     /// True when nothing was collected.
@@ -69,22 +82,19 @@ impl Collected<'_> {
 
     /// The pushed gyro values of axis `k` (0–2: x, y, z) in pseudo-deg/h, in message order.
     pub fn gyro_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
-        self.series.gyro[..self.len()]
+        self.series.gyro[k][self.used()]
             .iter()
-            .map(move |w| w[k] * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
+            .map(move |w| w * IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR)
     }
 
     /// The pushed gyro values of axis `k` (0–2) in rad/s, as the bag holds them.
     pub fn gyro_rad_s(&self, k: usize) -> Vec<f64> {
-        self.series.gyro[..self.len()]
-            .iter()
-            .map(|w| w[k])
-            .collect()
+        self.series.gyro[k][self.used()].to_vec()
     }
 
     /// The pushed accelerations of axis `k` (0–2: x, y, z) in m/s², in message order.
     pub fn acc_values(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
-        self.series.acc[..self.len()].iter().map(move |a| a[k])
+        self.series.acc[k][self.used()].iter().copied()
     }
 
     /// The error for a non-finite value of accumulator `axis` at message `index`.
@@ -115,7 +125,12 @@ pub fn collect(
             break;
         }
     }
-    Collected { series, t, stop }
+    Collected {
+        series,
+        offset: 0,
+        t,
+        stop,
+    }
 }
 
 #[cfg(test)]
@@ -133,8 +148,8 @@ mod tests {
             record_time: stamp.clone(),
             stamp,
             seq: (0..n as u32).collect(),
-            acc: vec![[0.0, 0.0, 9.81]; n],
-            gyro: vec![[0.001, 0.0, 0.0]; n],
+            acc: [vec![0.0; n], vec![0.0; n], vec![9.81; n]],
+            gyro: [vec![0.001; n], vec![0.0; n], vec![0.0; n]],
             ..Default::default()
         }
     }

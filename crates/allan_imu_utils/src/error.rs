@@ -62,12 +62,13 @@ pub enum Error {
     #[error("{0}")]
     Config(String),
     /// Writing outputs failed.
-    #[error("{path}: {source}")]
+    // The cause is part of the message, not a `source`: it is printed once.
+    #[error("{}: {}", .path.display(), bag2mat::shared::output::describe(.cause))]
     Io {
         /// The path.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// Drawing a plot failed.
     #[error("plot {path}: {what}")]

@@ -57,7 +57,7 @@ impl LaunchParams {
 pub fn read(path: &Path) -> Result<LaunchParams, Error> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
-        source: e,
+        cause: e,
     })?;
     parse(&text).map_err(|what| Error::Launch {
         path: path.to_path_buf(),

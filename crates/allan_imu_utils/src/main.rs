@@ -4,60 +4,82 @@
 use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Parser;
 
 use allan_imu_utils::cli::{Args, Config};
+use bag2mat::shared::{cli, output};
+
+const TOOL: &str = "allan_imu_utils";
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("allan_imu_utils: error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn run() -> anyhow::Result<()> {
     let t = std::time::Instant::now();
-    let config = Config::try_from(Args::parse()).context("bad arguments")?;
-    let what = match &config.curves {
-        Some(c) => c
-            .paths
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-        None => config.bag.display().to_string(),
+    let args = match Args::try_parse() {
+        Ok(a) => a,
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => return cli::usage(TOOL, &e.render().to_string()),
     };
+    let config = match Config::try_from(args) {
+        Ok(c) => c,
+        Err(e) => return cli::usage(TOOL, &e.to_string()),
+    };
+    match &config.curves {
+        Some(c) => c.paths.iter().for_each(|p| output::protect_input(p)),
+        None => output::protect_input(&config.bag),
+    }
+    // Every output of the run, or none.
+    let staging = output::Staging::begin();
     if config.curves.is_some() {
-        let o = allan_imu_utils::run::run_curves(&config)
-            .with_context(|| format!("analysing {what}"))?;
+        let o = match allan_imu_utils::run::run_curves(&config).map_err(|e| e.to_string()) {
+            Ok(o) => o,
+            Err(e) => return cli::fail(TOOL, &e),
+        };
+        if let Err(e) = staging.commit() {
+            return cli::fail(TOOL, &e);
+        }
         for note in &o.notes {
-            eprintln!("{note}");
+            if !config.quiet || note.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{note}");
+            }
         }
         let mut out = std::io::stdout().lock();
-        out.write_all(o.stdout.as_bytes())
+        if let Err(e) = out
+            .write_all(o.stdout.as_bytes())
             .and_then(|_| out.write_all(o.ieee952_text.as_bytes()))
-            .context("writing stdout")?;
-        return Ok(());
+        {
+            return cli::fail(TOOL, &format!("standard output: {e}"));
+        }
+        return ExitCode::SUCCESS;
     }
-    let outcomes =
-        allan_imu_utils::run::run(&config).with_context(|| format!("analysing {what}"))?;
+    let outcomes = match allan_imu_utils::run::run(&config).map_err(|e| e.to_string()) {
+        Ok(o) => o,
+        Err(e) => return cli::fail(TOOL, &e),
+    };
+    if let Err(e) = staging.commit() {
+        return cli::fail(TOOL, &e);
+    }
     let several = outcomes.len() > 1;
+    let mut out = std::io::stdout().lock();
     for outcome in &outcomes {
-        let mut out = std::io::stdout().lock();
+        let mut text = String::new();
         if several {
-            writeln!(out, "===== topic {} =====", outcome.topic).context("writing stdout")?;
+            text.push_str(&format!("===== topic {} =====\n", outcome.topic));
         }
         for note in &outcome.notes {
-            eprintln!("{note}");
+            if note.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{note}");
+            } else {
+                eprintln!("warning: {note}");
+            }
         }
-        out.write_all(outcome.stdout.as_bytes())
-            .context("writing stdout")?;
+        text.push_str(&outcome.stdout);
         if let Some(t) = &outcome.ieee952_text {
-            out.write_all(t.as_bytes()).context("writing stdout")?;
+            text.push_str(t);
+        }
+        if let Err(e) = out.write_all(text.as_bytes()) {
+            return cli::fail(TOOL, &format!("standard output: {e}"));
         }
         if config.timings {
             for (phase, d) in &outcome.timings {
@@ -68,5 +90,5 @@ fn run() -> anyhow::Result<()> {
     if config.timings {
         eprintln!("timing total {:.3} s", t.elapsed().as_secs_f64());
     }
-    Ok(())
+    ExitCode::SUCCESS
 }

@@ -85,8 +85,9 @@ fn skip_start(series: &mut bag2mat::ImuSeries, seconds: f64) -> Result<usize, Er
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);
-    series.acc.drain(..k);
-    series.gyro.drain(..k);
+    for c in series.acc.iter_mut().chain(series.gyro.iter_mut()) {
+        c.drain(..k);
+    }
     Ok(k)
 }
 
@@ -162,7 +163,41 @@ fn run_series(
             config.max_time_min
         ));
     }
+    // The Allan variance assumes one constant rate with no gap: a record that is not one
+    // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
+    let mut collected = collected;
+    let tm = bag2mat::timing::analyse(&collected.t);
+    if !tm.is_continuous()
+        && let Some(seg) = tm.longest()
+    {
+        notes.push(format!(
+            "warning: the stamps of '{topic}' are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: messages {}..{} ({} of {})",
+            tm.describe(),
+            seg.start,
+            seg.end,
+            seg.len(),
+            collected.len()
+        ));
+        collected.restrict(seg.start..seg.end);
+    } else if !tm.gaps.is_empty() {
+        notes.push(format!(
+            "warning: the stamps of '{topic}' have small gaps ({}); analysed as one record",
+            tm.describe()
+        ));
+    }
     analysis::check_enough(&collected, config.max_cluster)?;
+    for (k, name) in collect::FIELDS.iter().enumerate() {
+        let col: Vec<f64> = if k < 3 {
+            collected.gyro_rad_s(k)
+        } else {
+            collected.acc_values(k - 3).collect()
+        };
+        match allan_kalibr::input::value_problem(name, &col) {
+            Some((true, what)) => return Err(Error::Config(what)),
+            Some((false, what)) => notes.push(format!("warning: {what}")),
+            None => {}
+        }
+    }
     let t1 = Instant::now();
     let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster, config.ieee952)?;
     timings.push(("allan", t1.elapsed()));
@@ -204,7 +239,7 @@ fn run_series(
     let t2 = Instant::now();
     std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
         path: config.out_dir.clone(),
-        source: e,
+        cause: e,
     })?;
     let mut files = report::write_curve_files(&analysis, &config.name, &config.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {
@@ -261,7 +296,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut files = Vec::new();
     std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
         path: config.out_dir.clone(),
-        source: e,
+        cause: e,
     })?;
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {

@@ -290,3 +290,197 @@ fn opencv_reads_both_yaml_files() {
         assert_eq!(n, expected, "{file}: values read by OpenCV:\n{dump}");
     }
 }
+
+#[test]
+fn defect_05_max_cluster_is_validated_against_the_data() {
+    let bag = crate::common::testdata().join("p3_short_61s/p3_short_61s.bag");
+    let dir = tempfile::tempdir().unwrap();
+    for m in ["4294967296", "1000000000", "100000"] {
+        let t = std::time::Instant::now();
+        let out = run(bin()
+            .arg(&bag)
+            .args([
+                "--topic",
+                "imu",
+                "--max-cluster",
+                m,
+                "-q",
+                "--no-plots",
+                "--compat-only",
+            ])
+            .arg("--data-save-path")
+            .arg(dir.path()));
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "--max-cluster {m}: {err}");
+        assert!(
+            err.contains("--max-cluster") && err.contains("samples allow"),
+            "{err}"
+        );
+        assert!(
+            t.elapsed().as_secs() < 30,
+            "--max-cluster {m} ran for {:?}",
+            t.elapsed()
+        );
+    }
+    let out = run(bin().arg(&bag).args(["--max-cluster", "-1"]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("must be positive"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn defect_14_one_error_convention() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.bag");
+    let m = missing.to_str().unwrap();
+    let cases: [(Vec<&str>, i32, String); 3] = [
+        (
+            vec![m],
+            1,
+            format!("allan_imu_utils: error: {m}: no such file or directory"),
+        ),
+        (
+            vec!["--no-such-flag"],
+            2,
+            "allan_imu_utils: error: unexpected argument".into(),
+        ),
+        (
+            vec![m, "--max-time-min", "-5"],
+            2,
+            "allan_imu_utils: error: invalid value '-5'".into(),
+        ),
+    ];
+    for (args, code, start) in cases {
+        let out = run(bin().args(&args));
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.starts_with(&start), "{args:?}: {err}");
+        assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
+        assert!(!err.contains("os error"), "{err}");
+    }
+}
+
+/// A bag of white noise whose message `i` is stamped `stamp_ns(i)`; `scale` multiplies the
+/// accelerometer noise.
+fn write_bag_at(path: &Path, n: usize, stamp_ns: impl Fn(usize) -> u64, scale: f64) {
+    let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
+    let conn = w.add_imu_connection("/imu");
+    let mut state = SEED;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for i in 0..n {
+        let stamp = RosTime::from_nanos(stamp_ns(i));
+        let mut m = Imu {
+            seq: i as u32,
+            stamp,
+            ..Imu::default()
+        };
+        m.angular_velocity = [next() * 0.1, next() * 0.1, next() * 0.1];
+        m.linear_acceleration = [next() * scale, next() * scale, 9.81 + next() * scale];
+        w.write_imu(conn, stamp, &m).unwrap();
+    }
+    w.finish().unwrap();
+}
+
+#[test]
+fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
+    let dir = tempfile::tempdir().unwrap();
+    const T0: u64 = 1_600_000_000_000_000_000;
+    // 60 s at 200 Hz, a 1 h gap, 30 s more; and the first 60 s alone.
+    let gap = dir.path().join("gap.bag");
+    write_bag_at(
+        &gap,
+        18_000,
+        |i| {
+            if i < 12_000 {
+                T0 + i as u64 * 5_000_000
+            } else {
+                T0 + 3_660_000_000_000 + (i - 12_000) as u64 * 5_000_000
+            }
+        },
+        1.0,
+    );
+    let clean = dir.path().join("clean.bag");
+    write_bag_at(&clean, 12_000, |i| T0 + i as u64 * 5_000_000, 1.0);
+    let go = |bag: &Path, o: &str| {
+        let out = run(bin()
+            .arg(bag)
+            .args([
+                "--topic",
+                "/imu",
+                "--no-plots",
+                "--compat-only",
+                "-q",
+                "--data-save-path",
+            ])
+            .arg(dir.path().join(o)));
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        (
+            text(&out.stderr),
+            std::fs::read_to_string(dir.path().join(o).join("imu_imu_param.yaml")).unwrap(),
+        )
+    };
+    let (err, yaml) = go(&gap, "g");
+    let (_, clean_yaml) = go(&clean, "c");
+    assert!(
+        err.contains("warning: the stamps of '/imu' are not one continuous record"),
+        "{err}"
+    );
+    assert_eq!(yaml, clean_yaml, "the longest stretch is the first 60 s");
+}
+
+#[test]
+fn defect_11_degenerate_values_are_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("const.bag");
+    write_bag_at(
+        &bag,
+        12_000,
+        |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
+        0.0,
+    );
+    let out = run(bin()
+        .arg(&bag)
+        .args([
+            "--topic",
+            "/imu",
+            "--no-plots",
+            "--compat-only",
+            "-q",
+            "--data-save-path",
+        ])
+        .arg(dir.path()));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("linear_acceleration.x is constant") && err.contains("NaN"),
+        "{err}"
+    );
+    let big = dir.path().join("big.bag");
+    write_bag_at(
+        &big,
+        12_000,
+        |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
+        1e300,
+    );
+    let out = run(bin()
+        .arg(&big)
+        .args([
+            "--topic",
+            "/imu",
+            "--no-plots",
+            "--compat-only",
+            "-q",
+            "--data-save-path",
+        ])
+        .arg(dir.path()));
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("overflow"), "{err}");
+}

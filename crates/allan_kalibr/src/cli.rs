@@ -19,7 +19,7 @@ use crate::run::Config;
 /// ieee952_terms.csv, ieee952_curves.csv, ieee952_allan.{png,svg} and Kalibr/VINS/ORB-SLAM3
 /// yaml files. With --curves it analyses Allan curves another tool wrote instead of samples.
 #[derive(Debug, Clone, Parser, PartialEq)]
-#[command(name = "allan_kalibr", version)]
+#[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {
     /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
     #[arg(required_unless_present = "curves")]
@@ -35,13 +35,13 @@ pub struct Args {
     #[arg(long, value_name = "UNIT")]
     pub units: Vec<String>,
     /// Length of the record behind --curves, in seconds (for the confidence intervals).
-    #[arg(long, value_name = "SECONDS", conflicts_with = "samples")]
+    #[arg(long, value_name = "SECONDS", conflicts_with = "samples", value_parser = bag2mat::shared::cli::positive_f64)]
     pub duration: Option<f64>,
     /// Number of samples behind --curves (for the confidence intervals).
     #[arg(long, value_name = "N")]
     pub samples: Option<u64>,
     /// Drop the first SECONDS of the record (a warm-up) before any analysis.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
     /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml); repeatable,
     /// each topic then gets its own folder under the output directory [default: imu].
@@ -57,7 +57,7 @@ pub struct Args {
     /// IMU rate in Hz (drives the tau grid, as upstream's update_rate). Default: estimated
     /// from the timestamps. With --curves (also as --rate): the rate of a plain CSV whose τ
     /// do not start at one sample.
-    #[arg(long, value_name = "HZ", visible_alias = "rate")]
+    #[arg(long, value_name = "HZ", visible_alias = "rate", value_parser = rate_hz)]
     pub update_rate: Option<f64>,
     /// Chart title prefix (upstream's titlestr) [default: the input's file stem].
     #[arg(
@@ -77,12 +77,30 @@ pub struct Args {
     /// Output directory (default: the input's directory).
     #[arg(short = 'o', long, value_name = "OUTDIR")]
     pub outdir: Option<PathBuf>,
-    /// No progress bars.
+    /// Only errors and warnings on stderr: no progress bars, no "wrote" lines (the results
+    /// still go to stdout).
     #[arg(short, long)]
     pub quiet: bool,
     /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
     #[arg(long)]
     pub timings: bool,
+}
+
+/// The slowest update rate accepted, Hz: below it a τ grid of seconds-to-hours is meaningless
+/// and the printed numbers run to hundreds of digits.
+pub const MIN_RATE_HZ: f64 = 1e-3;
+/// The fastest update rate accepted, Hz (IMUs sample at 1 Hz to a few tens of kHz).
+pub const MAX_RATE_HZ: f64 = 1e7;
+
+/// `--update-rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
+fn rate_hz(s: &str) -> Result<f64, String> {
+    let v = bag2mat::shared::cli::positive_f64(s)?;
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
+        return Err(format!(
+            "{s} Hz is outside {MIN_RATE_HZ} .. {MAX_RATE_HZ:e} Hz"
+        ));
+    }
+    Ok(v)
 }
 
 /// The time column.

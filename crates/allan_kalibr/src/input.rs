@@ -53,6 +53,16 @@ impl ImuData {
         }
     }
 
+    /// Samples `range` only.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> ImuData {
+        ImuData {
+            t: self.t[range.clone()].to_vec(),
+            axes: std::array::from_fn(|a| self.axes[a][range.clone()].to_vec()),
+            topic: self.topic.clone(),
+            notes: self.notes.clone(),
+        }
+    }
+
     /// Checks that every sample is finite (a NaN would silently turn whole curves into NaN).
     pub fn check_finite(&self) -> Result<(), Error> {
         const NAMES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
@@ -118,18 +128,50 @@ fn load_mat(path: &Path) -> Result<ImuData, Error> {
     })
 }
 
+/// Largest sample magnitude accepted: the Allan variance sums squared differences, and
+/// (1e150)² = 1e300 stays finite in f64 where 1e300 would overflow to infinity.
+pub const MAX_ABS_VALUE: f64 = 1e150;
+
+/// What makes one axis unusable or its results meaningless, said in words: values too large
+/// for the sums of squares (an error), or a constant axis (its Allan deviation is 0 and the
+/// fits take logarithms of it: NaN). `None` for ordinary data.
+pub fn value_problem(axis: &str, col: &[f64]) -> Option<(bool, String)> {
+    let max = col.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if max > MAX_ABS_VALUE {
+        return Some((
+            true,
+            format!(
+                "{axis} holds values up to {max:e}: beyond {MAX_ABS_VALUE:e} the squared differences of the Allan variance overflow"
+            ),
+        ));
+    }
+    let first = *col.first()?;
+    if col.iter().all(|&v| v == first) {
+        return Some((
+            false,
+            format!(
+                "{axis} is constant ({first} in every sample): its Allan deviation is 0, so its noise fits are undefined (NaN); a sensor that reports no noise is saturated, quantized too coarsely or not streaming"
+            ),
+        ));
+    }
+    None
+}
+
 /// The rate used for the grid and what to tell the user about it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RateChoice {
     /// Hz, drives the τ grid.
     pub used: f64,
-    /// `(N-1)/(t_N - t_1)` when the timestamps allow it.
+    /// `(N-1)/(t_N - t_1)` of the analysed stretch, when the timestamps allow it.
     pub measured: Option<f64>,
     /// An info line (estimated) or a warning (disagreement), for stderr.
     pub message: Option<String>,
 }
 
-/// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span.
+/// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span. The run
+/// first cuts a record with gaps or rate changes to its longest continuous stretch
+/// (bag2mat::timing, median period), so a gap never lowers this; on continuous data the
+/// mean is exact where a median of intervals of large absolute times is quantised.
 pub fn measured_rate(t: &[f64]) -> Option<f64> {
     let (first, last) = (t.first()?, t.last()?);
     let span = last - first;

@@ -1,64 +1,80 @@
-//! `allan_kalibr`: parses the command line and runs the library; see `allan_kalibr::cli`.
+//! `allan_kalibr INPUT [--update-rate HZ] [--topic T] [-o OUTDIR]`: kalibr_allan without
+//! MATLAB; `allan_kalibr --curves PATH…` analyses Allan curves another tool wrote.
 
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::Parser;
 
 use allan_kalibr::cli::Args;
 use allan_kalibr::{Config, run, run_curves};
+use bag2mat::shared::{cli, output};
+
+const TOOL: &str = "allan_kalibr";
 
 fn main() -> ExitCode {
-    let config: Config = Args::parse().into();
+    let config: Config = match Args::try_parse() {
+        Ok(a) => a.into(),
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => return cli::usage(TOOL, &e.render().to_string()),
+    };
     if let Some(curves) = &config.curves {
-        return match run_curves(&config, curves)
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .context("allan_kalibr --curves")
-        {
-            Ok(out) => {
-                print!("{}", out.text);
-                for p in &out.written {
-                    eprintln!("wrote {}", p.display());
-                }
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                ExitCode::FAILURE
-            }
+        for p in &curves.paths {
+            output::protect_input(p);
+        }
+    } else {
+        output::protect_input(&config.input);
+    }
+    // Every output of the run, or none.
+    let staging = output::Staging::begin();
+    if let Some(curves) = &config.curves {
+        let out = match run_curves(&config, curves) {
+            Ok(o) => o,
+            Err(e) => return cli::fail(TOOL, &e),
         };
-    }
-    // The library's messages already carry their causes inline, so the error is flattened to
-    // its text before the context is added (printing the cause chain would repeat them).
-    let result = run(&config)
-        .map_err(|e| anyhow::anyhow!("{e}"))
-        .with_context(|| format!("allan_kalibr {}", config.input.display()));
-    match result {
-        Ok(outs) => {
-            let several = outs.len() > 1;
-            for out in &outs {
-                if several {
-                    println!("===== topic {} =====", out.topic.as_deref().unwrap_or("?"));
-                }
-                for n in &out.notes {
-                    eprintln!("{n}");
-                }
-                print!("{}", out.text);
-                if let Some(t) = &out.ieee952_text {
-                    print!("{t}");
-                }
-                for p in &out.written {
-                    eprintln!("wrote {}", p.display());
-                }
-                if config.timings {
-                    eprintln!("{}", out.timings);
-                }
+        if let Err(e) = staging.commit() {
+            return cli::fail(TOOL, &e);
+        }
+        print!("{}", out.text);
+        if !config.quiet {
+            for p in &out.written {
+                eprintln!("wrote {}", p.display());
             }
-            ExitCode::SUCCESS
         }
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+        return ExitCode::SUCCESS;
+    }
+    let outs = match run(&config) {
+        Ok(o) => o,
+        Err(e) => return cli::fail(TOOL, &e),
+    };
+    if let Err(e) = staging.commit() {
+        return cli::fail(TOOL, &e);
+    }
+    let several = outs.len() > 1;
+    for out in &outs {
+        if several {
+            println!("===== topic {} =====", out.topic.as_deref().unwrap_or("?"));
+        }
+        for n in &out.notes {
+            // Warnings always; other notes (the estimated rate) only without --quiet.
+            if !config.quiet || n.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{n}");
+            }
+        }
+        print!("{}", out.text);
+        if let Some(t) = &out.ieee952_text {
+            print!("{t}");
+        }
+        if !config.quiet {
+            for p in &out.written {
+                eprintln!("wrote {}", p.display());
+            }
+        }
+        if config.timings {
+            eprintln!("{}", out.timings);
         }
     }
+    ExitCode::SUCCESS
 }

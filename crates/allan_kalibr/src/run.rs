@@ -164,7 +164,8 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
 
 /// [`run`] on samples already in memory.
 pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
-    let mut notes = data.notes.clone();
+    // What the reader found (losses, fallbacks) is always said, also with --quiet.
+    let mut notes: Vec<String> = data.notes.iter().map(|n| format!("warning: {n}")).collect();
     let data_topic = data.topic.clone();
     if let Some(skip) = config.skip_start {
         let k = skip_start(&mut data, skip)?;
@@ -177,6 +178,43 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         return Err(Error::TooShort { n: data.len() });
     }
     data.check_finite()?;
+    // The Allan variance assumes one constant rate with no gap: a record that is not one
+    // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
+    let tm = bag2mat::timing::analyse(&data.t);
+    let data = match tm.longest() {
+        Some(seg) if !tm.is_continuous() => {
+            notes.push(format!(
+                "warning: the timestamps are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: samples {}..{} ({} of {})",
+                tm.describe(),
+                seg.start,
+                seg.end,
+                seg.len(),
+                data.len()
+            ));
+            let d = data.slice(seg.start..seg.end);
+            if d.len() < 3 {
+                return Err(Error::TooShort { n: d.len() });
+            }
+            d
+        }
+        _ => {
+            if !tm.gaps.is_empty() {
+                notes.push(format!(
+                    "warning: the timestamps have small gaps ({}); analysed as one record",
+                    tm.describe()
+                ));
+            }
+            data
+        }
+    };
+    const AXES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
+    for (name, col) in AXES.iter().zip(&data.axes) {
+        match input::value_problem(name, col) {
+            Some((true, what)) => return Err(Error::BadData { what }),
+            Some((false, what)) => notes.push(format!("warning: {what}")),
+            None => {}
+        }
+    }
     let rate = input::choose_rate(config.update_rate, &data.t)?;
     notes.extend(rate.message.clone());
     let topic = data.topic.clone().unwrap_or_else(|| {

@@ -331,3 +331,264 @@ fn non_finite_samples_are_a_clear_error() {
     );
     assert_no_outputs(&out);
 }
+
+/// A small .mat of white noise at 100 Hz (seeded LCG), `n` rows.
+fn noise_mat(path: &Path, n: usize) {
+    let mut d = DataImu::with_capacity(n);
+    let mut s: u64 = 0x5EED;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for i in 0..n {
+        d.push([
+            1.7e9 + i as f64 * 0.01,
+            next(),
+            next(),
+            9.81 + next(),
+            next() * 1e-3,
+            next() * 1e-3,
+            next() * 1e-3,
+        ]);
+    }
+    write_data_imu(path, &d).unwrap();
+}
+
+#[test]
+fn defect_14_one_error_convention() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.bag");
+    let m = missing.to_str().unwrap();
+    let cases: [(Vec<&str>, i32, String); 4] = [
+        (
+            vec![m],
+            1,
+            format!("allan_kalibr: error: {m}: no such file or directory"),
+        ),
+        (
+            vec!["--no-such-flag"],
+            2,
+            "allan_kalibr: error: unexpected argument".into(),
+        ),
+        (
+            vec![m, "--update-rate", "-1"],
+            2,
+            "allan_kalibr: error: invalid value '-1'".into(),
+        ),
+        (vec![], 2, "allan_kalibr: error: ".into()),
+    ];
+    for (args, code, start) in cases {
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.starts_with(&start), "{args:?}: {err}");
+        assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
+        assert!(!err.contains("os error"), "{err}");
+    }
+    let out = run(&[m, "--update-rate", "-1"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("must be positive"));
+}
+
+#[test]
+fn defect_11_update_rate_range_is_validated() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("n.mat");
+    noise_mat(&mat, 2000);
+    for r in ["1e-300", "0", "inf", "1e12"] {
+        let out = run(&[mat.to_str().unwrap(), "--update-rate", r, "-q"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--update-rate {r}: {err}");
+        assert!(err.starts_with("allan_kalibr: error:"), "{err}");
+    }
+}
+
+#[test]
+fn defect_13_quiet_prints_only_errors_and_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("n.mat");
+    noise_mat(&mat, 2000);
+    let out = run(&[
+        mat.to_str().unwrap(),
+        "--update-rate",
+        "100",
+        "-q",
+        "--compat-only",
+        "-o",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.lines()
+            .all(|l| l.starts_with("warning") || l.contains("error")),
+        "--quiet printed: {err}"
+    );
+}
+
+#[test]
+fn defect_08_outputs_are_all_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("n.mat");
+    noise_mat(&mat, 2000);
+    let o = dir.path().join("o");
+    std::fs::create_dir_all(o.join("allan_gyro.svg/in_the_way")).unwrap();
+    let out = run(&[
+        mat.to_str().unwrap(),
+        "--update-rate",
+        "100",
+        "-q",
+        "-o",
+        o.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.starts_with("allan_kalibr: error:"), "{err}");
+    let left: Vec<String> = std::fs::read_dir(&o)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        left,
+        vec!["allan_gyro.svg".to_string()],
+        "outputs or temp files left: {left:?}"
+    );
+}
+
+#[test]
+fn defect_07_the_input_is_never_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    // A bag named like an output, in the output directory: refused, not replaced.
+    let bag = dir.path().join("allan_curves.csv");
+    std::fs::copy(
+        crate::common::testdata().join("p3_short_61s/p3_short_61s.bag"),
+        &bag,
+    )
+    .unwrap();
+    let before = std::fs::read(&bag).unwrap();
+    let out = run(&[
+        bag.to_str().unwrap(),
+        "--topic",
+        "imu",
+        "-q",
+        "--compat-only",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("input"), "{err}");
+    assert_eq!(
+        std::fs::read(&bag).unwrap(),
+        before,
+        "the input bag was overwritten"
+    );
+}
+
+/// Writes `t` with seeded white noise as a .mat.
+fn mat_at(path: &Path, t: &[f64], scale: f64) {
+    let mut d = DataImu::with_capacity(t.len());
+    let mut s: u64 = 0xA11A;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for &ti in t {
+        d.push([
+            ti,
+            next() * scale,
+            next() * scale,
+            9.81 + next() * scale,
+            next() * 1e-3,
+            next() * 1e-3,
+            next() * 1e-3,
+        ]);
+    }
+    write_data_imu(path, &d).unwrap();
+}
+
+#[test]
+fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
+    let dir = tempfile::tempdir().unwrap();
+    // 60 s at 100 Hz, a 1 h gap, 30 s more; and the first 60 s alone.
+    let first: Vec<f64> = (0..6000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
+    let mut gapped = first.clone();
+    gapped.extend((0..3000).map(|i| 1.7e9 + 3660.0 + i as f64 * 0.01));
+    let (g, c) = (dir.path().join("gap.mat"), dir.path().join("clean.mat"));
+    mat_at(&g, &gapped, 0.01);
+    mat_at(&c, &first, 0.01);
+    let run_on = |m: &Path, o: &str| {
+        let out = run(&[
+            m.to_str().unwrap(),
+            "--compat-only",
+            "-o",
+            dir.path().join(o).to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+            std::fs::read_to_string(dir.path().join(o).join("imu.yaml")).unwrap(),
+        )
+    };
+    let (err, yaml) = run_on(&g, "g");
+    let (_, clean_yaml) = run_on(&c, "c");
+    assert!(
+        err.contains("update rate: 100 Hz"),
+        "rate not from the median period: {err}"
+    );
+    assert!(
+        err.contains("warning: the timestamps are not one continuous record")
+            && err.contains("1 gap"),
+        "{err}"
+    );
+    // The same numbers (the first line names the input file).
+    let body = |y: &str| y.lines().skip(1).collect::<Vec<_>>().join("\n");
+    assert_eq!(
+        body(&yaml),
+        body(&clean_yaml),
+        "the longest stretch is the first 60 s"
+    );
+}
+
+#[test]
+fn defect_11_degenerate_values_are_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let t: Vec<f64> = (0..3000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
+    // Constant accelerometer axes (scale 0): warned, with the reason for the NaN.
+    let c = dir.path().join("const.mat");
+    mat_at(&c, &t, 0.0);
+    let out = run(&[
+        c.to_str().unwrap(),
+        "--compat-only",
+        "-q",
+        "-o",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: ax is constant") && err.contains("NaN"),
+        "{err}"
+    );
+    // Values of 1e300: an error that says why.
+    let big = dir.path().join("big.mat");
+    mat_at(&big, &t, 1e300);
+    let out = run(&[
+        big.to_str().unwrap(),
+        "--compat-only",
+        "-q",
+        "-o",
+        dir.path().join("p").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("allan_kalibr: error:") && err.contains("overflow"),
+        "{err}"
+    );
+}

@@ -8,6 +8,7 @@
 //! time. `--time header` puts `header.stamp` in the `t` column instead (rows stay in
 //! record-time order). Several topics are read in one pass, each into its own folder.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::bag::RosTime;
@@ -73,15 +74,17 @@ pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f
 
 /// The matrix of one Imu series with the chosen time column.
 pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
-    let mut d = DataImu::with_capacity(s.len());
-    for ((t, a), g) in s.time(time).iter().zip(&s.acc).zip(&s.gyro) {
-        d.push(bagconvert_row(*t, *a, *g));
+    let t = s.time(time).iter().map(|r| r.to_sec()).collect();
+    let [ax, ay, az] = s.acc.clone();
+    let [wx, wy, wz] = s.gyro.clone();
+    DataImu {
+        columns: [t, ax, ay, az, wx, wy, wz],
     }
-    d
 }
 
-/// The matrix of one Imu series, consuming it column by column so that the samples are
-/// never held twice in full (peak memory stays near the size of the matrix).
+/// The matrix of one Imu series, consuming it: the six value columns are moved, not copied,
+/// and only the time column is computed (peak memory stays near the size of the matrix).
+/// The values are bagconvert's row ([`bagconvert_row`]) column by column.
 pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
     let ImuSeries {
         record_time,
@@ -102,11 +105,8 @@ pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
     };
     let t: Vec<f64> = t_src.iter().map(|r| r.to_sec()).collect();
     drop(t_src);
-    let split = |v: Vec<[f64; 3]>| -> [Vec<f64>; 3] {
-        std::array::from_fn(|c| v.iter().map(|x| x[c]).collect())
-    };
-    let [ax, ay, az] = split(acc);
-    let [wx, wy, wz] = split(gyro);
+    let [ax, ay, az] = acc;
+    let [wx, wy, wz] = gyro;
     DataImu {
         columns: [t, ax, ay, az, wx, wy, wz],
     }
@@ -135,11 +135,42 @@ pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Conv
     })
 }
 
-/// Writes the matrix in `format` to `out`, atomically.
-pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
+/// The output path that means standard output.
+pub const STDOUT: &str = "-";
+
+/// The format an output name implies by its extension (`.mat`, `.csv`, `.npy`).
+pub fn format_of(path: &Path) -> Option<Format> {
+    let e = path.extension()?.to_string_lossy().to_ascii_lowercase();
+    [Format::Mat, Format::Csv, Format::Npy]
+        .into_iter()
+        .find(|f| f.extension() == e)
+}
+
+/// The format to write: `--format` when given, else the output's extension, else MAT. A
+/// `--format` that contradicts the output's extension is refused (the file would be
+/// misnamed), with the message for the user.
+pub fn resolve_format(given: Option<Format>, output: Option<&Path>) -> Result<Format, String> {
+    let implied = output
+        .filter(|o| *o != Path::new(STDOUT))
+        .and_then(format_of);
+    match (given, implied) {
+        (Some(g), Some(i)) if g != i => Err(format!(
+            "--format {} contradicts the output name {} (.{}); give one or make them agree",
+            g.extension(),
+            output.map(|o| o.display().to_string()).unwrap_or_default(),
+            i.extension()
+        )),
+        (Some(g), _) => Ok(g),
+        (None, Some(i)) => Ok(i),
+        (None, None) => Ok(Format::Mat),
+    }
+}
+
+/// The bytes of the matrix in `format`.
+pub fn encode(w: &mut dyn Write, data: &DataImu, format: Format) -> std::io::Result<()> {
     match format {
-        Format::Mat => mat::write_data_imu(out, data),
-        Format::Csv => write_atomic(out, |w| {
+        Format::Mat => mat::encode_data_imu(w, data),
+        Format::Csv => {
             writeln!(w, "t,ax,ay,az,wx,wy,wz")?;
             for i in 0..data.rows() {
                 let r = data.row(i);
@@ -150,8 +181,8 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
                 )?;
             }
             Ok(())
-        }),
-        Format::Npy => write_atomic(out, |w| {
+        }
+        Format::Npy => {
             let dict = format!(
                 "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {COLS}), }}",
                 data.rows()
@@ -176,8 +207,23 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
                 }
             }
             w.write_all(&buf)
-        }),
+        }
     }
+}
+
+/// Writes the matrix in `format` to `out` (atomically; `-` is standard output).
+pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
+    if format == Format::Mat {
+        mat::check_size(out, data)?;
+    }
+    if out == Path::new(STDOUT) {
+        let stdout = std::io::stdout();
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, stdout.lock());
+        return encode(&mut w, data, format)
+            .and_then(|_| w.flush())
+            .map_err(|e| Error::io("standard output", e));
+    }
+    write_atomic(out, |w| encode(w, data, format))
 }
 
 /// What the `bag2mat` conversion runs with.
@@ -244,7 +290,19 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
         ));
     }
     log("Reading in rosbag file...");
+    crate::shared::output::protect_input(&cfg.bag);
     let read = read_imu_topics(&cfg.bag, &cfg.topics, &ReadOptions { quiet: cfg.quiet })?;
+    if read.series.len() > 1 && cfg.output.as_deref() == Some(Path::new(STDOUT)) {
+        return Err(Error::Output {
+            path: PathBuf::from(STDOUT),
+            what: format!(
+                "{} topics cannot share standard output; name an output directory",
+                read.series.len()
+            ),
+        });
+    }
+    // Several topics: all files or none.
+    let staging = crate::shared::output::Staging::begin();
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let outs = output_paths(cfg, &names);
@@ -276,6 +334,7 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
         write(&out, &data, cfg.format)?;
         written.push((out, data.rows()));
     }
+    staging.commit()?;
     log("Done processing IMU data");
     Ok(written)
 }

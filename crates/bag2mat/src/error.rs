@@ -20,12 +20,20 @@ pub enum Error {
     /// An operating-system error on a path.
     // The cause is part of the message and deliberately not a `source`: anyhow's chained
     // output would print it twice.
-    #[error("{path}: {cause}")]
+    #[error("{}: {}", .path.display(), crate::shared::output::describe(.cause))]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
         cause: std::io::Error,
+    },
+    /// An output that must not be written (an input of the run, a directory, …).
+    #[error("{}: not written: {what}", .path.display())]
+    Output {
+        /// The output path as given.
+        path: PathBuf,
+        /// Why.
+        what: String,
     },
     /// The input is none of the accepted kinds (see [`crate::source::ACCEPTED`]).
     #[error("{path}: not a bag this tool reads: {what}")]
@@ -69,7 +77,10 @@ pub enum Error {
     },
     /// The topic exists but does not carry `sensor_msgs/Imu` (with the right md5 for ROS 1).
     #[error(
-        "topic '{topic}' carries {msg_type} [{md5sum}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
+        "topic '{}' carries {} [{}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
+        crate::shared::cli::escape(.topic),
+        crate::shared::cli::escape(.msg_type),
+        crate::shared::cli::escape(.md5sum),
         crate::imu_msg::MD5
     )]
     WrongType {
@@ -79,6 +90,21 @@ pub enum Error {
         msg_type: String,
         /// Its md5.
         md5sum: String,
+    },
+    /// The input holds no topic at all (empty, or cut short before any complete chunk).
+    #[error("{}", no_topics(.why))]
+    NoTopics {
+        /// What the reader found (truncation, damage).
+        why: Vec<String>,
+    },
+    /// A topic the user asked for yielded no row at all (every message lost or undecodable,
+    /// or none recorded): an error, never an empty matrix.
+    #[error("{}", nothing_read(.topic, .why))]
+    NothingRead {
+        /// The topic.
+        topic: String,
+        /// What the reader found (losses, notes).
+        why: Vec<String>,
     },
     /// A message's bytes do not decode as the expected type.
     #[error("bad message: {what}")]
@@ -104,6 +130,36 @@ pub enum Error {
     },
 }
 
+fn no_topics(why: &[String]) -> String {
+    if why.is_empty() {
+        return "the input holds no topic at all".to_string();
+    }
+    let mut s = "the input holds no readable topic:".to_string();
+    for w in why {
+        s.push_str("\n  ");
+        s.push_str(w);
+    }
+    s
+}
+
+fn nothing_read(topic: &str, why: &[String]) -> String {
+    if why.is_empty() {
+        return format!(
+            "topic '{}' holds no message",
+            crate::shared::cli::escape(topic)
+        );
+    }
+    let mut s = format!(
+        "no message of topic '{}' could be read:",
+        crate::shared::cli::escape(topic)
+    );
+    for w in why {
+        s.push_str("\n  ");
+        s.push_str(w);
+    }
+    s
+}
+
 fn no_imu_topic(available: &[TopicSummary]) -> String {
     let mut s = "no topic carries sensor_msgs/Imu".to_string();
     list_topics(&mut s, available);
@@ -111,7 +167,10 @@ fn no_imu_topic(available: &[TopicSummary]) -> String {
 }
 
 fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
-    let mut s = format!("no sensor_msgs/Imu topic '{topic}' in the bag");
+    let mut s = format!(
+        "no sensor_msgs/Imu topic '{}' in the bag",
+        crate::shared::cli::escape(topic)
+    );
     list_topics(&mut s, available);
     s
 }
@@ -122,9 +181,12 @@ fn list_topics(s: &mut String, available: &[TopicSummary]) {
     } else {
         s.push_str("; topics in the bag:");
         for t in available {
+            // Names come from the file: control bytes are escaped.
             s.push_str(&format!(
                 "\n  {:<30} {:>10} msgs : {}",
-                t.topic, t.count, t.msg_type
+                crate::shared::cli::escape(&t.topic),
+                t.count,
+                crate::shared::cli::escape(&t.msg_type)
             ));
         }
     }

@@ -12,8 +12,7 @@ use crate::error::Error;
 use crate::series::is_imu;
 use crate::source::{self, InputKind, Loss};
 
-/// An interval longer than this many median periods counts as a gap.
-pub const GAP_FACTOR: f64 = 3.0;
+pub use crate::timing::GAP_FACTOR;
 
 /// One topic (and type) of an input.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,19 +63,22 @@ fn stats(t: &mut [u64]) -> (Option<f64>, Option<f64>, Option<f64>, u64, Option<f
     }
     let span = (t[t.len() - 1] - t[0]) as f64 * 1e-9;
     let mean_rate = (span > 0.0).then(|| (t.len() - 1) as f64 / span);
-    let mut d: Vec<f64> = t.windows(2).map(|w| (w[1] - w[0]) as f64 * 1e-9).collect();
+    // Seconds from the first stamp: exact to the ns for any recording shorter than 100 days.
+    let secs: Vec<f64> = t.iter().map(|&x| (x - t[0]) as f64 * 1e-9).collect();
+    let d: Vec<f64> = secs.windows(2).map(|w| w[1] - w[0]).collect();
     let mean = d.iter().sum::<f64>() / d.len() as f64;
     let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / d.len() as f64;
     let jitter = (mean > 0.0).then(|| var.sqrt() / mean);
     let longest = d.iter().cloned().fold(0.0, f64::max);
-    d.sort_by(|a, b| a.total_cmp(b));
-    let median = d[d.len() / 2];
-    let gaps = if median > 0.0 {
-        d.iter().filter(|&&x| x > GAP_FACTOR * median).count() as u64
-    } else {
-        0
-    };
-    (mean_rate, Some(median), jitter, gaps, Some(longest))
+    // Gaps are found where the analysers find them.
+    let tm = crate::timing::analyse(&secs);
+    (
+        mean_rate,
+        tm.median_period,
+        jitter,
+        tm.gaps.len() as u64,
+        Some(longest),
+    )
 }
 
 /// Reads every message's record time of `path` and summarises each topic.
@@ -103,6 +105,7 @@ pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
                 what: format!("{}: {e}", parts[i].label),
                 messages: None,
                 span: parts[i].span,
+                channel: None,
             });
         }
         for (c, v) in m {
@@ -188,8 +191,8 @@ impl InfoReport {
             s.push_str(&format!(
                 "{} {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>10}\n",
                 if t.imu { "*" } else { " " },
-                t.topic,
-                t.msg_type,
+                crate::shared::cli::escape(&t.topic),
+                crate::shared::cli::escape(&t.msg_type),
                 t.encoding,
                 t.count,
                 opt(t.mean_rate, 3),

@@ -19,7 +19,8 @@
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`).
+//! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
+//!   constant-rate segments of a series of stamps (info and both analysers use it).
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
 //!
@@ -42,6 +43,7 @@ pub mod shared;
 pub mod source;
 #[doc(hidden)]
 pub mod test_tools;
+pub mod timing;
 pub mod zstd;
 
 pub use bag::{Compression, RosTime};

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use bag2mat::convert::{Config, Format, run};
+use bag2mat::convert::{Config, Format, resolve_format, run};
+use bag2mat::shared::cli;
 use bag2mat::{TimeColumn, TopicSelector};
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -30,17 +31,17 @@ struct Args {
     /// Every topic that carries sensor_msgs/Imu, each into its own folder.
     #[arg(long)]
     all_imu_topics: bool,
-    /// Output file for one topic; output directory for several [default: beside the bag,
-    /// <stem>.<format>, or <topic>/<stem>.<format> per topic].
+    /// Output file for one topic ("-": standard output); output directory for several
+    /// [default: beside the bag, <stem>.<format>, or <topic>/<stem>.<format> per topic].
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = FormatArg::Mat)]
-    format: FormatArg,
+    /// Output format [default: from the output's extension (.mat, .csv, .npy), else mat].
+    #[arg(long, value_enum)]
+    format: Option<FormatArg>,
     /// The time in column t: the record (receive) time, as bagconvert, or header.stamp.
     #[arg(long, value_enum, default_value_t = TimeArg::Record)]
     time: TimeArg,
-    /// No progress bar and no log lines.
+    /// Only errors and warnings: no progress bar, no log lines.
     #[arg(short, long)]
     quiet: bool,
 }
@@ -78,28 +79,48 @@ pub enum TimeArg {
     Header,
 }
 
+const TOOL: &str = "bag2mat";
+
 fn main() -> ExitCode {
-    let a = Args::parse();
+    let a = match Args::try_parse() {
+        Ok(a) => a,
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => return cli::usage(TOOL, &e.render().to_string()),
+    };
     let result = match a.command {
         Some(Command::Info { bag, quiet }) => bag2mat::info::info(&bag, quiet).map(|r| {
             print!("{}", r.text(&bag));
         }),
         None => {
             let Some(bag) = a.bag else {
-                eprintln!(
-                    "bag2mat: error: no input given (bag2mat BAG TOPIC, or bag2mat info BAG)"
+                return cli::usage(
+                    TOOL,
+                    "no input given (bag2mat BAG TOPIC, or bag2mat info BAG)",
                 );
-                return ExitCode::from(2);
             };
             let mut topics: Vec<String> = a.topic.into_iter().collect();
             topics.extend(a.topics);
             if topics.is_empty() && !a.all_imu_topics {
-                eprintln!(
-                    "bag2mat: error: name a topic (TOPIC, --topic) or pass --all-imu-topics; `bag2mat info {}` lists them",
-                    bag.display()
+                return cli::usage(
+                    TOOL,
+                    &format!(
+                        "name a topic (TOPIC, --topic) or pass --all-imu-topics; `bag2mat info {}` lists them",
+                        bag.display()
+                    ),
                 );
-                return ExitCode::from(2);
             }
+            let given = a.format.map(|f| match f {
+                FormatArg::Mat => Format::Mat,
+                FormatArg::Csv => Format::Csv,
+                FormatArg::Npy => Format::Npy,
+            });
+            let format = match resolve_format(given, a.output.as_deref()) {
+                Ok(f) => f,
+                Err(e) => return cli::usage(TOOL, &e),
+            };
             let cfg = Config {
                 bag,
                 topics: TopicSelector {
@@ -107,11 +128,7 @@ fn main() -> ExitCode {
                     all_imu: a.all_imu_topics,
                 },
                 output: a.output,
-                format: match a.format {
-                    FormatArg::Mat => Format::Mat,
-                    FormatArg::Csv => Format::Csv,
-                    FormatArg::Npy => Format::Npy,
-                },
+                format,
                 time: match a.time {
                     TimeArg::Record => TimeColumn::Record,
                     TimeArg::Header => TimeColumn::Header,
@@ -123,9 +140,6 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("bag2mat: error: {e}");
-            ExitCode::FAILURE
-        }
+        Err(e) => cli::fail(TOOL, &e),
     }
 }

@@ -68,15 +68,27 @@ impl DataImu {
 
 /// Writes `data` as the variable `data_imu` into a v5 MAT file, atomically.
 pub fn write_data_imu(path: &Path, data: &DataImu) -> Result<(), Error> {
+    check_size(path, data)?;
+    write_atomic(path, |w| encode_data_imu(w, data))
+}
+
+/// Fails when the matrix is too large for a MAT v5 variable.
+pub fn check_size(path: &Path, data: &DataImu) -> Result<(), Error> {
     let n = data.rows();
-    let real_bytes = 8 * (COLS as u64) * n as u64;
-    if 56 + real_bytes > MAX_MATRIX_BYTES {
+    if 56 + 8 * (COLS as u64) * n as u64 > MAX_MATRIX_BYTES {
         return Err(Error::Mat {
             path: path.to_path_buf(),
             what: format!("{n} rows exceed what a MAT v5 variable can hold (2 GB); split the bag"),
         });
     }
-    write_atomic(path, |w| {
+    Ok(())
+}
+
+/// The bytes of a v5 MAT file holding `data` as `data_imu` (see [`check_size`]).
+pub fn encode_data_imu(w: &mut dyn std::io::Write, data: &DataImu) -> std::io::Result<()> {
+    let n = data.rows();
+    let real_bytes = 8 * (COLS as u64) * n as u64;
+    {
         let mut header = [b' '; 128];
         let text = b"MATLAB 5.0 MAT-file, Platform: GLNXA64, Created by: bag2mat (kalibr_allan bagconvert layout)";
         header[..text.len()].copy_from_slice(text);
@@ -111,7 +123,7 @@ pub fn write_data_imu(path: &Path, data: &DataImu) -> Result<(), Error> {
             }
         }
         Ok(())
-    })
+    }
 }
 
 /// Reads the variable `data_imu` (N×7) from a Level-5 MAT file. The file is streamed: the

@@ -91,10 +91,10 @@ pub struct ImuSeries {
     pub stamp: Vec<RosTime>,
     /// `header.seq` of each message (0 for ROS 2, which has none).
     pub seq: Vec<u32>,
-    /// Linear acceleration `[x, y, z]`, m/s².
-    pub acc: Vec<[f64; 3]>,
-    /// Angular velocity `[x, y, z]`, rad/s.
-    pub gyro: Vec<[f64; 3]>,
+    /// Linear acceleration, one column per axis x, y, z, m/s².
+    pub acc: [Vec<f64>; 3],
+    /// Angular velocity, one column per axis x, y, z, rad/s.
+    pub gyro: [Vec<f64>; 3],
     /// Things the binary should tell the user on stderr (topic fallback, lost chunks, …).
     pub notes: Vec<String>,
     /// Promised against delivered.
@@ -110,6 +110,16 @@ impl ImuSeries {
     /// True when there are no samples.
     pub fn is_empty(&self) -> bool {
         self.record_time.is_empty()
+    }
+
+    /// Angular velocity `[x, y, z]` of sample `i`, rad/s.
+    pub fn gyro_at(&self, i: usize) -> [f64; 3] {
+        std::array::from_fn(|c| self.gyro[c][i])
+    }
+
+    /// Linear acceleration `[x, y, z]` of sample `i`, m/s².
+    pub fn acc_at(&self, i: usize) -> [f64; 3] {
+        std::array::from_fn(|c| self.acc[c][i])
     }
 
     /// The chosen time column.
@@ -217,6 +227,8 @@ struct Selected {
     msg_type: String,
     channels: Vec<(u32, Codec)>,
     note: Option<String>,
+    /// Named by the user (not only found by `all_imu`).
+    named: bool,
 }
 
 fn other_slash_form(topic: &str) -> String {
@@ -228,40 +240,85 @@ fn other_slash_form(topic: &str) -> String {
 
 fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error> {
     let chans = src.channels();
+    if chans.is_empty() {
+        // Say why there is nothing (truncated, damaged) rather than "no topics".
+        let mut why: Vec<String> = src.notes().to_vec();
+        why.extend(src.losses().iter().map(|l| l.to_string()));
+        return Err(Error::NoTopics { why });
+    }
     let on = |t: &str| chans.iter().filter(|c| c.topic == t).collect::<Vec<_>>();
     let mut out: Vec<Selected> = Vec::new();
-    let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note| {
+    let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note, named: bool| {
         if out.iter().any(|s| s.topic == topic) {
             return Ok(());
         }
         let mut channels = Vec::new();
+        let mut others: Vec<&Channel> = Vec::new();
         for c in &cs {
             match imu_codec(c) {
                 Some(k) => channels.push((c.id, k)),
-                None => {
-                    return Err(Error::WrongType {
-                        topic: topic.clone(),
-                        msg_type: c.msg_type.clone(),
-                        md5sum: c
-                            .md5sum
-                            .clone()
-                            .unwrap_or_else(|| format!("encoding {}", c.encoding.name())),
-                    });
-                }
+                None => others.push(c),
             }
         }
+        let Some(first_other) = others.first() else {
+            out.push(Selected {
+                topic,
+                msg_type: cs[0].msg_type.clone(),
+                channels,
+                note,
+                named,
+            });
+            return Ok(());
+        };
+        if channels.is_empty() {
+            return Err(Error::WrongType {
+                topic: topic.clone(),
+                msg_type: first_other.msg_type.clone(),
+                md5sum: first_other
+                    .md5sum
+                    .clone()
+                    .unwrap_or_else(|| format!("encoding {}", first_other.encoding.name())),
+            });
+        }
+        // Imu plus another type on one topic: the Imu connection is converted, as
+        // bagconvert's rosbag::View + instantiate<sensor_msgs::Imu>() skips the others.
+        let other_types: Vec<String> = others
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} ({} messages)",
+                    crate::shared::cli::escape(&c.msg_type),
+                    c.count.map_or("?".to_string(), |n| n.to_string())
+                )
+            })
+            .collect();
+        let mixed = format!(
+            "topic '{}' also carries {}; only its sensor_msgs/Imu connection is converted, as bagconvert does",
+            crate::shared::cli::escape(&topic),
+            other_types.join(", ")
+        );
+        let note = Some(match note {
+            Some(n) => format!("{n}; {mixed}"),
+            None => mixed,
+        });
+        let msg_type = cs
+            .iter()
+            .find(|c| is_imu(c))
+            .map(|c| c.msg_type.clone())
+            .unwrap_or_default();
         out.push(Selected {
             topic,
-            msg_type: cs[0].msg_type.clone(),
+            msg_type,
             channels,
             note,
+            named,
         });
         Ok(())
     };
     for t in &sel.topics {
         let cs = on(t);
         if !cs.is_empty() {
-            push(&mut out, t.clone(), cs, None)?;
+            push(&mut out, t.clone(), cs, None, true)?;
             continue;
         }
         let other = other_slash_form(t);
@@ -272,8 +329,12 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
                 available: topic_summaries(src),
             });
         }
-        let note = format!("topic '{t}' is not in the bag; using '{other}'");
-        push(&mut out, other, cs, Some(note))?;
+        let note = format!(
+            "topic '{}' is not in the bag; using '{}'",
+            crate::shared::cli::escape(t),
+            crate::shared::cli::escape(&other)
+        );
+        push(&mut out, other, cs, Some(note), true)?;
     }
     if sel.all_imu {
         let mut topics: Vec<&str> = chans
@@ -285,11 +346,8 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         topics.dedup();
         let before = out.len();
         for t in topics {
-            // A topic that mixes Imu with another type is not "an Imu topic".
-            let cs = on(t);
-            if cs.iter().all(|c| is_imu(c)) {
-                push(&mut out, t.to_string(), cs, None)?;
-            }
+            // A topic that mixes Imu with another type gives its Imu connection (with a note).
+            push(&mut out, t.to_string(), on(t), None, false)?;
         }
         if out.is_empty() && before == 0 {
             return Err(Error::NoImuTopic {
@@ -300,34 +358,131 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
     Ok(out)
 }
 
-/// One decoded message.
-#[derive(Clone, Copy)]
-struct Row {
-    t: u64,
-    s: ImuSample,
+/// The smallest payload a decodable `sensor_msgs/Imu` has (ROS 1: 16 header bytes and 37
+/// doubles; CDR: 4 encapsulation bytes, the stamp, an empty frame_id and 37 aligned doubles):
+/// a part of `bytes` bytes holds at most `bytes / MIN_IMU_PAYLOAD` rows, whatever its index
+/// says.
+pub const MIN_IMU_PAYLOAD: u64 = 16 + 37 * 8;
+
+/// Parts decoded at once when the container does not say how many rows each holds: their
+/// rows are buffered, then appended in order, so memory stays near the size of the result.
+const WINDOW_PARTS_PER_THREAD: usize = 4;
+
+/// The columns of one topic's rows.
+#[derive(Debug, Clone, Default)]
+struct Rows {
+    record_time: Vec<RosTime>,
+    stamp: Vec<RosTime>,
+    seq: Vec<u32>,
+    acc: [Vec<f64>; 3],
+    gyro: [Vec<f64>; 3],
 }
 
-/// What one part delivered, per selected topic: the messages written straight into its
-/// slice of the columns, and those beyond it (or all, without a promised count) as rows.
-struct PartOut {
-    written: Vec<usize>,
-    rows: Vec<Vec<Row>>,
-    bad: Vec<u64>,
-    first_bad: Vec<Option<String>>,
-    read: source::PartRead,
+impl Rows {
+    fn zeroed(n: usize) -> Rows {
+        Rows {
+            record_time: vec![RosTime::default(); n],
+            stamp: vec![RosTime::default(); n],
+            seq: vec![0; n],
+            acc: std::array::from_fn(|_| vec![0.0; n]),
+            gyro: std::array::from_fn(|_| vec![0.0; n]),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.record_time.len()
+    }
+
+    fn push(&mut self, t: u64, s: &ImuSample) {
+        self.record_time.push(RosTime::from_nanos(t));
+        self.stamp.push(s.stamp);
+        self.seq.push(s.seq);
+        for c in 0..3 {
+            self.acc[c].push(s.acc[c]);
+            self.gyro[c].push(s.gyro[c]);
+        }
+    }
+
+    /// Appends rows `..n` of `slot`.
+    fn extend_from(&mut self, slot: &RowsMut<'_>, n: usize) {
+        self.record_time.extend_from_slice(&slot.record_time[..n]);
+        self.stamp.extend_from_slice(&slot.stamp[..n]);
+        self.seq.extend_from_slice(&slot.seq[..n]);
+        for c in 0..3 {
+            self.acc[c].extend_from_slice(&slot.acc[c][..n]);
+            self.gyro[c].extend_from_slice(&slot.gyro[c][..n]);
+        }
+    }
+
+    fn append(&mut self, other: &Rows) {
+        self.record_time.extend_from_slice(&other.record_time);
+        self.stamp.extend_from_slice(&other.stamp);
+        self.seq.extend_from_slice(&other.seq);
+        for c in 0..3 {
+            self.acc[c].extend_from_slice(&other.acc[c]);
+            self.gyro[c].extend_from_slice(&other.gyro[c]);
+        }
+    }
+
+    /// One mutable slot per part, of the given lengths.
+    fn split(&mut self, sizes: &[usize]) -> Vec<RowsMut<'_>> {
+        let mut rt = split_rows(&mut self.record_time, sizes).into_iter();
+        let mut st = split_rows(&mut self.stamp, sizes).into_iter();
+        let mut sq = split_rows(&mut self.seq, sizes).into_iter();
+        let [a0, a1, a2] = &mut self.acc;
+        let [g0, g1, g2] = &mut self.gyro;
+        let mut cols: [std::vec::IntoIter<&mut [f64]>; 6] = [
+            split_rows(a0, sizes).into_iter(),
+            split_rows(a1, sizes).into_iter(),
+            split_rows(a2, sizes).into_iter(),
+            split_rows(g0, sizes).into_iter(),
+            split_rows(g1, sizes).into_iter(),
+            split_rows(g2, sizes).into_iter(),
+        ];
+        (0..sizes.len())
+            .map(|_| {
+                let mut col = |j: usize| cols[j].next().unwrap_or_default();
+                RowsMut {
+                    acc: [col(0), col(1), col(2)],
+                    gyro: [col(3), col(4), col(5)],
+                    record_time: rt.next().unwrap_or_default(),
+                    stamp: st.next().unwrap_or_default(),
+                    seq: sq.next().unwrap_or_default(),
+                }
+            })
+            .collect()
+    }
+
+    /// Sorts by record time (stable) when the storage order differs from it; true if it did.
+    fn sort_by_record_time(&mut self) -> bool {
+        if !self.record_time.windows(2).any(|w| w[1] < w[0]) {
+            return false;
+        }
+        let mut order: Vec<usize> = (0..self.len()).collect();
+        order.sort_by_key(|&i| self.record_time[i]);
+        self.record_time = permute(&self.record_time, &order);
+        self.stamp = permute(&self.stamp, &order);
+        self.seq = permute(&self.seq, &order);
+        for c in 0..3 {
+            self.acc[c] = permute(&self.acc[c], &order);
+            self.gyro[c] = permute(&self.gyro[c], &order);
+        }
+        true
+    }
 }
 
-/// One part's slice of one topic's columns.
-struct Slices<'a> {
+/// One part's rows of every column of one topic.
+#[derive(Default)]
+struct RowsMut<'a> {
     record_time: &'a mut [RosTime],
     stamp: &'a mut [RosTime],
     seq: &'a mut [u32],
-    acc: &'a mut [[f64; 3]],
-    gyro: &'a mut [[f64; 3]],
+    acc: [&'a mut [f64]; 3],
+    gyro: [&'a mut [f64]; 3],
 }
 
-impl Slices<'_> {
-    fn len(&self) -> usize {
+impl RowsMut<'_> {
+    fn cap(&self) -> usize {
         self.record_time.len()
     }
 
@@ -335,22 +490,47 @@ impl Slices<'_> {
         self.record_time[i] = RosTime::from_nanos(t);
         self.stamp[i] = s.stamp;
         self.seq[i] = s.seq;
-        self.acc[i] = s.acc;
-        self.gyro[i] = s.gyro;
+        for c in 0..3 {
+            self.acc[c][i] = s.acc[c];
+            self.gyro[c][i] = s.gyro[c];
+        }
     }
 }
 
-/// Splits a column into one slice per part, of the given lengths.
-fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
-    let mut rest = column;
-    sizes
-        .iter()
-        .map(|&k| {
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
-            rest = tail;
-            head
-        })
-        .collect()
+/// Where one part's rows of one topic go: its planned slot, then (past the plan) a buffer.
+#[derive(Default)]
+struct Target<'a> {
+    slot: RowsMut<'a>,
+    filled: usize,
+    overflow: Rows,
+}
+
+impl Target<'_> {
+    fn put(&mut self, t: u64, s: &ImuSample) {
+        if self.filled < self.slot.cap() {
+            self.slot.set(self.filled, t, s);
+            self.filled += 1;
+        } else {
+            self.overflow.push(t, s);
+        }
+    }
+
+    fn rows(&self) -> usize {
+        self.filled + self.overflow.len()
+    }
+
+    /// True when the part delivered exactly what its slot was sized for.
+    fn exact(&self) -> bool {
+        self.filled == self.slot.cap() && self.overflow.len() == 0
+    }
+}
+
+/// What one part delivered, per selected topic (the rows themselves are in the targets).
+struct PartOut {
+    rows: Vec<u64>,
+    bad: Vec<u64>,
+    first_bad: Vec<Option<String>>,
+    read: source::PartRead,
 }
 
 /// Reads the selected Imu topics of `path` (any accepted input) in one pass.
@@ -363,6 +543,158 @@ pub fn read_imu_topics(
     read_from(src.as_ref(), sel, opts)
 }
 
+/// How part `i` routes a selected channel's messages: channel id → (topic, codec).
+type Lookup = Vec<Option<(usize, Codec)>>;
+
+/// Reads part `i` into `targets` (one per selected topic).
+fn decode_part(
+    src: &dyn Source,
+    i: usize,
+    lookup: &Lookup,
+    targets: &mut [Target<'_>],
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> PartOut {
+    let n_sel = targets.len();
+    let mut bad = vec![0u64; n_sel];
+    let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
+    let want = |c: u32| lookup.get(c as usize).is_some_and(|x| x.is_some());
+    let read = src.read_part(i, &want, &mut |c, t, data| {
+        if let Some(Some((k, codec))) = lookup.get(c as usize) {
+            match decode(*codec, data) {
+                Ok(s) => targets[*k].put(t, &s),
+                Err(e) => {
+                    bad[*k] += 1;
+                    first_bad[*k].get_or_insert_with(|| e.to_string());
+                }
+            }
+        }
+    });
+    pb.inc(if per_part_unit { 1 } else { read.delivered });
+    PartOut {
+        rows: targets.iter().map(|t| t.rows() as u64).collect(),
+        bad,
+        first_bad,
+        read,
+    }
+}
+
+/// Decodes every part into one [`Rows`] per selected topic, in storage order.
+///
+/// When every part says how many messages of each topic it holds, the columns are allocated
+/// once and each part is decoded in parallel straight into its own rows (no copy). A part
+/// that holds more or fewer than it said is still read whole (its extra rows are buffered)
+/// and the columns are then rebuilt in order. Without counts, parts are decoded a window at
+/// a time and appended, so memory stays near the size of the result. Slots are sized by the
+/// counts bounded by what the part's bytes can hold ([`MIN_IMU_PAYLOAD`]).
+fn decode_all(
+    src: &dyn Source,
+    lookup: &Lookup,
+    selected: &[Selected],
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> (Vec<Rows>, Vec<PartOut>) {
+    let parts = src.parts();
+    let n_sel = selected.len();
+    let planned: Option<Vec<Vec<usize>>> = parts
+        .iter()
+        .map(|p| {
+            let counts = p.counts.as_ref()?;
+            let bound = p.bytes / MIN_IMU_PAYLOAD;
+            Some(
+                selected
+                    .iter()
+                    .map(|s| {
+                        let n: u64 = counts
+                            .iter()
+                            .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                            .map(|(_, n)| *n)
+                            .fold(0u64, |a, b| a.saturating_add(b));
+                        n.min(bound) as usize
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    match planned {
+        Some(plan) => {
+            let mut columns: Vec<Rows> = (0..n_sel)
+                .map(|k| Rows::zeroed(plan.iter().map(|p| p[k]).sum()))
+                .collect();
+            let outs: Vec<PartOut>;
+            let mut rebuilt: Option<Vec<Rows>> = None;
+            {
+                // slots[k][i]: topic k's rows of part i.
+                let mut slots: Vec<std::vec::IntoIter<RowsMut>> = columns
+                    .iter_mut()
+                    .enumerate()
+                    .map(|(k, c)| {
+                        let sizes: Vec<usize> = plan.iter().map(|p| p[k]).collect();
+                        c.split(&sizes).into_iter()
+                    })
+                    .collect();
+                let mut per_part: Vec<Vec<Target>> = (0..parts.len())
+                    .map(|_| {
+                        slots
+                            .iter_mut()
+                            .map(|it| Target {
+                                slot: it.next().unwrap_or_default(),
+                                ..Target::default()
+                            })
+                            .collect()
+                    })
+                    .collect();
+                outs = per_part
+                    .par_iter_mut()
+                    .enumerate()
+                    .map(|(i, targets)| decode_part(src, i, lookup, targets, pb, per_part_unit))
+                    .collect();
+                if per_part.iter().flatten().any(|t| !t.exact()) {
+                    // Some part disagreed with its count: gather the rows in order.
+                    let mut r: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+                    for targets in &per_part {
+                        for (k, t) in targets.iter().enumerate() {
+                            r[k].extend_from(&t.slot, t.filled);
+                            r[k].append(&t.overflow);
+                        }
+                    }
+                    rebuilt = Some(r);
+                }
+            }
+            if let Some(r) = rebuilt {
+                columns = r;
+            }
+            (columns, outs)
+        }
+        None => {
+            let mut columns: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+            let mut outs = Vec::with_capacity(parts.len());
+            let window = (rayon::current_num_threads() * WINDOW_PARTS_PER_THREAD).max(1);
+            let mut start = 0;
+            while start < parts.len() {
+                let end = (start + window).min(parts.len());
+                let done: Vec<(Vec<Target>, PartOut)> = (start..end)
+                    .into_par_iter()
+                    .map(|i| {
+                        let mut targets: Vec<Target> =
+                            (0..n_sel).map(|_| Target::default()).collect();
+                        let o = decode_part(src, i, lookup, &mut targets, pb, per_part_unit);
+                        (targets, o)
+                    })
+                    .collect();
+                for (targets, o) in done {
+                    for (k, t) in targets.iter().enumerate() {
+                        columns[k].append(&t.overflow);
+                    }
+                    outs.push(o);
+                }
+                start = end;
+            }
+            (columns, outs)
+        }
+    }
+}
+
 /// [`read_imu_topics`] on an open source.
 pub fn read_from(
     src: &dyn Source,
@@ -370,16 +702,14 @@ pub fn read_from(
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
     let selected = select(src, sel)?;
-    let n_sel = selected.len();
     // Channel id → (selected topic, codec); a dense table for the usual small ids.
     let max_id = src.channels().iter().map(|c| c.id).max().unwrap_or(0) as usize;
-    let mut lookup: Vec<Option<(usize, Codec)>> = vec![None; max_id + 1];
+    let mut lookup: Lookup = vec![None; max_id + 1];
     for (k, s) in selected.iter().enumerate() {
         for &(id, codec) in &s.channels {
             lookup[id as usize] = Some((k, codec));
         }
     }
-    let want = |c: u32| lookup.get(c as usize).is_some_and(|x| x.is_some());
     let promised_of = |ids: &[(u32, Codec)]| -> Option<u64> {
         ids.iter()
             .map(|(id, _)| src.channels().iter().find(|c| c.id == *id)?.count)
@@ -397,116 +727,31 @@ pub fn read_from(
         if per_part_unit { "parts" } else { "msgs" },
     );
     pb.set_message("reading");
-    // Each part's promised count of each topic. Where every part states one, the topic's
-    // columns are allocated once at their final size and each part decodes straight into
-    // its own slice of them: the read holds one copy of the data, not rows and columns.
-    let expect: Vec<Vec<Option<usize>>> = parts
-        .iter()
-        .map(|p| {
-            (0..n_sel)
-                .map(|k| {
-                    p.counts.as_ref().map(|v| {
-                        v.iter()
-                            .filter(|(c, _)| selected[k].channels.iter().any(|(id, _)| id == c))
-                            .map(|(_, n)| *n as usize)
-                            .sum()
-                    })
-                })
-                .collect()
-        })
-        .collect();
-    let direct: Vec<bool> = (0..n_sel)
-        .map(|k| expect.iter().all(|e| e[k].is_some()))
-        .collect();
-    let mut cols: Vec<ImuSeries> = (0..n_sel)
-        .map(|k| {
-            let n = if direct[k] {
-                expect.iter().map(|e| e[k].unwrap_or(0)).sum()
-            } else {
-                0
-            };
-            ImuSeries {
-                record_time: vec![RosTime::default(); n],
-                stamp: vec![RosTime::default(); n],
-                seq: vec![0; n],
-                acc: vec![[0.0; 3]; n],
-                gyro: vec![[0.0; 3]; n],
-                ..ImuSeries::default()
-            }
-        })
-        .collect();
-    let sizes: Vec<Vec<usize>> = (0..n_sel)
-        .map(|k| {
-            expect
-                .iter()
-                .map(|e| if direct[k] { e[k].unwrap_or(0) } else { 0 })
-                .collect()
-        })
-        .collect();
-    let mut dests: Vec<Vec<Slices>> = (0..parts.len())
-        .map(|_| Vec::with_capacity(n_sel))
-        .collect();
-    for (c, sz) in cols.iter_mut().zip(&sizes) {
-        let sl = split_rows(&mut c.record_time, sz)
-            .into_iter()
-            .zip(split_rows(&mut c.stamp, sz))
-            .zip(split_rows(&mut c.seq, sz))
-            .zip(split_rows(&mut c.acc, sz))
-            .zip(split_rows(&mut c.gyro, sz));
-        for (d, ((((record_time, stamp), seq), acc), gyro)) in dests.iter_mut().zip(sl) {
-            d.push(Slices {
-                record_time,
-                stamp,
-                seq,
-                acc,
-                gyro,
-            });
-        }
-    }
-    let outs: Vec<PartOut> = dests
-        .into_par_iter()
-        .enumerate()
-        .map(|(i, mut dst)| {
-            let mut written = vec![0usize; n_sel];
-            let mut rows: Vec<Vec<Row>> = vec![Vec::new(); n_sel];
-            let mut bad = vec![0u64; n_sel];
-            let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
-            let read = src.read_part(i, &want, &mut |c, t, data| {
-                if let Some(Some((k, codec))) = lookup.get(c as usize) {
-                    match decode(*codec, data) {
-                        Ok(s) if written[*k] < dst[*k].len() => {
-                            dst[*k].set(written[*k], t, &s);
-                            written[*k] += 1;
-                        }
-                        Ok(s) => rows[*k].push(Row { t, s }),
-                        Err(e) => {
-                            bad[*k] += 1;
-                            first_bad[*k].get_or_insert_with(|| e.to_string());
-                        }
-                    }
-                }
-            });
-            pb.inc(if per_part_unit { 1 } else { read.delivered });
-            PartOut {
-                written,
-                rows,
-                bad,
-                first_bad,
-                read,
-            }
-        })
-        .collect();
+    let (columns, outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
     pb.finish_and_clear();
 
+    let n_sel = selected.len();
     let mut series = Vec::with_capacity(n_sel);
-    for ((k, s), cols_k) in selected.into_iter().enumerate().zip(cols) {
-        let got_of: Vec<u64> = outs
-            .iter()
-            .map(|o| (o.written[k] + o.rows[k].len()) as u64)
-            .collect();
-        let mut out = assemble(cols_k, &sizes[k], &outs, k);
-        out.topic = s.topic.clone();
-        out.msg_type = s.msg_type.clone();
+    let mut dropped: Vec<String> = Vec::new();
+    for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
+        let sorted = rows.sort_by_record_time();
+        let Rows {
+            record_time,
+            stamp,
+            seq,
+            acc,
+            gyro,
+        } = rows;
+        let mut out = ImuSeries {
+            topic: s.topic.clone(),
+            msg_type: s.msg_type.clone(),
+            record_time,
+            stamp,
+            seq,
+            acc,
+            gyro,
+            ..ImuSeries::default()
+        };
         let r = &mut out.report;
         r.promised = promised[k];
         r.delivered = out.record_time.len() as u64;
@@ -516,31 +761,45 @@ pub fn read_from(
                 r.first_error = o.first_bad[k].clone();
             }
         }
+        let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
         for (i, o) in outs.iter().enumerate() {
             let p = &parts[i];
             let mine: Option<u64> = p.counts.as_ref().map(|v| {
                 v.iter()
-                    .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                    .filter(|(c, _)| mine_ch(c))
                     .map(|(_, n)| *n)
-                    .sum()
+                    .fold(0u64, |a, b| a.saturating_add(b))
             });
-            let got = got_of[i] + o.bad[k];
+            let got = o.rows[k] + o.bad[k];
+            // What the part itself found lost on this topic (or on no particular channel).
+            let mut known = 0u64;
+            for l in &o.read.lost {
+                match l.channel {
+                    Some(c) if mine_ch(&c) => {
+                        known += l.messages.unwrap_or(0);
+                        r.losses.push(l.clone());
+                    }
+                    None if mine != Some(0) => r.losses.push(l.clone()),
+                    _ => {}
+                }
+            }
             let reason = match (&o.read.error, o.read.skipped) {
                 (Some(e), _) => Some(e.clone()),
                 (None, n) if n > 0 => o.read.skip_reason.clone(),
                 _ => None,
             };
-            let short = mine.is_some_and(|m| got < m);
+            let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
             if let Some(reason) = reason {
                 if mine == Some(0) {
                     continue;
                 }
                 r.losses.push(Loss {
                     what: format!("{}: {reason}", p.label),
-                    messages: mine.map(|m| m.saturating_sub(got)),
+                    messages: rest,
                     span: p.span,
+                    channel: None,
                 });
-            } else if short {
+            } else if rest.is_some_and(|n| n > 0) {
                 r.losses.push(Loss {
                     what: format!(
                         "{} holds {got} messages of '{}', its index says {}",
@@ -548,8 +807,9 @@ pub fn read_from(
                         s.topic,
                         mine.unwrap_or(0)
                     ),
-                    messages: mine.map(|m| m - got),
+                    messages: rest,
                     span: p.span,
+                    channel: None,
                 });
             }
         }
@@ -557,11 +817,22 @@ pub fn read_from(
         notes.extend(src.losses().iter().map(|l| l.to_string()));
         notes.extend(s.note.iter().cloned());
         notes.extend(r.losses.iter().map(|l| l.to_string()));
+        // Whatever the parts said, the container's own promise is checked as a whole.
         let lost: u64 = r.losses.iter().filter_map(|l| l.messages).sum();
-        if lost > 0 {
+        let missing = r
+            .promised
+            .map(|p| p.saturating_sub(r.delivered + r.undecodable))
+            .unwrap_or(lost);
+        if missing > 0 {
             notes.push(format!(
-                "{lost} of {} messages were lost to unreadable chunks",
-                r.promised.unwrap_or(r.delivered + lost)
+                "{missing} of {} messages on '{}' were lost{}",
+                r.promised.unwrap_or(r.delivered + missing),
+                s.topic,
+                if r.losses.is_empty() && src.losses().is_empty() {
+                    " (the container promises them; none of its parts could say where)"
+                } else {
+                    " (see above)"
+                }
             ));
         }
         if r.undecodable > 0 {
@@ -572,11 +843,29 @@ pub fn read_from(
                 r.first_error.as_deref().unwrap_or("?")
             ));
         }
-        if out.notes.iter().any(|n| n == SORTED_NOTE) {
+        if sorted {
             notes.push(SORTED_NOTE.to_string());
         }
         out.notes = notes;
+        if out.is_empty() {
+            // Nothing to convert is an error for a topic the user named; an Imu topic that
+            // --all-imu-topics found empty is left out, and said so.
+            if s.named || series.is_empty() && k + 1 == n_sel && dropped.len() + 1 == n_sel {
+                return Err(Error::NothingRead {
+                    topic: s.topic.clone(),
+                    why: out.notes.clone(),
+                });
+            }
+            dropped.push(format!(
+                "Imu topic '{}' holds no readable message and was left out",
+                s.topic
+            ));
+            continue;
+        }
         series.push(out);
+    }
+    for s in series.iter_mut() {
+        s.notes.extend(dropped.iter().cloned());
     }
     let read_ids: std::collections::BTreeSet<u32> = lookup
         .iter()
@@ -608,59 +897,17 @@ pub fn read_from(
 const SORTED_NOTE: &str =
     "messages were not stored in record-time order; sorted as rosbag::View does";
 
-/// Topic `k`'s columns: `cols` as the parts filled their slices (of `sizes`), when each
-/// delivered exactly what it promised; otherwise (no promise, fewer or more messages) the
-/// parts' slices and rows gathered in part order. Then sorted by record time when the
-/// storage order differs from it.
-fn assemble(cols: ImuSeries, sizes: &[usize], outs: &[PartOut], k: usize) -> ImuSeries {
-    let exact = outs
+/// Splits a column into one slice per part, of the given lengths.
+fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
+    let mut rest = column;
+    sizes
         .iter()
-        .zip(sizes)
-        .all(|(o, &n)| o.written[k] == n && o.rows[k].is_empty());
-    let mut s = if exact {
-        cols
-    } else {
-        let n: usize = outs.iter().map(|o| o.written[k] + o.rows[k].len()).sum();
-        let mut s = ImuSeries {
-            record_time: Vec::with_capacity(n),
-            stamp: Vec::with_capacity(n),
-            seq: Vec::with_capacity(n),
-            acc: Vec::with_capacity(n),
-            gyro: Vec::with_capacity(n),
-            ..ImuSeries::default()
-        };
-        let mut off = 0;
-        for (o, &size) in outs.iter().zip(sizes) {
-            let r = off..off + o.written[k];
-            s.record_time
-                .extend_from_slice(&cols.record_time[r.clone()]);
-            s.stamp.extend_from_slice(&cols.stamp[r.clone()]);
-            s.seq.extend_from_slice(&cols.seq[r.clone()]);
-            s.acc.extend_from_slice(&cols.acc[r.clone()]);
-            s.gyro.extend_from_slice(&cols.gyro[r]);
-            let rows = &o.rows[k];
-            s.record_time
-                .extend(rows.iter().map(|r| RosTime::from_nanos(r.t)));
-            s.stamp.extend(rows.iter().map(|r| r.s.stamp));
-            s.seq.extend(rows.iter().map(|r| r.s.seq));
-            s.acc.extend(rows.iter().map(|r| r.s.acc));
-            s.gyro.extend(rows.iter().map(|r| r.s.gyro));
-            off += size;
-        }
-        s
-    };
-    if s.record_time.windows(2).any(|w| w[1] < w[0]) {
-        let n = s.record_time.len();
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by_key(|&i| s.record_time[i]);
-        s.record_time = permute(&s.record_time, &order);
-        s.stamp = permute(&s.stamp, &order);
-        s.seq = permute(&s.seq, &order);
-        s.acc = permute(&s.acc, &order);
-        s.gyro = permute(&s.gyro, &order);
-        s.notes.push(SORTED_NOTE.to_string());
-    }
-    s
+        .map(|&k| {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            rest = tail;
+            head
+        })
+        .collect()
 }
 
 /// A folder name for each topic, for tools that write one output folder per topic: the
@@ -710,82 +957,6 @@ pub fn permute<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn sample(i: u32) -> ImuSample {
-        ImuSample {
-            seq: i,
-            stamp: RosTime::from_nanos(1000 * i as u64),
-            gyro: [i as f64; 3],
-            acc: [-(i as f64); 3],
-        }
-    }
-
-    fn part(written: usize, rows: Vec<Row>) -> PartOut {
-        PartOut {
-            written: vec![written],
-            rows: vec![rows],
-            bad: vec![0],
-            first_bad: vec![None],
-            read: source::PartRead::default(),
-        }
-    }
-
-    /// Columns as the parts filled them: three parts promised 2 + 2 + 2 messages; the first
-    /// delivered them, the second one short, the third one more (a row).
-    fn filled() -> (ImuSeries, Vec<usize>) {
-        let mut s = ImuSeries {
-            record_time: vec![RosTime::default(); 6],
-            stamp: vec![RosTime::default(); 6],
-            seq: vec![0; 6],
-            acc: vec![[0.0; 3]; 6],
-            gyro: vec![[0.0; 3]; 6],
-            ..ImuSeries::default()
-        };
-        for (slot, i) in [(0usize, 0u32), (1, 1), (2, 2), (4, 3), (5, 4)] {
-            s.record_time[slot] = RosTime::from_nanos(10 * i as u64);
-            s.stamp[slot] = sample(i).stamp;
-            s.seq[slot] = i;
-            s.acc[slot] = sample(i).acc;
-            s.gyro[slot] = sample(i).gyro;
-        }
-        (s, vec![2, 2, 2])
-    }
-
-    #[test]
-    fn assemble_keeps_exact_parts_and_gathers_the_rest_in_part_order() {
-        // every part as promised: the columns as they are (the same buffers)
-        let (mut cols, sizes) = filled();
-        cols.record_time[3] = RosTime::from_nanos(25);
-        cols.seq[3] = 9;
-        let before = cols.seq.as_ptr();
-        let exact = [part(2, vec![]), part(2, vec![]), part(2, vec![])];
-        let got = assemble(cols, &sizes, &exact, 0);
-        assert_eq!(got.seq, vec![0, 1, 2, 9, 3, 4]);
-        assert_eq!(got.seq.as_ptr(), before, "no copy");
-        let (cols, sizes) = filled();
-        // a short part and a part with one more: its slice, then its row, in part order
-        let uneven = [
-            part(2, vec![]),
-            part(1, vec![]),
-            part(
-                2,
-                vec![Row {
-                    t: 50,
-                    s: sample(5),
-                }],
-            ),
-        ];
-        let got = assemble(cols, &sizes, &uneven, 0);
-        assert_eq!(got.seq, vec![0, 1, 2, 3, 4, 5]);
-        assert_eq!(
-            got.record_time,
-            (0..6)
-                .map(|i| RosTime::from_nanos(10 * i))
-                .collect::<Vec<_>>()
-        );
-        assert_eq!(got.acc[5], [-5.0; 3]);
-        assert!(got.notes.is_empty(), "already in record-time order");
-    }
 
     #[test]
     fn folder_names_are_unique_and_flat() {

@@ -110,7 +110,16 @@ pub struct Part {
     pub span: Option<(u64, u64)>,
     /// Messages per channel the container promises in it, if it says.
     pub counts: Option<Vec<(u32, u64)>>,
+    /// An upper bound of the bytes its records take once decompressed, backed by bytes in
+    /// the file: what a reader may size buffers by (a damaged count never sizes memory).
+    pub bytes: u64,
 }
+
+/// The largest decompressed/stored size ratio a part's byte bound assumes for compressed
+/// data whose decompressed size is not backed by the file: IMU records (noisy doubles)
+/// compress by less than 4×; a part that expands more is still read whole, it only costs a
+/// buffer instead of a preallocated slot.
+pub const MAX_EXPANSION: u64 = 64;
 
 /// Data that the container held or promised and that cannot be delivered.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -121,13 +130,27 @@ pub struct Loss {
     pub messages: Option<u64>,
     /// Record-time span (ns) of the lost data, when known.
     pub span: Option<(u64, u64)>,
+    /// The channel the lost messages belong to, when known.
+    pub channel: Option<u32>,
+}
+
+impl Loss {
+    /// A loss of unknown size, on no particular channel.
+    pub fn new(what: impl Into<String>) -> Loss {
+        Loss {
+            what: what.into(),
+            messages: None,
+            span: None,
+            channel: None,
+        }
+    }
 }
 
 impl std::fmt::Display for Loss {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.what)?;
         if let Some(n) = self.messages {
-            write!(f, "; {n} messages lost")?;
+            write!(f, "; {n} message{} lost", if n == 1 { "" } else { "s" })?;
         }
         if let Some((a, b)) = self.span {
             write!(
@@ -153,6 +176,9 @@ pub struct PartRead {
     pub skipped: u64,
     /// Why the first skipped message was skipped.
     pub skip_reason: Option<String>,
+    /// Messages the part's own index promises that could not be delivered (damaged record
+    /// headers, a resynchronised stretch), with their channel, count and time span.
+    pub lost: Vec<Loss>,
 }
 
 /// The callback of [`Source::read_part`]: `(channel id, record time in ns, payload)`.

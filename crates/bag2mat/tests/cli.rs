@@ -77,7 +77,7 @@ fn bad_inputs_fail_cleanly() {
                 dir.path().join("missing.bag").display().to_string(),
                 "imu".into(),
             ],
-            "No such file",
+            "no such file",
         ),
         (
             vec![junk.display().to_string(), "imu".into()],

@@ -3,6 +3,7 @@
 //! what we write, and the command line as a user runs it.
 
 mod cli;
+mod defects;
 mod real_tools;
 mod reference;
 mod ros2;

@@ -278,7 +278,7 @@ fn our_mcap_and_sqlite3_read_back_exactly_in_rosbags_and_mcap() {
     let s = bag2mat::read_imu_series(&ros1, "imu", &ReadOptions { quiet: true }).unwrap();
     let want: Vec<String> = (0..s.len())
         .map(|i| {
-            let (w, a) = (s.gyro[i], s.acc[i]);
+            let (w, a) = (s.gyro_at(i), s.acc_at(i));
             format!(
                 "{} {} base_link {:?} {:?} {:?} {:?} {:?} {:?}",
                 s.record_time[i].as_nanos(),

@@ -94,7 +94,13 @@ fn write_then_read_every_compression() {
             let (t, imu) = synthetic(i);
             let k = i as usize;
             assert_eq!(
-                (s.record_time[k], s.stamp[k], s.seq[k], s.gyro[k], s.acc[k]),
+                (
+                    s.record_time[k],
+                    s.stamp[k],
+                    s.seq[k],
+                    s.gyro_at(k),
+                    s.acc_at(k)
+                ),
                 (
                     t,
                     imu.stamp,

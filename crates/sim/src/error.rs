@@ -20,12 +20,13 @@ pub enum SimError {
         msg: String,
     },
     /// Reading or writing a file failed.
-    #[error("{path}: {source}")]
+    // The cause is part of the message, not a `source`: it is printed once.
+    #[error("{}: {}", .path.display(), bag2mat::shared::output::describe(.cause))]
     Io {
         /// The file.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The spline cannot be built from the given poses.
     #[error("spline: {0}")]
@@ -59,10 +60,10 @@ pub type Result<T> = std::result::Result<T, SimError>;
 
 impl SimError {
     /// An I/O error with its path.
-    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+    pub fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Self {
         SimError::Io {
             path: path.into(),
-            source,
+            cause,
         }
     }
 }

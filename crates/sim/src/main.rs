@@ -1,17 +1,32 @@
 //! `sim` binary: parse the command line, run the library, report errors once.
 
-use anyhow::Context;
 use clap::Parser;
 use sim::cli::{Cli, Command};
 use std::process::ExitCode;
 
+const TOOL: &str = "sim";
+
 fn main() -> ExitCode {
-    match run(Cli::parse()) {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("sim: error: {e:#}");
-            ExitCode::FAILURE
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
         }
+        Err(e) => return bag2mat::shared::cli::usage(TOOL, &e.render().to_string()),
+    };
+    match run(cli) {
+        Ok(code) => code,
+        // What the user typed cannot be run: a usage error (exit 2).
+        Err(e)
+            if matches!(
+                e.downcast_ref::<sim::error::SimError>(),
+                Some(sim::error::SimError::InvalidArgument(_))
+            ) =>
+        {
+            bag2mat::shared::cli::usage(TOOL, &format!("{e:#}"))
+        }
+        Err(e) => bag2mat::shared::cli::fail(TOOL, &format!("{e:#}")),
     }
 }
 
@@ -19,15 +34,22 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Bag(a) => {
             let cfg = sim::bag_sim::BagConfig::try_from(*a)?;
+            // Refused before any work when it cannot fit; its size said up front.
+            sim::bag_sim::validate(&cfg)?;
+            sim::bag_sim::check_disk(&cfg)?;
             if !cfg.quiet {
+                eprintln!(
+                    "writing about {} messages, about {:.1} MB",
+                    sim::bag_sim::estimated_messages(&cfg),
+                    sim::bag_sim::estimated_bytes(&cfg) as f64 * 1e-6
+                );
                 eprintln!("{}", sim::report::bag_header(&cfg));
                 let n = sim::bag_sim::message_count(cfg.rate, cfg.duration) as usize;
                 for w in sim::noise::truth_file::widrow_warnings(&cfg.model, cfg.rate, n)? {
                     eprintln!("warning: {w}");
                 }
             }
-            let s = sim::bag_sim::run(&cfg)
-                .with_context(|| format!("writing {}", cfg.out.display()))?;
+            let s = sim::bag_sim::run(&cfg)?;
             if !cfg.quiet {
                 eprintln!("{}", sim::report::bag_done(&cfg, &s));
             }
@@ -35,8 +57,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Traj(a) => {
             let cfg = sim::traj::TrajConfig::try_from(a)?;
             eprintln!("{}", cfg.noise.describe(cfg.rate));
-            let s = sim::traj::run(&cfg)
-                .with_context(|| format!("writing into {}", cfg.out_dir.display()))?;
+            let s = sim::traj::run(&cfg)?;
             eprintln!(
                 "wrote {} files into {} ({} IMU samples, {} camera frames, {} landmarks)",
                 s.files,

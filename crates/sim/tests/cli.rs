@@ -91,8 +91,8 @@ fn default_bag_content_matches_the_seed_run() {
     for i in 0..s.acc.len() {
         let (mut w, mut a) = ([0.0; 3], [0.0, 0.0, 9.81]);
         g.apply(&mut w, &mut a);
-        assert_eq!(s.gyro[i], w, "gyro of message {i}");
-        assert_eq!(s.acc[i], a, "acc of message {i}");
+        assert_eq!(s.gyro_at(i), w, "gyro of message {i}");
+        assert_eq!(s.acc_at(i), a, "acc of message {i}");
         let expected = start_ns + (t * 1e9).round() as u64;
         assert_eq!(s.stamp[i].as_nanos(), expected, "stamp of message {i}");
         assert_eq!(
@@ -272,4 +272,128 @@ fn spline_self_check_passes_and_from_model_writes_bag_and_text() {
     );
     assert!(out.contains("knots: 4001"), "{out}");
     assert!(d.path().join("u/x.bag").exists() && d.path().join("u/imu_pose.txt").exists());
+}
+
+#[test]
+fn defect_12_time_range_and_size_are_checked_up_front() {
+    let d = tempfile::tempdir().unwrap();
+    // The last stamp would pass 2^32 s (and saturate, jumping back): refused, exit 2.
+    let out = crate::util::sim()
+        .current_dir(d.path())
+        .args([
+            "bag",
+            "-o",
+            "a.bag",
+            "--start-time",
+            "4294967294",
+            "--duration",
+            "2",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("32-bit ROS time"), "{err}");
+    assert!(!d.path().join("a.bag").exists());
+    // A job larger than the disk is refused before any work, with its size.
+    let t = std::time::Instant::now();
+    let out = crate::util::sim()
+        .current_dir(d.path())
+        .args([
+            "bag",
+            "-o",
+            "b.bag",
+            "--rate",
+            "1e7",
+            "--duration",
+            "1e6",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("GB") && err.contains("free"), "{err}");
+    assert!(t.elapsed().as_secs() < 30, "not refused up front");
+    // A normal job states its size.
+    let (_, err) = ok(d.path(), &["bag", "-o", "c.bag", "--duration", "2"]);
+    assert!(err.contains("about 401 messages, about"), "{err}");
+}
+
+#[test]
+fn defect_14_one_error_convention() {
+    let d = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], i32, &str); 4] = [
+        (
+            &["bag", "--no-such-flag"],
+            2,
+            "sim: error: unexpected argument",
+        ),
+        (
+            &["bag", "-o", "x.bag", "--rate", "-1", "-q"],
+            2,
+            "sim: error: invalid argument: --rate must be a positive",
+        ),
+        (
+            &["bag", "-o", "no/such/dir/x.bag", "--duration", "1", "-q"],
+            1,
+            "sim: error: no/such/dir/x.bag: no such file or directory",
+        ),
+        (&[], 2, "sim: error: "),
+    ];
+    for (args, code, start) in cases {
+        let out = crate::util::sim()
+            .current_dir(d.path())
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.starts_with(start), "{args:?}: {err}");
+        assert_eq!(
+            err.matches("error:").count(),
+            1,
+            "{args:?}: printed more than once: {err}"
+        );
+        assert!(!err.contains("os error"), "{err}");
+    }
+}
+
+/// Hidden temporary entries in `dir`.
+fn temps(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') && n.contains(".tmp"))
+        .collect()
+}
+
+#[test]
+fn defect_08_sigterm_and_sigint_remove_temp_files() {
+    let d = tempfile::tempdir().unwrap();
+    for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGINT, 130)] {
+        let mut child = crate::util::sim()
+            .current_dir(d.path())
+            .args(["bag", "-o", "long.bag", "--duration", "36000", "-q"])
+            .spawn()
+            .unwrap();
+        // Wait until the temporary bag is being written.
+        let t = std::time::Instant::now();
+        while temps(d.path()).is_empty() {
+            assert!(t.elapsed().as_secs() < 60, "no temporary file appeared");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        // SAFETY: signalling our own child by its id.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, sig) }, 0);
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "signal {sig}");
+        assert_eq!(
+            temps(d.path()),
+            Vec::<String>::new(),
+            "signal {sig}: temp left"
+        );
+        assert!(!d.path().join("long.bag").exists());
+    }
 }

@@ -80,8 +80,8 @@ print(t['model']['accelerometer']['axes']['z']['white_noise'])
     // And the data are quantised to the profile's LSB.
     let s = read_imu_series(&d.path().join("a.bag"), "imu", &ReadOptions { quiet: true }).unwrap();
     let lsb = std::f64::consts::PI / 180.0 / 16.384;
-    for g in &s.gyro[..100] {
-        for v in g {
+    for axis in &s.gyro {
+        for v in &axis[..100] {
             assert!(
                 (v / lsb - (v / lsb).round()).abs() < 1e-6,
                 "{v} not a multiple of the LSB"

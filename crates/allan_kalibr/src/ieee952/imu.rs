@@ -12,11 +12,12 @@ use std::fmt::Write as _;
 use rayon::prelude::*;
 
 use super::advisor::{self, Advice};
-use super::stationarity::{self, StartStats, Timing, Warmup};
+use super::stationarity::{self, StartStats, Warmup};
 use super::{
     Analysis, AxisVerdict, Config, CovBasis, CurveData, Ieee952Error, Term, Verdict, analyse_curve,
     short,
 };
+use bag2mat::timing::Timing;
 
 /// τ/T_lo from which a flicker floor with lower corner T_lo is within 2 % of 0.664·B in
 /// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
@@ -165,7 +166,7 @@ pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: 
         let model = move |tau: f64| f.predict(tau).max(0.0);
         ax.warmup = stationarity::warmup(st, &model);
     }
-    an.timing = t.map(stationarity::timing);
+    an.timing = t.map(bag2mat::timing::analyse);
 }
 
 /// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
@@ -496,43 +497,47 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
     s
 }
 
-/// The time-stamp findings.
+/// The time-stamp findings (`bag2mat::timing`): gaps the analysers kept (too small to cut
+/// the record at) and rate changes, listed at most [`MAX_LISTED`] each.
 pub fn timing_text(t: &Timing) -> String {
     let mut s = String::new();
-    if t.gap_count > 0 {
-        let list: Vec<String> = t
-            .gaps
+    let Some(period) = t.median_period.filter(|p| *p > 0.0) else {
+        return s;
+    };
+    if !t.gaps.is_empty() {
+        let mut longest: Vec<_> = t.gaps.iter().collect();
+        longest.sort_by(|a, b| b.length.total_cmp(&a.length));
+        longest.truncate(MAX_LISTED);
+        let list: Vec<String> = longest
             .iter()
-            .map(|g| format!("{} s at {}", short(g.length), advisor::duration_text(g.at)))
+            .map(|g| format!("{} s after sample {}", short(g.length), g.after))
             .collect();
         let _ = writeln!(
             s,
             "WARNING: {} gap(s) in the time stamps (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
-            t.gap_count,
-            t.missing,
+            t.gaps.len(),
+            t.gap_time() / period,
             list.join(", ")
         );
     }
-    if t.non_advancing > 0 {
-        let _ = writeln!(
-            s,
-            "WARNING: {} time step(s) do not advance (duplicated or out-of-order stamps)",
-            t.non_advancing
-        );
-    }
-    if t.rate_change_count > 0 {
+    if !t.rate_changes.is_empty() {
         let list: Vec<String> = t
             .rate_changes
             .iter()
-            .map(|r| format!("{:.2} Hz from {}", r.rate, advisor::duration_text(r.at)))
+            .take(MAX_LISTED)
+            .map(|i| format!("sample {i}"))
             .collect();
         let _ = writeln!(
             s,
-            "WARNING: the sample rate changes ({} stretch(es) off the median {:.3} Hz by > 1 %: {})",
-            t.rate_change_count,
-            1.0 / t.median_step,
+            "WARNING: the sample rate changes ({} change(s) off the median {:.3} Hz by > {:.0} %, at {})",
+            t.rate_changes.len(),
+            1.0 / period,
+            100.0 * bag2mat::timing::RATE_CHANGE_REL,
             list.join(", ")
         );
     }
     s
 }
+
+/// Gaps and rate changes listed at most (the counts are always given).
+pub const MAX_LISTED: usize = 5;

@@ -10,136 +10,14 @@
 //!   smaller of the model's and the second half's own (measured on its window means,
 //!   extrapolated as a random walk). A first window beyond [`WARMUP_Z`] of that is
 //!   reported, with its size and how long the excess lasts; `--skip-start` drops it.
-//! * **Gaps and rate changes** ([`timing`]): steps of the time stamps longer than
-//!   [`GAP_FACTOR`] times the median step of their block, and blocks of samples whose median
-//!   step differs from the record's by more than [`RATE_CHANGE_REL`]. The Allan estimators treat samples as
-//!   uniformly spaced; both distort the short-τ end.
+//!
+//! Gaps and rate changes are found by `bag2mat::timing`, the workspace's one place for them
+//! (the section reports what it found; the analysers cut a broken record before).
 
 /// A window whose mean is this many standard deviations from the rest is not noise.
 pub const WARMUP_Z: f64 = 5.0;
 /// The excess lasts while windows stay beyond this many standard deviations.
 pub const WARMUP_END_Z: f64 = 3.0;
-/// A time step longer than this many median steps is a gap.
-pub const GAP_FACTOR: f64 = 1.5;
-/// A block's mean step off the median by more than this fraction is a rate change.
-pub const RATE_CHANGE_REL: f64 = 0.01;
-/// Samples per block for the rate check.
-const RATE_BLOCK: usize = 2000;
-/// Gaps and rate changes listed at most (the counts are always given).
-pub const MAX_LISTED: usize = 5;
-
-/// A gap in the time stamps.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Gap {
-    /// Time since the first sample, s.
-    pub at: f64,
-    /// Length of the step, s.
-    pub length: f64,
-}
-
-/// A stretch sampled at another rate.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RateChange {
-    /// Time since the first sample, s.
-    pub at: f64,
-    /// The rate there, Hz.
-    pub rate: f64,
-}
-
-/// What the time stamps show.
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct Timing {
-    /// Median step, s.
-    pub median_step: f64,
-    /// Number of gaps.
-    pub gap_count: usize,
-    /// The longest gaps (at most [`MAX_LISTED`]), in time order.
-    pub gaps: Vec<Gap>,
-    /// Samples missing in the gaps (≈ Σ step/median − 1).
-    pub missing: f64,
-    /// Steps that do not advance (≤ 0).
-    pub non_advancing: usize,
-    /// Blocks at another rate (first of each run, at most [`MAX_LISTED`]).
-    pub rate_changes: Vec<RateChange>,
-    /// Number of runs of blocks at another rate.
-    pub rate_change_count: usize,
-}
-
-/// Median of a sample of at most 200 001 steps (exact for shorter records).
-fn median_step(t: &[f64]) -> f64 {
-    let n = t.len().saturating_sub(1);
-    if n == 0 {
-        return f64::NAN;
-    }
-    let stride = (n / 200_000).max(1);
-    let mut d: Vec<f64> = (0..n).step_by(stride).map(|i| t[i + 1] - t[i]).collect();
-    let k = d.len() / 2;
-    let (_, m, _) = d.select_nth_unstable_by(k, f64::total_cmp);
-    *m
-}
-
-/// Gaps, stalls and rate changes of the time stamps `t` (s). Steps are judged against the
-/// median step of their own block of samples, so a stretch at another rate is one rate
-/// change, not thousands of gaps.
-pub fn timing(t: &[f64]) -> Timing {
-    let med = median_step(t);
-    if !super::fit::is_positive(med) || t.len() < 2 {
-        return Timing {
-            median_step: med,
-            ..Timing::default()
-        };
-    }
-    let t0 = t[0];
-    let mut out = Timing {
-        median_step: med,
-        ..Timing::default()
-    };
-    let mut all_gaps: Vec<Gap> = Vec::new();
-    let mut in_change = false;
-    let mut buf: Vec<f64> = Vec::with_capacity(RATE_BLOCK);
-    for b in (0..t.len() - 1).step_by(RATE_BLOCK) {
-        let e = (b + RATE_BLOCK).min(t.len() - 1);
-        buf.clear();
-        buf.extend((b..e).map(|i| t[i + 1] - t[i]).filter(|d| *d > 0.0));
-        out.non_advancing += (e - b) - buf.len();
-        if buf.is_empty() {
-            continue;
-        }
-        let k = buf.len() / 2;
-        let local = *buf.select_nth_unstable_by(k, f64::total_cmp).1;
-        for i in b..e {
-            let d = t[i + 1] - t[i];
-            if d > GAP_FACTOR * local {
-                out.gap_count += 1;
-                out.missing += d / local - 1.0;
-                all_gaps.push(Gap {
-                    at: t[i] - t0,
-                    length: d,
-                });
-            }
-        }
-        if e - b < RATE_BLOCK / 2 {
-            continue;
-        }
-        let off = (local / med - 1.0).abs() > RATE_CHANGE_REL;
-        if off && !in_change {
-            out.rate_change_count += 1;
-            if out.rate_changes.len() < MAX_LISTED {
-                out.rate_changes.push(RateChange {
-                    at: t[b] - t0,
-                    rate: 1.0 / local,
-                });
-            }
-        }
-        in_change = off;
-    }
-    all_gaps.sort_by(|a, b| b.length.total_cmp(&a.length));
-    all_gaps.truncate(MAX_LISTED);
-    all_gaps.sort_by(|a, b| a.at.total_cmp(&b.at));
-    out.gaps = all_gaps;
-    out
-}
-
 /// A warm-up or drift at the start of one axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Warmup {
@@ -294,24 +172,11 @@ mod tests {
     const RNG_SEED: u64 = 0x0057_A710;
 
     #[test]
-    fn finds_gaps_and_rate_changes() {
-        let mut t: Vec<f64> = (0..100_000).map(|i| i as f64 * 0.005).collect();
-        // a 1 s gap at 100 s and a stretch at 100 Hz from 300 s
-        for v in t.iter_mut().skip(20_000) {
-            *v += 1.0;
-        }
-        let k = 60_000;
-        let base = t[k];
-        for (j, v) in t.iter_mut().enumerate().skip(k) {
-            *v = base + (j - k) as f64 * 0.01;
-        }
-        let r = timing(&t);
-        assert!((r.median_step - 0.005).abs() < 1e-12);
-        assert_eq!(r.gap_count, 1);
-        assert!((r.gaps[0].at - 99.995).abs() < 1e-6 && (r.gaps[0].length - 1.005).abs() < 1e-9);
-        assert_eq!(r.rate_change_count, 1, "{r:?}");
-        assert!((r.rate_changes[0].rate - 100.0).abs() < 1e-6);
+    fn skip_index_counts_the_samples_before_the_cut() {
+        let t: Vec<f64> = (0..100_000).map(|i| i as f64 * 0.005).collect();
         assert_eq!(skip_index(&t, 50.0), 10_000);
+        assert_eq!(skip_index(&t, 0.0), 0);
+        assert_eq!(skip_index(&t, 1e9), t.len());
     }
 
     #[test]

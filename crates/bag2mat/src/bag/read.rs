@@ -1,13 +1,21 @@
 //! Streaming reader for bag format 2.0.
 //!
-//! [`BagReader::open`] reads the bag header and the index section (connections and chunk
-//! infos). When the index is missing or unreadable — a writer that never finished leaves
-//! `index_pos = 0`, a truncated copy loses the index at the end — the chunk section is
-//! scanned record by record instead, every complete chunk is used, and the notes say how
-//! many bytes at the end were lost. Each chunk is one [`Part`] of the [`Source`] interface,
-//! read with positioned reads and decompressed by whichever thread reads it.
+//! [`BagReader::open`] never trusts one structure alone. It reads the index section
+//! (connections and chunk infos) record by record, skipping what is damaged, and it always
+//! walks the chunk section itself: every chunk record and the index-data records that follow
+//! it (the chunk's own `(time, offset)` list per connection). Every chunk found either way is
+//! a [`Part`]; the chunk infos are cross-checked against the chunks (a chunk the index does
+//! not list is read and noted; an info that points nowhere is reported). The walk stops at
+//! the end of the chunks (the index section, an incomplete record at a truncation) and
+//! resynchronises on the next chunk after a damaged record. Counts from the file never size
+//! memory: promises come from the chunk's own index data, which the file physically holds.
+//!
+//! Reading a chunk walks its records; a record whose framing is damaged is skipped and the
+//! walk resumes at the next message its index data lists (or the next valid record), and
+//! every message the chunk's index lists that was not delivered is reported with its count
+//! and time span.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
 use std::io::Read;
 use std::os::unix::fs::FileExt;
@@ -23,14 +31,48 @@ thread_local! {
     static BUFFERS: std::cell::RefCell<(Vec<u8>, Vec<u8>)> = const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
 
-/// Where a chunk is, and (when the bag is indexed) what it holds.
+/// Largest record header accepted (real headers are under 1 KiB: a damaged length must not
+/// make the reader allocate the file).
+const MAX_RECORD_HEADER: u64 = 64 * 1024;
+/// Bytes searched, after a damaged top-level record, for the next chunk record.
+const RESYNC_WINDOW: usize = 1 << 20;
+
+/// One index-data record of a chunk (the `(time, offset in the chunk body)` of each
+/// message of one connection): where its entries are and how many the file holds. The
+/// entries are read only when a chunk does not deliver what they list.
+#[derive(Debug, Clone, Copy, Default)]
+struct ChunkIndexData {
+    count: u64,
+    data_pos: u64,
+}
+
+/// Where a chunk is, and what it and the index say it holds.
 #[derive(Debug, Clone)]
 struct ChunkLoc {
     pos: u64,
-    /// `(connection, count)` from the chunk info; empty when scanned.
-    counts: Vec<(u32, u32)>,
+    /// Bytes of the chunk record's data (compressed body), when the walk saw it.
+    stored: Option<u64>,
+    /// Uncompressed body size from the chunk header, when the walk saw it.
+    size: Option<u64>,
+    /// The chunk's own index data per connection (found after the chunk by the walk).
+    index_data: BTreeMap<u32, ChunkIndexData>,
+    /// `(connection, count)` from the chunk info, when the index lists the chunk.
+    info_counts: Option<Vec<(u32, u32)>>,
     /// Time span from the chunk info.
     span: Option<(RosTime, RosTime)>,
+}
+
+impl ChunkLoc {
+    /// Messages per connection the bag promises for this chunk: its own index data when
+    /// present (entries the file physically holds), else the chunk info.
+    fn promised(&self) -> Option<Vec<(u32, u64)>> {
+        if !self.index_data.is_empty() {
+            return Some(self.index_data.iter().map(|(c, d)| (*c, d.count)).collect());
+        }
+        self.info_counts
+            .as_ref()
+            .map(|v| v.iter().map(|&(c, n)| (c, n as u64)).collect())
+    }
 }
 
 /// What the bag holds: its connections and the number of messages on each.
@@ -62,8 +104,18 @@ pub struct BagReader {
     parts: Vec<Part>,
 }
 
+/// The top-level records a walk found.
+#[derive(Default)]
+struct Walk {
+    chunks: Vec<ChunkLoc>,
+    connections: Vec<Connection>,
+}
+
+/// A record's header bytes, data position and data length.
+type RecordAt = (Vec<u8>, u64, u32);
+
 impl BagReader {
-    /// Opens a bag and reads its index (or scans it when the index is missing).
+    /// Opens a bag: reads its index section, walks its chunk section, and cross-checks them.
     pub fn open(path: &Path) -> Result<BagReader, Error> {
         let mut file = File::open(path).map_err(|e| Error::io(path, e))?;
         let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
@@ -89,15 +141,37 @@ impl BagReader {
             offset,
             what,
         };
-        let rec = record::raw_record(&head, MAGIC.len())
-            .ok_or_else(|| corrupt(13, "bag header record is incomplete".into()))?;
-        let h = Header::parse(rec.header).map_err(|w| corrupt(13, w))?;
-        if h.op().map_err(|w| corrupt(13, w))? != Op::BagHeader {
-            return Err(corrupt(13, "first record is not the bag header".into()));
-        }
-        let index_pos = h.u64("index_pos").map_err(|w| corrupt(13, w))?;
-        let chunk_count = h.u32("chunk_count").map_err(|w| corrupt(13, w))?;
-        let first = rec.end as u64;
+        // The bag header names the index; when it is damaged, the chunks after its usual
+        // 4104 bytes are walked as for a bag without an index.
+        let header = record::raw_record(&head, MAGIC.len())
+            .ok_or_else(|| "the bag header record is incomplete".to_string())
+            .and_then(|rec| {
+                let h = Header::parse(rec.header)?;
+                if h.op()? != Op::BagHeader {
+                    return Err("the first record is not the bag header".into());
+                }
+                Ok((
+                    h.u64("index_pos").unwrap_or(0),
+                    h.u32("chunk_count").ok(),
+                    rec.end as u64,
+                ))
+            });
+        let mut header_damage = None;
+        let (index_pos, chunk_count, first) = match header {
+            Ok(h) => h,
+            Err(e) if len > record::FIRST_RECORD_POS => {
+                header_damage = Some(e);
+                (0, None, record::FIRST_RECORD_POS)
+            }
+            Err(_) => {
+                return Err(corrupt(
+                    13,
+                    format!(
+                        "the bag header record is incomplete (the file is {len} bytes: truncated, no complete chunk)"
+                    ),
+                ));
+            }
+        };
         let mut reader = BagReader {
             path: path.to_path_buf(),
             file,
@@ -114,16 +188,41 @@ impl BagReader {
             channels: Vec::new(),
             parts: Vec::new(),
         };
-        let indexed = index_pos >= first
-            && index_pos < len
-            && reader.read_index(index_pos, chunk_count).is_ok();
-        if !indexed {
-            reader.notes.push(if index_pos == 0 {
-                "the bag has no index (index_pos = 0: the writer did not finish); scanning its chunks (`rosbag reindex` repairs it)".to_string()
+        if let Some(e) = &header_damage {
+            reader.notes.push(format!(
+                "the bag header is damaged ({e}); the chunks after it were walked without the index"
+            ));
+        }
+        let index_ok = index_pos >= first && index_pos < len;
+        let (index_conns, infos) = if index_ok {
+            reader.read_index(index_pos)
+        } else {
+            if header_damage.is_some() {
+            } else if index_pos == 0 {
+                reader.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
+            } else if index_pos >= len {
+                reader.losses.push(Loss::new(format!(
+                    "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
+                    index_pos - len
+                )));
             } else {
-                format!("the bag's index at byte {index_pos} is missing or unreadable (file is {len} bytes: truncated?); scanning its chunks")
-            });
-            reader.scan(first)?;
+                reader.notes.push(format!(
+                    "the bag's index_pos {index_pos} points into its header; its chunks were walked"
+                ));
+            }
+            (Vec::new(), Vec::new())
+        };
+        let walk_end = if index_ok { index_pos } else { len };
+        let info_positions: BTreeSet<u64> = infos.iter().map(|i| i.chunk_pos).collect();
+        let walk = reader.walk(first, walk_end, &info_positions);
+        reader.merge(walk, index_conns, infos, chunk_count);
+        if reader.chunks.is_empty() && reader.index.connections.is_empty() {
+            let what = if len <= first + 8 {
+                "truncated, no complete chunk (only the bag header is there)".to_string()
+            } else {
+                "truncated or damaged, no complete chunk".to_string()
+            };
+            return Err(corrupt(first, what));
         }
         reader.build_interface();
         Ok(reader)
@@ -131,6 +230,14 @@ impl BagReader {
 
     /// The channels and parts of the [`Source`] interface.
     fn build_interface(&mut self) {
+        let all_counted = self.chunks.iter().all(|c| c.promised().is_some());
+        let mut counts: BTreeMap<u32, u64> = BTreeMap::new();
+        for c in &self.chunks {
+            for (conn, n) in c.promised().into_iter().flatten() {
+                *counts.entry(conn).or_default() += n;
+            }
+        }
+        self.index.counts = counts.clone();
         self.channels = self
             .index
             .connections
@@ -141,19 +248,31 @@ impl BagReader {
                 msg_type: c.msg_type.clone(),
                 encoding: Encoding::Ros1,
                 md5sum: Some(c.md5sum.clone()),
-                count: Some(self.index.counts.get(&c.id).copied().unwrap_or(0)),
+                count: all_counted.then(|| counts.get(&c.id).copied().unwrap_or(0)),
             })
+            .collect();
+        let ends: Vec<u64> = self
+            .chunks
+            .iter()
+            .skip(1)
+            .map(|c| c.pos)
+            .chain([self.len])
             .collect();
         self.parts = self
             .chunks
             .iter()
-            .map(|c| Part {
-                label: format!("chunk at byte {}", c.pos),
-                span: c.span.map(|(a, b)| (a.as_nanos(), b.as_nanos())),
-                counts: self
-                    .index
-                    .indexed
-                    .then(|| c.counts.iter().map(|&(conn, n)| (conn, n as u64)).collect()),
+            .zip(ends)
+            .map(|(c, end)| {
+                let stored = c.stored.unwrap_or(end.saturating_sub(c.pos));
+                Part {
+                    label: format!("chunk at byte {}", c.pos),
+                    span: self.time_span(c),
+                    counts: c.promised(),
+                    bytes: c
+                        .size
+                        .unwrap_or(u64::MAX)
+                        .min(stored.saturating_mul(source::MAX_EXPANSION)),
+                }
             })
             .collect();
     }
@@ -180,6 +299,358 @@ impl BagReader {
             .collect()
     }
 
+    /// Reads the index section record by record: connections and chunk infos. A damaged
+    /// record is skipped (noted); damaged framing ends the section (the walk still finds
+    /// every chunk).
+    fn read_index(&mut self, index_pos: u64) -> (Vec<Connection>, Vec<ChunkInfo>) {
+        let mut connections = Vec::new();
+        let mut infos = Vec::new();
+        let mut pos = index_pos;
+        let mut damaged = 0;
+        while pos < self.len {
+            let Some((hb, data_pos, dlen)) = self.record_at(pos, self.len) else {
+                self.notes.push(format!(
+                    "the index section is damaged at byte {pos} (a record runs past the end of the file); the chunks were walked instead"
+                ));
+                break;
+            };
+            let data = self.bytes_at(data_pos, dlen).unwrap_or_default();
+            let decoded = Header::parse(&hb).and_then(|h| match h.op()? {
+                Op::Connection => Connection::decode(&h, &data).map(|c| connections.push(c)),
+                Op::ChunkInfo => ChunkInfo::decode(&h, &data).map(|i| infos.push(i)),
+                other => Err(format!("unexpected {other:?} record")),
+            });
+            if let Err(e) = decoded {
+                damaged += 1;
+                if damaged == 1 {
+                    self.notes.push(format!(
+                        "the index section has a damaged record at byte {pos} ({e}); skipped, the chunks themselves were walked"
+                    ));
+                }
+            }
+            pos = data_pos + dlen as u64;
+        }
+        if damaged > 1 {
+            self.notes.push(format!(
+                "{damaged} damaged index records were skipped in all"
+            ));
+        }
+        (connections, infos)
+    }
+
+    /// Walks the chunk section from `first` to `end`: chunk records (header only), the
+    /// index-data records after each, and stray connection records. Stops at the index
+    /// section or an incomplete record; after a damaged record, resumes at the next chunk.
+    fn walk(&mut self, first: u64, end: u64, info_positions: &BTreeSet<u64>) -> Walk {
+        let mut w = Walk::default();
+        let mut pos = first;
+        while pos < end {
+            let Some((hb, data_pos, dlen)) = self.record_at(pos, end) else {
+                if end == self.len {
+                    self.losses.push(Loss::new(format!(
+                        "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
+                        self.len - pos
+                    )));
+                } else {
+                    self.damaged_at(
+                        pos,
+                        end,
+                        "a record runs past the end of the chunk section",
+                        info_positions,
+                        &mut pos,
+                    );
+                    continue;
+                }
+                break;
+            };
+            let next = data_pos + dlen as u64;
+            let h = match Header::parse(&hb) {
+                Ok(h) => h,
+                Err(e) => {
+                    self.damaged_at(pos, end, &e, info_positions, &mut pos);
+                    continue;
+                }
+            };
+            match h.op() {
+                Ok(Op::Chunk) => {
+                    let compression = h.str("compression").ok().and_then(Compression::from_name);
+                    let size = h.u32("size").ok();
+                    if compression.is_none() || size.is_none() {
+                        self.damaged_at(pos, end, "damaged chunk header", info_positions, &mut pos);
+                        continue;
+                    }
+                    w.chunks.push(ChunkLoc {
+                        pos,
+                        stored: Some(dlen as u64),
+                        size: size.map(|s| s as u64),
+                        index_data: BTreeMap::new(),
+                        info_counts: None,
+                        span: None,
+                    });
+                }
+                Ok(Op::IndexData) => {
+                    if let (Some(c), Ok(conn)) = (w.chunks.last_mut(), h.u32("conn")) {
+                        // The entries the file holds, whatever the count field says.
+                        let count =
+                            (h.u32("count").unwrap_or(u32::MAX) as u64).min(dlen as u64 / 12);
+                        c.index_data
+                            .entry(conn)
+                            .or_insert(ChunkIndexData { count, data_pos });
+                    }
+                }
+                Ok(Op::Connection) => {
+                    if let Ok(data) = self.bytes_at(data_pos, dlen)
+                        && let Ok(c) = Connection::decode(&h, &data)
+                    {
+                        w.connections.push(c);
+                    }
+                }
+                Ok(Op::ChunkInfo) => {
+                    // The index section, where the header said it would not be.
+                    break;
+                }
+                Ok(_) | Err(_) => {
+                    self.damaged_at(
+                        pos,
+                        end,
+                        "unexpected or unknown record op",
+                        info_positions,
+                        &mut pos,
+                    );
+                    continue;
+                }
+            }
+            pos = next;
+        }
+        w
+    }
+
+    /// Records a damaged top-level record at `*pos` and moves `*pos` to the next chunk: the
+    /// next position a chunk info names, else the next valid chunk record found in the bytes.
+    fn damaged_at(
+        &mut self,
+        at: u64,
+        end: u64,
+        why: &str,
+        info_positions: &BTreeSet<u64>,
+        pos: &mut u64,
+    ) {
+        let next = info_positions
+            .range(at + 1..end)
+            .next()
+            .copied()
+            .or_else(|| self.find_chunk(at + 1, end));
+        let to = next.unwrap_or(end);
+        self.losses.push(Loss::new(format!(
+            "bytes {at}..{to} of the chunk section are damaged ({why}) and were skipped"
+        )));
+        *pos = to;
+    }
+
+    /// The next position in `from..end` where a valid chunk record starts.
+    fn find_chunk(&self, from: u64, end: u64) -> Option<u64> {
+        let mut at = from;
+        let mut buf = vec![0u8; RESYNC_WINDOW];
+        while at < end {
+            let n = ((end - at) as usize).min(RESYNC_WINDOW);
+            buf.resize(n, 0);
+            self.file.read_exact_at(&mut buf, at).ok()?;
+            // `op=\x05` inside a chunk header; the record starts up to 64 bytes before it.
+            let mut i = 0;
+            while let Some(k) = find(&buf[i..], b"op=\x05") {
+                let q = at + (i + k) as u64;
+                for back in 8..=72u64 {
+                    let Some(p) = q.checked_sub(back) else { break };
+                    if p < from {
+                        break;
+                    }
+                    if let Some((hb, data_pos, dlen)) = self.record_at(p, end)
+                        && data_pos > q
+                        && let Ok(h) = Header::parse(&hb)
+                        && h.op() == Ok(Op::Chunk)
+                        && h.str("compression")
+                            .ok()
+                            .and_then(Compression::from_name)
+                            .is_some()
+                        && h.u32("size").is_ok()
+                        && data_pos + dlen as u64 <= end
+                    {
+                        return Some(p);
+                    }
+                }
+                i += k + 1;
+            }
+            if n < RESYNC_WINDOW {
+                break;
+            }
+            at += (RESYNC_WINDOW - 128) as u64;
+        }
+        None
+    }
+
+    /// Joins what the index section and the walk found, and says where they disagree.
+    fn merge(
+        &mut self,
+        walk: Walk,
+        index_conns: Vec<Connection>,
+        mut infos: Vec<ChunkInfo>,
+        chunk_count: Option<u32>,
+    ) {
+        let had_index = !infos.is_empty() || !index_conns.is_empty();
+        let mut chunks: BTreeMap<u64, ChunkLoc> =
+            walk.chunks.into_iter().map(|c| (c.pos, c)).collect();
+        infos.sort_by_key(|i| i.chunk_pos);
+        let mut unlisted: BTreeSet<u64> = chunks.keys().copied().collect();
+        for info in infos {
+            match chunks.get_mut(&info.chunk_pos) {
+                Some(c) if c.info_counts.is_none() => {
+                    unlisted.remove(&info.chunk_pos);
+                    let own = c.promised();
+                    let mut mine: Vec<(u32, u64)> =
+                        info.counts.iter().map(|&(k, n)| (k, n as u64)).collect();
+                    // rosbag lists a chunk's connections in any order.
+                    mine.sort_unstable();
+                    if own.is_some() && own.as_ref() != Some(&mine) {
+                        self.notes.push(format!(
+                            "the chunk info of the chunk at byte {} lists {:?} messages per connection, the chunk's own index {:?}; the chunk is read whole and its own index is used",
+                            info.chunk_pos,
+                            mine,
+                            own.unwrap_or_default()
+                        ));
+                    }
+                    c.info_counts = Some(info.counts);
+                    c.span = Some((info.start_time, info.end_time));
+                }
+                Some(_) => self.notes.push(format!(
+                    "two chunk infos name the chunk at byte {}; the chunk is read once",
+                    info.chunk_pos
+                )),
+                None => {
+                    // Not seen by the walk (it stopped early): read it if it is a chunk.
+                    let ok = self
+                        .record_at(info.chunk_pos, self.len)
+                        .and_then(|(hb, _, dlen)| {
+                            let h = Header::parse(&hb).ok()?;
+                            (h.op().ok()? == Op::Chunk).then_some(dlen)
+                        });
+                    match ok {
+                        Some(dlen) => {
+                            chunks.insert(
+                                info.chunk_pos,
+                                ChunkLoc {
+                                    pos: info.chunk_pos,
+                                    stored: Some(dlen as u64),
+                                    size: None,
+                                    index_data: BTreeMap::new(),
+                                    info_counts: Some(info.counts),
+                                    span: Some((info.start_time, info.end_time)),
+                                },
+                            );
+                        }
+                        None => self.losses.push(Loss {
+                            what: format!(
+                                "the index lists a chunk at byte {} that holds no chunk record",
+                                info.chunk_pos
+                            ),
+                            messages: Some(info.counts.iter().map(|&(_, n)| n as u64).sum()),
+                            span: Some((info.start_time.as_nanos(), info.end_time.as_nanos())),
+                            channel: None,
+                        }),
+                    }
+                }
+            }
+        }
+        if had_index && !unlisted.is_empty() {
+            self.notes.push(format!(
+                "{} chunk(s) are not listed in the bag's index (first at byte {}); they were read",
+                unlisted.len(),
+                unlisted.iter().next().copied().unwrap_or(0)
+            ));
+        }
+        if let Some(n) = chunk_count
+            && had_index
+            && n as usize != chunks.len()
+        {
+            self.notes.push(format!(
+                "the bag header announces {n} chunks; {} were found",
+                chunks.len()
+            ));
+        }
+        self.chunks = chunks.into_values().collect();
+        let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
+        for c in index_conns.into_iter().chain(walk.connections) {
+            connections.entry(c.id).or_insert(c);
+        }
+        // Connections the chunks use but no readable record outside them describes: rosbag
+        // also writes each connection record inside the first chunk that uses it.
+        let referenced: BTreeSet<u32> = self
+            .chunks
+            .iter()
+            .flat_map(|c| {
+                c.index_data
+                    .keys()
+                    .copied()
+                    .chain(c.info_counts.iter().flatten().map(|(k, _)| *k))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let unknown = |m: &BTreeMap<u32, Connection>| referenced.iter().any(|k| !m.contains_key(k));
+        if !had_index || unknown(&connections) || self.chunks.iter().any(|c| c.promised().is_none())
+        {
+            for i in 0..self.chunks.len() {
+                let needs_count = self.chunks[i].promised().is_none();
+                if !needs_count && !unknown(&connections) && had_index {
+                    continue;
+                }
+                let pos = self.chunks[i].pos;
+                let mut found = Vec::new();
+                let mut counts: BTreeMap<u32, u64> = BTreeMap::new();
+                let r = self.with_chunk_body(pos, |body| {
+                    walk_body(body, &Vec::new, &mut |rec| match rec {
+                        BodyRecord::Connection(hb, data) => {
+                            if let Ok(c) =
+                                Header::parse(hb).and_then(|h| Connection::decode(&h, data))
+                            {
+                                found.push(c);
+                            }
+                        }
+                        BodyRecord::Message(c, ..) => *counts.entry(c).or_default() += 1,
+                    });
+                    Ok(())
+                });
+                if r.is_err() {
+                    continue;
+                }
+                for c in found {
+                    connections.entry(c.id).or_insert(c);
+                }
+                if needs_count {
+                    // Counted by reading: the scan's count stands in for the missing index.
+                    self.chunks[i].info_counts = Some(
+                        counts
+                            .into_iter()
+                            .map(|(k, n)| (k, n.min(u32::MAX as u64) as u32))
+                            .collect(),
+                    );
+                }
+            }
+        }
+        self.index.connections = connections.into_values().collect();
+        self.index.chunk_count = self.chunks.len();
+        self.index.indexed = had_index;
+    }
+
+    fn bytes_at(&self, pos: u64, len: u32) -> Result<Vec<u8>, Error> {
+        if pos + len as u64 > self.len {
+            return Err(self.corrupt(pos, "record runs past the end of the file"));
+        }
+        let mut buf = vec![0u8; len as usize];
+        self.file
+            .read_exact_at(&mut buf, pos)
+            .map_err(|e| Error::io(&self.path, e))?;
+        Ok(buf)
+    }
+
     fn corrupt(&self, offset: u64, what: impl Into<String>) -> Error {
         Error::Corrupt {
             path: self.path.clone(),
@@ -188,146 +659,13 @@ impl BagReader {
         }
     }
 
-    fn read_index(&mut self, index_pos: u64, chunk_count: u32) -> Result<(), String> {
-        let mut buf = vec![0u8; (self.len - index_pos) as usize];
-        self.file
-            .read_exact_at(&mut buf, index_pos)
-            .map_err(|e| e.to_string())?;
-        let mut pos = 0;
-        let mut connections = Vec::new();
-        let mut infos = Vec::new();
-        while pos < buf.len() {
-            let rec =
-                record::raw_record(&buf, pos).ok_or("incomplete record in the index section")?;
-            let h = Header::parse(rec.header)?;
-            match h.op()? {
-                Op::Connection => connections.push(Connection::decode(&h, rec.data)?),
-                Op::ChunkInfo => infos.push(ChunkInfo::decode(&h, rec.data)?),
-                other => return Err(format!("unexpected {other:?} record in the index section")),
-            }
-            pos = rec.end;
-        }
-        if infos.len() != chunk_count as usize {
-            return Err(format!(
-                "bag header announces {chunk_count} chunks, index lists {}",
-                infos.len()
-            ));
-        }
-        infos.sort_by_key(|i| i.chunk_pos);
-        for info in &infos {
-            for (conn, n) in &info.counts {
-                *self.index.counts.entry(*conn).or_default() += *n as u64;
-            }
-        }
-        connections.sort_by_key(|c: &Connection| c.id);
-        connections.dedup_by_key(|c| c.id);
-        self.index.connections = connections;
-        self.index.chunk_count = infos.len();
-        self.chunks = infos
-            .into_iter()
-            .map(|i| ChunkLoc {
-                pos: i.chunk_pos,
-                counts: i.counts,
-                span: Some((i.start_time, i.end_time)),
-            })
-            .collect();
-        self.index.indexed = true;
-        Ok(())
-    }
-
-    /// Walks the chunk section record by record; stops at the first incomplete record.
-    fn scan(&mut self, first: u64) -> Result<(), Error> {
-        let mut pos = first;
-        let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
-        while pos < self.len {
-            let Some((h_bytes, data_pos, data_len)) = self.record_at(pos) else {
-                self.losses.push(Loss {
-                    what: format!(
-                        "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
-                        self.len - pos
-                    ),
-                    messages: None,
-                    span: None,
-                });
-                break;
-            };
-            let h = Header::parse(&h_bytes).map_err(|w| self.corrupt(pos, w))?;
-            match h.op().map_err(|w| self.corrupt(pos, w))? {
-                Op::Chunk => {
-                    let (mut raw, mut decompressed) = (Vec::new(), Vec::new());
-                    match self.read_chunk_into(
-                        &h_bytes,
-                        data_pos,
-                        data_len,
-                        &mut raw,
-                        &mut decompressed,
-                    ) {
-                        Ok(compression) => {
-                            let body = if compression == Compression::None {
-                                &raw
-                            } else {
-                                &decompressed
-                            };
-                            let mut bpos = 0;
-                            while let Some(rec) = record::raw_record(body, bpos) {
-                                if let Ok(bh) = Header::parse(rec.header) {
-                                    match bh.op() {
-                                        Ok(Op::Connection) => {
-                                            if let Ok(c) = Connection::decode(&bh, rec.data) {
-                                                connections.entry(c.id).or_insert(c);
-                                            }
-                                        }
-                                        Ok(Op::MessageData) => {
-                                            if let Ok(c) = bh.u32("conn") {
-                                                *self.index.counts.entry(c).or_default() += 1;
-                                            }
-                                        }
-                                        _ => {}
-                                    }
-                                }
-                                bpos = rec.end;
-                            }
-                            self.chunks.push(ChunkLoc {
-                                pos,
-                                counts: Vec::new(),
-                                span: None,
-                            });
-                        }
-                        Err(e) => self.losses.push(Loss {
-                            what: format!("chunk at byte {pos} is unreadable and was skipped: {e}"),
-                            messages: None,
-                            span: None,
-                        }),
-                    }
-                }
-                Op::Connection => {
-                    if let Ok(c) = Connection::decode(&h, &self.bytes_at(data_pos, data_len)?) {
-                        connections.entry(c.id).or_insert(c);
-                    }
-                }
-                _ => {}
-            }
-            pos = data_pos + data_len as u64;
-        }
-        self.index.connections = connections.into_values().collect();
-        self.index.chunk_count = self.chunks.len();
-        Ok(())
-    }
-
-    fn bytes_at(&self, pos: u64, len: u32) -> Result<Vec<u8>, Error> {
-        let mut buf = vec![0u8; len as usize];
-        self.file
-            .read_exact_at(&mut buf, pos)
-            .map_err(|e| Error::io(&self.path, e))?;
-        Ok(buf)
-    }
-
-    /// The header bytes, data position and data length of the record at `pos`, if whole.
-    fn record_at(&self, pos: u64) -> Option<(Vec<u8>, u64, u32)> {
+    /// The header bytes, data position and data length of the record at `pos`, if it is
+    /// whole before `end` and its header is of a sane size.
+    fn record_at(&self, pos: u64, end: u64) -> Option<RecordAt> {
         let mut b4 = [0u8; 4];
         self.file.read_exact_at(&mut b4, pos).ok()?;
         let hlen = u32::from_le_bytes(b4) as u64;
-        if pos + 4 + hlen + 4 > self.len {
+        if hlen > MAX_RECORD_HEADER || pos + 4 + hlen + 4 > end {
             return None;
         }
         let mut header = vec![0u8; hlen as usize];
@@ -335,7 +673,7 @@ impl BagReader {
         self.file.read_exact_at(&mut b4, pos + 4 + hlen).ok()?;
         let dlen = u32::from_le_bytes(b4);
         let data_pos = pos + 8 + hlen;
-        if data_pos + dlen as u64 > self.len {
+        if data_pos + dlen as u64 > end {
             return None;
         }
         Some((header, data_pos, dlen))
@@ -350,7 +688,7 @@ impl BagReader {
         f: impl FnOnce(&[u8]) -> Result<R, String>,
     ) -> Result<R, String> {
         let (h, data_pos, dlen) = self
-            .record_at(pos)
+            .record_at(pos, self.len)
             .ok_or("chunk record runs past the end of the file")?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
@@ -375,7 +713,7 @@ impl BagReader {
     ) -> Result<Compression, String> {
         let h = Header::parse(h_bytes)?;
         if h.op()? != Op::Chunk {
-            return Err("index points at a record that is not a chunk".into());
+            return Err("not a chunk record".into());
         }
         let name = h.str("compression")?;
         let compression = Compression::from_name(name)
@@ -403,36 +741,118 @@ impl BagReader {
         Ok(compression)
     }
 
-    /// Calls `f(connection, record time, data)` for each message record of the chunk at
-    /// `pos` whose connection `want` accepts, in body order. Returns how many it delivered
-    /// and, when the body could not be read to its end, why.
+    /// Calls `f(connection, record time, data)` for each message record of chunk `c` whose
+    /// connection `want` accepts, in body order, and reports what the chunk's index lists
+    /// that could not be delivered.
     fn for_each_in_chunk(
         &self,
-        pos: u64,
+        c: &ChunkLoc,
         want: &dyn Fn(u32) -> bool,
         f: &mut MessageSink<'_>,
     ) -> PartRead {
         let mut out = PartRead::default();
-        let r = self.with_chunk_body(pos, |body| {
-            let mut bpos = 0;
-            while bpos < body.len() {
-                let rec = record::raw_record(body, bpos)
-                    .ok_or_else(|| format!("incomplete record at body offset {bpos}"))?;
-                let (op, conn, time) = record::op_conn_time(rec.header)?;
-                if op == Some(Op::MessageData as u8) {
-                    let conn = conn.ok_or("message record without 'conn'")?;
-                    if want(conn) {
-                        let t = time.ok_or("message record without 'time'")?;
-                        f(conn, t.as_nanos(), rec.data);
-                        out.delivered += 1;
+        let mut delivered_at: Vec<u32> = Vec::new();
+        let mut per_conn: Vec<(u32, u64)> = Vec::new();
+        let mut damage: Vec<String> = Vec::new();
+        // The offsets the chunk's index lists, read only if a record turns out damaged.
+        let listed_offsets = || {
+            let mut v: Vec<u32> = self.index_entries(c).iter().map(|e| e.2).collect();
+            v.sort_unstable();
+            v
+        };
+        let r = self.with_chunk_body(c.pos, |body| {
+            damage = walk_body(body, &listed_offsets, &mut |rec| {
+                if let BodyRecord::Message(conn, t, off, data) = rec
+                    && want(conn)
+                {
+                    f(conn, t, data);
+                    out.delivered += 1;
+                    delivered_at.push(off);
+                    match per_conn.iter_mut().find(|(k, _)| *k == conn) {
+                        Some(e) => e.1 += 1,
+                        None => per_conn.push((conn, 1)),
                     }
                 }
-                bpos = rec.end;
-            }
+            });
             Ok(())
         });
-        out.error = r.err();
+        if let Err(e) = r {
+            out.error = Some(e);
+            return out;
+        }
+        let short = c.index_data.iter().any(|(conn, d)| {
+            want(*conn) && per_conn.iter().find(|(k, _)| k == conn).map_or(0, |e| e.1) < d.count
+        });
+        if short {
+            // Listed messages of wanted connections that were not delivered.
+            delivered_at.sort_unstable();
+            let mut lost: BTreeMap<u32, (u64, u64, u64)> = BTreeMap::new();
+            for (conn, t, off) in self.index_entries(c) {
+                if want(conn) && delivered_at.binary_search(&off).is_err() {
+                    let e = lost.entry(conn).or_insert((0, t, t));
+                    e.0 += 1;
+                    e.1 = e.1.min(t);
+                    e.2 = e.2.max(t);
+                }
+            }
+            let why = if damage.is_empty() {
+                "its record is not a readable message".to_string()
+            } else {
+                damage.join("; ")
+            };
+            for (conn, (n, a, b)) in lost {
+                out.lost.push(Loss {
+                    what: format!(
+                        "chunk at byte {}: {} that the chunk's index lists could not be read ({why})",
+                        c.pos,
+                        if n == 1 { "a message" } else { "messages" }
+                    ),
+                    messages: Some(n),
+                    span: Some((a, b)),
+                    channel: Some(conn),
+                });
+            }
+        }
+        if out.lost.is_empty() && !damage.is_empty() {
+            out.lost.push(Loss::new(format!(
+                "chunk at byte {}: {}",
+                c.pos,
+                damage.join("; ")
+            )));
+        }
         out
+    }
+
+    /// The `(connection, record time ns, body offset)` entries of the chunk's index data.
+    fn index_entries(&self, c: &ChunkLoc) -> Vec<(u32, u64, u32)> {
+        let mut out = Vec::new();
+        for (conn, d) in &c.index_data {
+            let Ok(data) = self.bytes_at(d.data_pos, (d.count * 12) as u32) else {
+                continue;
+            };
+            out.extend(data.chunks_exact(12).map(|e| {
+                let t = RosTime::from_bytes(&e[..8]).unwrap_or_default();
+                (
+                    *conn,
+                    t.as_nanos(),
+                    u32::from_le_bytes([e[8], e[9], e[10], e[11]]),
+                )
+            }));
+        }
+        out
+    }
+
+    /// Record-time span of a chunk: its chunk info's, else its index data's.
+    fn time_span(&self, c: &ChunkLoc) -> Option<(u64, u64)> {
+        if let Some((a, b)) = c.span {
+            return Some((a.as_nanos(), b.as_nanos()));
+        }
+        let e = self.index_entries(c);
+        let first = e.first()?.1;
+        Some(
+            e.iter()
+                .fold((first, first), |(a, b), x| (a.min(x.1), b.max(x.1))),
+        )
     }
 
     /// The path this reader was opened on.
@@ -444,6 +864,118 @@ impl BagReader {
     pub fn file_len(&self) -> u64 {
         self.len
     }
+}
+
+/// A whole record inside a chunk body, as [`walk_body`] hands it out.
+enum BodyRecord<'a> {
+    /// A message: connection, record time (ns), body offset, data.
+    Message(u32, u64, u32, &'a [u8]),
+    /// A connection record: header bytes and data.
+    Connection(&'a [u8], &'a [u8]),
+}
+
+/// Walks the records of a chunk body, calling `f` for each whole message or connection
+/// record. A record whose framing or header is damaged is skipped: the walk resumes at the
+/// next offset in `listed` (the chunk's index, sorted) past it, else at the next valid
+/// record found in the bytes. Returns a description of each damaged stretch. The per-message
+/// work is [`record::op_conn_time`], which does not allocate.
+fn walk_body<'a>(
+    body: &'a [u8],
+    listed: &dyn Fn() -> Vec<u32>,
+    f: &mut dyn FnMut(BodyRecord<'a>),
+) -> Vec<String> {
+    let mut damage = Vec::new();
+    let mut offsets: Option<Vec<u32>> = None;
+    let mut pos = 0usize;
+    while pos < body.len() {
+        let rec = record::raw_record(body, pos);
+        let fields = rec.as_ref().map(|r| record::op_conn_time(r.header));
+        match (rec, fields) {
+            (Some(r), Some(Ok((Some(op), conn, time)))) if op == Op::MessageData as u8 => {
+                match (conn, time) {
+                    (Some(c), Some(t)) => {
+                        f(BodyRecord::Message(c, t.as_nanos(), pos as u32, r.data))
+                    }
+                    _ => damage.push(format!(
+                        "the message record at body offset {pos} lacks its 'conn' or 'time' field"
+                    )),
+                }
+                pos = r.end;
+                continue;
+            }
+            (Some(r), Some(Ok((Some(op), _, _)))) if op == Op::Connection as u8 => {
+                f(BodyRecord::Connection(r.header, r.data));
+                pos = r.end;
+                continue;
+            }
+            (Some(r), Some(Ok((op, _, _))))
+                if r.end == body.len() || parse_body_record(body, r.end).is_some() =>
+            {
+                // Framing intact, header damaged (op flipped or missing): skip this record.
+                damage.push(format!(
+                    "the record at body offset {pos} has {}",
+                    match op {
+                        Some(b) => format!("an unknown op 0x{b:02x}"),
+                        None => "no op field".to_string(),
+                    }
+                ));
+                pos = r.end;
+                continue;
+            }
+            _ => {}
+        }
+        let next = offsets
+            .get_or_insert_with(listed)
+            .iter()
+            .copied()
+            .find(|&o| o as usize > pos && parse_body_record(body, o as usize).is_some())
+            .map(|o| o as usize)
+            .or_else(|| resync(body, pos + 1));
+        let to = next.unwrap_or(body.len());
+        damage.push(format!(
+            "damaged record framing at body offset {pos}: bytes {pos}..{to} skipped"
+        ));
+        pos = to;
+    }
+    damage
+}
+
+/// The end of the record at `pos` if its framing holds and its header names a message
+/// (with `conn` and `time`) or a connection.
+fn parse_body_record(body: &[u8], pos: usize) -> Option<usize> {
+    let r = record::raw_record(body, pos)?;
+    match record::op_conn_time(r.header).ok()? {
+        (Some(op), Some(_), Some(_)) if op == Op::MessageData as u8 => Some(r.end),
+        (Some(op), Some(_), _) if op == Op::Connection as u8 => Some(r.end),
+        _ => None,
+    }
+}
+
+/// The next offset at or after `from` where a whole message or connection record starts
+/// and is followed by another whole record (or the end of the body).
+fn resync(body: &[u8], from: usize) -> Option<usize> {
+    let mut i = from;
+    while let Some(k) = find(&body[i..], b"op=") {
+        let q = i + k;
+        for back in 4..=96usize {
+            let Some(p) = q.checked_sub(back) else { break };
+            if p < from {
+                break;
+            }
+            if let Some(end) = parse_body_record(body, p)
+                && (end == body.len() || parse_body_record(body, end).is_some())
+            {
+                return Some(p);
+            }
+        }
+        i = q + 1;
+    }
+    None
+}
+
+/// Position of `needle` in `hay`.
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
 }
 
 impl Source for BagReader {
@@ -469,7 +1001,7 @@ impl Source for BagReader {
         sink: &mut MessageSink<'_>,
     ) -> PartRead {
         match self.chunks.get(part) {
-            Some(c) => self.for_each_in_chunk(c.pos, want, sink),
+            Some(c) => self.for_each_in_chunk(c, want, sink),
             None => PartRead {
                 error: Some("no such chunk".into()),
                 ..PartRead::default()

@@ -23,7 +23,7 @@ use crate::error::Error;
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
 
 /// Bytes read at once while walking the top-level records.
-const SCAN_WINDOW: usize = 256 * 1024;
+const SCAN_WINDOW: usize = 64 * 1024;
 /// Unchunked messages are grouped into parts of about this many bytes.
 const LOOSE_PART_BYTES: u64 = 4 << 20;
 /// Largest schema, channel or header record read during the walk (a damaged length must not
@@ -279,11 +279,10 @@ impl McapReader {
                 break;
             };
             if first && op != Op::Header as u8 {
-                return Err(Error::Corrupt {
-                    path: self.path.clone(),
-                    offset: pos,
-                    what: "the first record is not an MCAP Header".into(),
-                });
+                // The Header only names the profile and library: its damage costs nothing.
+                self.notes.push(format!(
+                    "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
+                ));
             }
             let small = |w: &mut Window| -> Result<Option<Vec<u8>>, Error> {
                 if clen > MAX_META_RECORD {
@@ -296,13 +295,9 @@ impl McapReader {
             match Op::from_byte(op) {
                 Some(Op::Header) if first => match small(&mut w)?.map(|b| Header::decode(&b)) {
                     Some(Ok(h)) => self.header = h,
-                    _ => {
-                        return Err(Error::Corrupt {
-                            path: self.path.clone(),
-                            offset: pos,
-                            what: "unreadable MCAP Header record".into(),
-                        });
-                    }
+                    _ => self.notes.push(format!(
+                        "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
+                    )),
                 },
                 Some(Op::Schema) => {
                     if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {
@@ -333,6 +328,9 @@ impl McapReader {
                                 compression: h.compression.clone(),
                             });
                             self.parts.push(Part {
+                                bytes: h.uncompressed_size.min(
+                                    h.compressed_size.saturating_mul(source::MAX_EXPANSION),
+                                ),
                                 label: format!("chunk at byte {pos}"),
                                 span: Some((h.message_start_time, h.message_end_time)),
                                 counts: None,
@@ -347,11 +345,13 @@ impl McapReader {
                             ),
                             messages: None,
                             span: Some((h.message_start_time, h.message_end_time)),
+                            channel: None,
                         }),
                         Err(e) => self.losses.push(Loss {
                             what: format!("chunk at byte {pos} has an unreadable header ({e}); skipped"),
                             messages: None,
                             span: None,
+                            channel: None,
                         }),
                     }
                 }
@@ -406,6 +406,7 @@ impl McapReader {
             && end - *start <= LOOSE_PART_BYTES
         {
             *e = end;
+            p.bytes = end - *start;
             if let Some(t) = t {
                 p.span = Some(match p.span {
                     Some((a, b)) => (a.min(t), b.max(t)),
@@ -416,6 +417,7 @@ impl McapReader {
         }
         self.locs.push(Loc::Loose { start: pos, end });
         self.parts.push(Part {
+            bytes: end - pos,
             label: format!("unchunked messages from byte {pos}"),
             span: t.map(|t| (t, t)),
             counts: None,
@@ -447,6 +449,7 @@ impl McapReader {
             what,
             messages,
             span,
+            channel: None,
         });
     }
 
@@ -499,6 +502,7 @@ impl McapReader {
                     ),
                     messages: None,
                     span: Some((ci.message_start_time, ci.message_end_time)),
+                    channel: None,
                 });
             }
         }

@@ -122,6 +122,7 @@ impl BagDir {
                     what: format!("{} is listed in metadata.yaml but missing", p.display()),
                     messages: None,
                     span: None,
+                    channel: None,
                 });
                 continue;
             }
@@ -359,6 +360,13 @@ impl Ros2BagWriter {
             span: None,
             scratch: Vec::with_capacity(512),
         })
+    }
+
+    /// Sets the MCAP chunk size (bytes of records per chunk; no effect on sqlite3).
+    pub fn set_mcap_chunk_size(&mut self, bytes: usize) {
+        if let StorageWriter::Mcap(w) = &mut self.storage {
+            w.set_chunk_size(bytes);
+        }
     }
 
     /// Declares a topic of any type with its `ros2msg` definition and type hash.

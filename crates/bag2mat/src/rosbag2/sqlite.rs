@@ -10,10 +10,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use rusqlite::{Connection, OpenFlags, params};
+use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
 
 use crate::error::Error;
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
+
+/// Fewer bytes than any stored row takes (cell header, rowid, three columns): bounds the ids
+/// a file can hold.
+const MIN_ROW_BYTES: i64 = 8;
 
 /// Message ids per part.
 const ROWS_PER_PART: i64 = 65_536;
@@ -92,11 +96,23 @@ impl Sqlite3Reader {
                 .collect::<Result<Vec<_>, _>>()
             })
             .map_err(|e| sql_err(path, e))?;
-        let (lo, hi): (Option<i64>, Option<i64>) = conn
-            .query_row("SELECT min(id), max(id) FROM messages", [], |r| {
-                Ok((r.get(0)?, r.get(1)?))
-            })
-            .map_err(|e| sql_err(path, e))?;
+        let mut notes = Vec::new();
+        // The ends of the id range; when a damaged page hides them, every id the file could
+        // hold is covered (parts over absent ids are cheap, empty seeks).
+        let (lo, hi): (Option<i64>, Option<i64>) = match conn.query_row(
+            "SELECT min(id), max(id) FROM messages",
+            [],
+            |r| Ok((r.get(0)?, r.get(1)?)),
+        ) {
+            Ok(v) => v,
+            Err(e) => {
+                let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0) as i64;
+                notes.push(format!(
+                    "the messages table's first or last id is unreadable ({e}); every id the file could hold was tried"
+                ));
+                (Some(0), Some(len / MIN_ROW_BYTES))
+            }
+        };
         let mut ranges = Vec::new();
         if let (Some(lo), Some(hi)) = (lo, hi) {
             let mut a = lo;
@@ -112,6 +128,8 @@ impl Sqlite3Reader {
         let parts = ranges
             .iter()
             .map(|(a, b)| Part {
+                // Rows hold no count; the bound is never used to size memory.
+                bytes: u64::MAX,
                 label: format!("message rows {a}..{}", b - 1),
                 span: None,
                 counts: None,
@@ -123,7 +141,7 @@ impl Sqlite3Reader {
             channels,
             ranges,
             parts,
-            notes: Vec::new(),
+            notes,
             losses: Vec::new(),
             schema_version,
         })
@@ -194,25 +212,89 @@ impl Source for Sqlite3Reader {
                 return out;
             }
         };
-        let r = (|| -> Result<(), rusqlite::Error> {
-            let mut st = conn.prepare_cached(
-                "SELECT topic_id, timestamp, data FROM messages WHERE id >= ?1 AND id < ?2",
-            )?;
-            let mut rows = st.query(params![a, b])?;
-            while let Some(row) = rows.next()? {
-                let topic = row.get::<_, i64>(0)? as u32;
-                if !want(topic) {
-                    continue;
+        // Rows are read in id order; a damaged page ends the query, and the read resumes at
+        // the first id past it that SQLite can read (probed at doubling distances), so one
+        // bad page costs its own rows only. What was skipped is reported.
+        let mut stray: Option<(u64, u32)> = None;
+        let mut lo = a;
+        while lo < b {
+            let mut last: Option<i64> = None;
+            let r = (|| -> Result<(), String> {
+                let mut st = conn
+                    .prepare_cached(
+                        "SELECT id, topic_id, timestamp, data FROM messages WHERE id >= ?1 AND id < ?2",
+                    )
+                    .map_err(|e| format!("sqlite3: {e}"))?;
+                let mut rows = st
+                    .query(params![lo, b])
+                    .map_err(|e| format!("sqlite3: {e}"))?;
+                while let Some(row) = rows.next().map_err(|e| format!("sqlite3: {e}"))? {
+                    let id = row.get::<_, i64>(0).map_err(|e| format!("sqlite3: {e}"))?;
+                    // Ids come in increasing order inside the range; anything else is a
+                    // damaged b-tree (a loop would otherwise deliver rows forever).
+                    if id < lo || id >= b || last.is_some_and(|l| id <= l) {
+                        return Err(format!("damaged table: row id {id} out of order"));
+                    }
+                    last = Some(id);
+                    let fields = (|| -> Result<(), rusqlite::Error> {
+                        let topic = row.get::<_, i64>(1)? as u32;
+                        if !want(topic) {
+                            if !self.channels.iter().any(|c| c.id == topic) {
+                                // A row naming no topic of the table: its message is lost.
+                                let e = stray.get_or_insert((0u64, topic));
+                                e.0 += 1;
+                            }
+                            return Ok(());
+                        }
+                        let t = row.get::<_, i64>(2)?.max(0) as u64;
+                        let data = row.get_ref(3)?.as_blob()?;
+                        sink(topic, t, data);
+                        out.delivered += 1;
+                        Ok(())
+                    })();
+                    if let Err(e) = fields {
+                        out.skipped += 1;
+                        out.skip_reason
+                            .get_or_insert_with(|| format!("row {id}: sqlite3: {e}"));
+                    }
                 }
-                let t = row.get::<_, i64>(1)?.max(0) as u64;
-                let data = row.get_ref(2)?.as_blob()?;
-                sink(topic, t, data);
-                out.delivered += 1;
-            }
-            Ok(())
-        })();
-        if let Err(e) = r {
-            out.error = Some(format!("sqlite3: {e}"));
+                Ok(())
+            })();
+            let Err(e) = r else { break };
+            let from = last.map_or(lo, |l| l + 1);
+            let mut step = 1i64;
+            let resume = loop {
+                let at = from.saturating_add(step);
+                if at >= b {
+                    break None;
+                }
+                let ok: Result<Option<i64>, _> = conn
+                    .prepare_cached("SELECT id FROM messages WHERE id >= ?1 AND id < ?2 LIMIT 1")
+                    .and_then(|mut st| st.query_row(params![at, b], |r| r.get(0)).optional());
+                match ok {
+                    Ok(Some(id)) => break Some(id),
+                    Ok(None) => break None,
+                    Err(_) => step = step.saturating_mul(2),
+                }
+            };
+            let to = resume.unwrap_or(b);
+            out.lost.push(Loss::new(format!(
+                "message rows {from}..{} are unreadable ({e}) and were skipped",
+                to - 1
+            )));
+            lo = to;
+        }
+        if let Some((n, id)) = stray {
+            out.lost.push(Loss {
+                what: format!(
+                    "message rows {a}..{}: {n} row(s) name topic id {id}{}, which the topics table does not hold (damaged rows)",
+                    b - 1,
+                    if n > 1 { " or another" } else { "" }
+                ),
+                messages: Some(n),
+                span: None,
+                channel: None,
+            });
         }
         self.give(conn);
         out

@@ -1,42 +1,269 @@
-//! Atomic output files: written under a temporary name beside the target and renamed into
-//! place only when complete, so a failed or interrupted run never leaves a half-written file.
-//! Every crate of the workspace writes its outputs through here.
+//! Output files that never clobber what is not ours. Every crate of the workspace writes
+//! its outputs through here.
+//!
+//! * A regular file is written under a temporary name beside its target
+//!   (`.<name>.<pid>.<n>.tmp`) and renamed into place only when complete, so a failed or
+//!   interrupted run never leaves a half-written file. The temporary file is removed on
+//!   every error path, when dropped, and on SIGINT/SIGTERM (one handler, registered here).
+//! * A symlink is followed: its target is written, the link stays.
+//! * A target that exists and is not a regular file (`/dev/null`, `/dev/stdout`, a FIFO) is
+//!   written through, never replaced; a directory is refused.
+//! * An input of the run ([`protect_input`]) is never an output (same device and inode).
+//! * [`Staging`]: a run that writes several files commits them together, all or none.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::Error;
 
-/// A file being written under a temporary name; [`AtomicFile::commit`] renames it into place.
-/// Dropped without a commit, the temporary file is removed.
-pub struct AtomicFile {
+/// Temporary paths alive in this process (files or directories), removed on SIGINT/SIGTERM.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Inputs of this run, as (device, inode, path).
+static INPUTS: Mutex<Vec<(u64, u64, PathBuf)>> = Mutex::new(Vec::new());
+/// When a [`Staging`] is active: the `(temporary, target)` pairs waiting for its commit.
+static STAGED: Mutex<Option<Vec<(PathBuf, PathBuf)>>> = Mutex::new(None);
+/// Makes temporary names unique within the process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Installs, once, the SIGINT/SIGTERM handler that removes every live temporary path and
+/// then exits with the conventional status (130, 143).
+fn install_signal_cleanup() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+            return;
+        };
+        std::thread::spawn(move || {
+            if let Some(sig) = signals.forever().next() {
+                for p in lock(&LIVE).drain(..) {
+                    if p.is_dir() {
+                        let _ = std::fs::remove_dir_all(&p);
+                    } else {
+                        let _ = std::fs::remove_file(&p);
+                    }
+                }
+                std::process::exit(128 + sig);
+            }
+        });
+    });
+}
+
+fn register(p: &Path) {
+    install_signal_cleanup();
+    lock(&LIVE).push(p.to_path_buf());
+}
+
+fn unregister(p: &Path) {
+    lock(&LIVE).retain(|x| x != p);
+}
+
+/// Declares `path` an input of this run: no output may be it (nor, for a directory, one of
+/// the files in it).
+pub fn protect_input(path: &Path) {
+    let mut v = lock(&INPUTS);
+    let mut add = |p: &Path| {
+        if let Ok(m) = std::fs::metadata(p) {
+            v.push((m.dev(), m.ino(), p.to_path_buf()));
+        }
+    };
+    add(path);
+    if path.is_dir()
+        && let Ok(rd) = std::fs::read_dir(path)
+    {
+        for e in rd.flatten() {
+            add(&e.path());
+        }
+    }
+}
+
+/// A plain description of an OS error: no "(os error N)", and the usual causes named the
+/// way a person reads them.
+pub fn describe(e: &std::io::Error) -> String {
+    use std::io::ErrorKind as K;
+    match e.kind() {
+        K::NotFound => "no such file or directory".into(),
+        K::PermissionDenied => "permission denied".into(),
+        K::AlreadyExists => "a file is in the way (it already exists)".into(),
+        K::IsADirectory => "it is a directory".into(),
+        K::NotADirectory => "a component of the path is not a directory".into(),
+        K::StorageFull => "no space left on the device".into(),
+        K::ReadOnlyFilesystem => "the file system is read-only".into(),
+        K::DirectoryNotEmpty => "a directory that is not empty is in the way".into(),
+        _ => {
+            let s = e.to_string();
+            match s.find(" (os error") {
+                Some(i) => s[..i].to_string(),
+                None => s,
+            }
+        }
+    }
+}
+
+/// The file a path names once its symlinks are followed (a dangling link names its target).
+fn resolve(target: &Path) -> PathBuf {
+    let mut p = target.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => match std::fs::read_link(&p) {
+                Ok(to) if to.is_absolute() => p = to,
+                Ok(to) => {
+                    p = p.parent().map(|d| d.join(&to)).unwrap_or(to);
+                }
+                Err(_) => return p,
+            },
+            _ => return p,
+        }
+    }
+    p
+}
+
+/// Refuses an output that is an input of the run.
+fn check_not_input(target: &Path, real: &Path) -> Result<(), Error> {
+    let Ok(m) = std::fs::metadata(real) else {
+        return Ok(());
+    };
+    for (dev, ino, input) in lock(&INPUTS).iter() {
+        if m.dev() == *dev && m.ino() == *ino {
+            return Err(Error::Output {
+                path: target.to_path_buf(),
+                what: format!(
+                    "it is the input {} (choose another output; the input is never overwritten)",
+                    input.display()
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A temporary path beside its target that is renamed into place on commit (or staged, when
+/// a [`Staging`] is active), and removed otherwise.
+pub struct TempPath {
     tmp: PathBuf,
+    target: PathBuf,
+    done: bool,
+}
+
+impl TempPath {
+    /// A fresh `.<name>.<pid>.<n><suffix>` beside `target` (after its symlinks), registered
+    /// for removal on SIGINT/SIGTERM. Nothing is created.
+    pub fn beside(target: &Path, suffix: &str) -> Result<TempPath, Error> {
+        let real = resolve(target);
+        check_not_input(target, &real)?;
+        if real.is_dir() {
+            return Err(Error::Output {
+                path: target.to_path_buf(),
+                what: "it is a directory (name a file)".into(),
+            });
+        }
+        let dir = match real.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = real.file_name().ok_or_else(|| Error::Output {
+            path: target.to_path_buf(),
+            what: "the path has no file name".into(),
+        })?;
+        let tmp = dir.join(format!(
+            ".{}.{}.{}{suffix}",
+            name.to_string_lossy(),
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        register(&tmp);
+        Ok(TempPath {
+            tmp,
+            target: real,
+            done: false,
+        })
+    }
+
+    /// Where to write now.
+    pub fn path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Renames the temporary path into place, or hands it to the active [`Staging`]. On
+    /// failure the temporary path is removed and the error names the target.
+    pub fn commit(mut self) -> Result<(), Error> {
+        self.done = true;
+        if let Some(staged) = lock(&STAGED).as_mut() {
+            staged.push((self.tmp.clone(), self.target.clone()));
+            return Ok(());
+        }
+        let r = std::fs::rename(&self.tmp, &self.target);
+        if r.is_err() {
+            remove(&self.tmp);
+        }
+        unregister(&self.tmp);
+        r.map_err(|e| Error::io(&self.target, e))
+    }
+}
+
+fn remove(p: &Path) {
+    if p.is_dir() {
+        let _ = std::fs::remove_dir_all(p);
+    } else {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+impl Drop for TempPath {
+    fn drop(&mut self) {
+        if !self.done {
+            remove(&self.tmp);
+            unregister(&self.tmp);
+        }
+    }
+}
+
+/// Where an [`AtomicFile`] writes.
+enum Dest {
+    /// A temporary file renamed into place on commit.
+    Temp(TempPath),
+    /// An existing non-regular file (device, FIFO), written directly.
+    Through,
+}
+
+/// A file being written; [`AtomicFile::commit`] puts it in place. Dropped without a commit,
+/// nothing is left behind.
+pub struct AtomicFile {
+    dest: Dest,
     target: PathBuf,
     file: Option<BufWriter<File>>,
 }
 
 impl AtomicFile {
-    /// Creates `.<name>.<pid>.tmp` in the target's directory.
+    /// Starts writing `target` (see the module doc for symlinks, devices and inputs).
     pub fn create(target: &Path) -> Result<AtomicFile, Error> {
-        let dir = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
+        check_not_input(target, target)?;
+        // Devices and FIFOs (also behind /dev/stdout's links into /proc) are opened as named.
+        let through = std::fs::metadata(target)
+            .map(|m| !m.is_file() && !m.is_dir())
+            .unwrap_or(false);
+        let (dest, file) = if through {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .truncate(true)
+                .open(target)
+                .map_err(|e| Error::io(target, e))?;
+            (Dest::Through, f)
+        } else {
+            let t = TempPath::beside(target, ".tmp")?;
+            let f = File::create(t.path()).map_err(|e| Error::io(target, e))?;
+            (Dest::Temp(t), f)
         };
-        let name = target.file_name().ok_or_else(|| {
-            Error::io(
-                target,
-                std::io::Error::other("output path has no file name"),
-            )
-        })?;
-        let tmp = dir.join(format!(
-            ".{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let file = File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         Ok(AtomicFile {
-            tmp,
+            dest,
             target: target.to_path_buf(),
             file: Some(BufWriter::with_capacity(1 << 20, file)),
         })
@@ -47,29 +274,24 @@ impl AtomicFile {
         self.file.as_mut().expect("AtomicFile used after commit")
     }
 
-    /// The final path.
+    /// The final path, as given.
     pub fn target(&self) -> &Path {
         &self.target
     }
 
-    /// Flushes and renames the file into place. The rename is atomic: readers see the old
-    /// file or the whole new one. There is no fsync: the guarantee is against failed or
-    /// interrupted runs, not power loss, and an fsync of a 1 GB bag would double its cost.
+    /// Flushes and puts the file in place. The rename is atomic: readers see the old file or
+    /// the whole new one. There is no fsync: the guarantee is against failed or interrupted
+    /// runs, not power loss, and an fsync of a 1 GB bag would double its cost. On any error
+    /// the temporary file is removed.
     pub fn commit(mut self) -> Result<(), Error> {
         let file = self.file.take().expect("AtomicFile committed twice");
-        let file = file
+        let flushed = file
             .into_inner()
-            .map_err(|e| Error::io(&self.tmp, e.into_error()))?;
-        drop(file);
-        std::fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))
-    }
-}
-
-impl Drop for AtomicFile {
-    fn drop(&mut self) {
-        if self.file.is_some() {
-            self.file = None;
-            let _ = std::fs::remove_file(&self.tmp);
+            .map_err(|e| Error::io(&self.target, e.into_error()));
+        drop(flushed?);
+        match std::mem::replace(&mut self.dest, Dest::Through) {
+            Dest::Temp(t) => t.commit(),
+            Dest::Through => Ok(()),
         }
     }
 }
@@ -84,55 +306,82 @@ where
     f.commit()
 }
 
-/// A directory being filled under a temporary name beside the target (`.<name>.<pid>.tmp`);
-/// [`AtomicDir::commit`] renames it into place. Dropped without a commit, it is removed
-/// with everything in it. The target must not exist (a bag directory is never merged into
-/// or replaced, as `ros2 bag record` refuses an existing one).
+/// Several outputs committed together: while a `Staging` is active, every commit of this
+/// module (files, plots, directories) only stages its temporary path; [`Staging::commit`]
+/// renames them all, and dropping it uncommitted removes them all. A run that fails half
+/// way therefore leaves none of its outputs, and never a mix of old and new ones.
+pub struct Staging {
+    done: bool,
+}
+
+impl Staging {
+    /// Starts staging (one at a time per process).
+    pub fn begin() -> Staging {
+        *lock(&STAGED) = Some(Vec::new());
+        Staging { done: false }
+    }
+
+    /// Renames every staged output into place. If a rename fails, the outputs not yet
+    /// renamed are removed and the error names the first that failed.
+    pub fn commit(mut self) -> Result<(), Error> {
+        self.done = true;
+        let staged = lock(&STAGED).take().unwrap_or_default();
+        let mut err = None;
+        for (tmp, target) in staged {
+            if err.is_none()
+                && let Err(e) = std::fs::rename(&tmp, &target)
+            {
+                err = Some(Error::io(&target, e));
+            }
+            if err.is_some() {
+                remove(&tmp);
+            }
+            unregister(&tmp);
+        }
+        err.map_or(Ok(()), Err)
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.done {
+            for (tmp, _) in lock(&STAGED).take().unwrap_or_default() {
+                remove(&tmp);
+                unregister(&tmp);
+            }
+        }
+    }
+}
+
+/// A directory being filled under a temporary name beside the target; [`AtomicDir::commit`]
+/// renames it into place. Dropped without a commit, it is removed with everything in it.
+/// The target must not exist (a bag directory is never merged into or replaced, as
+/// `ros2 bag record` refuses an existing one).
 pub struct AtomicDir {
-    tmp: PathBuf,
+    tmp: TempPath,
     target: PathBuf,
-    committed: bool,
 }
 
 impl AtomicDir {
     /// Creates the temporary directory; fails when `target` already exists.
     pub fn create(target: &Path) -> Result<AtomicDir, Error> {
         if target.exists() {
-            return Err(Error::io(
-                target,
-                std::io::Error::new(
-                    std::io::ErrorKind::AlreadyExists,
-                    "already exists (remove it or choose another output)",
-                ),
-            ));
+            return Err(Error::Output {
+                path: target.to_path_buf(),
+                what: "it already exists (remove it or choose another output)".into(),
+            });
         }
-        let dir = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = target.file_name().ok_or_else(|| {
-            Error::io(
-                target,
-                std::io::Error::other("output path has no file name"),
-            )
-        })?;
-        let tmp = dir.join(format!(
-            ".{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&tmp);
-        std::fs::create_dir(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let tmp = TempPath::beside(target, ".tmp")?;
+        std::fs::create_dir(tmp.path()).map_err(|e| Error::io(target, e))?;
         Ok(AtomicDir {
             tmp,
             target: target.to_path_buf(),
-            committed: false,
         })
     }
 
     /// Where to write the files now.
     pub fn path(&self) -> &Path {
-        &self.tmp
+        self.tmp.path()
     }
 
     /// The final path.
@@ -141,18 +390,8 @@ impl AtomicDir {
     }
 
     /// Renames the directory into place.
-    pub fn commit(mut self) -> Result<(), Error> {
-        std::fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for AtomicDir {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_dir_all(&self.tmp);
-        }
+    pub fn commit(self) -> Result<(), Error> {
+        self.tmp.commit()
     }
 }
 
@@ -160,8 +399,21 @@ impl Drop for AtomicDir {
 mod tests {
     use super::*;
 
+    /// Staging is process-wide: the tests that write files take turns.
+    static SERIAL: Mutex<()> = Mutex::new(());
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
     #[test]
     fn failed_write_leaves_nothing_behind() {
+        let _turn = lock(&SERIAL);
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.txt");
         let r = write_atomic(&target, |w| {
@@ -169,9 +421,48 @@ mod tests {
             Err(std::io::Error::other("boom"))
         });
         assert!(r.is_err());
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        assert!(names(dir.path()).is_empty());
         write_atomic(&target, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert_eq!(names(dir.path()), vec!["out.txt"]);
+    }
+
+    #[test]
+    fn symlinks_are_followed_and_devices_written_through() {
+        let _turn = lock(&SERIAL);
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.txt");
+        std::fs::write(&real, b"old").unwrap();
+        let link = dir.path().join("link.txt");
+        std::os::unix::fs::symlink("real.txt", &link).unwrap();
+        write_atomic(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        write_atomic(Path::new("/dev/null"), |w| w.write_all(b"x")).unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+    }
+
+    #[test]
+    fn staging_commits_all_or_none() {
+        let _turn = lock(&SERIAL);
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        {
+            let _s = Staging::begin();
+            write_atomic(&a, |w| w.write_all(b"a")).unwrap();
+            write_atomic(&b, |w| w.write_all(b"b")).unwrap();
+            assert!(!a.exists() && !b.exists());
+        }
+        assert!(names(dir.path()).is_empty(), "dropped staging left files");
+        let s = Staging::begin();
+        write_atomic(&a, |w| w.write_all(b"a")).unwrap();
+        write_atomic(&b, |w| w.write_all(b"b")).unwrap();
+        s.commit().unwrap();
+        assert_eq!(names(dir.path()), vec!["a", "b"]);
     }
 }

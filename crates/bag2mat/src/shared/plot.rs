@@ -72,8 +72,9 @@ pub fn write_png_svg(
 }
 
 /// Draws a PNG atomically. plotters' bitmap backend writes to a path and picks the encoder
-/// from the extension, so `draw` paints into a temporary `.png` beside `target`, which is
-/// renamed into place only after a successful encode (and removed otherwise).
+/// from the extension, so `draw` paints into a temporary `.png` beside `target`
+/// ([`crate::shared::output::TempPath`]), which is put in place only after a successful
+/// encode (and removed otherwise, on a signal too).
 pub fn png_atomic<F>(
     target: &std::path::Path,
     size: (u32, u32),
@@ -86,22 +87,11 @@ where
 {
     use plotters::prelude::{BitMapBackend, IntoDrawingArea};
     register_font();
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = target.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
+    let tmp = crate::shared::output::TempPath::beside(target, ".tmp.png")?;
     let plot_err = |what: String| crate::Error::Plot {
         path: target.to_path_buf(),
         what,
     };
-    let result = draw(BitMapBackend::new(&tmp, size).into_drawing_area());
-    if let Err(what) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(plot_err(what));
-    }
-    std::fs::rename(&tmp, target).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        crate::Error::io(target, e)
-    })
+    draw(BitMapBackend::new(tmp.path(), size).into_drawing_area()).map_err(plot_err)?;
+    tmp.commit()
 }

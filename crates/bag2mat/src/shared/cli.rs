@@ -1,0 +1,81 @@
+//! How every binary of the workspace ends: one convention for all four tools.
+//!
+//! * A failure prints `<tool>: error: <what>: <cause>` once on stderr and exits with 1.
+//! * A usage error (what the user typed cannot be run) prints `<tool>: error: <what>`, the
+//!   usage lines, and exits with 2.
+//! * Warnings are `warning: <what>` lines; `--quiet` keeps only errors and warnings.
+//!
+//! The argument parser stays in each binary; these helpers take its rendered text.
+
+use std::process::ExitCode;
+
+/// Exit status of a run that failed.
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit status of a command line that cannot be run.
+pub const EXIT_USAGE: u8 = 2;
+
+/// Prints a failure the one way, and returns exit status 1.
+pub fn fail(tool: &str, what: &dyn std::fmt::Display) -> ExitCode {
+    eprintln!("{tool}: error: {what}");
+    ExitCode::from(EXIT_FAILURE)
+}
+
+/// Prints a usage error (`rendered` is the parser's message, which may start with
+/// `error: ` and carry usage lines after it) and returns exit status 2.
+pub fn usage(tool: &str, rendered: &str) -> ExitCode {
+    let text = rendered.trim_end();
+    let text = text.strip_prefix("error: ").unwrap_or(text);
+    eprintln!("{tool}: error: {text}");
+    ExitCode::from(EXIT_USAGE)
+}
+
+/// A value parser for numbers that must be finite and positive: "must be positive" (not
+/// the parser's "unexpected argument '-1'", which the binaries avoid by accepting negative
+/// numbers as values).
+pub fn positive_f64(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))?;
+    if !v.is_finite() || v <= 0.0 {
+        return Err(format!("{s} must be positive (and finite)"));
+    }
+    Ok(v)
+}
+
+/// Text from a file (a topic name, a type) made safe to print: control characters are
+/// escaped, so a damaged or hostile name cannot move the cursor or clear the terminal.
+pub fn escape(s: &str) -> String {
+    if !s.chars().any(|c| c.is_control()) {
+        return s.to_string();
+    }
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positive_and_escape() {
+        assert_eq!(positive_f64("200"), Ok(200.0));
+        assert!(positive_f64("-1").unwrap_err().contains("must be positive"));
+        assert!(positive_f64("0").unwrap_err().contains("must be positive"));
+        assert!(
+            positive_f64("nan")
+                .unwrap_err()
+                .contains("must be positive")
+        );
+        assert!(positive_f64("abc").unwrap_err().contains("not a number"));
+        assert_eq!(escape("/imu"), "/imu");
+        assert_eq!(escape("/i\x1b[2Jmu\n"), "/i\\u{1b}[2Jmu\\n");
+    }
+}
