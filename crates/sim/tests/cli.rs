@@ -79,7 +79,7 @@ fn default_bag_content_matches_the_seed_run() {
     )
     .unwrap();
     let n = sim::bag_sim::message_count(200.0, 60.0);
-    assert_eq!(s.acc.len() as u64, n, "message count");
+    assert_eq!(s.len() as u64, n, "message count");
     assert_eq!(s.topic, "imu");
     // Oracle: replay the noise model with the same seed (static: gyro 0, acc (0, 0, 9.81)).
     let mut g = NoiseGenerator::new(
@@ -88,7 +88,7 @@ fn default_bag_content_matches_the_seed_run() {
     );
     let start_ns: u64 = START.parse::<u64>().unwrap() * 1_000_000_000;
     let mut t = 0.0f64;
-    for i in 0..s.acc.len() {
+    for i in 0..s.len() {
         let (mut w, mut a) = ([0.0; 3], [0.0, 0.0, 9.81]);
         g.apply(&mut w, &mut a);
         assert_eq!(s.gyro_at(i), w, "gyro of message {i}");
@@ -246,7 +246,7 @@ fn spline_self_check_passes_and_from_model_writes_bag_and_text() {
         &ReadOptions { quiet: true },
     )
     .unwrap();
-    assert_eq!(s.acc.len(), 4001);
+    assert_eq!(s.len(), 4001);
     assert_eq!(
         std::fs::read_to_string(d.path().join("s/imu_pose.txt"))
             .unwrap()
