@@ -657,7 +657,7 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
     let region = region::read(&region_pts);
 
     let terms = match (&fitted, verdict.fits()) {
-        (Some(f), true) => make_terms(f, &fd, cfg),
+        (Some(f), true) => make_terms(f, &fd, &curve, cfg),
         _ => Terms {
             q: Term::not_fitted(),
             n: Term::from_reading(region.n),
@@ -852,7 +852,22 @@ fn fit_and_check(
     Some((f, misses, max_mis))
 }
 
-fn make_terms(f: &fit::FitResult, fd: &fit::FitData, cfg: &Config) -> Terms {
+/// The largest coefficient of term `j` the fitted points allow on their own: its Allan
+/// variance may nowhere exceed the curve's upper 95 % bound (every term adds to the curve).
+/// The upper bound of a term the fit left at zero whose interval says nothing (0 or ∞).
+fn data_bound(j: usize, f: &fit::FitResult, fd: &fit::FitData, curve: &[Point]) -> f64 {
+    f.used
+        .iter()
+        .filter_map(|&i| {
+            let fp = &fd.points[i];
+            let hi95 = curve.iter().find(|c| c.m == fp.m)?.hi95;
+            let b = fit::basis_at(j, fp.tau, &f.shapes);
+            (hi95.is_finite() && b > 0.0).then(|| hi95 * hi95 / b)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Config) -> Terms {
     let z = z_of(cfg.term_confidence);
     let have_stats = fd.basis.is_some();
     let one = |j: usize| -> Term {
@@ -869,7 +884,7 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, cfg: &Config) -> Terms {
         if f.left_out[j] || c <= 0.0 {
             // left out by the selection, at its bound, or the 1/τ² coefficient negative
             // (the low-pass correction, not a quantization): 0 with the upper bound
-            let hi = if f.left_out[j] {
+            let mut hi = if f.left_out[j] {
                 (z * se_c).sqrt()
             } else {
                 fit::inverted_interval(fd, f, &cfg.fit, j, z)
@@ -877,6 +892,12 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, cfg: &Config) -> Terms {
                     .max(0.0)
                     .sqrt()
             };
+            if !(hi > 0.0 && hi.is_finite()) {
+                // The fit's own error says nothing here (a term left out where the full fit
+                // had it at its bound has no standard error; an interval the data do not
+                // close is ∞): bound the term by the curve itself, never "< 0".
+                hi = data_bound(j, f, fd, curve).sqrt();
+            }
             return Term {
                 value: 0.0,
                 std_err: f64::NAN,
