@@ -325,6 +325,8 @@ struct ChildRun {
     signal: Option<i32>,
     timed_out: bool,
     stderr: String,
+    /// Wall time of the child.
+    elapsed: Duration,
 }
 
 fn run_child(bin: &Path, input: &Path, out: &Path) -> ChildRun {
@@ -378,6 +380,7 @@ fn run_child(bin: &Path, input: &Path, out: &Path) -> ChildRun {
         signal: status.signal(),
         timed_out,
         stderr: reader.join().unwrap_or_default(),
+        elapsed: start.elapsed(),
     }
 }
 
@@ -514,6 +517,8 @@ struct Tally {
     warned: usize,
     error: usize,
     failed: usize,
+    /// The slowest variant: (seconds, variant, what was done to it).
+    slowest: Option<(f64, usize, String)>,
 }
 
 fn main() {
@@ -628,6 +633,10 @@ fn main() {
                             println!("{} {v} {what}: {outcome:?}: {first}", f.name());
                         }
                         let mut t = tally.lock().expect("tally");
+                        let secs = r.elapsed.as_secs_f64();
+                        if t.slowest.as_ref().is_none_or(|(s, _, _)| secs > *s) {
+                            t.slowest = Some((secs, v, what.clone()));
+                        }
                         match outcome {
                             Ok(Outcome::Clean) => t.clean += 1,
                             Ok(Outcome::Altered) => t.altered += 1,
@@ -645,14 +654,18 @@ fn main() {
         let t = tally.into_inner().expect("tally");
         failures += t.failed;
         println!(
-            "{}: {variants} variants in {:.1} s: {} clean, {} altered values, {} warned, {} errors, {} FAILED",
+            "{}: {variants} variants in {:.1} s: {} clean, {} altered values, {} warned, {} errors, {} FAILED; slowest {}",
             f.name(),
             t0.elapsed().as_secs_f64(),
             t.clean,
             t.altered,
             t.warned,
             t.error,
-            t.failed
+            t.failed,
+            t.slowest
+                .as_ref()
+                .map(|(s, v, w)| format!("{s:.2} s (variant {v}: {w})"))
+                .unwrap_or_default()
         );
         summary.push(format!(
             "{} {}/{}/{}/{}/{}",
