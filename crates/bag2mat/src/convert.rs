@@ -219,9 +219,12 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
     if out == Path::new(STDOUT) {
         let stdout = std::io::stdout();
         let mut w = std::io::BufWriter::with_capacity(1 << 20, stdout.lock());
-        return encode(&mut w, data, format)
-            .and_then(|_| w.flush())
-            .map_err(|e| Error::io("standard output", e));
+        return match encode(&mut w, data, format).and_then(|_| w.flush()) {
+            // The reader stopped reading (`bag2mat … -o - | head`): not an error, as for
+            // every Unix filter.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+            r => r.map_err(|e| Error::io("standard output", e)),
+        };
     }
     write_atomic(out, |w| encode(w, data, format))
 }

@@ -447,6 +447,32 @@ fn defect_06_outputs_write_through_devices_and_links() {
     assert_eq!(std::fs::read(&real).unwrap(), want);
 }
 
+/// `bag2mat … -o - | head`: a reader that stops early is not an error (no "Broken pipe"
+/// message, exit 0), as for every Unix filter.
+#[test]
+fn stdout_closed_by_the_reader_is_not_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("big.bag");
+    // 20 000 rows of csv (~2 MB): far more than a pipe buffer holds.
+    write_synthetic(&bag, "imu", 20_000, Compression::None, false);
+    let mut child = bag2mat()
+        .arg(&bag)
+        .arg("imu")
+        .args(["-o", "-", "--format", "csv", "-q"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Read one line, then close the pipe.
+    let mut first = [0u8; 16];
+    std::io::Read::read_exact(child.stdout.as_mut().unwrap(), &mut first).unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}: {err}", out.status);
+    assert!(!err.contains("error"), "{err}");
+}
+
 #[test]
 fn defect_07_the_input_is_never_overwritten() {
     let dir = tempfile::tempdir().unwrap();
