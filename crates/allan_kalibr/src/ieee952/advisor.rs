@@ -86,7 +86,10 @@ pub fn duration_text(s: f64) -> String {
     if !s.is_finite() {
         return "-".into();
     }
-    if s < 120.0 {
+    if s < 1.0 {
+        // a second of data already gives that precision ("0 s" read as nothing)
+        "< 1 s".into()
+    } else if s < 120.0 {
         format!("{s:.0} s")
     } else if s < 7200.0 {
         format!("{:.0} min", s / 60.0)
@@ -123,5 +126,6 @@ mod tests {
         assert!(u.precision.is_nan() && u.record_10.is_nan());
         assert_eq!(duration_text(14_400.0), "4.0 h");
         assert_eq!(duration_text(90.0), "90 s");
+        assert_eq!(duration_text(0.4), "< 1 s");
     }
 }
