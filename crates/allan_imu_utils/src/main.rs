@@ -1,7 +1,6 @@
 //! `allan_imu_utils BAG [--topic imu] [--name imu] [--data-save-path DIR] [--max-time-min 120]
 //! [--max-cluster 100] [--launch FILE.launch]`: imu_utils without ROS.
 
-use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -44,12 +43,8 @@ fn main() -> ExitCode {
                 eprintln!("{note}");
             }
         }
-        let mut out = std::io::stdout().lock();
-        if let Err(e) = out
-            .write_all(o.stdout.as_bytes())
-            .and_then(|_| out.write_all(o.ieee952_text.as_bytes()))
-        {
-            return cli::fail(TOOL, &format!("standard output: {e}"));
+        if let Err(e) = cli::print(&(o.stdout + &o.ieee952_text)) {
+            return cli::fail(TOOL, &e);
         }
         return ExitCode::SUCCESS;
     }
@@ -61,7 +56,7 @@ fn main() -> ExitCode {
         return cli::fail(TOOL, &e);
     }
     let several = outcomes.len() > 1;
-    let mut out = std::io::stdout().lock();
+    let mut printing = true;
     for outcome in &outcomes {
         let mut text = String::new();
         if several {
@@ -78,8 +73,11 @@ fn main() -> ExitCode {
         if let Some(t) = &outcome.ieee952_text {
             text.push_str(t);
         }
-        if let Err(e) = out.write_all(text.as_bytes()) {
-            return cli::fail(TOOL, &format!("standard output: {e}"));
+        if printing {
+            match cli::print(&text) {
+                Ok(more) => printing = more,
+                Err(e) => return cli::fail(TOOL, &e),
+            }
         }
         if config.timings {
             for (phase, d) in &outcome.timings {

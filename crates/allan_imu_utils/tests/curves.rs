@@ -128,3 +128,26 @@ fn curves_of_an_unknown_format_is_a_clear_error() {
         "no outputs on error"
     );
 }
+
+/// `allan_imu_utils … | head`: a reader that closed the pipe is not an error (it printed
+/// "standard output: Broken pipe (os error 32)" and exited 1).
+#[test]
+fn stdout_closed_by_the_reader_is_not_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let src = real("BMI160");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_allan_imu_utils"))
+        .args(["--curves", src.to_str().unwrap(), "--name", "BMI160", "-q"])
+        .arg("--data-save-path")
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run allan_imu_utils");
+    // The reader goes away before a byte is written.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "exit {:?}: {err}", o.status);
+    assert!(!err.contains("error"), "{err}");
+}

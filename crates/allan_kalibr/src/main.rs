@@ -37,7 +37,9 @@ fn main() -> ExitCode {
         if let Err(e) = staging.commit() {
             return cli::fail(TOOL, &e);
         }
-        print!("{}", out.text);
+        if let Err(e) = cli::print(&out.text) {
+            return cli::fail(TOOL, &e);
+        }
         if !config.quiet {
             for p in &out.written {
                 eprintln!("wrote {}", p.display());
@@ -53,9 +55,14 @@ fn main() -> ExitCode {
         return cli::fail(TOOL, &e);
     }
     let several = outs.len() > 1;
+    let mut printing = true;
     for out in &outs {
+        let mut text = String::new();
         if several {
-            println!("===== topic {} =====", out.topic.as_deref().unwrap_or("?"));
+            text.push_str(&format!(
+                "===== topic {} =====\n",
+                out.topic.as_deref().unwrap_or("?")
+            ));
         }
         for n in &out.notes {
             // Warnings always; other notes (the estimated rate) only without --quiet.
@@ -63,9 +70,15 @@ fn main() -> ExitCode {
                 eprintln!("{n}");
             }
         }
-        print!("{}", out.text);
+        text.push_str(&out.text);
         if let Some(t) = &out.ieee952_text {
-            print!("{t}");
+            text.push_str(t);
+        }
+        if printing {
+            match cli::print(&text) {
+                Ok(more) => printing = more,
+                Err(e) => return cli::fail(TOOL, &e),
+            }
         }
         if !config.quiet {
             for p in &out.written {
