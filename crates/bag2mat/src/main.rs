@@ -91,9 +91,15 @@ fn main() -> ExitCode {
         Err(e) => return cli::usage(TOOL, &e.render().to_string()),
     };
     let result = match a.command {
-        Some(Command::Info { bag, quiet }) => bag2mat::info::info(&bag, quiet).map(|r| {
-            print!("{}", r.text(&bag));
-        }),
+        Some(Command::Info { bag, quiet }) => match bag2mat::info::info(&bag, quiet) {
+            Ok(r) => {
+                if let Err(e) = cli::print(&r.text(&bag)) {
+                    return cli::fail(TOOL, &e);
+                }
+                Ok(())
+            }
+            Err(e) => Err(e),
+        },
         None => {
             let Some(bag) = a.bag else {
                 return cli::usage(

@@ -106,3 +106,31 @@ fn bad_inputs_fail_cleanly() {
         "{err}"
     );
 }
+
+/// A standard output that fails (a full disk: /dev/full) is an error in the one convention,
+/// exit 1, never a panic (`bag2mat info` panicked "failed printing to stdout").
+#[test]
+fn a_failing_standard_output_is_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("s.bag");
+    write_synthetic(&bag, "imu", 300, Compression::None, false);
+    for args in [vec!["info"], vec![]] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full");
+        let mut cmd = bag2mat();
+        cmd.args(&args).arg(&bag);
+        if args.is_empty() {
+            cmd.args(["imu", "-o", "-", "--format", "csv", "-q"]);
+        }
+        let o = cmd.stdout(full).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("bag2mat: error: standard output:"),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}

@@ -96,30 +96,30 @@ pub struct CompareConfig {
     pub check: bool,
 }
 
-/// `sim compare`: prints and writes the tables; with `check`, prints every failed
-/// assertion on stderr. Returns false when a check failed.
-pub fn run(cfg: &CompareConfig) -> Result<bool> {
+/// `sim compare`: writes the tables and plots; with `check`, prints every failed assertion
+/// on stderr. Returns what goes to standard output (the tables, and the checks' count) and
+/// false when a check failed.
+pub fn run(cfg: &CompareConfig) -> Result<(String, bool)> {
     let c = compare(cfg)?;
     let md = markdown(&c);
-    print!("{md}");
     bag2mat::shared::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
     eprintln!("wrote {}", cfg.output.display());
     for f in crate::compare_plot::plot(cfg)? {
         eprintln!("wrote {}", f.display());
     }
     if !cfg.check {
-        return Ok(true);
+        return Ok((md, true));
     }
     let (checked, failures) = check(&c);
     for f in &failures {
         eprintln!("check failed: {f}");
     }
-    println!(
-        "comparison checks: {} passed, {} failed",
+    let text = format!(
+        "{md}comparison checks: {} passed, {} failed\n",
         checked - failures.len(),
         failures.len()
     );
-    Ok(failures.is_empty())
+    Ok((text, failures.is_empty()))
 }
 
 /// The preset's name as used in folder names.

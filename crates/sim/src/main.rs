@@ -30,6 +30,14 @@ fn main() -> ExitCode {
     }
 }
 
+/// Standard output through the workspace's one writer: a closed pipe (`| head`) ends the
+/// printing quietly; a failed write is an error, not a panic.
+fn out(text: &str) -> anyhow::Result<()> {
+    bag2mat::shared::cli::print(text)
+        .map(|_| ())
+        .map_err(anyhow::Error::msg)
+}
+
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Bag(a) => {
@@ -70,29 +78,31 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Integrate(a) => {
             let cfg = sim::integrate::IntegrateConfig::try_from(a)?;
             let (table, files) = sim::integrate::run(&cfg)?;
-            print!("{}", sim::integrate::format_table(&table));
+            out(&sim::integrate::format_table(&table))?;
             for f in files {
                 eprintln!("wrote {}", f.display());
             }
         }
         Command::Compare(a) => {
             let cfg = sim::compare::CompareConfig::try_from(a)?;
-            if !sim::compare::run(&cfg)? {
+            let (text, pass) = sim::compare::run(&cfg)?;
+            out(&text)?;
+            if !pass {
                 return Ok(ExitCode::FAILURE);
             }
         }
         Command::Sensors(a) => {
             if a.spec_example {
-                print!("{}", sim::cli_model::SPEC_EXAMPLE);
+                out(sim::cli_model::SPEC_EXAMPLE)?;
             } else {
                 sim::bag_sim::validate_rate(a.rate)?;
-                print!("{}", sim::noise::profiles::listing(a.rate));
+                out(&sim::noise::profiles::listing(a.rate))?;
             }
         }
         Command::Spline(a) => {
             if a.self_check {
                 let (text, pass) = sim::report::spline_self_check(a.pose_rate)?;
-                print!("{text}");
+                out(&text)?;
                 return Ok(if pass {
                     ExitCode::SUCCESS
                 } else {
@@ -104,7 +114,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 eprintln!("{}", n.describe(cfg.rate));
             }
             let s = sim::spline_sim::run(&cfg)?;
-            print!("{}", sim::report::spline_summary(&s));
+            out(&sim::report::spline_summary(&s))?;
         }
     }
     Ok(ExitCode::SUCCESS)

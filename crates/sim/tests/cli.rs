@@ -397,3 +397,22 @@ fn defect_08_sigterm_and_sigint_remove_temp_files() {
         assert!(!d.path().join("long.bag").exists());
     }
 }
+
+/// A standard output that fails (a full disk: /dev/full) is an error in the one convention,
+/// exit 1, never a panic (it panicked "failed printing to stdout").
+#[test]
+fn a_failing_standard_output_is_an_error_not_a_panic() {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .expect("/dev/full");
+    let o = crate::util::sim()
+        .args(["sensors"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.starts_with("sim: error: standard output:"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
