@@ -342,6 +342,9 @@ pub fn second_diff_sums(x: &[f64], ms: &[usize]) -> Vec<f64> {
         .zip(ms)
         .zip(cnt.iter().zip(&full))
         .map(|((acc, &m), (&c, &f))| {
+            if c == 0 {
+                return 0.0; // no term (n ≤ 2m), as second_diff_sum says
+            }
             lanes_finish(acc, &x[f..c], &x[f + m..c + m], &x[f + 2 * m..c + 2 * m])
         })
         .collect()
