@@ -88,8 +88,13 @@ impl Collected<'_> {
     }
 
     /// The pushed gyro values of axis `k` (0–2) in rad/s, as the bag holds them.
-    pub fn gyro_rad_s(&self, k: usize) -> Vec<f64> {
-        self.series.gyro[k][self.used()].to_vec()
+    pub fn gyro_rad_s(&self, k: usize) -> &[f64] {
+        &self.series.gyro[k][self.used()]
+    }
+
+    /// The pushed accelerations of axis `k` (0–2) in m/s², as the bag holds them.
+    pub fn acc_m_s2(&self, k: usize) -> &[f64] {
+        &self.series.acc[k][self.used()]
     }
 
     /// The pushed accelerations of axis `k` (0–2: x, y, z) in m/s², in message order.

@@ -4,6 +4,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use rayon::prelude::*;
+
 use allan_kalibr::ieee952::imu::{self, ImuAnalysis, Sensor};
 use allan_kalibr::ieee952::{CurveData, CurvePoint, Overlap, curves_in, files};
 
@@ -166,7 +168,7 @@ fn run_series(
     // The Allan variance assumes one constant rate with no gap: a record that is not one
     // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
     let mut collected = collected;
-    let tm = bag2mat::timing::analyse(&collected.t);
+    let mut tm = bag2mat::timing::analyse(&collected.t);
     if !tm.is_continuous()
         && let Some(seg) = tm.longest()
     {
@@ -179,6 +181,8 @@ fn run_series(
             collected.len()
         ));
         collected.restrict(seg.start..seg.end);
+        // the section reports the stamps of the analysed stretch
+        tm = bag2mat::timing::analyse(&collected.t);
     } else if !tm.gaps.is_empty() {
         notes.push(format!(
             "warning: the stamps of '{topic}' have small gaps ({}); analysed as one record",
@@ -186,13 +190,19 @@ fn run_series(
         ));
     }
     analysis::check_enough(&collected, config.max_cluster)?;
-    for (k, name) in collect::FIELDS.iter().enumerate() {
-        let col: Vec<f64> = if k < 3 {
-            collected.gyro_rad_s(k)
-        } else {
-            collected.acc_values(k - 3).collect()
-        };
-        match allan_kalibr::input::value_problem(name, &col) {
+    let problems: Vec<_> = (0..collect::FIELDS.len())
+        .into_par_iter()
+        .map(|k| {
+            let col = if k < 3 {
+                collected.gyro_rad_s(k)
+            } else {
+                collected.acc_m_s2(k - 3)
+            };
+            allan_kalibr::input::value_problem(collect::FIELDS[k], col)
+        })
+        .collect();
+    for problem in problems {
+        match problem {
             Some((true, what)) => return Err(Error::Config(what)),
             Some((false, what)) => notes.push(format!("warning: {what}")),
             None => {}
@@ -219,7 +229,7 @@ fn run_series(
             &allan_kalibr::ieee952::Config::default(),
         );
         let starts: Vec<_> = axes.iter().map(|a| a.start.clone()).collect();
-        imu::add_stationarity(&mut an, &starts, Some(&collected.t));
+        imu::add_stationarity(&mut an, &starts, Some(tm));
         Some(an)
     } else {
         None

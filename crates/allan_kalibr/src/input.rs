@@ -65,22 +65,33 @@ impl ImuData {
 
     /// Checks that every sample is finite (a NaN would silently turn whole curves into NaN).
     pub fn check_finite(&self) -> Result<(), Error> {
-        const NAMES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
-        for (a, col) in self.axes.iter().enumerate() {
-            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+        self.scan_checked().map(|_| ())
+    }
+
+    /// One pass over each column (the six in parallel): fails like [`ImuData::check_finite`]
+    /// on the first non-finite sample (axes in order), else returns what [`value_problem`]
+    /// needs, so the run reads the columns once for both checks.
+    pub fn scan_checked(&self) -> Result<[ColumnScan; 6], Error> {
+        use rayon::prelude::*;
+        let scans: Vec<ColumnScan> = self.axes.par_iter().map(|c| ColumnScan::of(c)).collect();
+        for (a, (scan, col)) in scans.iter().zip(&self.axes).enumerate() {
+            if let Some(i) = scan.first_non_finite {
                 return Err(Error::BadData {
                     what: format!(
                         "sample {} of {} is {} (every sample must be finite)",
                         i + 1,
-                        NAMES[a],
+                        AXIS_NAMES[a],
                         col[i]
                     ),
                 });
             }
         }
-        Ok(())
+        Ok(std::array::from_fn(|a| scans[a]))
     }
 }
+
+/// The six sample columns' names, in `data_imu` order.
+pub const AXIS_NAMES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
 
 /// True for a `.mat` path (by extension, as upstream's scripts name them).
 fn is_mat(path: &Path) -> bool {
@@ -132,10 +143,90 @@ fn load_mat(path: &Path) -> Result<ImuData, Error> {
 /// (1e150)² = 1e300 stays finite in f64 where 1e300 would overflow to infinity.
 pub const MAX_ABS_VALUE: f64 = 1e150;
 
+/// What one pass over a column finds: its first non-finite sample, its largest magnitude and
+/// whether it is constant. The finiteness check and [`value_problem`] share it, so a run reads
+/// each column once for both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColumnScan {
+    /// Index of the first NaN or ±∞.
+    pub first_non_finite: Option<usize>,
+    /// Largest |value| (NaN ignored, 0 for an empty column).
+    pub max_abs: f64,
+    /// The first sample (None for an empty column).
+    pub first: Option<f64>,
+    /// Every sample equals the first (false for a NaN first sample, as `==` says).
+    pub constant: bool,
+}
+
+impl ColumnScan {
+    /// Scans `col` once (8 independent lanes, so the compiler vectorises it).
+    pub fn of(col: &[f64]) -> ColumnScan {
+        const L: usize = 8;
+        let first = col.first().copied();
+        let f = first.unwrap_or(0.0);
+        let (mut mx, mut bad, mut differ) = ([0.0f64; L], [false; L], [false; L]);
+        let (chunks, rest) = col.as_chunks::<L>();
+        for c in chunks {
+            for l in 0..L {
+                mx[l] = mx[l].max(c[l].abs());
+                bad[l] |= !c[l].is_finite();
+                differ[l] |= c[l] != f;
+            }
+        }
+        let mut max_abs = mx.iter().fold(0.0f64, |m, &v| m.max(v));
+        let (mut any_bad, mut any_differ) = (bad.contains(&true), differ.contains(&true));
+        for &v in rest {
+            max_abs = max_abs.max(v.abs());
+            any_bad |= !v.is_finite();
+            any_differ |= v != f;
+        }
+        ColumnScan {
+            // rare: found again by a plain search
+            first_non_finite: if any_bad {
+                col.iter().position(|v| !v.is_finite())
+            } else {
+                None
+            },
+            max_abs,
+            first,
+            constant: first.is_some() && !any_differ,
+        }
+    }
+
+    /// [`value_problem`] of the scanned column, named `axis`.
+    pub fn problem(&self, axis: &str) -> Option<(bool, String)> {
+        let max = self.max_abs;
+        if max > MAX_ABS_VALUE {
+            return Some((
+                true,
+                format!(
+                    "{axis} holds values up to {max:e}: beyond {MAX_ABS_VALUE:e} the squared differences of the Allan variance overflow"
+                ),
+            ));
+        }
+        let first = self.first?;
+        if self.constant {
+            return Some((
+                false,
+                format!(
+                    "{axis} is constant ({first} in every sample): its Allan deviation is 0, so its noise fits are undefined (NaN); a sensor that reports no noise is saturated, quantized too coarsely or not streaming"
+                ),
+            ));
+        }
+        None
+    }
+}
+
 /// What makes one axis unusable or its results meaningless, said in words: values too large
 /// for the sums of squares (an error), or a constant axis (its Allan deviation is 0 and the
 /// fits take logarithms of it: NaN). `None` for ordinary data.
 pub fn value_problem(axis: &str, col: &[f64]) -> Option<(bool, String)> {
+    ColumnScan::of(col).problem(axis)
+}
+
+/// The former one-column [`value_problem`], kept as the obviously correct reference.
+#[cfg(test)]
+fn value_problem_slow(axis: &str, col: &[f64]) -> Option<(bool, String)> {
     let max = col.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if max > MAX_ABS_VALUE {
         return Some((
@@ -230,6 +321,40 @@ mod tests {
 
     fn times(n: usize, rate: f64) -> Vec<f64> {
         (0..n).map(|i| 1.6e9 + i as f64 / rate).collect()
+    }
+
+    #[test]
+    fn column_scan_matches_the_plain_checks() {
+        let mut cols: Vec<Vec<f64>> = vec![
+            vec![],
+            vec![1.0],
+            vec![2.5; 21],
+            (0..37).map(|i| (i as f64 * 0.3).sin()).collect(),
+            vec![-3e151, 1.0, 2.0],
+        ];
+        for (len, at, v) in [
+            (21, 0, f64::NAN),
+            (21, 20, f64::NAN),
+            (40, 17, f64::INFINITY),
+            (9, 8, f64::NEG_INFINITY),
+            (16, 3, 2e150),
+        ] {
+            let mut c: Vec<f64> = (0..len).map(|i| i as f64).collect();
+            c[at] = v;
+            cols.push(c);
+        }
+        let mut nan_first = vec![1.0; 12];
+        nan_first[0] = f64::NAN;
+        cols.push(nan_first);
+        for c in &cols {
+            let scan = ColumnScan::of(c);
+            assert_eq!(scan.problem("ax"), value_problem_slow("ax", c), "{c:?}");
+            assert_eq!(
+                scan.first_non_finite,
+                c.iter().position(|v| !v.is_finite()),
+                "{c:?}"
+            );
+        }
     }
 
     #[test]

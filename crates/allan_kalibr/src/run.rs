@@ -120,7 +120,8 @@ pub struct Timings {
     pub load: f64,
     /// τ grid, sig2 curves and both fits.
     pub analyse: f64,
-    /// The IEEE 952 analysis (0 when disabled).
+    /// The IEEE 952 analysis (0 when disabled): its curves, and the part of its fits that
+    /// outlasted the compat path they run beside.
     pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
@@ -177,12 +178,15 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
     }
-    data.check_finite()?;
-    // The Allan variance assumes one constant rate with no gap: a record that is not one
-    // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
-    let tm = bag2mat::timing::analyse(&data.t);
-    let data = match tm.longest() {
-        Some(seg) if !tm.is_continuous() => {
+    // One pass per column for the finiteness check and the value checks below, beside the
+    // stamps' analysis: the Allan variance assumes one constant rate with no gap, so a record
+    // that is not one continuous stretch is cut to its longest (bag2mat::timing finds gaps
+    // and rate changes).
+    let (scans, tm) = rayon::join(|| data.scan_checked(), || bag2mat::timing::analyse(&data.t));
+    let scans = scans?;
+    let cut = tm.longest().filter(|_| !tm.is_continuous());
+    let data = match cut {
+        Some(seg) => {
             notes.push(format!(
                 "warning: the timestamps are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: samples {}..{} ({} of {})",
                 tm.describe(),
@@ -207,9 +211,18 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             data
         }
     };
-    const AXES: [&str; 6] = ["ax", "ay", "az", "wx", "wy", "wz"];
-    for (name, col) in AXES.iter().zip(&data.axes) {
-        match input::value_problem(name, col) {
+    // The stamps' analysis and the column scans describe the analysed samples unless the
+    // record was cut (then the stretch is looked at again).
+    let (tm, scans) = if cut.is_none() {
+        (tm, scans)
+    } else {
+        (
+            bag2mat::timing::analyse(&data.t),
+            std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a])),
+        )
+    };
+    for (name, scan) in input::AXIS_NAMES.iter().zip(&scans) {
+        match scan.problem(name) {
             Some((true, what)) => return Err(Error::BadData { what }),
             Some((false, what)) => notes.push(format!("warning: {what}")),
             None => {}
@@ -225,10 +238,11 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             .cloned()
             .unwrap_or_else(|| "imu".into())
     });
-    // The IEEE 952 analysis reads the raw columns, so it runs before the compat path turns
-    // them into prefix sums. Data too short for it only costs the section, with a note.
+    // The IEEE 952 analysis reads the raw columns, so its curves are made before the compat
+    // path turns them into prefix sums; its fits then run beside the compat path. Data too
+    // short for it only cost the section, with a note.
     let start = Instant::now();
-    let ieee = if config.ieee952 {
+    let curves = if config.ieee952 {
         let a = &data.axes;
         let series = [
             &a[3][..],
@@ -238,15 +252,29 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             &a[1][..],
             &a[2][..],
         ];
-        crate::ieee952::imu::analyse_section(series, rate.used, Some(&data.t), &mut notes)
+        crate::ieee952::imu::section_curves(series, rate.used, &mut notes)
     } else {
         None
     };
-    let ieee_s = start.elapsed().as_secs_f64();
-    let start = Instant::now();
+    let curves_s = start.elapsed().as_secs_f64();
     let ImuData { axes, .. } = data;
-    let analysis = analyse(axes, rate.used, config.estimator, config.quiet)?;
-    let analyse_s = start.elapsed().as_secs_f64();
+    let ((ieee, fits_s), analysis) = rayon::join(
+        || {
+            let start = Instant::now();
+            let an = curves
+                .as_ref()
+                .map(|c| c.finish(Some(tm), &crate::ieee952::Config::default()));
+            (an, start.elapsed().as_secs_f64())
+        },
+        || {
+            let start = Instant::now();
+            analyse(axes, rate.used, config.estimator, config.quiet).map(|a| (a, start.elapsed()))
+        },
+    );
+    let (analysis, analyse_t) = analysis?;
+    let analyse_s = analyse_t.as_secs_f64();
+    // the section's share of the wall time: its curves, and its fits less what they overlapped
+    let ieee_s = curves_s + (fits_s - analyse_s).max(0.0);
     let start = Instant::now();
     let text = report::full_text(&analysis.accel, &analysis.gyro);
 
@@ -294,18 +322,27 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     } else {
         config.title.clone()
     };
-    written.extend(write_plots(&analysis, &title, dir)?);
-    if let Some(an) = &ieee {
-        written.extend(crate::ieee952::files::write_outputs(an, dir, "", &topic)?);
-        let truth = crate::ieee952::plot::find_truth(&config.input, an);
-        written.extend(crate::ieee952::plot::write_chart(
-            an,
-            &title,
-            truth.as_ref(),
-            dir,
-            "",
-        )?);
-    }
+    // The charts are rendered in parallel (each is one thread's work).
+    let (compat_plots, section_files) = rayon::join(
+        || write_plots(&analysis, &title, dir),
+        || -> Result<Vec<PathBuf>, Error> {
+            let Some(an) = &ieee else {
+                return Ok(Vec::new());
+            };
+            let mut w = crate::ieee952::files::write_outputs(an, dir, "", &topic)?;
+            let truth = crate::ieee952::plot::find_truth(&config.input, an);
+            w.extend(crate::ieee952::plot::write_chart(
+                an,
+                &title,
+                truth.as_ref(),
+                dir,
+                "",
+            )?);
+            Ok(w)
+        },
+    );
+    written.extend(compat_plots?);
+    written.extend(section_files?);
     let timings = Timings {
         load: 0.0,
         analyse: analyse_s,

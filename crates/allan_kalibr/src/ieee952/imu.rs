@@ -118,34 +118,76 @@ pub fn analyse_curves(
     }
 }
 
+/// The part of [`analyse_imu`] that reads the samples: each axis' curve and warm-up
+/// statistics. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
+/// the sample columns on (the compat path turns them into prefix sums in place) while the
+/// fits run.
+#[derive(Debug, Clone)]
+pub struct ImuCurves {
+    /// Sample rate, Hz.
+    pub rate: f64,
+    /// Gyro x y z, then acc x y z.
+    pub sensors: [(Sensor, [CurveData; 3]); 2],
+    /// Each axis' start statistics, same order.
+    pub starts: Vec<Option<StartStats>>,
+}
+
+impl ImuCurves {
+    /// Curves and start statistics of six rate series (gyro x y z in rad/s, then acc x y z
+    /// in m/s²) at `rate` Hz, the axes in parallel.
+    pub fn from_samples(
+        series: [&[f64]; 6],
+        rate: f64,
+        cfg: &Config,
+    ) -> Result<ImuCurves, Ieee952Error> {
+        let tau0 = 1.0 / rate;
+        // The warm-up statistics are taken in the same parallel pass, while the axis is in cache.
+        let (data, starts): (Vec<_>, Vec<Option<StartStats>>) = series
+            .par_iter()
+            .map(|y| {
+                CurveData::from_samples(y, tau0, cfg)
+                    .map(|c| (c, StartStats::from_samples(y, tau0)))
+            })
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .unzip();
+        let mut it = data.into_iter();
+        let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
+        Ok(ImuCurves {
+            rate,
+            sensors: [(Sensor::Gyro, take3()), (Sensor::Acc, take3())],
+            starts,
+        })
+    }
+
+    /// The fits, the advice and the warm-up checks; `timing` as in [`analyse_imu`].
+    pub fn finish(&self, timing: Option<Timing>, cfg: &Config) -> ImuAnalysis {
+        let mut an = analyse_curves(&self.sensors, self.rate, cfg);
+        add_stationarity(&mut an, &self.starts, timing);
+        an
+    }
+}
+
 /// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz,
-/// with the warm-up check on each; `t` (s) adds the gap and rate checks.
+/// with the warm-up check on each; `timing` (`bag2mat::timing::analyse` of the series' time
+/// stamps, which the caller has already run to cut the record) adds the gap and rate checks.
 pub fn analyse_imu(
     series: [&[f64]; 6],
     rate: f64,
-    t: Option<&[f64]>,
+    timing: Option<Timing>,
     cfg: &Config,
 ) -> Result<ImuAnalysis, Ieee952Error> {
-    let tau0 = 1.0 / rate;
-    let data = series
-        .par_iter()
-        .map(|y| CurveData::from_samples(y, tau0, cfg))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut it = data.into_iter();
-    let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
-    let sensors = [(Sensor::Gyro, take3()), (Sensor::Acc, take3())];
-    let mut an = analyse_curves(&sensors, rate, cfg);
-    let starts: Vec<Option<StartStats>> = series
-        .iter()
-        .map(|y| StartStats::from_samples(y, tau0))
-        .collect();
-    add_stationarity(&mut an, &starts, t);
-    Ok(an)
+    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(timing, cfg))
 }
 
 /// Adds the warm-up checks (each axis' start statistics, gyro x y z then acc x y z, against
-/// its fitted model) and the time-stamp checks.
-pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: Option<&[f64]>) {
+/// its fitted model) and the time-stamp checks (`bag2mat::timing::analyse` of the analysed
+/// stamps: the run has it already, from deciding whether to cut the record).
+pub fn add_stationarity(
+    an: &mut ImuAnalysis,
+    starts: &[Option<StartStats>],
+    timing: Option<Timing>,
+) {
     for ax in an.axes.iter_mut() {
         let k = match ax.sensor {
             Sensor::Gyro => ax.axis,
@@ -166,7 +208,7 @@ pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: 
         let model = move |tau: f64| f.predict(tau).max(0.0);
         ax.warmup = stationarity::warmup(st, &model);
     }
-    an.timing = t.map(bag2mat::timing::analyse);
+    an.timing = timing;
 }
 
 /// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
@@ -175,11 +217,21 @@ pub fn add_stationarity(an: &mut ImuAnalysis, starts: &[Option<StartStats>], t: 
 pub fn analyse_section(
     series: [&[f64]; 6],
     rate: f64,
-    t: Option<&[f64]>,
+    timing: Option<Timing>,
     notes: &mut Vec<String>,
 ) -> Option<ImuAnalysis> {
-    match analyse_imu(series, rate, t, &Config::default()) {
-        Ok(an) => Some(an),
+    section_curves(series, rate, notes).map(|c| c.finish(timing, &Config::default()))
+}
+
+/// The sample-reading part of [`analyse_section`] ([`ImuCurves::from_samples`] with the
+/// default settings; the reason it cannot run goes into `notes`).
+pub fn section_curves(
+    series: [&[f64]; 6],
+    rate: f64,
+    notes: &mut Vec<String>,
+) -> Option<ImuCurves> {
+    match ImuCurves::from_samples(series, rate, &Config::default()) {
+        Ok(c) => Some(c),
         Err(e) => {
             notes.push(format!("IEEE 952 analysis skipped: {e}"));
             None

@@ -236,12 +236,14 @@ fn second_diff_sums_blocked(x: &[f64], ms: &[usize]) -> Vec<f64> {
 /// registers and hide the add latency.
 const LANES: usize = 32;
 
+/// Adds `((c[k] − 2b[k]) + a[k])²` into lane `k mod LANES` of `acc`, for the whole chunks
+/// of `LANES` of three equally long slices (the caller hands the remainder to
+/// [`lanes_finish`]).
 #[inline(always)]
-fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    let mut acc = [0.0f64; LANES];
-    let (a8, ar) = a.as_chunks::<LANES>();
-    let (b8, br) = b.as_chunks::<LANES>();
-    let (c8, cr) = c.as_chunks::<LANES>();
+fn lanes_body(acc: &mut [f64; LANES], a: &[f64], b: &[f64], c: &[f64]) {
+    let (a8, _) = a.as_chunks::<LANES>();
+    let (b8, _) = b.as_chunks::<LANES>();
+    let (c8, _) = c.as_chunks::<LANES>();
     for ((a, b), c) in a8.iter().zip(b8).zip(c8) {
         for l in 0..LANES {
             // imu_utils' expression order: (x[k+2m] − 2x[k+m]) + x[k].
@@ -249,7 +251,10 @@ fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
             acc[l] += d * d;
         }
     }
-    // Pairwise reduction of the lanes.
+}
+
+/// Pairwise reduction of the lanes, then the remainder (fewer than `LANES` terms) in order.
+fn lanes_finish(mut acc: [f64; LANES], a: &[f64], b: &[f64], c: &[f64]) -> f64 {
     let mut width = LANES;
     while width > 1 {
         width /= 2;
@@ -258,7 +263,7 @@ fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
         }
     }
     let mut s = acc[0];
-    for ((a, b), c) in ar.iter().zip(br).zip(cr) {
+    for ((a, b), c) in a.iter().zip(b).zip(c) {
         let d = (c - 2.0 * b) + a;
         s += d * d;
     }
@@ -267,31 +272,82 @@ fn second_diff_sum_body(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn second_diff_sum_avx512(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    second_diff_sum_body(a, b, c)
+fn lanes_avx512(acc: &mut [f64; LANES], a: &[f64], b: &[f64], c: &[f64]) {
+    lanes_body(acc, a, b, c)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn second_diff_sum_avx2(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    second_diff_sum_body(a, b, c)
+fn lanes_avx2(acc: &mut [f64; LANES], a: &[f64], b: &[f64], c: &[f64]) {
+    lanes_body(acc, a, b, c)
+}
+
+/// [`lanes_body`] with the CPU's widest vector unit (the same operations in the same order
+/// per lane whichever is used, so the sums do not depend on it).
+fn lanes(acc: &mut [f64; LANES], a: &[f64], b: &[f64], c: &[f64]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F (checked just above).
+            return unsafe { lanes_avx512(acc, a, b, c) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { lanes_avx2(acc, a, b, c) };
+        }
+    }
+    lanes_body(acc, a, b, c)
 }
 
 /// `Σ_k ((c[k] − 2b[k]) + a[k])²` over three equally long slices, with the CPU's widest
 /// vector unit.
 fn second_diff_sum_slices(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports AVX-512F (checked just above).
-            return unsafe { second_diff_sum_avx512(a, b, c) };
+    let mut acc = [0.0f64; LANES];
+    lanes(&mut acc, a, b, c);
+    let full = a.len() - a.len() % LANES;
+    lanes_finish(acc, &a[full..], &b[full..], &c[full..])
+}
+
+/// Start indices per tile of [`second_diff_sums`] (a multiple of `LANES`; 64 KiB of `x`, so
+/// a tile and its neighbours up to 2m stay in L1/L2 while every m of the set walks it).
+const SWEEP_TILE: usize = 8 * 1024;
+
+/// [`second_diff_sum`] for every `m` of `ms`, bit for bit, in one cache-blocked sweep: the
+/// start indices are walked tile by tile and every m adds the tile's terms into its own
+/// `LANES` accumulators, so each lane sums the same terms in the same order as
+/// [`second_diff_sum`] does, while the part of `x` a tile needs comes from memory once for
+/// the whole set instead of once per m (for m up to about a tile, all of it).
+pub fn second_diff_sums(x: &[f64], ms: &[usize]) -> Vec<f64> {
+    let n = x.len();
+    let cnt: Vec<usize> = ms.iter().map(|&m| n.saturating_sub(2 * m)).collect();
+    let full: Vec<usize> = cnt.iter().map(|&c| c - c % LANES).collect();
+    let mut acc = vec![[0.0f64; LANES]; ms.len()];
+    let end = full.iter().copied().max().unwrap_or(0);
+    let mut k0 = 0;
+    while k0 < end {
+        for ((acc, &m), &f) in acc.iter_mut().zip(ms).zip(&full) {
+            let k1 = (k0 + SWEEP_TILE).min(f);
+            if k0 < k1 {
+                lanes(
+                    acc,
+                    &x[k0..k1],
+                    &x[k0 + m..k1 + m],
+                    &x[k0 + 2 * m..k1 + 2 * m],
+                );
+            }
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { second_diff_sum_avx2(a, b, c) };
-        }
+        k0 += SWEEP_TILE;
     }
-    second_diff_sum_body(a, b, c)
+    acc.into_iter()
+        .zip(ms)
+        .zip(cnt.iter().zip(&full))
+        .map(|((acc, &m), (&c, &f))| {
+            if c == 0 {
+                return 0.0; // no term (n ≤ 2m), as second_diff_sum says
+            }
+            lanes_finish(acc, &x[f..c], &x[f + m..c + m], &x[f + 2 * m..c + 2 * m])
+        })
+        .collect()
 }
 
 /// `Σ_k ((x[k+2m] − 2x[k+m]) + x[k])²` over every k with k + 2m < x.len() (0 when there is
@@ -423,6 +479,30 @@ mod tests {
                 p.avar,
                 slow.avar
             );
+        }
+    }
+
+    #[test]
+    fn sweep_over_many_m_is_bit_identical_to_one_pass_per_m() {
+        let mut rng = StdRng::seed_from_u64(RNG_SEED + 3);
+        let mut b = 0.0;
+        // longer than a few tiles, not a multiple of LANES or of the tile
+        let x: Vec<f64> = (0..3 * SWEEP_TILE + 77)
+            .map(|_| {
+                let w: f64 = StandardNormal.sample(&mut rng);
+                b += w;
+                1e3 + b
+            })
+            .collect();
+        let n = x.len();
+        let ms: Vec<usize> = [1, 2, 3, 31, 32, 33, 100, 4096, SWEEP_TILE, SWEEP_TILE + 5]
+            .into_iter()
+            .chain([n / 2 - 40, n / 2 - 1, n / 2, n / 2 + 1, n])
+            .collect();
+        let many = second_diff_sums(&x, &ms);
+        for (&m, v) in ms.iter().zip(&many) {
+            let one = second_diff_sum(&x, m);
+            assert_eq!(v.to_bits(), one.to_bits(), "m={m}: {v:e} vs {one:e}");
         }
     }
 
