@@ -10,7 +10,10 @@
 //! [`super`]), and for a flicker floor B, whose information grows with the number of
 //! independent clusters in the floor. So a precision p of this record T becomes x after
 //! T·(p/x)². A term the record does not resolve has no precision; its 95 % upper bound says
-//! how small it is, and that a longer record is needed to see it at all.
+//! how small it is, and that a longer record is needed to see it at all. For K that bound
+//! still answers "how long?": by the Cramér–Rao bound a K at its upper bound K⁺ would need
+//! T_x = 2·N·z²/(K⁺·x²) for ±x, a smaller K longer (and every other term only adds to the
+//! record needed), so T_x — and at least this record — is a lower bound, marked as such.
 
 use super::{Analysis, Term, Verdict};
 
@@ -26,6 +29,8 @@ pub struct TermAdvice {
     pub record_10: f64,
     /// Record length (s) for ±25 % at 95 %.
     pub record_25: f64,
+    /// The records are lower bounds (a term not resolved, from its 95 % upper bound).
+    pub at_least: bool,
 }
 
 impl TermAdvice {
@@ -34,6 +39,7 @@ impl TermAdvice {
             precision: f64::NAN,
             record_10: f64::NAN,
             record_25: f64::NAN,
+            at_least: false,
         }
     }
 }
@@ -66,6 +72,23 @@ fn term_advice(t: &Term, record: f64) -> TermAdvice {
         precision: p,
         record_10: needed(TARGETS[0]),
         record_25: needed(TARGETS[1]),
+        at_least: false,
+    }
+}
+
+/// For a K the record does not resolve: the record it needs at least, from its 95 % upper
+/// bound and the white noise N (module docs); none without both.
+fn k_at_least(k: &Term, n: &Term, record: f64) -> TermAdvice {
+    let fine = |v: f64| super::fit::is_positive(v) && v.is_finite();
+    if k.verdict == Verdict::Resolved || !fine(k.hi) || !fine(n.value) {
+        return TermAdvice::none();
+    }
+    let needed = |x: f64| (2.0 * n.value * Z95 * Z95 / (k.hi * x * x)).max(record);
+    TermAdvice {
+        precision: f64::NAN,
+        record_10: needed(TARGETS[0]),
+        record_25: needed(TARGETS[1]),
+        at_least: true,
     }
 }
 
@@ -77,7 +100,10 @@ pub fn advise(a: &Analysis) -> Option<Advice> {
         record,
         n: term_advice(&a.terms.n, record),
         b: term_advice(&a.terms.b, record),
-        k: term_advice(&a.terms.k, record),
+        k: match term_advice(&a.terms.k, record) {
+            t if t.precision.is_finite() => t,
+            _ => k_at_least(&a.terms.k, &a.terms.n, record),
+        },
     })
 }
 
@@ -112,6 +138,40 @@ mod tests {
             hi: value + 2.0 * se,
             verdict,
         }
+    }
+
+    #[test]
+    fn unresolved_k_gets_the_record_its_upper_bound_needs_at_least() {
+        let n = term(0.01, 1e-5, Verdict::Resolved);
+        let k = Term {
+            value: 0.0,
+            std_err: f64::NAN,
+            lo: 0.0,
+            hi: 1e-4,
+            verdict: Verdict::NotSignificant,
+        };
+        // 2·N·z²/(K⁺·x²) with x = 25 %: 2·0.01·3.8415/(1e-4·0.0625) = 12 293 s
+        let a = k_at_least(&k, &n, 3600.0);
+        assert!(a.at_least && a.precision.is_nan());
+        let want = 2.0 * 0.01 * Z95 * Z95 / (1e-4 * 0.0625);
+        assert!((a.record_25 - want).abs() < 1e-6 * want, "{a:?}");
+        assert!((a.record_10 - want * 6.25).abs() < 1e-6 * want * 6.25);
+        // never less than the record that did not resolve it
+        let long = k_at_least(&k, &n, 1e6);
+        assert_eq!((long.record_10, long.record_25), (1e6, 1e6));
+        // a resolved K, or no bound, gets nothing from here
+        assert!(!k_at_least(&n, &n, 3600.0).at_least);
+        assert!(
+            !k_at_least(
+                &Term {
+                    hi: f64::INFINITY,
+                    ..k
+                },
+                &n,
+                3600.0
+            )
+            .at_least
+        );
     }
 
     #[test]

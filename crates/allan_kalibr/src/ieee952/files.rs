@@ -67,9 +67,11 @@ pub const COL_PRECISION: &str = "precision95";
 pub const COL_RECORD_10: &str = "record_for_10pct_s";
 /// Record length for ±25 % at 95 %, s.
 pub const COL_RECORD_25: &str = "record_for_25pct_s";
+/// The two records are lower bounds (a term not resolved: from its 95 % upper bound).
+pub const COL_RECORD_AT_LEAST: &str = "record_is_lower_bound";
 
 /// The columns of `ieee952_terms.csv`, in order.
-pub const TERMS_COLUMNS: [&str; 22] = [
+pub const TERMS_COLUMNS: [&str; 23] = [
     COL_SENSOR,
     COL_AXIS,
     COL_TERM,
@@ -92,6 +94,7 @@ pub const TERMS_COLUMNS: [&str; 22] = [
     COL_PRECISION,
     COL_RECORD_10,
     COL_RECORD_25,
+    COL_RECORD_AT_LEAST,
 ];
 
 /// `ieee952_curves.csv`: axis code (`gx` … `az`).
@@ -210,6 +213,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
             precision: f64::NAN,
             record_10: f64::NAN,
             record_25: f64::NAN,
+            at_least: false,
         };
         let adv = ax.advice;
         let rows: [(&str, &Term, &str, Option<super::region::Reading>, _); 6] = [
@@ -244,7 +248,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
                 reg.map_or((f64::NAN, f64::NAN, f64::NAN), |r| (r.value, r.lo, r.hi));
             let _ = writeln!(
                 s,
-                "{},{axis},{name},{},{},{},{},{},{:?},{unit},{source},{},{lo_t},{hi_t},{chi},{delta},{rv},{rl},{rh},{},{},{}",
+                "{},{axis},{name},{},{},{},{},{},{:?},{unit},{source},{},{lo_t},{hi_t},{chi},{delta},{rv},{rl},{rh},{},{},{},{}",
                 sensor.name(),
                 t.value,
                 t.std_err,
@@ -255,7 +259,8 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
                 fit_code(&an.verdict),
                 adv.precision,
                 adv.record_10,
-                adv.record_25
+                adv.record_25,
+                adv.at_least
             );
         }
         // the shape parameters, as rows of their own: the Gauss–Markov correlation time
@@ -266,7 +271,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
         ] {
             let _ = writeln!(
                 s,
-                "{},{axis},{name},{value},NaN,NaN,NaN,{},{:?},s,{},{},{lo_t},{hi_t},{chi},{delta},NaN,NaN,NaN,NaN,NaN,NaN",
+                "{},{axis},{name},{value},NaN,NaN,NaN,{},{:?},s,{},{},{lo_t},{hi_t},{chi},{delta},NaN,NaN,NaN,NaN,NaN,NaN,false",
                 sensor.name(),
                 t.reported().is_some(),
                 t.verdict,

@@ -532,6 +532,12 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
                 )
             } else if term.verdict == Verdict::NotFitted {
                 format!("{name} -")
+            } else if t.at_least {
+                format!(
+                    "{name} not resolved: at least {} / {}",
+                    advisor::duration_text(t.record_25),
+                    advisor::duration_text(t.record_10)
+                )
             } else {
                 format!("{name} not resolved: longer than this record")
             }
