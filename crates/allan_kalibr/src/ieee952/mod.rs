@@ -852,19 +852,15 @@ fn fit_and_check(
     Some((f, misses, max_mis))
 }
 
-/// The largest coefficient of term `j` the fitted points allow on their own: its Allan
-/// variance may nowhere exceed the curve's upper 95 % bound (every term adds to the curve).
-/// The upper bound of a term the fit left at zero whose interval says nothing (0 or ∞).
+/// The largest value of term `j` the fitted points allow on their own (the curve's upper
+/// 95 % band, [`region::upper_bound`]): the upper bound of a term the fit left at zero whose
+/// interval says nothing (0 or ∞).
 fn data_bound(j: usize, f: &fit::FitResult, fd: &fit::FitData, curve: &[Point]) -> f64 {
-    f.used
+    let used = f
+        .used
         .iter()
-        .filter_map(|&i| {
-            let fp = &fd.points[i];
-            let hi95 = curve.iter().find(|c| c.m == fp.m)?.hi95;
-            let b = fit::basis_at(j, fp.tau, &f.shapes);
-            (hi95.is_finite() && b > 0.0).then(|| hi95 * hi95 / b)
-        })
-        .fold(f64::INFINITY, f64::min)
+        .filter_map(|&i| curve.iter().find(|c| c.m == fd.points[i].m));
+    region::upper_bound(used, |tau| fit::basis_at(j, tau, &f.shapes).sqrt())
 }
 
 fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Config) -> Terms {
@@ -896,7 +892,7 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
                 // The fit's own error says nothing here (a term left out where the full fit
                 // had it at its bound has no standard error; an interval the data do not
                 // close is ∞): bound the term by the curve itself, never "< 0".
-                hi = data_bound(j, f, fd, curve).sqrt();
+                hi = data_bound(j, f, fd, curve);
             }
             return Term {
                 value: 0.0,

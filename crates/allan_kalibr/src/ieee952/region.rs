@@ -99,6 +99,22 @@ pub fn white_near_1s(tau: &[f64], is_white: &[bool]) -> Vec<usize> {
 /// Half-width (a factor of τ) of the window of white-noise points the N reading averages.
 pub const N_WINDOW: f64 = 2.0;
 
+/// The largest value of a term the curve allows at 95 %: every term's Allan deviation is at
+/// most the curve's, so the term is at most min over `points` of σ_hi95(τ) / `per_unit`(τ),
+/// `per_unit` being the term's Allan deviation per unit of its value (∞ when no point
+/// bounds it). The region readings' upper bounds and the fit's bound on a term it left at
+/// zero both come from here.
+pub fn upper_bound<'a>(
+    points: impl IntoIterator<Item = &'a Point>,
+    per_unit: impl Fn(f64) -> f64,
+) -> f64 {
+    points
+        .into_iter()
+        .map(|p| p.hi95 / per_unit(p.tau))
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Readings from `points` (the usable range of one curve, ascending τ, on the fit grid) with
 /// their 95 % bounds `lo95`/`hi95` (NaN when the sample count is unknown: then the readings
 /// carry no interval).
@@ -124,11 +140,8 @@ pub fn read(points: &[Point]) -> Readings {
         tau: tau[i],
         kind: ReadingKind::Line,
     };
-    let bound = |f: &dyn Fn(f64) -> f64| -> Option<Reading> {
-        let hi = (0..pts.len())
-            .map(|i| pts[i].hi95 * f(tau[i]))
-            .filter(|v| v.is_finite())
-            .fold(f64::INFINITY, f64::min);
+    let bound = |per_unit: &dyn Fn(f64) -> f64| -> Option<Reading> {
+        let hi = upper_bound(pts.iter().copied(), per_unit);
         hi.is_finite().then_some(Reading {
             value: 0.0,
             lo: 0.0,
@@ -144,7 +157,7 @@ pub fn read(points: &[Point]) -> Readings {
     let is_white: Vec<bool> = slope.iter().map(|s| (s + 0.5).abs() <= SLOPE_TOL).collect();
     let white = white_near_1s(&tau, &is_white);
     let n = if white.is_empty() {
-        bound(&|t: f64| t.sqrt())
+        bound(&|t: f64| 1.0 / t.sqrt())
     } else {
         let line = (white
             .iter()
@@ -170,7 +183,7 @@ pub fn read(points: &[Point]) -> Readings {
     let b = if slope[imin].abs() <= SLOPE_TOL {
         Some(scaled(imin, 1.0 / B_FLOOR_FACTOR))
     } else {
-        bound(&|_| 1.0 / B_FLOOR_FACTOR)
+        bound(&|_| B_FLOOR_FACTOR)
     };
     // K: the +½ region at the long end (contiguous from the last point), its shortest τ
     let mut first_k = None;
@@ -184,6 +197,6 @@ pub fn read(points: &[Point]) -> Readings {
     let k = first_k
         .filter(|&i| i > imin)
         .map(|i| scaled(i, (3.0 / tau[i]).sqrt()))
-        .or_else(|| bound(&|t: f64| (3.0 / t).sqrt()));
+        .or_else(|| bound(&|t: f64| (t / 3.0).sqrt()));
     Readings { n, b, k }
 }
