@@ -217,14 +217,9 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
         mat::check_size(out, data)?;
     }
     if out == Path::new(STDOUT) {
-        let stdout = std::io::stdout();
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, stdout.lock());
-        return match encode(&mut w, data, format).and_then(|_| w.flush()) {
-            // The reader stopped reading (`bag2mat … -o - | head`): not an error, as for
-            // every Unix filter.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-            r => r.map_err(|e| Error::io("standard output", e)),
-        };
+        return crate::shared::cli::to_stdout(|w| encode(w, data, format))
+            .map(|_| ())
+            .map_err(|e| Error::io("standard output", e));
     }
     write_atomic(out, |w| encode(w, data, format))
 }

@@ -14,20 +14,25 @@ pub const EXIT_FAILURE: u8 = 1;
 /// Exit status of a command line that cannot be run.
 pub const EXIT_USAGE: u8 = 2;
 
-/// Writes `text` to standard output. A reader that closed the pipe early (`tool … | head`) is
-/// not an error, as for every Unix filter: `Ok(false)` says to print no more. Other failures
-/// come back described plainly (no "os error N").
-pub fn print(text: &str) -> Result<bool, String> {
+/// Runs `write` on (buffered) standard output. A reader that closed the pipe early (`tool …
+/// | head`) is not an error, as for every Unix filter: `Ok(false)` says to write no more.
+pub fn to_stdout(
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> std::io::Result<bool> {
     use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, std::io::stdout().lock());
+    match write(&mut out).and_then(|_| out.flush()) {
         Ok(()) => Ok(true),
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
-        Err(e) => Err(format!(
-            "standard output: {}",
-            crate::shared::output::describe(&e)
-        )),
+        Err(e) => Err(e),
     }
+}
+
+/// Writes `text` to standard output ([`to_stdout`]); other failures come back described
+/// plainly (no "os error N").
+pub fn print(text: &str) -> Result<bool, String> {
+    to_stdout(|w| w.write_all(text.as_bytes()))
+        .map_err(|e| format!("standard output: {}", crate::shared::output::describe(&e)))
 }
 
 /// Prints a failure the one way, and returns exit status 1.
