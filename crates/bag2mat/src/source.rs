@@ -188,14 +188,24 @@ pub type MessageSink<'a> = dyn FnMut(u32, u64, &[u8]) + 'a;
 pub trait Source: Sync {
     /// What it is.
     fn kind(&self) -> InputKind;
+    /// What opening found: channels, parts, notes and losses.
+    fn contents(&self) -> &Contents;
     /// Its channels.
-    fn channels(&self) -> &[Channel];
+    fn channels(&self) -> &[Channel] {
+        &self.contents().channels
+    }
     /// Its parts, in storage order.
-    fn parts(&self) -> &[Part];
+    fn parts(&self) -> &[Part] {
+        &self.contents().parts
+    }
     /// What opening found (unindexed, truncated, scanned, …).
-    fn notes(&self) -> &[String];
+    fn notes(&self) -> &[String] {
+        &self.contents().notes
+    }
     /// What opening found lost (incomplete records, unreadable index entries, …).
-    fn losses(&self) -> &[Loss];
+    fn losses(&self) -> &[Loss] {
+        &self.contents().losses
+    }
     /// Reads part `part`, calling `sink` for each message of a channel `want` accepts, in
     /// storage order.
     fn read_part(
@@ -204,6 +214,19 @@ pub trait Source: Sync {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut MessageSink<'_>,
     ) -> PartRead;
+}
+
+/// What a source found on opening, the same for every format: each reader fills one.
+#[derive(Debug, Clone, Default)]
+pub struct Contents {
+    /// Its channels.
+    pub channels: Vec<Channel>,
+    /// Its parts, in storage order.
+    pub parts: Vec<Part>,
+    /// What opening found (unindexed, truncated, scanned, …).
+    pub notes: Vec<String>,
+    /// What opening found lost.
+    pub losses: Vec<Loss>,
 }
 
 /// Recognises `path` from its content.

@@ -98,10 +98,7 @@ pub struct BagReader {
     len: u64,
     chunks: Vec<ChunkLoc>,
     index: BagIndex,
-    notes: Vec<String>,
-    losses: Vec<Loss>,
-    channels: Vec<source::Channel>,
-    parts: Vec<Part>,
+    contents: source::Contents,
 }
 
 /// The top-level records a walk found.
@@ -183,13 +180,10 @@ impl BagReader {
                 chunk_count: 0,
                 indexed: false,
             },
-            notes: Vec::new(),
-            losses: Vec::new(),
-            channels: Vec::new(),
-            parts: Vec::new(),
+            contents: source::Contents::default(),
         };
         if let Some(e) = &header_damage {
-            reader.notes.push(format!(
+            reader.contents.notes.push(format!(
                 "the bag header is damaged ({e}); the chunks after it were walked without the index"
             ));
         }
@@ -199,14 +193,14 @@ impl BagReader {
         } else {
             if header_damage.is_some() {
             } else if index_pos == 0 {
-                reader.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
+                reader.contents.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
             } else if index_pos >= len {
-                reader.losses.push(Loss::new(format!(
+                reader.contents.losses.push(Loss::new(format!(
                     "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
                     index_pos - len
                 )));
             } else {
-                reader.notes.push(format!(
+                reader.contents.notes.push(format!(
                     "the bag's index_pos {index_pos} points into its header; its chunks were walked"
                 ));
             }
@@ -238,7 +232,7 @@ impl BagReader {
             }
         }
         self.index.counts = counts.clone();
-        self.channels = self
+        self.contents.channels = self
             .index
             .connections
             .iter()
@@ -258,7 +252,7 @@ impl BagReader {
             .map(|c| c.pos)
             .chain([self.len])
             .collect();
-        self.parts = self
+        self.contents.parts = self
             .chunks
             .iter()
             .zip(ends)
@@ -309,7 +303,7 @@ impl BagReader {
         let mut damaged = 0;
         while pos < self.len {
             let Some((hb, data_pos, dlen)) = self.record_at(pos, self.len) else {
-                self.notes.push(format!(
+                self.contents.notes.push(format!(
                     "the index section is damaged at byte {pos} (a record runs past the end of the file); the chunks were walked instead"
                 ));
                 break;
@@ -323,7 +317,7 @@ impl BagReader {
             if let Err(e) = decoded {
                 damaged += 1;
                 if damaged == 1 {
-                    self.notes.push(format!(
+                    self.contents.notes.push(format!(
                         "the index section has a damaged record at byte {pos} ({e}); skipped, the chunks themselves were walked"
                     ));
                 }
@@ -331,7 +325,7 @@ impl BagReader {
             pos = data_pos + dlen as u64;
         }
         if damaged > 1 {
-            self.notes.push(format!(
+            self.contents.notes.push(format!(
                 "{damaged} damaged index records were skipped in all"
             ));
         }
@@ -347,7 +341,7 @@ impl BagReader {
         while pos < end {
             let Some((hb, data_pos, dlen)) = self.record_at(pos, end) else {
                 if end == self.len {
-                    self.losses.push(Loss::new(format!(
+                    self.contents.losses.push(Loss::new(format!(
                         "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
                         self.len - pos
                     )));
@@ -441,7 +435,7 @@ impl BagReader {
             .copied()
             .or_else(|| self.find_chunk(at + 1, end));
         let to = next.unwrap_or(end);
-        self.losses.push(Loss::new(format!(
+        self.contents.losses.push(Loss::new(format!(
             "bytes {at}..{to} of the chunk section are damaged ({why}) and were skipped"
         )));
         *pos = to;
@@ -511,7 +505,7 @@ impl BagReader {
                     // rosbag lists a chunk's connections in any order.
                     mine.sort_unstable();
                     if own.is_some() && own.as_ref() != Some(&mine) {
-                        self.notes.push(format!(
+                        self.contents.notes.push(format!(
                             "the chunk info of the chunk at byte {} lists {:?} messages per connection, the chunk's own index {:?}; the chunk is read whole and its own index is used",
                             info.chunk_pos,
                             mine,
@@ -521,7 +515,7 @@ impl BagReader {
                     c.info_counts = Some(info.counts);
                     c.span = Some((info.start_time, info.end_time));
                 }
-                Some(_) => self.notes.push(format!(
+                Some(_) => self.contents.notes.push(format!(
                     "two chunk infos name the chunk at byte {}; the chunk is read once",
                     info.chunk_pos
                 )),
@@ -547,7 +541,7 @@ impl BagReader {
                                 },
                             );
                         }
-                        None => self.losses.push(Loss {
+                        None => self.contents.losses.push(Loss {
                             what: format!(
                                 "the index lists a chunk at byte {} that holds no chunk record",
                                 info.chunk_pos
@@ -561,7 +555,7 @@ impl BagReader {
             }
         }
         if had_index && !unlisted.is_empty() {
-            self.notes.push(format!(
+            self.contents.notes.push(format!(
                 "{} chunk(s) are not listed in the bag's index (first at byte {}); they were read",
                 unlisted.len(),
                 unlisted.iter().next().copied().unwrap_or(0)
@@ -571,7 +565,7 @@ impl BagReader {
             && had_index
             && n as usize != chunks.len()
         {
-            self.notes.push(format!(
+            self.contents.notes.push(format!(
                 "the bag header announces {n} chunks; {} were found",
                 chunks.len()
             ));
@@ -982,17 +976,8 @@ impl Source for BagReader {
     fn kind(&self) -> InputKind {
         InputKind::Ros1Bag
     }
-    fn channels(&self) -> &[source::Channel] {
-        &self.channels
-    }
-    fn parts(&self) -> &[Part] {
-        &self.parts
-    }
-    fn notes(&self) -> &[String] {
-        &self.notes
-    }
-    fn losses(&self) -> &[Loss] {
-        &self.losses
+    fn contents(&self) -> &source::Contents {
+        &self.contents
     }
     fn read_part(
         &self,

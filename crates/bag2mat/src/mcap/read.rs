@@ -65,11 +65,9 @@ pub struct McapReader {
     pub statistics: Option<Statistics>,
     /// Whether an intact summary section was used.
     pub summary_used: bool,
-    channels: Vec<source::Channel>,
+    /// Where each part's bytes are (parallel to the contents' parts).
     locs: Vec<Loc>,
-    parts: Vec<Part>,
-    notes: Vec<String>,
-    losses: Vec<Loss>,
+    contents: source::Contents,
 }
 
 /// Positioned reads through a window, for walking many small records cheaply.
@@ -128,11 +126,8 @@ impl McapReader {
             mcap_channels: BTreeMap::new(),
             statistics: None,
             summary_used: false,
-            channels: Vec::new(),
             locs: Vec::new(),
-            parts: Vec::new(),
-            notes: Vec::new(),
-            losses: Vec::new(),
+            contents: source::Contents::default(),
         };
         let footer = r.read_footer();
         let mut data_end = len;
@@ -150,14 +145,14 @@ impl McapReader {
                         r.schemas.clear();
                         r.mcap_channels.clear();
                         r.statistics = None;
-                        r.notes.push(format!(
+                        r.contents.notes.push(format!(
                             "the summary section is damaged ({e}); the data section was scanned instead"
                         ));
                     }
                 }
             }
         } else {
-            r.notes.push(
+            r.contents.notes.push(
                 "the file has no footer (the recording was cut short, or the file is truncated); its records were scanned".to_string(),
             );
         }
@@ -280,7 +275,7 @@ impl McapReader {
             };
             if first && op != Op::Header as u8 {
                 // The Header only names the profile and library: its damage costs nothing.
-                self.notes.push(format!(
+                self.contents.notes.push(format!(
                     "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
                 ));
             }
@@ -295,7 +290,7 @@ impl McapReader {
             match Op::from_byte(op) {
                 Some(Op::Header) if first => match small(&mut w)?.map(|b| Header::decode(&b)) {
                     Some(Ok(h)) => self.header = h,
-                    _ => self.notes.push(format!(
+                    _ => self.contents.notes.push(format!(
                         "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
                     )),
                 },
@@ -303,7 +298,7 @@ impl McapReader {
                     if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {
                         self.schemas.entry(s.id).or_insert(s);
                     } else {
-                        self.notes
+                        self.contents.notes
                             .push(format!("unreadable Schema record at byte {pos} skipped"));
                     }
                 }
@@ -311,7 +306,7 @@ impl McapReader {
                     if let Some(Ok(c)) = small(&mut w)?.map(|b| record::Channel::decode(&b)) {
                         self.mcap_channels.entry(c.id).or_insert(c);
                     } else {
-                        self.notes
+                        self.contents.notes
                             .push(format!("unreadable Channel record at byte {pos} skipped"));
                     }
                 }
@@ -327,7 +322,7 @@ impl McapReader {
                                 crc: h.uncompressed_crc,
                                 compression: h.compression.clone(),
                             });
-                            self.parts.push(Part {
+                            self.contents.parts.push(Part {
                                 bytes: h.uncompressed_size.min(
                                     h.compressed_size.saturating_mul(source::MAX_EXPANSION),
                                 ),
@@ -339,7 +334,7 @@ impl McapReader {
                                 self.collect_inner_channels(self.locs.len() - 1);
                             }
                         }
-                        Ok((h, _)) => self.losses.push(Loss {
+                        Ok((h, _)) => self.contents.losses.push(Loss {
                             what: format!(
                                 "chunk at byte {pos}: its records length disagrees with the record length; skipped"
                             ),
@@ -347,7 +342,7 @@ impl McapReader {
                             span: Some((h.message_start_time, h.message_end_time)),
                             channel: None,
                         }),
-                        Err(e) => self.losses.push(Loss {
+                        Err(e) => self.contents.losses.push(Loss {
                             what: format!("chunk at byte {pos} has an unreadable header ({e}); skipped"),
                             messages: None,
                             span: None,
@@ -360,7 +355,7 @@ impl McapReader {
                         .get(content_pos, 6.min(clen as usize))
                         .map_err(io)?
                         .to_vec();
-                    if let (Ok((ch, n)), Some(p)) = (MessageIndex::count(&b), self.parts.last_mut())
+                    if let (Ok((ch, n)), Some(p)) = (MessageIndex::count(&b), self.contents.parts.last_mut())
                         && matches!(self.locs.last(), Some(Loc::Chunk { .. }))
                     {
                         p.counts.get_or_insert_with(Vec::new).push((ch as u32, n));
@@ -392,7 +387,8 @@ impl McapReader {
             });
         }
         if !seen_data_end && pos >= end && self.summary_used {
-            self.notes
+            self.contents
+                .notes
                 .push("the data section has no Data End record".to_string());
         }
         Ok(())
@@ -401,7 +397,7 @@ impl McapReader {
     /// Extends the current run of unchunked records, or starts a new one.
     fn add_loose(&mut self, pos: u64, end: u64, t: Option<u64>) {
         if let (Some(Loc::Loose { start, end: e }), Some(p)) =
-            (self.locs.last_mut(), self.parts.last_mut())
+            (self.locs.last_mut(), self.contents.parts.last_mut())
             && *e == pos
             && end - *start <= LOOSE_PART_BYTES
         {
@@ -416,7 +412,7 @@ impl McapReader {
             return;
         }
         self.locs.push(Loc::Loose { start: pos, end });
-        self.parts.push(Part {
+        self.contents.parts.push(Part {
             bytes: end - pos,
             label: format!("unchunked messages from byte {pos}"),
             span: t.map(|t| (t, t)),
@@ -445,7 +441,7 @@ impl McapReader {
             Some((op, _)) if op == Op::Message as u8 => Some(1),
             _ => None,
         };
-        self.losses.push(Loss {
+        self.contents.losses.push(Loss {
             what,
             messages,
             span,
@@ -488,6 +484,7 @@ impl McapReader {
             return;
         }
         let found: std::collections::BTreeSet<u64> = self
+            .contents
             .parts
             .iter()
             .filter_map(|p| p.label.strip_prefix("chunk at byte "))
@@ -495,7 +492,7 @@ impl McapReader {
             .collect();
         for ci in chunk_indexes {
             if !found.contains(&ci.chunk_start_offset) {
-                self.losses.push(Loss {
+                self.contents.losses.push(Loss {
                     what: format!(
                         "the summary lists a chunk at byte {} that the data section does not hold",
                         ci.chunk_start_offset
@@ -514,17 +511,21 @@ impl McapReader {
             .as_ref()
             .map(|s| s.channel_message_counts.iter().copied().collect());
         // Without statistics, the message indexes count the messages when every part has them.
-        let indexed: Option<BTreeMap<u16, u64>> =
-            self.parts.iter().all(|p| p.counts.is_some()).then(|| {
+        let indexed: Option<BTreeMap<u16, u64>> = self
+            .contents
+            .parts
+            .iter()
+            .all(|p| p.counts.is_some())
+            .then(|| {
                 let mut m = BTreeMap::new();
-                for p in &self.parts {
+                for p in &self.contents.parts {
                     for (c, n) in p.counts.iter().flatten() {
                         *m.entry(*c as u16).or_default() += n;
                     }
                 }
                 m
             });
-        self.channels = self
+        self.contents.channels = self
             .mcap_channels
             .values()
             .map(|c| {
@@ -636,17 +637,8 @@ impl Source for McapReader {
     fn kind(&self) -> InputKind {
         InputKind::Mcap
     }
-    fn channels(&self) -> &[source::Channel] {
-        &self.channels
-    }
-    fn parts(&self) -> &[Part] {
-        &self.parts
-    }
-    fn notes(&self) -> &[String] {
-        &self.notes
-    }
-    fn losses(&self) -> &[Loss] {
-        &self.losses
+    fn contents(&self) -> &source::Contents {
+        &self.contents
     }
     fn read_part(
         &self,

@@ -21,9 +21,7 @@ use crate::error::Error;
 use crate::imu_msg::Imu;
 use crate::mcap::{ChunkCompression, McapReader, McapWriter};
 use crate::shared::output::AtomicDir;
-use crate::source::{
-    self, Channel, Decompressed, InputKind, Loss, MessageSink, Part, PartRead, Source,
-};
+use crate::source::{self, Channel, Decompressed, InputKind, Loss, MessageSink, PartRead, Source};
 use metadata::{BagInfo, OFFERED_QOS_PROFILES, WrittenBag, WrittenTopic};
 
 thread_local! {
@@ -45,13 +43,10 @@ struct FileSource {
 /// A ROS 2 bag directory, read as one source.
 pub struct BagDir {
     files: Vec<FileSource>,
-    channels: Vec<Channel>,
     /// Part in the bag → (file, part in the file).
     part_map: Vec<(usize, usize)>,
-    parts: Vec<Part>,
     message_zstd: bool,
-    notes: Vec<String>,
-    losses: Vec<Loss>,
+    contents: source::Contents,
     /// The parsed `metadata.yaml`, when there is one.
     pub info: Option<BagInfo>,
 }
@@ -230,12 +225,14 @@ impl BagDir {
         }
         BagDir {
             files: out_files,
-            channels,
             part_map,
-            parts,
             message_zstd,
-            notes,
-            losses,
+            contents: source::Contents {
+                channels,
+                parts,
+                notes,
+                losses,
+            },
             info,
         }
     }
@@ -249,17 +246,8 @@ impl Source for BagDir {
             InputKind::Zstd
         }
     }
-    fn channels(&self) -> &[Channel] {
-        &self.channels
-    }
-    fn parts(&self) -> &[Part] {
-        &self.parts
-    }
-    fn notes(&self) -> &[String] {
-        &self.notes
-    }
-    fn losses(&self) -> &[Loss] {
-        &self.losses
+    fn contents(&self) -> &source::Contents {
+        &self.contents
     }
     fn read_part(
         &self,

@@ -26,11 +26,9 @@ const ROWS_PER_PART: i64 = 65_536;
 pub struct Sqlite3Reader {
     path: PathBuf,
     pool: Mutex<Vec<Connection>>,
-    channels: Vec<source::Channel>,
+    /// Message ids of each part, `a..b` (parallel to the contents' parts).
     ranges: Vec<(i64, i64)>,
-    parts: Vec<Part>,
-    notes: Vec<String>,
-    losses: Vec<Loss>,
+    contents: source::Contents,
     /// The `schema` table's version, when the file has one (ROS 2 Iron and later).
     pub schema_version: Option<i64>,
 }
@@ -138,11 +136,13 @@ impl Sqlite3Reader {
         Ok(Sqlite3Reader {
             path: path.to_path_buf(),
             pool: Mutex::new(vec![conn]),
-            channels,
             ranges,
-            parts,
-            notes,
-            losses: Vec::new(),
+            contents: source::Contents {
+                channels,
+                parts,
+                notes,
+                losses: Vec::new(),
+            },
             schema_version,
         })
     }
@@ -182,17 +182,8 @@ impl Source for Sqlite3Reader {
     fn kind(&self) -> InputKind {
         InputKind::Sqlite3
     }
-    fn channels(&self) -> &[source::Channel] {
-        &self.channels
-    }
-    fn parts(&self) -> &[Part] {
-        &self.parts
-    }
-    fn notes(&self) -> &[String] {
-        &self.notes
-    }
-    fn losses(&self) -> &[Loss] {
-        &self.losses
+    fn contents(&self) -> &source::Contents {
+        &self.contents
     }
     fn read_part(
         &self,
@@ -239,7 +230,7 @@ impl Source for Sqlite3Reader {
                     let fields = (|| -> Result<(), rusqlite::Error> {
                         let topic = row.get::<_, i64>(1)? as u32;
                         if !want(topic) {
-                            if !self.channels.iter().any(|c| c.id == topic) {
+                            if !self.contents.channels.iter().any(|c| c.id == topic) {
                                 // A row naming no topic of the table: its message is lost.
                                 let e = stray.get_or_insert((0u64, topic));
                                 e.0 += 1;
