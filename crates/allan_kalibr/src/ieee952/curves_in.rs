@@ -648,8 +648,14 @@ fn csv_rows(path: &Path, text: &str) -> Result<Vec<Vec<f64>>, CurvesError> {
     Ok(rows)
 }
 
-fn read_kalibr(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesError> {
-    let rows = csv_rows(path, text)?;
+/// The sample period of a CSV of curves: 1/`--rate` when given, else its first (smallest
+/// positive) τ, which a curve starting at one sample is.
+fn sample_period(
+    path: &Path,
+    rows: &[Vec<f64>],
+    opts: &Options,
+    why_none: &str,
+) -> Result<f64, CurvesError> {
     let tau_min = rows
         .iter()
         .filter_map(|r| r.first().copied())
@@ -658,10 +664,20 @@ fn read_kalibr(path: &Path, text: &str, opts: &Options) -> Result<Curves, Curves
     if !tau_min.is_finite() {
         return Err(CurvesError::UnknownFormat {
             path: path.to_path_buf(),
-            why: "allan_curves.csv without a positive tau1".into(),
+            why: why_none.into(),
         });
     }
-    let tau0 = opts.rate.map_or(tau_min, |r| 1.0 / r);
+    Ok(opts.rate.map_or(tau_min, |r| 1.0 / r))
+}
+
+fn read_kalibr(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesError> {
+    let rows = csv_rows(path, text)?;
+    let tau0 = sample_period(
+        path,
+        &rows,
+        opts,
+        "allan_curves.csv without a positive tau1",
+    )?;
     let mut ms = Vec::new();
     let mut acc = Vec::new();
     let mut gyr = Vec::new();
@@ -847,18 +863,7 @@ fn read_plain(path: &Path, text: &str, unit: &str, opts: &Options) -> Result<Cur
         ))
     })?;
     let rows = csv_rows(path, text)?;
-    let tau_min = rows
-        .iter()
-        .filter_map(|r| r.first().copied())
-        .filter(|t| *t > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if !tau_min.is_finite() {
-        return Err(CurvesError::UnknownFormat {
-            path: path.to_path_buf(),
-            why: "no positive tau".into(),
-        });
-    }
-    let tau0 = opts.rate.map_or(tau_min, |r| 1.0 / r);
+    let tau0 = sample_period(path, &rows, opts, "no positive tau")?;
     let mut ms = Vec::new();
     let mut vals = Vec::new();
     for (i, r) in rows.iter().enumerate() {
