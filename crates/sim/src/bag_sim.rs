@@ -16,6 +16,7 @@ use crate::noise::NoiseGenerator;
 use crate::noise::generate::ImuNoise;
 use crate::noise::model::ImuModel;
 use crate::rotation::quat_from_matrix;
+use crate::sensor_chain::MotionChain;
 use bag2mat::bag::BagWriter;
 use bag2mat::bag::write::ConnId;
 use bag2mat::imu_msg::Imu;
@@ -325,6 +326,13 @@ pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
     let fixed = (cfg.motion == Motion::Static).then(|| cfg.motion.sample(0.0));
     let to_xyzw = |q: [f64; 4]| [q[1], q[2], q[3], q[0]];
     let fixed_q = fixed.map(|m| to_xyzw(quat_from_matrix(&m.r_wb)));
+    // A moving IMU's motion goes through the sensor's low-pass and decimation like its
+    // noise (a static one reads a constant, which the filter passes unchanged).
+    let mut chain = match fixed {
+        Some(_) => None,
+        None => MotionChain::new(&cfg.model, cfg.rate)?,
+    };
+    let motion = cfg.motion;
     const PROGRESS_STEP: u64 = 1 << 14;
     for (i, t) in Grid::AccumulatedF64
         .times(cfg.duration, cfg.rate)
@@ -337,7 +345,14 @@ pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
                 (m, to_xyzw(quat_from_matrix(&m.r_wb)))
             }
         };
-        let (mut g, mut a): ([f64; 3], [f64; 3]) = (m.gyro.into(), m.acc.into());
+        let (mut g, mut a): ([f64; 3], [f64; 3]) = match &mut chain {
+            Some(c) => c.output(
+                t,
+                |tau| motion.sample(tau).gyro.into(),
+                |tau| motion.sample(tau).acc.into(),
+            ),
+            None => (m.gyro.into(), m.acc.into()),
+        };
         noise.apply(&mut g, &mut a);
         let stamp = RosTime::from_nanos(cfg.start_ns + (t * 1e9).round() as u64);
         sink.push(stamp, q, g, a)?;

@@ -278,7 +278,8 @@ pub struct BagArgs {
     /// header.frame_id.
     #[arg(long, default_value = "base_link")]
     pub frame_id: String,
-    /// Motion model.
+    /// Motion model. A moving IMU's motion goes through the sensor's low-pass filter and
+    /// decimation like its noise (a profile or spec with a filter delays and attenuates it).
     #[arg(long, value_enum, default_value_t = MotionArg::Static)]
     pub motion: MotionArg,
     /// Chunk compression (ROS 1: none, bz2, lz4; MCAP: none, zstd, lz4).

@@ -4,7 +4,8 @@
 //! * [`noise`]: continuous ↔ discrete noise parameters (THE place for these conversions in
 //!   the workspace), the seeded `addIMUnoise` generator, and the real-sensor model (every
 //!   IEEE 952 term, the DLPF chain, profiles, spec files) with its exact truth curves.
-//! * [`motion`]: the analytic models (static level IMU, 20 s ellipse).
+//! * [`motion`]: the analytic models (static level IMU, 20 s ellipse);
+//!   [`sensor_chain`]: a moving IMU's motion through the sensor's low-pass and decimation.
 //! * [`grid`]: upstream's accumulated time grids.
 //! * [`bag_sim`]: `sim bag` — the `ros_version` static (or ellipse) IMU bag via bag2mat.
 //! * [`traj`]: `sim traj` — the `master` text files (IMU poses, camera poses, landmarks,
@@ -52,6 +53,7 @@ pub mod noise;
 pub mod plot;
 pub mod report;
 pub mod rotation;
+pub mod sensor_chain;
 pub mod spline;
 pub mod spline_sim;
 pub mod textio;

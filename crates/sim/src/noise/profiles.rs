@@ -5,10 +5,12 @@
 //! document; "assumed" means the datasheet gives no such figure and the value is our choice,
 //! with the reason. Datasheets quote noise densities in °/s/√Hz, °/√h, µg/√Hz or m/s/√h;
 //! they are converted here to the continuous-time SI densities of [`super::model`]
-//! (ARW °/√h ÷ 60 → °/√s; VRW m/s/√h ÷ 60 → m/s²/√Hz). None of them specifies the order
-//! or type of its digital low-pass filter: a 2nd-order Butterworth at the datasheet's
-//! −3 dB bandwidth stands for it (the ADIS16470's decimation stage is an average, modelled
-//! as such).
+//! (ARW °/√h ÷ 60 → °/√s; VRW m/s/√h ÷ 60 → m/s²/√Hz). The BMI088 datasheet does not give
+//! the order or type of its digital low-pass filter, and the STIM300's says only "CIC type
+//! filters with linear phase response" (TS1524 rev. 31): a 2nd-order Butterworth at the
+//! datasheet's −3 dB bandwidth stands for both (same corner, not the same phase). The
+//! ADIS16470's decimation stage is an average, modelled as such. The figures were checked
+//! against the documents named in [`Profile::source`] on 2026-11-30.
 
 use super::model::{
     AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, SensorModel, Warmup,
@@ -75,13 +77,13 @@ impl Profile {
                 "the seed's preset: white noise and bias random walk only (vio_data_simulation model)"
             }
             Profile::Bmi088 => {
-                "Bosch BMI088 (consumer MEMS), data sheet BST-BMI088-DS001 (rev. 1.3-1.9); gyro 200 Hz ODR / 23 Hz bandwidth, accel 200 Hz ODR normal mode / 80 Hz"
+                "Bosch BMI088 (consumer MEMS), data sheet BST-BMI088-DS001 rev. 1.4 and Bosch's product flyer; gyro 200 Hz ODR / 23 Hz bandwidth, accel 200 Hz ODR normal mode / 80 Hz"
             }
             Profile::Adis16470 => {
                 "Analog Devices ADIS16470 (industrial MEMS IMU), data sheet Rev. C, Table 1; 2000 SPS internal, averaging decimation to the output rate, 32-bit output registers"
             }
             Profile::Stim300 => {
-                "Safran Sensonor STIM300 (tactical-grade MEMS IMU), data sheet TS1524 rev. 9 (10 g accelerometers); 2000 SPS internal, 66 Hz low-pass"
+                "Safran Sensonor STIM300 (tactical-grade MEMS IMU), noise figures of data sheet TS1524 rev. 9 (10 g accelerometers; rev. 31 quotes a quieter accelerometer); 2000 SPS internal, 66 Hz low-pass"
             }
         }
     }
@@ -104,13 +106,13 @@ fn legacy(p: Profile, c: ContinuousNoise) -> ImuModel {
 }
 
 fn bmi088() -> ImuModel {
-    // Gyroscope. Datasheet: rate noise density 0.014 °/s/√Hz (gyroscope table; also quoted by
-    // Bosch's FAE on the Bosch Sensortec community forum, 2020).
+    // Gyroscope. Datasheet rev. 1.4, Table 5: output noise "BW = 47 Hz (@ 0.014 °/s/√Hz)
+    // 0.1 °/s"; the product flyer gives the same 0.014 °/s/√Hz.
     let gyro_n = 0.014 * DEG;
-    // Bias instability: the BMI088 data sheet's gyroscope table lists a bias stability of
-    // 2 °/h; we could not re-read that page from this session, so treat it as assumed at the
-    // datasheet's order. Corner times assumed (floor seen from ≈ 5 s to 500 s on consumer
-    // MEMS Allan curves such as ../shared/reference/real_curves/BMI160).
+    // Bias instability: not in the datasheet's tables; Bosch's product flyer claims "bias
+    // stability of less than 2 °/h", an upper bound taken here as the value. Corner times
+    // assumed (floor seen from ≈ 5 s to 500 s on consumer MEMS Allan curves such as
+    // ../shared/reference/real_curves/BMI160).
     let gyro_b = 2.0 * DEG_PER_H;
     // Random walk: not in the datasheet. Assumed 4e-7 rad/s²/√Hz, which makes the +½ slope
     // rise out of the floor near 1000 s.
@@ -118,9 +120,9 @@ fn bmi088() -> ImuModel {
     // Output LSB: 16-bit at the default ±2000 °/s range (register 0x0F = 0x00): 16.384 LSB
     // per °/s.
     let gyro_lsb = DEG / 16.384;
-    // Warm-up: zero-rate offset temperature coefficient 0.015 °/s/K (datasheet's "zero-rate
-    // offset over temperature"; the same figure as the BMI055/BMG160 gyro core); the
-    // self-heating of 1 K with a 300 s time constant is assumed.
+    // Warm-up: zero-rate offset temperature coefficient ±0.015 °/s per K at ±2000 °/s
+    // (datasheet Table 5, TCO); the self-heating of 1 K with a 300 s time constant is
+    // assumed.
     let gyro_warm = Warmup::Thermal {
         temperature_rise: 1.0,
         tau: 300.0,
@@ -144,7 +146,8 @@ fn bmi088() -> ImuModel {
         warmup: Some(gyro_warm),
         ..Default::default()
     };
-    // Accelerometer. Datasheet: output noise density 160 µg/√Hz on x and y, 190 µg/√Hz on z.
+    // Accelerometer. Datasheet Table 4: output noise density 160 µg/√Hz on x and y,
+    // 190 µg/√Hz on z (normal mode, ±3 g; the flyer's 230 µg/√Hz is at ±24 g).
     let acc_axis = |ug: f64| AxisModel {
         white_noise: ug * 1e-6 * G0,
         // Not in the datasheet; assumed 1e-5 m/s³/√Hz (+½ slope from ≈ 1000 s).
@@ -169,8 +172,9 @@ fn bmi088() -> ImuModel {
     ImuModel {
         label: "bmi088".into(),
         gyro: SensorModel {
-            // Gyro data path at 2000 Hz (its highest ODR, 532 Hz "unfiltered"); the 200 Hz ODR
-            // with 23 Hz bandwidth setting (GYRO_BANDWIDTH = 0x04).
+            // Gyro data path at 2000 Hz (its highest ODR, 532 Hz "unfiltered" in the register
+            // table, 523 Hz in Table 5); the 200 Hz ODR with 23 Hz bandwidth setting
+            // (GYRO_BANDWIDTH = 0x04).
             chain: Chain {
                 internal_rate_hz: Some(2000.0),
                 filter: Filter::Butterworth2 { cutoff_hz: 23.0 },
@@ -190,8 +194,8 @@ fn bmi088() -> ImuModel {
 }
 
 fn adis16470() -> ImuModel {
-    // Gyroscope, Rev. C Table 1: angular random walk 0.34 °/√h (= 0.008 °/s/√Hz rate noise
-    // density /√2, the one-sided figure on the front page); in-run bias stability 8 °/h.
+    // Gyroscope, Table 1 (the same in Rev. A and Rev. C): angular random walk 0.34 °/√h
+    // (= 0.008 °/s/√Hz rate noise density, 10–40 Hz, /√2); in-run bias stability 8 °/h.
     let gyro = AxisModel {
         white_noise: 0.34 * DEG_PER_SQRT_H,
         // Not in the datasheet; assumed 1e-6 rad/s²/√Hz (+½ slope near 2000 s).
@@ -205,7 +209,8 @@ fn adis16470() -> ImuModel {
         // 32-bit gyro output (GYRO_OUT + GYRO_LOW): 0.1 °/s per 16-bit LSB / 65536. The 16-bit
         // register alone (0.1 °/s) would be coarser than the per-sample noise.
         resolution: 0.1 * DEG / 65536.0,
-        // Assumed: 2 K self-heating in 600 s with 0.002 °/s/K.
+        // Assumed: 2 K self-heating in 600 s with 0.002 °/s/K (Table 1 gives only the bias
+        // error over −10…+75 °C, 0.2 °/s 1σ, ≈ 0.0024 °/s/K).
         warmup: Some(Warmup::Thermal {
             temperature_rise: 2.0,
             tau: 600.0,
@@ -250,8 +255,10 @@ fn adis16470() -> ImuModel {
 }
 
 fn stim300() -> ImuModel {
-    // Gyroscope, TS1524 rev. 9: bias instability 0.5 °/h, angular random walk 0.15 °/√h
-    // (the FAQ: measured per IEEE 952 over 18 h at 1000 SPS with a 131 Hz low-pass).
+    // Gyroscope, TS1524 rev. 9 (as quoted by NavToolkit's stim300_model; rev. 31, Table
+    // 5-3, gives the same): bias instability 0.5 °/h (rev. 31: 0.3 °/h minimum, 0.5 °/h at
+    // 600 s), angular random walk 0.15 °/√h (Sensonor's FAQ: measured per IEEE 952 over
+    // 18 h at 1000 SPS with a 131 Hz low-pass).
     let gyro = AxisModel {
         white_noise: 0.15 * DEG_PER_SQRT_H,
         // Not in the datasheet; assumed 2e-8 rad/s²/√Hz (+½ slope only beyond ≈ 5 h).
@@ -272,7 +279,11 @@ fn stim300() -> ImuModel {
         }),
         ..Default::default()
     };
-    // Accelerometer (10 g), rev. 9: bias instability 0.05 mg, velocity random walk 0.06 m/s/√h.
+    // Accelerometer (10 g), rev. 9: bias instability 0.05 mg, velocity random walk
+    // 0.06 m/s/√h. Rev. 31 (Table 5-5) quotes a quieter part: 0.006 mg at 600 s and
+    // 0.024 m/s/√h, with an internal accelerometer rate of 8000 SPS. The rev. 9 figures are
+    // kept so that the profile stays the one the studies were run on; a rev. 31 unit is a
+    // `--noise-spec` with `base: stim300` and those two figures.
     let acc = AxisModel {
         white_noise: 0.06 / 60.0,
         // Not in the datasheet; assumed 5e-6 m/s³/√Hz (+½ slope near 3.5 h).
@@ -288,6 +299,7 @@ fn stim300() -> ImuModel {
     };
     // 2000 SPS internal rate; the −3 dB frequency 66 Hz is one of the configurable ones
     // (16, 33, 66, 131, 262 Hz) and the one below the 100 Hz Nyquist of a 200 Hz output.
+    // (The STIM300's own output rates are 125…2000 SPS; 200 Hz needs its external trigger.)
     let chain = Chain {
         internal_rate_hz: Some(2000.0),
         filter: Filter::Butterworth2 { cutoff_hz: 66.0 },
