@@ -41,7 +41,8 @@
 //! 95 % lower bound above 0, a fitting model, and where the data show it: the term's own line
 //! comes within 20 % of the model somewhere in the fitted range ([`RESOLVED_SHARE`] of the
 //! Allan variance) — a bias instability only where there is a floor, not at the V where the
-//! white-noise and random-walk lines cross. Where the data leave the flicker
+//! white-noise and random-walk lines cross, and only where that floor is the curve's own
+//! lowest point within [`B_FLOOR_TOL`]. Where the data leave the flicker
 //! floor's shape open (a flat floor or one with a lower corner, [`fit::flicker_band`]), each
 //! interval spans every plausible shape ([`fit::FitResult::alternatives`]). A fit whose
 //! model misses the curve beyond its statistics by more than [`APPROX_DELTA`] is declared
@@ -104,6 +105,11 @@ pub const FIT_TOL: f64 = 0.10;
 /// measured one somewhere in the fitted range: its line within 20 % (0.8² = 0.64) of the
 /// curve.
 pub const RESOLVED_SHARE: f64 = 0.64;
+/// A bias instability is resolved only where the measured curve shows its floor: 0.664·B
+/// within this fraction of the curve's lowest point in the fitted range. A B the model
+/// infers from the curve's bend (a floor with a corner it never reaches, a bump, the white
+/// noise still adding at the minimum) is "never dominant", with its value and interval.
+pub const B_FLOOR_TOL: f64 = 0.20;
 /// A fit whose model discrepancy δ exceeds this is declared "approximately": the model stays
 /// within [`FIT_TOL`] of the curve, yet misses points whose own error is far smaller, so
 /// the terms lean on the model's shape rather than on the data (5 %: half the tolerance;
@@ -866,6 +872,13 @@ fn data_bound(j: usize, f: &fit::FitResult, fd: &fit::FitData, curve: &[Point]) 
 fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Config) -> Terms {
     let z = z_of(cfg.term_confidence);
     let have_stats = fd.basis.is_some();
+    // the measured floor of the fitted range, for B's verdict (see [`B_FLOOR_TOL`])
+    let floor = curve
+        .iter()
+        .filter(|p| p.in_range)
+        .map(|p| p.adev)
+        .fold(f64::INFINITY, f64::min);
+    let floor_shown = |b: f64| (region::B_FLOOR_FACTOR * b / floor - 1.0).abs() <= B_FLOOR_TOL;
     let one = |j: usize| -> Term {
         if !cfg.fit.terms[j] {
             return Term::not_fitted();
@@ -910,7 +923,7 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
             lo_c = lo_c.min((alt.coef[j] - z * alt.std_err[j]).max(0.0));
             hi_c = hi_c.max(alt.coef[j] + z * alt.std_err[j]);
         }
-        let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE;
+        let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE && (j != 2 || floor_shown(value));
         let verdict = if !have_stats {
             // no sample count: no interval, so nothing is "resolved" statistically; a term the
             // model needs and that dominates somewhere is still the model's
@@ -1007,6 +1020,111 @@ mod tests {
                 "n={n}: K reported in {false_k}/{trials} white series, tol {MAX_FALSE_K_RATE}"
             );
         }
+    }
+
+    /// An exact-model curve of `n` samples at `tau0` on a 1.25-geometric m grid up to n/2.3
+    /// (imu_utils' longest τ), as `--curves` delivers it; `avar(τ)` gives the values.
+    fn exact_curve(n: usize, tau0: f64, avar: impl Fn(f64) -> f64) -> CurveData {
+        let mut ms = Vec::new();
+        let mut m = 1.0f64;
+        while (m as usize) <= (n as f64 / 2.3) as usize {
+            let k = m.round() as usize;
+            if ms.last() != Some(&k) {
+                ms.push(k);
+            }
+            m *= 1.25;
+        }
+        CurveData {
+            tau0,
+            n: Some(n),
+            kind: Overlap::Overlapping,
+            points: ms
+                .into_iter()
+                .map(|m| {
+                    let tau = m as f64 * tau0;
+                    CurvePoint {
+                        m,
+                        tau,
+                        avar: avar(tau),
+                        id: None,
+                        id_method: IdMethod::None,
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    fn analyse_exact(c: &CurveData) -> Analysis {
+        let cfg = Config::default();
+        let basis = c.basis(cfg.fit.per_octave);
+        analyse_curve(c, &cfg, basis.as_ref())
+    }
+
+    /// The floor the verdict compares 0.664·B with: the lowest curve point of the range.
+    fn range_floor(a: &Analysis) -> f64 {
+        a.curve
+            .iter()
+            .filter(|p| p.in_range)
+            .map(|p| p.adev)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// A B-dominated floor is resolved; the same curve whose last, noisiest points fall (the
+    /// "falling tail" of a few clusters, kalibr_allan#64, seen on real imu_utils curves) has
+    /// a floor below 0.664·B by more than [`B_FLOOR_TOL`]: B is no longer called resolved,
+    /// though the model and its value barely move.
+    #[test]
+    fn a_bias_instability_is_resolved_only_where_the_curve_shows_its_floor() {
+        let (n, tau0) = (2_400_000, 0.005);
+        let (nn, b, k) = (7.6e-4f64, 2.5e-4f64, 2e-6f64);
+        let model = |t: f64| nn * nn / t + fit::FLICKER_AVAR * b * b + k * k * t / 3.0;
+        let clean = analyse_exact(&exact_curve(n, tau0, model));
+        assert_eq!(
+            clean.terms.b.verdict,
+            Verdict::Resolved,
+            "{}",
+            clean.verdict
+        );
+        let floor = range_floor(&clean);
+        assert!((region::B_FLOOR_FACTOR * clean.terms.b.value / floor - 1.0).abs() <= B_FLOOR_TOL);
+        // the tail: the points beyond T/4 fall to 40 % of the model (within their 95 % band)
+        let t_end = n as f64 * tau0;
+        let tail = |t: f64| model(t) * if t > t_end / 4.0 { 0.16 } else { 1.0 };
+        let dipped = analyse_exact(&exact_curve(n, tau0, tail));
+        assert!(dipped.verdict.fits(), "{}", dipped.verdict);
+        let floor = range_floor(&dipped);
+        let ratio = region::B_FLOOR_FACTOR * dipped.terms.b.value / floor;
+        assert!(
+            ratio > 1.0 + B_FLOOR_TOL,
+            "the tail sets the floor: {ratio}"
+        );
+        assert_eq!(dipped.terms.b.verdict, Verdict::NeverDominant);
+        assert!(
+            (dipped.terms.b.value / b - 1.0).abs() < 0.2,
+            "{}",
+            dipped.terms.b.value
+        );
+    }
+
+    /// A τ⁻² excess over the white-noise line that never comes near the curve (the short-τ
+    /// bend of a sensor's chain, or a quantization too small to read) is not fitted as Q:
+    /// N is then the white-noise level the −½ line shows, not that level minus Q's share.
+    #[test]
+    fn a_quantization_that_never_dominates_is_left_out_of_the_model() {
+        let (n, tau0) = (2_400_000, 0.0025);
+        let (nn, q) = (5.0e-5f64, 1.0e-6f64);
+        // Q's share of the AVAR at τ0: 3Q²/τ0² / (that + N²/τ0) ≈ 0.3, below 0.64
+        let model = |t: f64| 3.0 * q * q / (t * t) + nn * nn / t + 1e-9 * t;
+        let a = analyse_exact(&exact_curve(n, tau0, model));
+        assert!(a.verdict.fits(), "{}", a.verdict);
+        assert_eq!(a.terms.q.value, 0.0, "Q left out");
+        assert!(a.terms.q.hi > 0.0, "with its upper bound");
+        // N: the white level, within the share Q still has where the fit starts
+        assert!(
+            (a.terms.n.value / nn - 1.0).abs() < 0.03,
+            "{}",
+            a.terms.n.value
+        );
     }
 
     #[test]

@@ -293,3 +293,47 @@ fn real_curves_acceptance() {
         "{fitting}/{total} axes fit, need {MIN_FITTING_SHARE}"
     );
 }
+
+/// The same acceptance on other imu_utils data directories: `REAL_CURVES_EXTRA` lists
+/// `DIR:SECONDS` pairs separated by commas (the record length from the directory's launch
+/// file), e.g. imu_utils' own `data/` split per IMU.
+#[test]
+#[ignore = "needs REAL_CURVES_EXTRA; --ignored --nocapture"]
+fn real_curves_acceptance_elsewhere() {
+    let list = std::env::var("REAL_CURVES_EXTRA").expect("REAL_CURVES_EXTRA=DIR:SECONDS,...");
+    let (mut fitting, mut total, mut failed) = (0, 0, Vec::new());
+    for item in list.split(',') {
+        let (dir, secs) = item.rsplit_once(':').expect("DIR:SECONDS");
+        let c = curves_in::read(
+            &[std::path::PathBuf::from(dir)],
+            &Options {
+                duration: Some(secs.parse().expect("SECONDS")),
+                ..Options::default()
+            },
+        )
+        .unwrap();
+        let cfg = Config::default();
+        for s in &c.sensors {
+            let basis = s.axes[0].basis(cfg.fit.per_octave);
+            for (i, ax) in s.axes.iter().enumerate() {
+                let a = analyse_curve(ax, &cfg, basis.as_ref());
+                let label = format!("{dir} {} {}", s.sensor.name(), ["x", "y", "z"][i]);
+                if std::env::var("REAL_CURVES_ROWS").is_ok() {
+                    print_row(dir, s.sensor, i, &a);
+                }
+                // Every axis is checked (and printed) before the test fails.
+                match std::panic::catch_unwind(|| check_real_axis(&label, &a)) {
+                    Ok((ok, line)) => {
+                        println!("{line}");
+                        fitting += ok as usize;
+                    }
+                    Err(_) => failed.push(label),
+                }
+                total += 1;
+            }
+        }
+    }
+    println!("{fitting}/{total} axes fit over a range with τ = 1 s spanning two decades");
+    assert!(failed.is_empty(), "failed: {failed:?}");
+    assert!(fitting as f64 >= MIN_FITTING_SHARE * total as f64);
+}
