@@ -351,7 +351,7 @@ fn term_text(t: &Term, unit: &str) -> String {
             }
         }
         Verdict::NeverDominant => format!(
-            "not resolved: its line never reaches the curve ({:.2e} {unit}{})",
+            "not resolved: the curve never shows it on its own ({:.2e} {unit}{})",
             t.value,
             iv(t)
         ),

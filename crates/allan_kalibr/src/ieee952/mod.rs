@@ -296,9 +296,10 @@ pub enum Verdict {
     Resolved,
     /// The lower bound of its interval is 0: the data do not show the term.
     NotSignificant,
-    /// Significant, but its line never comes within 20 % of the curve in the fitted range
-    /// (e.g. a bias instability under the V of the white-noise and random-walk lines): its
-    /// value leans on the model.
+    /// Significant, but the curve never shows it on its own: its line never comes within
+    /// 20 % of the curve in the fitted range (e.g. a bias instability under the V of the
+    /// white-noise and random-walk lines), or, for B, the curve's lowest point is not at
+    /// 0.664·B within [`B_FLOOR_TOL`]. Its value leans on the model.
     NeverDominant,
     /// No reliable fit: the value is the IEEE 952 region reading, with its own interval.
     RegionReading,
