@@ -296,18 +296,23 @@ fn real_curves_acceptance() {
 
 /// The same acceptance on other imu_utils data directories: `REAL_CURVES_EXTRA` lists
 /// `DIR:SECONDS` pairs separated by commas (the record length from the directory's launch
-/// file), e.g. imu_utils' own `data/` split per IMU.
+/// file; `DIR` alone infers the sample count from the grid), e.g. imu_utils' own `data/`
+/// split per IMU.
 #[test]
 #[ignore = "needs REAL_CURVES_EXTRA; --ignored --nocapture"]
 fn real_curves_acceptance_elsewhere() {
     let list = std::env::var("REAL_CURVES_EXTRA").expect("REAL_CURVES_EXTRA=DIR:SECONDS,...");
     let (mut fitting, mut total, mut failed) = (0, 0, Vec::new());
     for item in list.split(',') {
-        let (dir, secs) = item.rsplit_once(':').expect("DIR:SECONDS");
+        // DIR alone: the sample count inferred from the grid, as without --duration
+        let (dir, duration) = match item.rsplit_once(':') {
+            Some((d, secs)) => (d, Some(secs.parse().expect("SECONDS"))),
+            None => (item, None),
+        };
         let c = curves_in::read(
             &[std::path::PathBuf::from(dir)],
             &Options {
-                duration: Some(secs.parse().expect("SECONDS")),
+                duration,
                 ..Options::default()
             },
         )
