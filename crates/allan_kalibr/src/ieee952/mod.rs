@@ -116,6 +116,12 @@ pub const B_FLOOR_TOL: f64 = 0.20;
 /// the real curves of `testdata/real_curves` have δ ≤ 4 % except a heavily filtered
 /// accelerometer whose curve bends slowly over four decades, δ 7 %).
 pub const APPROX_DELTA: f64 = 0.05;
+/// The misses of one short-τ feature (a bump above the white-noise line) lie within this
+/// factor of τ of its first miss (two octaves: a resonance's Allan bump is about that wide).
+pub const SHORT_FEATURE_SPAN: f64 = 4.0;
+/// A fit starts past a short-τ feature instead of ending before it only when that leaves a
+/// range wider by this many decades (a clear gain, so a long-end bend is still cut there).
+pub const SHORT_FEATURE_GAIN: f64 = 1.0;
 /// A declared fit range spans at least this many decades of τ; shorter is "no reliable fit".
 pub const MIN_RANGE_DECADES: f64 = 1.0;
 
@@ -707,7 +713,8 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
 /// declared-fit check — every curve point of the range within the larger of [`FIT_TOL`] and
 /// its 95 % band of the model. A miss among the first points of the range moves the start
 /// past it; a miss further up ends the range before it (the long τ the model cannot
-/// describe). Fewer than [`fit::MIN_FIT_POINTS`] points or less than [`MIN_RANGE_DECADES`]
+/// describe), unless it is a short-τ feature (a bump above the white-noise line) that the
+/// start can move past for a range wider by [`SHORT_FEATURE_GAIN`] decades. Fewer than [`fit::MIN_FIT_POINTS`] points or less than [`MIN_RANGE_DECADES`]
 /// left: no reliable fit. Returns the last fit, the verdict and the largest misfit.
 fn declare_fit(
     data: &CurveData,
@@ -806,12 +813,32 @@ fn declare_fit(
                 .position(|p| p.tau > last_in_zone * (1.0 + 1e-12))
                 .unwrap_or(np);
         } else {
-            end = fd
-                .points
+            // Past the start zone the first miss is either where the model stops following
+            // the curve (cut the long end before it) or a short-τ feature between the start
+            // and the white-noise region — a vibration or resonance bump above the −½ line
+            // (start past it). The long cut, unless starting past the feature leaves a range
+            // wider by SHORT_FEATURE_GAIN decades.
+            let pos_from = |tau: f64| fd.points.iter().position(|p| p.tau >= tau).unwrap_or(np);
+            let end_cut = pos_from(first.0 * (1.0 - 1e-12));
+            let feature_end = misses
                 .iter()
-                .position(|p| p.tau >= first.0 * (1.0 - 1e-12))
-                .unwrap_or(end);
-            long_cut_at = Some(end);
+                .take_while(|m| m.0 <= first.0 * SHORT_FEATURE_SPAN)
+                .map(|m| m.0)
+                .fold(first.0, f64::max);
+            let start_past = pos_from(feature_end * (1.0 + 1e-12));
+            let decades = |a: usize, b: usize| {
+                if b > a + 1 {
+                    (fd.points[b - 1].tau / fd.points[a].tau).log10()
+                } else {
+                    0.0
+                }
+            };
+            if decades(start_past, end) > decades(start, end_cut) + SHORT_FEATURE_GAIN {
+                start = start_past;
+            } else {
+                end = end_cut;
+                long_cut_at = Some(end);
+            }
         }
         last_fit = Some(f);
     }
@@ -1121,6 +1148,32 @@ mod tests {
         assert_eq!(a.terms.q.value, 0.0, "Q left out");
         assert!(a.terms.q.hi > 0.0, "with its upper bound");
         // N: the white level, within the share Q still has where the fit starts
+        assert!(
+            (a.terms.n.value / nn - 1.0).abs() < 0.03,
+            "{}",
+            a.terms.n.value
+        );
+    }
+
+    /// A vibration line at 10 Hz puts an Allan bump (AVAR of a sinusoid of amplitude A:
+    /// A²·sin⁴(πf₀τ)/(πf₀τ)²) above the white-noise line between the start and the white
+    /// region, as on a real MicroStrain GX4 accelerometer's curve. The fit starts past it
+    /// instead of ending before it (which left no reliable fit): a range with τ = 1 s over
+    /// three decades, N the white level.
+    #[test]
+    fn a_short_tau_bump_moves_the_start_past_it() {
+        let (n, tau0) = (2_900_000, 0.002);
+        let (nn, k, amp, f0) = (8e-4f64, 2e-5f64, 4e-3f64, 10.0f64);
+        let model = |t: f64| {
+            let x = std::f64::consts::PI * f0 * t;
+            // ±4 % log-periodic ripple: a real curve's misfit everywhere, so the bump is not
+            // trimmed as a statistical outlier at the start but met as a miss mid-range
+            (nn * nn / t + k * k * t / 3.0) * (1.0 + 0.04 * (4.0 * t.ln()).sin())
+                + amp * amp * x.sin().powi(4) / (x * x)
+        };
+        let a = analyse_exact(&exact_curve(n, tau0, model));
+        let (lo, hi) = a.verdict.range().expect("a fit past the bump");
+        assert!(lo > 0.05 && lo < 1.0 && hi / lo > 1e3, "{}", a.verdict);
         assert!(
             (a.terms.n.value / nn - 1.0).abs() < 0.03,
             "{}",
