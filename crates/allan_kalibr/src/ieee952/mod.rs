@@ -122,6 +122,9 @@ pub const SHORT_FEATURE_SPAN: f64 = 4.0;
 /// A fit starts past a short-τ feature instead of ending before it only when that leaves a
 /// range wider by this many decades (a clear gain, so a long-end bend is still cut there).
 pub const SHORT_FEATURE_GAIN: f64 = 1.0;
+/// Where IEEE 952 reads N (s): a fit only moves its start past a short-τ feature while the
+/// range keeps this τ, so that N is read, not extrapolated.
+pub const N_READING_TAU: f64 = 1.0;
 /// A declared fit range spans at least this many decades of τ; shorter is "no reliable fit".
 pub const MIN_RANGE_DECADES: f64 = 1.0;
 
@@ -714,7 +717,8 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
 /// its 95 % band of the model. A miss among the first points of the range moves the start
 /// past it; a miss further up ends the range before it (the long τ the model cannot
 /// describe), unless it is a short-τ feature (a bump above the white-noise line) that the
-/// start can move past for a range wider by [`SHORT_FEATURE_GAIN`] decades. Fewer than [`fit::MIN_FIT_POINTS`] points or less than [`MIN_RANGE_DECADES`]
+/// start can move past, keeping [`N_READING_TAU`], for a range wider by
+/// [`SHORT_FEATURE_GAIN`] decades. Fewer than [`fit::MIN_FIT_POINTS`] points or less than [`MIN_RANGE_DECADES`]
 /// left: no reliable fit. Returns the last fit, the verdict and the largest misfit.
 fn declare_fit(
     data: &CurveData,
@@ -833,7 +837,10 @@ fn declare_fit(
                     0.0
                 }
             };
-            if decades(start_past, end) > decades(start, end_cut) + SHORT_FEATURE_GAIN {
+            if start_past < np
+                && fd.points[start_past].tau <= N_READING_TAU
+                && decades(start_past, end) > decades(start, end_cut) + SHORT_FEATURE_GAIN
+            {
                 start = start_past;
             } else {
                 end = end_cut;
