@@ -350,6 +350,9 @@ pub struct FitResult {
     pub free: [bool; TERM_COUNT],
     /// Terms left out by [`FitConfig::select`] (coefficient 0; their variance is the full model's).
     pub left_out: [bool; TERM_COUNT],
+    /// For a term left out: its coefficient (≥ 0) in the fit that had it, the full model's or,
+    /// for a quantization taken out again, the selected one's; its upper bound starts there.
+    pub left_out_coef: [f64; TERM_COUNT],
     /// Positions (into [`FitData::points`]) of the points used: a contiguous range.
     pub used: Vec<usize>,
     /// Re-weighting iterations of the final fit.
@@ -829,7 +832,8 @@ pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
 /// ([`SELECT_CHI2_GM`]), or, once B is in, give the flicker floor a lower corner at its best
 /// place ([`SELECT_CHI2`]: one parameter; [`flicker_band`]). The chosen model is then
 /// refitted with its own δ. Terms left out are reported at 0 with the upper bound of the
-/// all-terms fit.
+/// all-terms fit (ĉ + z·se); a quantization taken out again (below) with that of the
+/// selected fit that had it.
 pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
     let f = fit_terms(data, used, cfg)?;
     // A quantization term whose line never comes near the curve is not one the curve shows:
@@ -848,6 +852,7 @@ pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult>
         };
         if let Some(mut g) = fit_terms(data, used, &without) {
             g.left_out[0] = true;
+            g.left_out_coef[0] = f.coef[0];
             g.coef[0] = 0.0;
             g.cov[0][0] = f.cov[0][0];
             g.free[0] = false;
@@ -969,11 +974,13 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     let mut left_out = [false; TERM_COUNT];
     let mut coef = s.coef;
     let mut cov = s.cov;
+    let mut left_out_coef = [0.0; TERM_COUNT];
     for j in 0..TERM_COUNT {
         if cfg.terms[j] && !terms[j] {
             left_out[j] = true;
             coef[j] = 0.0;
             cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
+            left_out_coef[j] = full.as_ref().map_or(0.0, |f| f.coef[j].max(0.0));
         }
     }
     if coef[GM] == 0.0 {
@@ -1060,6 +1067,7 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         cov,
         free: std::array::from_fn(|j| coef[j] != 0.0),
         left_out,
+        left_out_coef,
         used: used.to_vec(),
         iterations: s.iterations,
         converged: s.converged,
