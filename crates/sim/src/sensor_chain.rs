@@ -228,8 +228,9 @@ mod tests {
         }
     }
 
-    /// A sinusoid comes out scaled by |H(f)| and delayed by the filter's phase: the
-    /// transfer function of the noise model's filter, seen on the motion.
+    /// A sinusoid comes out scaled by |H(f)|: the transfer function of the noise model's
+    /// filter, seen on the motion (its delay is checked from the command line, on a moving
+    /// bag, in `tests/real_sensors.rs`).
     #[test]
     fn a_sinusoid_comes_out_with_the_filters_gain() {
         let (rate, fi, fc) = (400.0, 3200.0, 50.0);

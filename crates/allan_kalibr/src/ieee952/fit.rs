@@ -48,10 +48,10 @@
 //! of the model ([`super::RESOLVED_SHARE`]) is taken out again and the model refitted: a
 //! τ⁻² excess that small is the white-noise region's bend (a filter, aliasing) more often
 //! than a quantization, and kept it lowers N below the −½ line (real imu_utils curves of a
-//! MicroStrain GX4 gyro: N 10 % under the IEEE 952 reading with it, 0.2 % without). Non-negativity: every subset of terms is solved
-//! unconstrained and the cheapest feasible one kept — with six unknowns this enumeration
-//! of active sets is the exact NNLS optimum. Intervals by test inversion
-//! ([`inverted_interval`]).
+//! MicroStrain GX4 gyro: N 10 % under the IEEE 952 reading with it, 0.2 % without).
+//! Non-negativity: every subset of terms is solved unconstrained and the cheapest feasible
+//! one kept — with six unknowns this enumeration of active sets is the exact NNLS optimum.
+//! Intervals by test inversion ([`inverted_interval`]).
 //!
 //! Two shapes that are not power laws, so that they are not read as one (issue 10: "handle
 //! flicker floors, Gauss–Markov bumps and quantization without inventing terms"):

@@ -303,11 +303,12 @@ fn real_curves_acceptance() {
 fn real_curves_acceptance_elsewhere() {
     let list = std::env::var("REAL_CURVES_EXTRA").expect("REAL_CURVES_EXTRA=DIR:SECONDS,...");
     let (mut fitting, mut total, mut failed) = (0, 0, Vec::new());
-    for item in list.split(',') {
-        // DIR alone: the sample count inferred from the grid, as without --duration
+    for item in list.split(',').filter(|i| !i.is_empty()) {
+        // DIR alone: the sample count inferred from the grid, as without --duration (a ':' in
+        // the path is kept unless a number follows the last one)
         let (dir, duration) = match item.rsplit_once(':') {
-            Some((d, secs)) => (d, Some(secs.parse().expect("SECONDS"))),
-            None => (item, None),
+            Some((d, secs)) if secs.parse::<f64>().is_ok() => (d, secs.parse().ok()),
+            _ => (item, None),
         };
         let c = curves_in::read(
             &[std::path::PathBuf::from(dir)],

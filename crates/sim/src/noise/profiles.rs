@@ -283,7 +283,8 @@ fn stim300() -> ImuModel {
     // 0.06 m/s/√h. Rev. 31 (Table 5-5) quotes a quieter part: 0.006 mg at 600 s and
     // 0.024 m/s/√h, with an internal accelerometer rate of 8000 SPS. The rev. 9 figures are
     // kept so that the profile stays the one the studies were run on; a rev. 31 unit is a
-    // `--noise-spec` with `base: stim300` and those two figures.
+    // `--noise-spec` with `base: stim300` and an `accelerometer:` section with those two
+    // figures and `internal_rate_hz: 8000` (the 66 Hz filter kept).
     let acc = AxisModel {
         white_noise: 0.06 / 60.0,
         // Not in the datasheet; assumed 5e-6 m/s³/√Hz (+½ slope near 3.5 h).

@@ -33,7 +33,8 @@ pub struct TruthInfo<'a> {
     pub samples: usize,
     /// RNG seed.
     pub seed: u64,
-    /// Motion model name (the truth describes the noise; a moving IMU adds its motion).
+    /// Motion model name (the truth describes the noise; a moving IMU adds its motion, through
+    /// the sensor's chain).
     pub motion: &'a str,
 }
 
@@ -202,7 +203,7 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
     let _ = writeln!(o, "seed: {}", info.seed);
     let _ = writeln!(
         o,
-        "motion: {}   # the truth is the noise; a moving IMU adds its motion",
+        "motion: {}   # the truth is the noise; a moving IMU adds its motion (through the sensor's low-pass and decimation)",
         info.motion
     );
     let _ = writeln!(o, "output_rate_hz: {}", g(info.rate));
