@@ -1232,6 +1232,19 @@ mod tests {
         );
     }
 
+    /// White noise N and random walk K with a ±4 % log-periodic ripple: a real curve's misfit
+    /// everywhere, so that a bump is not trimmed as a statistical outlier at the start but
+    /// met as a miss mid-range.
+    fn rippled(nn: f64, k: f64, t: f64) -> f64 {
+        (nn * nn / t + k * k * t / 3.0) * (1.0 + 0.04 * (4.0 * t.ln()).sin())
+    }
+
+    /// Allan variance of a sinusoid of amplitude `amp` at `f0` Hz: A²·sin⁴(πf₀τ)/(πf₀τ)².
+    fn line_avar(amp: f64, f0: f64, t: f64) -> f64 {
+        let x = std::f64::consts::PI * f0 * t;
+        amp * amp * x.sin().powi(4) / (x * x)
+    }
+
     /// A vibration line at 10 Hz puts an Allan bump (AVAR of a sinusoid of amplitude A:
     /// A²·sin⁴(πf₀τ)/(πf₀τ)²) above the white-noise line between the start and the white
     /// region, as on a real MicroStrain GX4 accelerometer's curve. The fit starts past it
@@ -1241,13 +1254,7 @@ mod tests {
     fn a_short_tau_bump_moves_the_start_past_it() {
         let (n, tau0) = (2_900_000, 0.002);
         let (nn, k, amp, f0) = (8e-4f64, 2e-5f64, 4e-3f64, 10.0f64);
-        let model = |t: f64| {
-            let x = std::f64::consts::PI * f0 * t;
-            // ±4 % log-periodic ripple: a real curve's misfit everywhere, so the bump is not
-            // trimmed as a statistical outlier at the start but met as a miss mid-range
-            (nn * nn / t + k * k * t / 3.0) * (1.0 + 0.04 * (4.0 * t.ln()).sin())
-                + amp * amp * x.sin().powi(4) / (x * x)
-        };
+        let model = |t: f64| rippled(nn, k, t) + line_avar(amp, f0, t);
         let a = analyse_exact(&exact_curve(n, tau0, model));
         let (lo, hi) = a.verdict.range().expect("a fit past the bump");
         assert!(lo > 0.05 && lo < 1.0 && hi / lo > 1e3, "{}", a.verdict);
@@ -1265,12 +1272,8 @@ mod tests {
     fn a_bump_past_one_second_or_a_dip_is_not_skipped_at_the_start() {
         let (n, tau0) = (2_900_000, 0.002);
         let (nn, k) = (8e-4f64, 2e-5f64);
-        let base = |t: f64| (nn * nn / t + k * k * t / 3.0) * (1.0 + 0.04 * (4.0 * t.ln()).sin());
-        let slow = |t: f64| {
-            let x = std::f64::consts::PI * 0.01 * t;
-            base(t) + 1.5e-4f64.powi(2) * x.sin().powi(4) / (x * x)
-        };
-        let dip = |t: f64| base(t) * (1.0 - 0.4 * (-(t / 0.05).ln().powi(2) / 0.3).exp());
+        let slow = |t: f64| rippled(nn, k, t) + line_avar(1.5e-4, 0.01, t);
+        let dip = |t: f64| rippled(nn, k, t) * (1.0 - 0.4 * (-(t / 0.05).ln().powi(2) / 0.3).exp());
         for (name, curve) in [("slow line", &slow as &dyn Fn(f64) -> f64), ("dip", &dip)] {
             let a = analyse_exact(&exact_curve(n, tau0, curve));
             assert!(
