@@ -439,47 +439,34 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
 #[test]
 fn defect_11_degenerate_values_are_explained() {
     let dir = tempfile::tempdir().unwrap();
-    let bag = dir.path().join("const.bag");
-    write_bag_at(
-        &bag,
-        12_000,
-        |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
-        0.0,
-    );
-    let out = run(bin()
-        .arg(&bag)
-        .args([
-            "--topic",
-            "/imu",
-            "--no-plots",
-            "--compat-only",
-            "-q",
-            "--data-save-path",
-        ])
-        .arg(dir.path()));
+    // a 60 s, 200 Hz bag whose every value is `value`; returns the run's output
+    let analyse = |name: &str, value: f64| {
+        let bag = dir.path().join(name);
+        write_bag_at(
+            &bag,
+            12_000,
+            |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
+            value,
+        );
+        run(bin()
+            .arg(&bag)
+            .args([
+                "--topic",
+                "/imu",
+                "--no-plots",
+                "--compat-only",
+                "-q",
+                "--data-save-path",
+            ])
+            .arg(dir.path()))
+    };
+    let out = analyse("const.bag", 0.0);
     let err = text(&out.stderr);
     assert!(
         err.contains("linear_acceleration.x is constant") && err.contains("NaN"),
         "{err}"
     );
-    let big = dir.path().join("big.bag");
-    write_bag_at(
-        &big,
-        12_000,
-        |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
-        1e300,
-    );
-    let out = run(bin()
-        .arg(&big)
-        .args([
-            "--topic",
-            "/imu",
-            "--no-plots",
-            "--compat-only",
-            "-q",
-            "--data-save-path",
-        ])
-        .arg(dir.path()));
+    let out = analyse("big.bag", 1e300);
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("overflow"), "{err}");

@@ -118,22 +118,14 @@ fn imu(i: u32) -> (u64, Imu) {
 }
 
 fn status(i: u32) -> Vec<u8> {
-    let text = format!("status {i}");
-    let mut d = (text.len() as u32).to_le_bytes().to_vec();
-    d.extend_from_slice(text.as_bytes());
-    d
+    bag2mat::test_tools::string_message(&format!("status {i}"))
 }
 
 fn write_ros1(path: &Path, c: Compression) {
     let mut w = BagWriter::create(path, c).expect("create bag");
     w.set_chunk_threshold(CHUNK_BYTES);
     let ci = w.add_imu_connection("imu");
-    let cs = w.add_connection(
-        "/status",
-        "std_msgs/String",
-        "992ce8a1687cec8c8bd883ec73ca41d1",
-        "string data",
-    );
+    let cs = bag2mat::test_tools::add_string_connection(&mut w, "/status");
     for i in 0..MESSAGES {
         let (t, m) = imu(i);
         w.write_imu(ci, RosTime::from_nanos(t), &m).expect("write");

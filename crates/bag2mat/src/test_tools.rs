@@ -110,3 +110,35 @@ pub const ROS2_MODES: [(&str, &[&str]); 7] = [
         ],
     ),
 ];
+
+/// The hidden temporary files of atomic outputs (`.<name>.<pid>.<n>.tmp`, see
+/// [`crate::shared::output`]) left in `dir`: a test of an interrupted or failed run expects
+/// none.
+pub fn temp_files_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') && n.contains(".tmp"))
+        .collect()
+}
+
+/// A `std_msgs/String` connection on `topic`: the non-Imu topic the tests and the fuzz
+/// campaign put beside the Imu one (its md5 and definition as genpy writes them).
+pub fn add_string_connection(
+    w: &mut crate::bag::BagWriter,
+    topic: &str,
+) -> crate::bag::write::ConnId {
+    w.add_connection(
+        topic,
+        "std_msgs/String",
+        "992ce8a1687cec8c8bd883ec73ca41d1",
+        "string data",
+    )
+}
+
+/// A `std_msgs/String` message body: the text with its u32 length.
+pub fn string_message(text: &str) -> Vec<u8> {
+    let mut d = (text.len() as u32).to_le_bytes().to_vec();
+    d.extend_from_slice(text.as_bytes());
+    d
+}

@@ -505,14 +505,7 @@ fn defect_07_the_input_is_never_overwritten() {
     }
 }
 
-/// Hidden temporary files left in `dir`.
-fn temps(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with('.') && n.contains(".tmp"))
-        .collect()
-}
+use bag2mat::test_tools::temp_files_in as temps;
 
 #[test]
 fn defect_08_failed_outputs_leave_no_temp_files() {
@@ -642,17 +635,13 @@ fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
     {
         let mut w = bag2mat::bag::BagWriter::create(&bag, Compression::None).unwrap();
         let imu = w.add_imu_connection("imu");
-        let other = w.add_connection(
-            "imu",
-            "std_msgs/String",
-            "992ce8a1687cec8c8bd883ec73ca41d1",
-            "string data",
-        );
+        let other = bag2mat::test_tools::add_string_connection(&mut w, "imu");
         for i in 0..500 {
             let (t, m) = synthetic(i);
             w.write_imu(imu, t, &m).unwrap();
             if i % 50 == 0 {
-                w.write_raw(other, t, &[2, 0, 0, 0, b'h', b'i']).unwrap();
+                w.write_raw(other, t, &bag2mat::test_tools::string_message("hi"))
+                    .unwrap();
             }
         }
         w.finish().unwrap();

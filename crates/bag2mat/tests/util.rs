@@ -46,21 +46,12 @@ pub fn synthetic(i: u32) -> (RosTime, Imu) {
 pub fn write_synthetic(path: &Path, topic: &str, n: u32, compression: Compression, extra: bool) {
     let mut w = BagWriter::create(path, compression).unwrap();
     let c = w.add_imu_connection(topic);
-    let s = extra.then(|| {
-        w.add_connection(
-            "/status",
-            "std_msgs/String",
-            "992ce8a1687cec8c8bd883ec73ca41d1",
-            "string data",
-        )
-    });
+    let s = extra.then(|| bag2mat::test_tools::add_string_connection(&mut w, "/status"));
     for i in 0..n {
         let (t, imu) = synthetic(i);
         w.write_imu(c, t, &imu).unwrap();
         if let (Some(s), true) = (s, i % 100 == 0) {
-            let text = format!("status {i}");
-            let mut data = (text.len() as u32).to_le_bytes().to_vec();
-            data.extend_from_slice(text.as_bytes());
+            let data = bag2mat::test_tools::string_message(&format!("status {i}"));
             w.write_raw(s, t, &data).unwrap();
         }
     }

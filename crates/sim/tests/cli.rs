@@ -360,14 +360,7 @@ fn defect_14_one_error_convention() {
     }
 }
 
-/// Hidden temporary entries in `dir`.
-fn temps(dir: &std::path::Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with('.') && n.contains(".tmp"))
-        .collect()
-}
+use bag2mat::test_tools::temp_files_in as temps;
 
 #[test]
 fn defect_08_sigterm_and_sigint_remove_temp_files() {
