@@ -624,22 +624,27 @@ fn oadev_cost_per_m() {
     }
 }
 
+/// The analysis of one gyro axis of preset `preset` (seed's low, medium, high), 4 h at 20 Hz.
+fn gyro_4h_at_20hz(preset: usize, seed: u64) -> super::Analysis {
+    let (rate, duration) = (20.0, 4.0 * 3600.0);
+    let p = presets()[preset];
+    let y = simulate_axis(
+        p.gyro_n,
+        p.gyro_k,
+        1.0 / rate,
+        (duration * rate) as usize,
+        seed,
+    );
+    analyse(&y, 1.0 / rate, &Config::default()).expect("simulated series analyses")
+}
+
 /// A term the data do not show is reported with a usable 95 % upper bound: positive and
 /// finite, and no looser than the curve allows (its Allan deviation at the bound stays within
 /// the curve's upper 95 % band at some fitted point). On the seed's ideal IMU the selection
 /// leaves B, Q and R out, and their bounds used to be "< 0" (B, R) or "< ∞" (Q).
 #[test]
 fn unresolved_terms_have_a_positive_finite_upper_bound() {
-    let (rate, duration) = (20.0, 4.0 * 3600.0);
-    let p = presets()[0];
-    let y = simulate_axis(
-        p.gyro_n,
-        p.gyro_k,
-        1.0 / rate,
-        (duration * rate) as usize,
-        BASE_SEED + 7,
-    );
-    let r = analyse(&y, 1.0 / rate, &Config::default()).expect("simulated series analyses");
+    let r = gyro_4h_at_20hz(0, BASE_SEED + 7);
     assert!(r.verdict.fits(), "{:?}", r.verdict);
     let t = &r.terms;
     let mut checked = 0;
@@ -665,16 +670,7 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
     /// The bound ignores the covariance between terms and the finite τ range (measured
     /// ratio 1.09 on this seed); a factor 2 either way still tells a user hours from days.
     const CR_RECORD_FACTOR: f64 = 2.0;
-    let (rate, duration) = (20.0, 4.0 * 3600.0);
-    let p = presets()[1];
-    let y = simulate_axis(
-        p.gyro_n,
-        p.gyro_k,
-        1.0 / rate,
-        (duration * rate) as usize,
-        BASE_SEED + 11,
-    );
-    let a = analyse(&y, 1.0 / rate, &Config::default()).expect("simulated series analyses");
+    let a = gyro_4h_at_20hz(1, BASE_SEED + 11);
     assert_eq!(a.terms.k.verdict, Verdict::Resolved, "{:?}", a.terms.k);
     let adv = super::advisor::advise(&a).expect("sample count known");
     let z2 = 1.959_963_984_540_054f64.powi(2);
