@@ -36,6 +36,30 @@ fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
 
 /// As [`write_bag`] with stamps `dt_ns` apart.
 fn write_bag_dt(path: &Path, n: usize, nan_at: Option<usize>, dt_ns: u64) {
+    write_noise_bag(
+        path,
+        n,
+        |i| 1_600_000_000_000_000_000 + i as u64 * dt_ns,
+        1.0,
+        nan_at,
+    );
+}
+
+/// A bag of white noise whose message `i` is stamped `stamp_ns(i)`; `scale` multiplies the
+/// accelerometer noise.
+fn write_bag_at(path: &Path, n: usize, stamp_ns: impl Fn(usize) -> u64, scale: f64) {
+    write_noise_bag(path, n, stamp_ns, scale, None);
+}
+
+/// `n` seeded white-noise Imu messages on `/imu`: message `i` stamped `stamp_ns(i)`, the
+/// accelerometer noise times `scale`, a NaN in acc y at `nan_at`.
+fn write_noise_bag(
+    path: &Path,
+    n: usize,
+    stamp_ns: impl Fn(usize) -> u64,
+    scale: f64,
+    nan_at: Option<usize>,
+) {
     let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
     let conn = w.add_imu_connection("/imu");
     let mut state = SEED;
@@ -46,14 +70,14 @@ fn write_bag_dt(path: &Path, n: usize, nan_at: Option<usize>, dt_ns: u64) {
         (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     for i in 0..n {
-        let stamp = RosTime::from_nanos(1_600_000_000_000_000_000 + i as u64 * dt_ns);
+        let stamp = RosTime::from_nanos(stamp_ns(i));
         let mut m = Imu {
             seq: i as u32,
             stamp,
             ..Imu::default()
         };
         m.angular_velocity = [next() * 0.1, next() * 0.1, next() * 0.1];
-        m.linear_acceleration = [next(), next(), 9.81 + next()];
+        m.linear_acceleration = [next() * scale, next() * scale, 9.81 + next() * scale];
         if nan_at == Some(i) {
             m.linear_acceleration[1] = f64::NAN;
         }
@@ -361,32 +385,6 @@ fn defect_14_one_error_convention() {
         assert_eq!(err.matches("error:").count(), 1, "{args:?}: {err}");
         assert!(!err.contains("os error"), "{err}");
     }
-}
-
-/// A bag of white noise whose message `i` is stamped `stamp_ns(i)`; `scale` multiplies the
-/// accelerometer noise.
-fn write_bag_at(path: &Path, n: usize, stamp_ns: impl Fn(usize) -> u64, scale: f64) {
-    let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
-    let conn = w.add_imu_connection("/imu");
-    let mut state = SEED;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    for i in 0..n {
-        let stamp = RosTime::from_nanos(stamp_ns(i));
-        let mut m = Imu {
-            seq: i as u32,
-            stamp,
-            ..Imu::default()
-        };
-        m.angular_velocity = [next() * 0.1, next() * 0.1, next() * 0.1];
-        m.linear_acceleration = [next() * scale, next() * scale, 9.81 + next() * scale];
-        w.write_imu(conn, stamp, &m).unwrap();
-    }
-    w.finish().unwrap();
 }
 
 #[test]
