@@ -387,6 +387,21 @@ fn defect_14_one_error_convention() {
     }
 }
 
+/// imu_utils' own outputs only (no plots, no IEEE 952 section) of `/imu` in `bag`, into `out`.
+fn run_compat(bag: &Path, out: &Path) -> std::process::Output {
+    run(bin()
+        .arg(bag)
+        .args([
+            "--topic",
+            "/imu",
+            "--no-plots",
+            "--compat-only",
+            "-q",
+            "--data-save-path",
+        ])
+        .arg(out))
+}
+
 #[test]
 fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
     let dir = tempfile::tempdir().unwrap();
@@ -408,17 +423,7 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
     let clean = dir.path().join("clean.bag");
     write_bag_at(&clean, 12_000, |i| T0 + i as u64 * 5_000_000, 1.0);
     let go = |bag: &Path, o: &str| {
-        let out = run(bin()
-            .arg(bag)
-            .args([
-                "--topic",
-                "/imu",
-                "--no-plots",
-                "--compat-only",
-                "-q",
-                "--data-save-path",
-            ])
-            .arg(dir.path().join(o)));
+        let out = run_compat(bag, &dir.path().join(o));
         assert!(out.status.success(), "{}", text(&out.stderr));
         (
             text(&out.stderr),
@@ -437,7 +442,8 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
 #[test]
 fn defect_11_degenerate_values_are_explained() {
     let dir = tempfile::tempdir().unwrap();
-    // a 60 s, 200 Hz bag whose every value is `value`; returns the run's output
+    // a 60 s, 200 Hz bag whose accelerometer noise is scaled by `value` (0: constant);
+    // returns the run's output
     let analyse = |name: &str, value: f64| {
         let bag = dir.path().join(name);
         write_bag_at(
@@ -446,17 +452,7 @@ fn defect_11_degenerate_values_are_explained() {
             |i| 1_600_000_000_000_000_000 + i as u64 * 5_000_000,
             value,
         );
-        run(bin()
-            .arg(&bag)
-            .args([
-                "--topic",
-                "/imu",
-                "--no-plots",
-                "--compat-only",
-                "-q",
-                "--data-save-path",
-            ])
-            .arg(dir.path()))
+        run_compat(&bag, dir.path())
     };
     let out = analyse("const.bag", 0.0);
     let err = text(&out.stderr);
