@@ -16,12 +16,13 @@
 # BENCH_ROSBAGS_MSGS (300000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 root=$(pwd)
 work=${1:-$(mktemp -d /tmp/imu-bench.XXXXXX)}
 mkdir -p "$work"
 echo "work dir: $work"
-cargo build --release --quiet -p sim -p bag2mat -p allan_kalibr -p allan_imu_utils
-bin="$root/target/release"
+build_release sim bag2mat allan_kalibr allan_imu_utils
+bin="$(target_dir)/release"
 N=2880001
 py_write=${BENCH_PY_WRITE_MSGS:-$N}
 py_read=${BENCH_PY_READ_MSGS:-200000}

@@ -6,7 +6,7 @@
 # samples). No pass/fail: figures only.
 #
 # usage: scripts/bench_allan_kalibr.sh INPUT [--topic imu] [--update-rate HZ] [--no-bit-exact]
-# env:   CARGO_TARGET_DIR (default <repo>/target), BENCH_VENV (default $CARGO_TARGET_DIR/bench-venv),
+# env:   BENCH_VENV (default $CARGO_TARGET_DIR/bench-venv),
 #        BENCH_RUNS (default 3: best of N for the default path)
 set -euo pipefail
 
@@ -25,13 +25,13 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ -f "$INPUT" ]] || { echo "no such file: $INPUT" >&2; exit 2; }
-TARGET="${CARGO_TARGET_DIR:-$ROOT/target}"
+TARGET=$(cd "$ROOT" && . scripts/lib.sh && target_dir)
 VENV="${BENCH_VENV:-$TARGET/bench-venv}"
 RUNS="${BENCH_RUNS:-3}"
 PY=/usr/bin/python3 # Debian python: numpy/scipy come from the system (--system-site-packages)
 
 echo "== building (release)"
-(cd "$ROOT" && CARGO_TARGET_DIR="$TARGET" cargo build --release -q -p allan_kalibr -p bag2mat)
+(cd "$ROOT" && . scripts/lib.sh && build_release allan_kalibr bag2mat)
 AK="$TARGET/release/allan_kalibr"
 B2M="$TARGET/release/bag2mat"
 

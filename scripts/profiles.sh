@@ -9,9 +9,10 @@
 # usage: scripts/profiles.sh [--duration S] [--rate HZ] [--seed N] [--out DIR]
 #   defaults: 14400 s (4 h), 200 Hz, seed 1, out/profiles. Each bag is deleted once analysed
 #   (a 4 h bag is 1.1 GB); the plots, terms and truth files stay in DIR/<profile>/.
-# env: BIN_DIR: use these binaries instead of building target/release.
+# env: BIN_DIR: use these binaries instead of building the release ones (in cargo's target dir).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 duration=14400 rate=200 seed=1 out=out/profiles
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -23,8 +24,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 if [ -z "${BIN_DIR:-}" ]; then
-  cargo build --release --quiet -p sim -p allan_kalibr
-  BIN_DIR=target/release
+  build_release sim allan_kalibr
+  BIN_DIR="$(target_dir)/release"
 fi
 mkdir -p "$out"
 profiles=$("$BIN_DIR/sim" sensors | awk '/^[a-z0-9]+ — /{print $1}')
