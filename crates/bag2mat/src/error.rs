@@ -43,6 +43,15 @@ pub enum Error {
         /// What was found instead.
         what: String,
     },
+    /// A log (text, ULog, DataFlash, NumPy) was recognised but cannot be read as asked: what
+    /// to add or change is in the message.
+    #[error("{}: {what}", .path.display())]
+    Log {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and what to add.
+        what: String,
+    },
     /// A storage file (sqlite3, metadata.yaml) could not be read.
     #[error("{path}: {what}")]
     Storage {

@@ -150,10 +150,25 @@ pub struct ImuRead {
 enum Codec {
     Ros1,
     Cdr,
+    /// Rows a log reader decoded ([`crate::decoded::Row`]), whatever the topic's type.
+    Row,
+}
+
+impl Codec {
+    /// The smallest payload a message of this codec has.
+    fn min_payload(self) -> u64 {
+        match self {
+            Codec::Ros1 | Codec::Cdr => MIN_IMU_PAYLOAD,
+            Codec::Row => crate::decoded::ROW_LEN as u64,
+        }
+    }
 }
 
 /// The Imu codec for a channel, or `None` when it does not carry `sensor_msgs/Imu`.
 fn imu_codec(c: &Channel) -> Option<Codec> {
+    if c.encoding == Encoding::Row {
+        return Some(Codec::Row);
+    }
     let imu_type = c.msg_type == imu_msg::TYPE || c.msg_type == crate::cdr::TYPE;
     match (&c.encoding, imu_type) {
         (Encoding::Ros1, true) => match &c.md5sum {
@@ -174,6 +189,7 @@ fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
         Codec::Ros1 => ImuSample::decode(data),
         Codec::Cdr => crate::cdr::decode_sample(data),
+        Codec::Row => crate::decoded::Row::decode(data),
     }
 }
 
@@ -539,7 +555,18 @@ pub fn read_imu_topics(
     sel: &TopicSelector,
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
-    let src = source::open(path)?;
+    read_imu_topics_with(path, sel, opts, &crate::formats::InputOptions::default())
+}
+
+/// [`read_imu_topics`], with what the user said about a log whose content does not say it
+/// all (a text log's columns and units).
+pub fn read_imu_topics_with(
+    path: &Path,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+    input: &crate::formats::InputOptions,
+) -> Result<ImuRead, Error> {
+    let src = source::open_with(path, input)?;
     read_from(src.as_ref(), sel, opts)
 }
 
@@ -600,7 +627,12 @@ fn decode_all(
         .iter()
         .map(|p| {
             let counts = p.counts.as_ref()?;
-            let bound = p.bytes / MIN_IMU_PAYLOAD;
+            let min_payload = selected
+                .iter()
+                .flat_map(|s| s.channels.iter().map(|(_, k)| k.min_payload()))
+                .min()
+                .unwrap_or(MIN_IMU_PAYLOAD);
+            let bound = p.bytes / min_payload;
             Some(
                 selected
                     .iter()
