@@ -235,12 +235,20 @@ pub fn role_of(name: &str) -> Option<(Role, Option<TimeUnit>)> {
         .filter(|c| c.is_ascii_alphanumeric())
         .map(|c| c.to_ascii_lowercase())
         .collect();
+    // `t_s`, `time_ms`, `timestamp_ns` (a unit after a separator), then `timeus`
+    let lower = name.trim().to_ascii_lowercase();
+    if let Some((base, suffix)) = lower.rsplit_once(['_', ' ', '.'])
+        && let Ok(u) = TimeUnit::parse(suffix)
+        && ["t", "time", "timestamp", "stamp"].contains(&base)
+    {
+        return Some((Role::Time, Some(u)));
+    }
     if TIME_NAMES.contains(&n.as_str()) {
         return Some((Role::Time, None));
     }
-    for u in [TimeUnit::Ns, TimeUnit::Us, TimeUnit::Ms, TimeUnit::S] {
+    for u in [TimeUnit::Ns, TimeUnit::Us, TimeUnit::Ms] {
         if let Some(base) = n.strip_suffix(u.name())
-            && ["time", "timestamp", "t", "stamp"].contains(&base)
+            && ["time", "timestamp", "stamp"].contains(&base)
         {
             return Some((Role::Time, Some(u)));
         }
@@ -998,9 +1006,8 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
             if total_bad == 1 { "" } else { "s" }
         );
         if total_bad > limit {
-            return Err(Error::Corrupt {
+            return Err(Error::Log {
                 path: path.to_path_buf(),
-                offset: 0,
                 what: format!(
                     "{msg}: more than {limit} of its {total_lines} lines ({}%) do not parse; check the delimiter and --columns",
                     MAX_BAD_FRACTION * 100.0
@@ -1034,20 +1041,21 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
     }
     if back > 0 {
         notes.push(format!(
-            "{back} time stamp{} go backwards (first at line {})",
-            if back == 1 { "" } else { "s" },
+            "{back} time stamp{} backwards (first at line {})",
+            if back == 1 { " goes" } else { "s go" },
             first_back.unwrap_or(0)
         ));
     }
     if dup > 0 {
         notes.push(format!(
-            "{dup} time stamp{} repeat the one before (first at line {}); the rows are kept",
-            if dup == 1 { "" } else { "s" },
+            "{dup} time stamp{} the one before (first at line {}); the rows are kept",
+            if dup == 1 { " repeats" } else { "s repeat" },
             first_dup.unwrap_or(0)
         ));
     }
     check_plausible(path, &lay, &chunks)?;
-    if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() {
+    let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
+    if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
         notes.push(format!("{}: {}", path.display(), lay.what));
     }
     if lay.gyro.is_none() {
@@ -1165,6 +1173,11 @@ mod tests {
             assert_eq!(role_of(n).map(|x| x.0), Some(r), "{n}");
         }
         assert_eq!(role_of("time_ms"), Some((Role::Time, Some(TimeUnit::Ms))));
+        assert_eq!(role_of("t_s"), Some((Role::Time, Some(TimeUnit::S))));
+        assert_eq!(
+            role_of("timestampus"),
+            Some((Role::Time, Some(TimeUnit::Us)))
+        );
         for n in ["temperature", "seq", "field.orientation.x", "x", "mag_x"] {
             assert_eq!(role_of(n), None, "{n}");
         }
