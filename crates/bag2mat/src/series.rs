@@ -122,6 +122,31 @@ impl ImuSeries {
         std::array::from_fn(|c| self.acc[c][i])
     }
 
+    /// The sensor this topic does not carry: its three columns NaN in every sample (PX4
+    /// `sensor_gyro`/`sensor_accel`, ArduPilot batches, a text log with one sensor).
+    pub fn absent_sensor(&self) -> Option<crate::Sensor> {
+        let none = |c: &[Vec<f64>; 3]| !self.is_empty() && c.iter().flatten().all(|v| v.is_nan());
+        if none(&self.acc) {
+            Some(crate::Sensor::Acc)
+        } else if none(&self.gyro) {
+            Some(crate::Sensor::Gyro)
+        } else {
+            None
+        }
+    }
+
+    /// Fails with [`Error::OneSensor`] when the topic lacks a sensor (for the analysers,
+    /// which fit both).
+    pub fn require_both_sensors(&self) -> Result<(), Error> {
+        match self.absent_sensor() {
+            Some(missing) => Err(Error::OneSensor {
+                topic: self.topic.clone(),
+                missing,
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// The chosen time column.
     pub fn time(&self, which: TimeColumn) -> &[RosTime] {
         match which {
