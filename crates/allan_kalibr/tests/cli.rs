@@ -63,12 +63,14 @@ fn assert_no_outputs(dir: &Path) {
 /// The line that opens the IEEE 952 section after upstream's text.
 const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
 /// What the IEEE 952 section writes beside the compat outputs.
-const IEEE_OUTPUTS: [&str; 7] = [
+const IEEE_OUTPUTS: [&str; 9] = [
     "ieee952_terms.csv",
     "ieee952_curves.csv",
     "kalibr_imu_ieee952.yaml",
     "vins_imu_ieee952.yaml",
     "orbslam3_imu_ieee952.yaml",
+    "openvins_kalibr_imu_chain_ieee952.yaml",
+    "basalt_imu_noise_ieee952.json",
     "ieee952_allan.png",
     "ieee952_allan.svg",
 ];

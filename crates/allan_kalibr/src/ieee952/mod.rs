@@ -76,6 +76,7 @@ pub mod plot;
 pub mod region;
 pub mod stationarity;
 pub mod tau_grid;
+pub mod vio_files;
 
 #[cfg(test)]
 mod tests_accuracy;
