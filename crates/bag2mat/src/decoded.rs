@@ -68,8 +68,9 @@ impl Row {
     }
 }
 
-/// One topic's messages: their log (record) times and, for an Imu topic, their rows.
-#[derive(Debug, Clone)]
+/// One topic's messages (or a piece of them): their log (record) times and, for an Imu
+/// topic, their rows.
+#[derive(Debug, Clone, Default)]
 pub struct Stream {
     /// Topic name.
     pub topic: String,
@@ -130,12 +131,14 @@ pub struct DecodedSource {
     kind: InputKind,
     contents: Contents,
     streams: Vec<Stream>,
-    /// Part → (stream, first message, end).
-    map: Vec<(usize, usize, usize)>,
+    /// Part → (stream, channel, first message, end).
+    map: Vec<(usize, u32, usize, usize)>,
 }
 
 impl DecodedSource {
-    /// Serves `streams` (channel ids are their indices), with what opening found.
+    /// Serves `streams`, with what opening found. Consecutive streams of one topic and type
+    /// are pieces of one channel (a reader that parsed in parallel hands its pieces over
+    /// without joining them); channel ids count the channels in order.
     pub fn new(
         kind: InputKind,
         streams: Vec<Stream>,
@@ -148,30 +151,49 @@ impl DecodedSource {
             ..Contents::default()
         };
         let mut map = Vec::new();
-        for (id, s) in streams.iter().enumerate() {
-            contents.channels.push(Channel {
-                id: id as u32,
-                topic: s.topic.clone(),
-                msg_type: s.msg_type.clone(),
-                encoding: if s.imu {
-                    Encoding::Row
-                } else {
-                    Encoding::Other(kind_encoding(kind).to_string())
-                },
-                md5sum: None,
-                count: Some(s.len() as u64),
-            });
+        for (k, s) in streams.iter().enumerate() {
+            if let Some(c) = contents.channels.last_mut()
+                && c.topic == s.topic
+                && c.msg_type == s.msg_type
+                && k > 0
+            {
+                c.count = c.count.map(|n| n + s.len() as u64);
+            } else {
+                contents.channels.push(Channel {
+                    id: contents.channels.len() as u32,
+                    topic: s.topic.clone(),
+                    msg_type: s.msg_type.clone(),
+                    encoding: if s.imu {
+                        Encoding::Row
+                    } else {
+                        Encoding::Other(kind_encoding(kind).to_string())
+                    },
+                    md5sum: None,
+                    count: Some(s.len() as u64),
+                });
+            }
+            let id = contents.channels.len() as u32 - 1;
+            let before: u64 = map
+                .iter()
+                .filter(|m: &&(usize, u32, usize, usize)| m.1 == id)
+                .map(|m| (m.3 - m.2) as u64)
+                .sum();
             let mut a = 0;
             while a < s.len() {
                 let b = (a + PART_ROWS).min(s.len());
                 let t = &s.record[a..b];
                 contents.parts.push(Part {
-                    label: format!("messages {}..{} of '{}'", a + 1, b, s.topic),
+                    label: format!(
+                        "messages {}..{} of '{}'",
+                        before + a as u64 + 1,
+                        before + b as u64,
+                        s.topic
+                    ),
                     span: t.iter().min().zip(t.iter().max()).map(|(x, y)| (*x, *y)),
-                    counts: Some(vec![(id as u32, (b - a) as u64)]),
+                    counts: Some(vec![(id, (b - a) as u64)]),
                     bytes: ((b - a) * if s.imu { ROW_LEN } else { 0 }) as u64,
                 });
-                map.push((id, a, b));
+                map.push((k, id, a, b));
                 a = b;
             }
         }
@@ -207,21 +229,21 @@ impl source::Source for DecodedSource {
         sink: &mut MessageSink<'_>,
     ) -> source::PartRead {
         let mut r = source::PartRead::default();
-        let Some(&(id, a, b)) = self.map.get(part) else {
+        let Some(&(k, id, a, b)) = self.map.get(part) else {
             r.error = Some(format!("no part {part}"));
             return r;
         };
-        if !want(id as u32) {
+        if !want(id) {
             return r;
         }
-        let s = &self.streams[id];
+        let s = &self.streams[k];
         for i in a..b {
             let payload = if s.imu {
                 &s.rows[i * ROW_LEN..(i + 1) * ROW_LEN]
             } else {
                 &[][..]
             };
-            sink(id as u32, s.record[i], payload);
+            sink(id, s.record[i], payload);
         }
         r.delivered = (b - a) as u64;
         r
@@ -251,8 +273,26 @@ mod tests {
         }
         let mut o = Stream::other("status", "text/other");
         o.push_time(3);
+        // a reader that parsed in parallel hands its pieces over: one channel
+        let mut s2 = s.clone();
+        s2.record.drain(n / 2..);
+        s2.rows.drain(n / 2 * ROW_LEN..);
+        let mut s3 = s.clone();
+        s3.record.drain(..n / 2);
+        s3.rows.drain(..n / 2 * ROW_LEN);
         let src = DecodedSource::new(InputKind::Text, vec![s, o], vec![], vec![]);
         assert_eq!(src.contents().parts.len(), 3);
+        let pieces = DecodedSource::new(InputKind::Text, vec![s2, s3], vec![], vec![]);
+        assert_eq!(pieces.channels().len(), 1);
+        assert_eq!(pieces.channels()[0].count, Some(n as u64));
+        let whole = read_from(
+            &pieces,
+            &TopicSelector::one("imu"),
+            &ReadOptions { quiet: true },
+        )
+        .unwrap();
+        assert_eq!(whole.series[0].record_time.len(), n);
+        assert_eq!(whole.series[0].acc[0][n - 1], (n - 1) as f64);
         let r = read_from(
             &src,
             &TopicSelector::one("imu"),

@@ -148,7 +148,7 @@ pub fn open_files(
             Some(Err(e)) => notes.push(format!("{topic}: sensor.yaml does not parse: {e}")),
             _ => {}
         }
-        streams.push(p.stream);
+        streams.extend(p.streams);
     }
     Ok(DecodedSource::new(
         InputKind::EurocDir,

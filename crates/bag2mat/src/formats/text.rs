@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use super::InputOptions;
-use crate::decoded::{DecodedSource, Row, Stream};
+use crate::decoded::{DecodedSource, ROW_LEN, Row, Stream};
 use crate::error::Error;
 use crate::source::InputKind;
 
@@ -390,8 +390,8 @@ fn bad(path: &Path, what: String) -> Error {
 }
 
 /// Finds the header, delimiter, columns and units.
-fn layout(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Layout, Error> {
-    let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
+fn layout(path: &Path, head: &[u8], file_len: u64, opts: &InputOptions) -> Result<Layout, Error> {
+    let head = &head[..head.len().min(SNIFF_BYTES)];
     let head = match std::str::from_utf8(head) {
         Ok(s) => s,
         Err(e) => std::str::from_utf8(&head[..e.valid_up_to()]).unwrap_or(""),
@@ -411,7 +411,7 @@ fn layout(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Layout, Erro
     let mut first_data: Option<&str> = None;
     let (mut body, mut body_line) = (0usize, 1u64);
     for raw in head.split_inclusive('\n') {
-        if !raw.ends_with('\n') && raw.len() + offset < bytes.len() {
+        if !raw.ends_with('\n') && ((raw.len() + offset) as u64) < file_len {
             break; // cut by the sniff window
         }
         line_no += 1;
@@ -761,10 +761,8 @@ pub fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {
     };
     let digits = |d: &[u8]| d.iter().all(u8::is_ascii_digit);
     if !int.is_empty() && digits(int) && digits(frac) && int.len() <= 19 {
-        let mut v: u64 = 0;
-        for &b in int {
-            v = v.checked_mul(10)?.checked_add((b - b'0') as u64)?;
-        }
+        // 19 digits stay below u64::MAX (1.8e19)
+        let v = int.iter().fold(0u64, |v, &b| v * 10 + (b - b'0') as u64);
         let mut ns = v.checked_mul(mult)?;
         // the fraction, to the nanosecond (rounded half up)
         let mut scale = mult;
@@ -808,8 +806,8 @@ fn num(s: &[u8]) -> Option<f64> {
 /// What one byte range of the body gave.
 #[derive(Default)]
 struct Chunk {
-    record: Vec<u64>,
-    rows: Vec<Row>,
+    /// The rows, as a piece of the topic's stream.
+    rows: Stream,
     /// Lines in the range (so later ranges know their line numbers).
     lines: u64,
     bad: u64,
@@ -817,14 +815,80 @@ struct Chunk {
     first_bad: Option<(u64, String)>,
     /// Line of each row in the range (for the stamp checks' messages).
     row_lines: Vec<u32>,
+    /// A line the csv crate read held a quote: a quoted field may hold a line break, so the
+    /// file is read by the csv crate whole.
+    quoted: bool,
 }
 
-fn parse_range(text: &[u8], lay: &Layout, first_row: usize, rate: Option<f64>) -> Chunk {
-    let mut out = Chunk::default();
-    let delim = match lay.delim {
-        Delim::Byte(b) | Delim::Whitespace(b) => b,
+/// The row of a record's fields (`get(i)`: field `i`), or why not. Without a time column
+/// the stamp is 0 and numbered later.
+fn row_of<'f>(
+    lay: &Layout,
+    n_fields: usize,
+    get: impl Fn(usize) -> Option<&'f [u8]>,
+) -> Result<Row, String> {
+    let t = match lay.time {
+        Some(i) => {
+            let f =
+                get(i).ok_or_else(|| format!("{n_fields} fields, the time is field {}", i + 1))?;
+            parse_time_ns(f, lay.time_unit).ok_or_else(|| {
+                format!(
+                    "time '{}' is not a non-negative number",
+                    String::from_utf8_lossy(f)
+                )
+            })?
+        }
+        None => 0,
     };
-    let ws = matches!(lay.delim, Delim::Whitespace(_));
+    let three = |cols: Option<[usize; 3]>, si: f64| -> Result<[f64; 3], String> {
+        let Some(c) = cols else {
+            return Ok([f64::NAN; 3]);
+        };
+        let mut v = [0.0; 3];
+        for a in 0..3 {
+            let f = get(c[a])
+                .ok_or_else(|| format!("{n_fields} fields, expected at least {}", c[a] + 1))?;
+            v[a] = num(f).ok_or_else(|| {
+                format!(
+                    "field {} '{}' is not a number",
+                    c[a] + 1,
+                    String::from_utf8_lossy(f)
+                )
+            })? * si;
+        }
+        Ok(v)
+    };
+    let gyro = three(lay.gyro, lay.gyro_si)?;
+    let acc = three(lay.acc, lay.acc_si)?;
+    Ok(Row {
+        stamp: t,
+        acc,
+        gyro,
+    })
+}
+
+impl Chunk {
+    fn take(&mut self, line: u64, r: Result<Row, String>) {
+        match r {
+            Ok(row) => {
+                self.rows.push(row.stamp, &row);
+                self.row_lines.push(line as u32);
+            }
+            Err(why) => {
+                self.bad += 1;
+                self.first_bad.get_or_insert((line, why));
+            }
+        }
+    }
+}
+
+/// Reads `text` with the `csv` crate (quoting, comments, flexible rows): for a range whose
+/// fields may be quoted, and for each line [`fast_row`] does not take.
+fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) -> u64 {
+    let (delim, ws) = match lay.delim {
+        Delim::Byte(b) => (b, false),
+        Delim::Whitespace(b) => (b, true),
+    };
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -833,122 +897,248 @@ fn parse_range(text: &[u8], lay: &Layout, first_row: usize, rate: Option<f64>) -
         .quoting(!ws)
         .from_reader(text);
     let mut rec = csv::ByteRecord::new();
-    let mut last_line = 0u64;
+    // a record's line: the line of the last byte the reader took for it (the csv crate's own
+    // record position is where it started reading, before skipped comment and blank lines)
+    let (mut at, mut line) = (0usize, line0);
+    let mut line_of = |end: u64| {
+        let b = (end.saturating_sub(1) as usize).min(text.len()).max(at);
+        line += text[at..b].iter().filter(|&&c| c == b'\n').count() as u64;
+        at = b;
+        line
+    };
     loop {
         match rdr.read_byte_record(&mut rec) {
             Ok(false) => break,
             Ok(true) => {}
             Err(e) => {
-                let line = e.position().map_or(last_line + 1, |p| p.line());
+                let line = line_of(rdr.position().byte());
                 out.bad += 1;
                 out.first_bad.get_or_insert((line, e.to_string()));
                 continue;
             }
         }
-        let line = rec.position().map_or(last_line + 1, |p| p.line());
-        last_line = line;
-        let n_fields = if ws {
-            rec.iter().filter(|f| !f.is_empty()).count()
-        } else {
-            rec.len()
+        let line = line_of(rdr.position().byte());
+        // whitespace: runs of spaces and tabs separate fields
+        let ws_fields = || {
+            rec.iter()
+                .flat_map(|f| f.split(|&c| c == b'\t'))
+                .filter(|f| !f.is_empty())
         };
+        let n_fields = if ws { ws_fields().count() } else { rec.len() };
         if n_fields == 0 || n_fields == 1 && rec.get(0).is_some_and(|f| trim(f).is_empty()) {
             continue; // blank line
         }
-        let get = |i: usize| {
+        let r = row_of(lay, n_fields, |i| {
+            if ws { ws_fields().nth(i) } else { rec.get(i) }
+        });
+        out.take(line, r);
+    }
+    let lines = text.iter().filter(|&&c| c == b'\n').count() as u64;
+    lines + u64::from(!text.is_empty() && !text.ends_with(b"\n"))
+}
+
+/// What a column of the fast path holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Col {
+    Skip,
+    Time,
+    Gyro(usize),
+    Acc(usize),
+}
+
+/// The columns of a layout, in file order, up to the last one read.
+fn columns(lay: &Layout) -> Vec<Col> {
+    let mut c = Vec::new();
+    let mut set = |i: usize, v: Col| {
+        if c.len() <= i {
+            c.resize(i + 1, Col::Skip);
+        }
+        c[i] = v;
+    };
+    if let Some(i) = lay.time {
+        set(i, Col::Time);
+    }
+    for (k, &i) in lay.gyro.iter().flatten().enumerate() {
+        set(i, Col::Gyro(k));
+    }
+    for (k, &i) in lay.acc.iter().flatten().enumerate() {
+        set(i, Col::Acc(k));
+    }
+    c
+}
+
+/// One pass over a plain line (no quotes, no comment, every field where the layout says):
+/// the row and the bytes it took with its line end; `None` hands the line to the `csv`
+/// crate ([`parse_csv`]), which reads it or says why not. Trailing columns past the last
+/// one read are skipped.
+fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
+    let ws = matches!(lay.delim, Delim::Whitespace(_));
+    let d = match lay.delim {
+        Delim::Byte(x) => x,
+        Delim::Whitespace(_) => b' ',
+    };
+    let blank = |c: u8| c == b' ' || c == b'\t';
+    let mut i = 0;
+    let mut row = Row {
+        stamp: 0,
+        acc: [f64::NAN; 3],
+        gyro: [f64::NAN; 3],
+    };
+    for (k, col) in cols.iter().enumerate() {
+        while i < b.len() && blank(b[i]) && (ws || d != b'\t') {
+            i += 1;
+        }
+        match col {
+            Col::Time => {
+                let e = i + b[i..]
+                    .iter()
+                    .position(|&c| !(c.is_ascii_digit() || c == b'.'))
+                    .unwrap_or(b.len() - i);
+                row.stamp = parse_time_ns(&b[i..e], lay.time_unit)?;
+                i = e;
+            }
+            Col::Gyro(a) | Col::Acc(a) => {
+                let (v, n) = fast_float2::parse_partial::<f64, _>(&b[i..]).ok()?;
+                i += n;
+                match col {
+                    Col::Gyro(_) => row.gyro[*a] = v * lay.gyro_si,
+                    _ => row.acc[*a] = v * lay.acc_si,
+                }
+            }
+            Col::Skip => {
+                while i < b.len()
+                    && b[i] != d
+                    && b[i] != b'\n'
+                    && b[i] != b'\r'
+                    && !(ws && blank(b[i]))
+                {
+                    if b[i] == b'"' {
+                        return None;
+                    }
+                    i += 1;
+                }
+            }
+        }
+        while i < b.len() && blank(b[i]) && (ws || d != b'\t') {
+            i += 1;
+        }
+        let last = k + 1 == cols.len();
+        if !last {
             if ws {
-                rec.iter().filter(|f| !f.is_empty()).nth(i)
+                if i == 0 || !blank(b[i - 1]) {
+                    return None;
+                }
+            } else if b.get(i) == Some(&d) {
+                i += 1;
             } else {
-                rec.get(i)
-            }
-        };
-        let parsed = (|| -> Result<(u64, Row), String> {
-            let t = match lay.time {
-                Some(i) => {
-                    let f = get(i).ok_or_else(|| {
-                        format!("{} fields, the time is field {}", n_fields, i + 1)
-                    })?;
-                    parse_time_ns(f, lay.time_unit).ok_or_else(|| {
-                        format!(
-                            "time '{}' is not a non-negative number",
-                            String::from_utf8_lossy(f)
-                        )
-                    })?
-                }
-                None => {
-                    let k = (first_row + out.rows.len()) as f64;
-                    (k * 1e9 / rate.unwrap_or(1.0)).round() as u64
-                }
-            };
-            let three = |cols: Option<[usize; 3]>, si: f64| -> Result<[f64; 3], String> {
-                let Some(c) = cols else {
-                    return Ok([f64::NAN; 3]);
-                };
-                let mut v = [0.0; 3];
-                for a in 0..3 {
-                    let f = get(c[a]).ok_or_else(|| {
-                        format!("{} fields, expected at least {}", n_fields, c[a] + 1)
-                    })?;
-                    v[a] = num(f).ok_or_else(|| {
-                        format!(
-                            "field {} '{}' is not a number",
-                            c[a] + 1,
-                            String::from_utf8_lossy(f)
-                        )
-                    })? * si;
-                }
-                Ok(v)
-            };
-            let gyro = three(lay.gyro, lay.gyro_si)?;
-            let acc = three(lay.acc, lay.acc_si)?;
-            Ok((
-                t,
-                Row {
-                    stamp: t,
-                    acc,
-                    gyro,
-                },
-            ))
-        })();
-        match parsed {
-            Ok((t, row)) => {
-                out.record.push(t);
-                out.rows.push(row);
-                out.row_lines.push(line as u32);
-            }
-            Err(why) => {
-                out.bad += 1;
-                out.first_bad.get_or_insert((line, why));
+                return None;
             }
         }
     }
-    out.lines = text.iter().filter(|&&b| b == b'\n').count() as u64
-        + u64::from(!text.is_empty() && !text.ends_with(b"\n"));
+    // the line end, straight after the last column read (the usual case)
+    match (b.get(i), b.get(i + 1)) {
+        (None, _) => return (i > 0).then_some((row, i)),
+        (Some(b'\n'), _) => return Some((row, i + 1)),
+        (Some(b'\r'), Some(b'\n')) => return Some((row, i + 2)),
+        _ => {}
+    }
+    // the rest of the line: further columns are skipped (no quote in them)
+    let rest = &b[i..];
+    let end = rest.iter().position(|&c| c == b'\n').unwrap_or(rest.len());
+    let tail = &rest[..end];
+    if !tail.is_empty() {
+        let t = tail.strip_suffix(b"\r").unwrap_or(tail);
+        let ok = t.is_empty() || (ws && blank(t[0])) || (!ws && t[0] == d);
+        if !ok || t.contains(&b'"') || t.contains(&b'#') {
+            return None;
+        }
+    }
+    let took = i + end + usize::from(end < rest.len());
+    (took > 0).then_some((row, took))
+}
+
+fn parse_range(text: &[u8], lay: &Layout, quoted: bool, piece: Stream) -> Chunk {
+    let mut out = Chunk {
+        rows: piece,
+        ..Chunk::default()
+    };
+    if quoted {
+        out.lines = parse_csv(text, lay, 1, &mut out);
+        return out;
+    }
+    let cols = columns(lay);
+    let mut pos = 0;
+    let mut line = 0u64;
+    while pos < text.len() {
+        line += 1;
+        let rest = &text[pos..];
+        if let Some((row, took)) = fast_row(rest, lay, &cols) {
+            out.take(line, Ok(row));
+            pos += took;
+            continue;
+        }
+        let end = rest
+            .iter()
+            .position(|&c| c == b'\n')
+            .map_or(rest.len(), |p| p + 1);
+        out.quoted |= rest[..end].contains(&b'"');
+        parse_csv(&rest[..end], lay, line, &mut out);
+        pos += end;
+    }
+    out.lines = line;
     out
 }
 
-/// Splits `body` into ranges of about [`RANGE_BYTES`] ending at line ends.
-fn ranges(body: &[u8]) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut a = 0;
-    while a < body.len() {
-        let mut b = (a + RANGE_BYTES).min(body.len());
-        if b < body.len() {
-            b = body[b..]
-                .iter()
-                .position(|&c| c == b'\n')
-                .map_or(body.len(), |p| b + p + 1);
+/// Bytes read past a range's end to find the end of its last line (more when a line is
+/// longer).
+const RANGE_OVERLAP: u64 = 64 * 1024;
+
+/// The lines of the body that start in `a..b` (file offsets), read into `buf`: the bytes of
+/// those lines are `buf[start..end]`. Ranges that partition the body partition its lines.
+fn read_range(
+    file: &std::fs::File,
+    (body, len): (u64, u64),
+    (a, b): (u64, u64),
+    buf: &mut Vec<u8>,
+) -> std::io::Result<(usize, usize)> {
+    use std::os::unix::fs::FileExt;
+    let from = if a > body { a - 1 } else { a };
+    let mut over = RANGE_OVERLAP;
+    loop {
+        let to = (b + over).min(len);
+        buf.resize((to - from) as usize, 0);
+        file.read_exact_at(buf, from)?;
+        // the first line start at or after file offset x, as an index into buf
+        let start_at = |x: u64| -> Option<usize> {
+            if x <= body {
+                return Some((x - from) as usize);
+            }
+            if x >= len {
+                return Some(buf.len());
+            }
+            let i = (x - 1 - from) as usize;
+            buf[i..].iter().position(|&c| c == b'\n').map(|p| i + p + 1)
+        };
+        match (start_at(a), start_at(b)) {
+            (Some(s), Some(e)) => return Ok((s.min(e), e)),
+            _ if to == len => {
+                let s = start_at(a).unwrap_or(buf.len());
+                return Ok((s, buf.len()));
+            }
+            _ => over *= 4,
         }
-        out.push(a..b);
-        a = b;
     }
-    out
+}
+
+thread_local! {
+    /// Each parsing thread's range buffer, reused from range to range.
+    static RANGE_BUF: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// A parsed text log: one stream, and what reading it found.
 pub struct Parsed {
-    /// The samples.
-    pub stream: Stream,
+    /// The samples: pieces of the topic's stream, in file order.
+    pub streams: Vec<Stream>,
     /// Notes (units assumed, stamps out of order, malformed lines).
     pub notes: Vec<String>,
     /// True when the header is EuRoC/ASL's.
@@ -957,31 +1147,43 @@ pub struct Parsed {
 
 /// Parses the text log at `path` into a stream named `topic`.
 pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let lay = layout(path, &bytes, opts)?;
-    let body = &bytes[lay.body..];
-    // a quoted field may hold a line break: such a file is read as one range
-    let rs = if lay.delim != Delim::Whitespace(b' ') && body.contains(&b'"') {
-        vec![0..body.len()]
-    } else {
-        ranges(body)
-    };
-    // Rows without a time column are numbered across ranges: ranges are parsed in order
-    // then, which only costs speed for a log without stamps.
-    let chunks: Vec<Chunk> = if lay.time.is_none() {
-        let mut v: Vec<Chunk> = Vec::new();
-        let mut n = 0;
-        for r in rs {
-            let c = parse_range(&body[r], &lay, n, opts.rate);
-            n += c.rows.len();
-            v.push(c);
-        }
-        v
-    } else {
-        rs.into_par_iter()
-            .map(|r| parse_range(&body[r], &lay, 0, None))
-            .collect()
-    };
+    let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let head = read_head(path).map_err(io)?;
+    let lay = layout(path, &head, len, opts)?;
+    let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
+    let piece = || Stream::imu(topic, msg_type);
+    // The body in ranges read and parsed in parallel, each into its own piece of the
+    // topic's stream (no copy of the file nor of the rows). A quoted field may hold a line
+    // break: a file whose lines hold quotes is read by the csv crate whole instead.
+    let body = lay.body as u64;
+    let bounds: Vec<(u64, u64)> = (body..len)
+        .step_by(RANGE_BYTES)
+        .map(|a| (a, (a + RANGE_BYTES as u64).min(len)))
+        .collect();
+    let parsed: Result<Vec<(Chunk, bool)>, std::io::Error> = bounds
+        .into_par_iter()
+        .map(|r| {
+            RANGE_BUF.with(|b| {
+                let buf = &mut b.borrow_mut();
+                let (s, e) = read_range(&file, (body, len), r, buf)?;
+                let c = parse_range(&buf[s..e], &lay, false, piece());
+                let quoted = c.quoted;
+                Ok((c, quoted))
+            })
+        })
+        .collect();
+    let mut chunks: Vec<Chunk> = Vec::new();
+    let mut quoted = false;
+    for (c, q) in parsed.map_err(io)? {
+        quoted |= q;
+        chunks.push(c);
+    }
+    if quoted && !matches!(lay.delim, Delim::Whitespace(_)) {
+        let bytes = std::fs::read(path).map_err(io)?;
+        chunks = vec![parse_range(&bytes[lay.body..], &lay, true, piece())];
+    }
     let mut notes = Vec::new();
     let total_rows: usize = chunks.iter().map(|c| c.rows.len()).sum();
     let total_bad: u64 = chunks.iter().map(|c| c.bad).sum();
@@ -1016,15 +1218,21 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
         }
         notes.push(msg);
     }
-    let mut stream = Stream::imu(topic, if lay.euroc { "euroc/imu" } else { "text/imu" });
-    stream.record.reserve(total_rows);
-    stream.rows.reserve(total_rows * crate::decoded::ROW_LEN);
     // stamps that go backwards or repeat, with the line of the first of each
     let (mut back, mut dup) = (0u64, 0u64);
     let (mut first_back, mut first_dup) = (None, None);
     let mut prev: Option<u64> = None;
-    for (c, l0) in chunks.iter().zip(&line_starts) {
-        for (k, (&t, row)) in c.record.iter().zip(&c.rows).enumerate() {
+    let mut k_row = 0u64;
+    for (c, l0) in chunks.iter_mut().zip(&line_starts) {
+        let piece = &mut c.rows;
+        for k in 0..piece.len() {
+            if lay.time.is_none() {
+                // no time column: the rows are numbered at the given rate
+                let t = (k_row as f64 * 1e9 / opts.rate.unwrap_or(1.0)).round() as u64;
+                piece.record[k] = t;
+                piece.rows[k * ROW_LEN..k * ROW_LEN + 8].copy_from_slice(&t.to_le_bytes());
+            }
+            let t = piece.record[k];
             if let Some(p) = prev {
                 let line = l0 + c.row_lines[k] as u64 - 1;
                 if t < p {
@@ -1036,7 +1244,7 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
                 }
             }
             prev = Some(t);
-            stream.push(t, row);
+            k_row += 1;
         }
     }
     if back > 0 {
@@ -1068,8 +1276,19 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
             "'{topic}' has no accelerometer columns: its acc values are NaN"
         ));
     }
+    let _ = total_rows;
     Ok(Parsed {
-        stream,
+        streams: {
+            // every piece that holds rows; the topic still exists when none does
+            let mut v: Vec<Stream> = Vec::new();
+            for c in chunks {
+                if !c.rows.is_empty() || v.is_empty() {
+                    v.retain(|p| !p.is_empty());
+                    v.push(c.rows);
+                }
+            }
+            v
+        },
         notes,
         euroc: lay.euroc,
     })
@@ -1079,7 +1298,12 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
 fn check_plausible(path: &Path, lay: &Layout, chunks: &[Chunk]) -> Result<(), Error> {
     let n: usize = chunks.iter().map(|c| c.rows.len()).sum();
     let step = (n / PLAUSIBILITY_ROWS).max(1);
-    let sample: Vec<&Row> = chunks.iter().flat_map(|c| &c.rows).step_by(step).collect();
+    let sample: Vec<crate::imu_msg::ImuSample> = chunks
+        .iter()
+        .flat_map(|c| c.rows.rows.chunks_exact(ROW_LEN))
+        .step_by(step)
+        .filter_map(|b| Row::decode(b).ok())
+        .collect();
     if sample.is_empty() {
         return Ok(());
     }
@@ -1144,7 +1368,7 @@ pub fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
     let p = parse(path, "imu", opts)?;
     Ok(DecodedSource::new(
         InputKind::Text,
-        vec![p.stream],
+        p.streams,
         p.notes,
         Vec::new(),
     ))
@@ -1180,6 +1404,48 @@ mod tests {
         );
         for n in ["temperature", "seq", "field.orientation.x", "x", "mag_x"] {
             assert_eq!(role_of(n), None, "{n}");
+        }
+    }
+
+    /// The one-pass reader and the csv crate give the same rows, and the lines the one
+    /// pass does not take go to the csv crate.
+    #[test]
+    fn the_fast_path_reads_what_the_csv_crate_reads() {
+        let lay = |delim, time: Option<usize>| Layout {
+            delim,
+            time,
+            gyro: Some([1, 2, 3]),
+            acc: Some([5, 6, 7]),
+            time_unit: TimeUnit::Ns,
+            gyro_si: 0.5,
+            acc_si: 2.0,
+            gyro_stated: true,
+            acc_stated: true,
+            body: 0,
+            body_line: 1,
+            what: String::new(),
+            euroc: false,
+        };
+        let csv = "1,0.5,-1e-3,3,temp,1.25e2,-0,7,extra\r\n2, 0.25 ,2,3,x,4,5,6\n# comment\n\n3,1,2,3,\"q\",4,5,6\n4,1,2\n5,1,2,3,x,4,5,nan";
+        let ws = "  1   0.5 -1e-3\t3 t 1.25e2 -0 7\n2 1 2 3 x 4 5 6 9 9\n";
+        for (text, d) in [(csv, Delim::Byte(b',')), (ws, Delim::Whitespace(b' '))] {
+            let l = lay(d, Some(0));
+            let fast = parse_range(text.as_bytes(), &l, false, Stream::imu("i", "t"));
+            let mut slow = Chunk {
+                rows: Stream::imu("i", "t"),
+                ..Chunk::default()
+            };
+            slow.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
+            assert_eq!(fast.rows.record, slow.rows.record, "{text:?}");
+            for (a, b) in fast.rows.rows.iter().zip(&slow.rows.rows) {
+                assert_eq!(a, b, "{text:?}");
+            }
+            assert_eq!(fast.rows.rows.len(), slow.rows.rows.len());
+            assert_eq!(
+                (fast.bad, fast.row_lines.clone()),
+                (slow.bad, slow.row_lines.clone())
+            );
+            assert_eq!(fast.first_bad, slow.first_bad);
         }
     }
 
