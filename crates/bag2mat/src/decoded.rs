@@ -110,6 +110,14 @@ impl Stream {
         self.rows.extend_from_slice(&row.encode());
     }
 
+    /// Room for `n` more messages.
+    pub fn reserve(&mut self, n: usize) {
+        self.record.reserve(n);
+        if self.imu {
+            self.rows.reserve(n * ROW_LEN);
+        }
+    }
+
     /// Appends a message of a times-only topic.
     pub fn push_time(&mut self, record: u64) {
         self.record.push(record);

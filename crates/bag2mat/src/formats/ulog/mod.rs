@@ -326,10 +326,65 @@ struct Found {
     truncated: Option<u64>,
 }
 
+/// Bytes read at a time: the file is parsed through one window, never held whole.
+const WINDOW: usize = 8 << 20;
+
+/// A window on the file, moved forward as the parser asks for bytes.
+struct Window {
+    file: std::fs::File,
+    len: u64,
+    buf: Vec<u8>,
+    start: u64,
+}
+
+impl Window {
+    /// Bytes `at..at + n` of the file, or `None` past its end.
+    fn get(&mut self, at: u64, n: usize) -> std::io::Result<Option<&[u8]>> {
+        use std::os::unix::fs::FileExt;
+        let end = at.saturating_add(n as u64);
+        if end > self.len {
+            return Ok(None);
+        }
+        if at < self.start || end > self.start + self.buf.len() as u64 {
+            let to = self.len.min(at + WINDOW.max(n) as u64);
+            self.buf.resize((to - at) as usize, 0);
+            self.file.read_exact_at(&mut self.buf, at)?;
+            self.start = at;
+        }
+        let i = (at - self.start) as usize;
+        Ok(Some(&self.buf[i..i + n]))
+    }
+}
+
+/// Data messages per message id, from a hop over the message headers (sizes only): what
+/// each stream reserves room for. A damaged stretch ends the hop; it only sizes memory.
+fn count_data(win: &mut Window, mut at: u64) -> std::io::Result<HashMap<u16, usize>> {
+    let mut n: HashMap<u16, usize> = HashMap::new();
+    while let Some(h) = win.get(at, 5)? {
+        let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
+        if ty == b'D' {
+            *n.entry(u16::from_le_bytes([h[3], h[4]])).or_default() += 1;
+        } else if !b"BFIMPQARLCSO".contains(&ty) {
+            break;
+        }
+        at += 3 + size as u64;
+    }
+    Ok(n)
+}
+
 /// Opens a ULog file.
 pub fn open(path: &Path) -> Result<DecodedSource, Error> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    read(path, &bytes)
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    read(
+        path,
+        Window {
+            file,
+            len,
+            buf: Vec::new(),
+            start: 0,
+        },
+    )
 }
 
 fn corrupt(path: &Path, e: CursorError) -> Error {
@@ -343,9 +398,14 @@ fn corrupt(path: &Path, e: CursorError) -> Error {
     }
 }
 
-/// Reads a ULog held in memory.
-pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
-    let mut c = Cursor::new(bytes);
+/// Reads a ULog through a window on it.
+fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
+    let io = |e| Error::io(path, e);
+    let header = win
+        .get(0, HEADER_LEN.min(win.len as usize))
+        .map_err(io)?
+        .unwrap_or(&[]);
+    let mut c = Cursor::new(header);
     let magic = c
         .take(MAGIC.len(), "ULog magic")
         .map_err(|e| corrupt(path, e))?;
@@ -366,15 +426,15 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
     let mut found = Found::default();
     let mut last_t: u64 = 0;
     let mut appended_at: Option<u64> = None;
-    while !c.is_empty() {
-        let at = c.offset();
-        let head = (|| -> Result<(u16, u8), CursorError> {
-            Ok((c.le::<u16>("message size")?, c.le::<u8>("message type")?))
-        })();
-        let Ok((size, ty)) = head else {
+    let mut at = HEADER_LEN as u64;
+    // exact room for each subscription's messages (a hop over the message headers)
+    let counts = count_data(&mut win, at).map_err(io)?;
+    while at < win.len {
+        let Some(h) = win.get(at, 3).map_err(io)? else {
             found.truncated = Some(at);
             break;
         };
+        let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
         let known = matches!(
             ty,
             b'B' | b'F'
@@ -392,33 +452,35 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
         );
         if !known {
             // resynchronise on the next sync marker
-            let rest = &bytes[at as usize..];
-            let skip = rest
-                .windows(SYNC.len())
-                .position(|w| w == SYNC)
-                .map_or(rest.len(), |p| p.saturating_sub(3));
-            let skip = skip.max(1);
-            found.skipped.push((at, skip as u64));
-            c = Cursor::at(
-                &bytes[(at as usize + skip).min(bytes.len())..],
-                at + skip as u64,
-            );
+            let n = WINDOW.min((win.len - at) as usize);
+            let rest = win.get(at, n).map_err(io)?.unwrap_or(&[]);
+            let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
+                Some(p) => p.saturating_sub(3),
+                None if at + (n as u64) < win.len => n - SYNC.len(),
+                None => n,
+            };
+            let skip = skip.max(1) as u64;
+            found.skipped.push((at, skip));
+            at += skip;
             continue;
         }
         // a message cut by the start of appended data (the logger's DATA_APPENDED flag)
         if let Some(ap) = appended_at
             && at < ap
             && at + 3 + size as u64 > ap
-            && (ap as usize) <= bytes.len()
+            && ap <= win.len
         {
             found.skipped.push((at, ap - at));
-            c = Cursor::at(&bytes[ap as usize..], ap);
+            at = ap;
             continue;
         }
-        let Ok(mut m) = c.sub(size as usize, "message body") else {
+        let Some(body) = win.get(at + 3, size as usize).map_err(io)? else {
             found.truncated = Some(at);
             break;
         };
+        let mut m = Cursor::at(body, at + 3);
+        let msg_at = at;
+        at += 3 + size as u64;
         match ty {
             b'B' => {
                 // flag bits: compat[8], incompat[8], appended offsets[3]
@@ -448,7 +510,7 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
                     Ok((multi, id, m.str(n, "message name")?))
                 })();
                 let Ok((multi, id, name)) = parsed else {
-                    found.skipped.push((at, size as u64 + 3));
+                    found.skipped.push((msg_at, size as u64 + 3));
                     continue;
                 };
                 let key = (name.to_string(), multi);
@@ -467,6 +529,8 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
                     });
                     streams.len() - 1
                 });
+                let room = counts.get(&id).copied().unwrap_or(0);
+                streams[stream].reserve(room);
                 let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
                 subs.insert(
                     id,
@@ -484,7 +548,7 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
             }
             b'D' => {
                 let Ok(id) = m.le::<u16>("msg_id") else {
-                    found.skipped.push((at, size as u64 + 3));
+                    found.skipped.push((msg_at, size as u64 + 3));
                     continue;
                 };
                 let data = m.rest();
