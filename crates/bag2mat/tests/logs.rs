@@ -421,3 +421,77 @@ fn npy_from_bag2mat_reads_back_bit_for_bit_and_unknown_files_name_every_format()
         assert!(err.contains(f), "{f}: {err}");
     }
 }
+
+#[test]
+fn a_damaged_ulog_says_what_it_lost_and_keeps_the_rest() {
+    use bag2mat::formats::ulog::write::{SENSOR_COMBINED, VEHICLE_IMU, Writer};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("damaged.ulg");
+    let mut u = Writer::new(Vec::new(), 0).unwrap();
+    u.format(SENSOR_COMBINED).unwrap();
+    u.format(VEHICLE_IMU).unwrap();
+    u.add(0, 0, "sensor_combined").unwrap();
+    u.add(0, 1, "vehicle_imu").unwrap();
+    let combined = |t: u64| {
+        let mut b = t.to_le_bytes().to_vec();
+        b.extend([0u8; 12]); // gyro_rad
+        b.extend([0u8; 8]);
+        b.extend(9.81f32.to_le_bytes().repeat(3));
+        b.extend([0u8; 8]);
+        b
+    };
+    let deltas = |t: u64, dt: u16| {
+        let mut b = t.to_le_bytes().to_vec();
+        b.extend(t.to_le_bytes());
+        b.extend([0u8; 8]);
+        b.extend(0.01f32.to_le_bytes().repeat(6));
+        b.extend(dt.to_le_bytes().repeat(2));
+        b.extend([0u8; 4]);
+        b
+    };
+    for i in 0..100u64 {
+        u.data(0, &combined(1_000_000 + 5_000 * i)).unwrap();
+        u.data(
+            1,
+            &deltas(1_000_000 + 5_000 * i, if i == 40 { 0 } else { 5_000 }),
+        )
+        .unwrap();
+    }
+    let mut bytes = u.finish().unwrap();
+    // garbage, then the logger's sync marker and more data, then a message cut short
+    bytes.extend([0xEE; 37]);
+    let mut u = Writer::new(Vec::new(), 0).unwrap();
+    u.sync().unwrap();
+    for i in 100..150u64 {
+        u.data(0, &combined(1_000_000 + 5_000 * i)).unwrap();
+    }
+    let tail = u.finish().unwrap();
+    bytes.extend(&tail[16 + 43..]); // without the second file header and flag bits
+    bytes.extend([50, 0, b'D', 0, 0, 1, 2]);
+    std::fs::write(&path, &bytes).unwrap();
+    let r = read_imu_topics(
+        &path,
+        &TopicSelector {
+            topics: vec![],
+            all_imu: true,
+        },
+        &ReadOptions { quiet: true },
+    )
+    .unwrap();
+    let combined = &r.series[0];
+    assert_eq!(
+        (combined.topic.as_str(), combined.len()),
+        ("sensor_combined", 150)
+    );
+    let notes = combined.notes.join("\n");
+    assert!(notes.contains("37 bytes in 1 stretch"), "{notes}");
+    assert!(notes.contains("ends inside a message"), "{notes}");
+    let deltas = &r.series[1];
+    assert_eq!(deltas.len(), 99);
+    let notes = deltas.notes.join("\n");
+    assert!(
+        notes.contains("'vehicle_imu': a delta with a zero dt; 1 message lost"),
+        "{notes}"
+    );
+    assert_eq!(deltas.gyro[0][0], 0.01f32 as f64 / 5e-3);
+}

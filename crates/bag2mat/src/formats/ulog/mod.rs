@@ -23,7 +23,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::cursor::{Cursor, CursorError};
-use crate::decoded::{DecodedSource, Row, Stream};
+use crate::decoded::Row;
 use crate::error::Error;
 use crate::source::{InputKind, Loss};
 
@@ -304,20 +304,18 @@ impl Decoder {
     }
 }
 
-/// A subscription (`A` message): which stream its data go to and how they decode.
-struct Sub {
-    stream: usize,
+/// How a channel's data messages are read: its decoder (an IMU topic) and where its
+/// `timestamp` is (the first field of every logged topic).
+#[derive(Debug, Clone)]
+struct Chan {
     decoder: Option<Decoder>,
-    /// Offset of the leading `timestamp` (the first field of every logged topic).
     ts: Option<Slot>,
 }
 
-/// What reading found, beyond the rows.
+/// What the hop over the file found, beyond the channels.
 #[derive(Default)]
 struct Found {
     dropouts: Vec<(u64, u16)>,
-    /// Rows a decoder refused, per stream: count and first reason.
-    refused: HashMap<usize, (u64, &'static str)>,
     /// Bytes skipped to resynchronise: (offset, length).
     skipped: Vec<(u64, u64)>,
     /// Data messages for an id no `A` message announced.
@@ -326,18 +324,20 @@ struct Found {
     truncated: Option<u64>,
 }
 
-/// Bytes read at a time: the file is parsed through one window, never held whole.
+/// Bytes per part: the unit of parallel decoding, at a message boundary.
+const PART_BYTES: u64 = 4 << 20;
+/// Bytes read at a time while hopping over the file.
 const WINDOW: usize = 8 << 20;
 
 /// A window on the file, moved forward as the parser asks for bytes.
-struct Window {
-    file: std::fs::File,
+struct Window<'f> {
+    file: &'f std::fs::File,
     len: u64,
     buf: Vec<u8>,
     start: u64,
 }
 
-impl Window {
+impl Window<'_> {
     /// Bytes `at..at + n` of the file, or `None` past its end.
     fn get(&mut self, at: u64, n: usize) -> std::io::Result<Option<&[u8]>> {
         use std::os::unix::fs::FileExt;
@@ -356,53 +356,97 @@ impl Window {
     }
 }
 
-/// Data messages per message id, from a hop over the message headers (sizes only): what
-/// each stream reserves room for. A damaged stretch ends the hop; it only sizes memory.
-fn count_data(win: &mut Window, mut at: u64) -> std::io::Result<HashMap<u16, usize>> {
-    let mut n: HashMap<u16, usize> = HashMap::new();
-    while let Some(h) = win.get(at, 5)? {
-        let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
-        if ty == b'D' {
-            *n.entry(u16::from_le_bytes([h[3], h[4]])).or_default() += 1;
-        } else if !b"BFIMPQARLCSO".contains(&ty) {
-            break;
-        }
-        at += 3 + size as u64;
+/// One step of the walk over the messages.
+enum Step {
+    /// A message: its offset, type and size (its body follows the 3 header bytes).
+    Msg(u64, u8, u16),
+    /// Bytes that are no message (resynchronised to the next sync marker) or cut by the
+    /// start of appended data: offset and length.
+    Skip(u64, u64),
+    /// The file ends inside a message at this offset.
+    Cut(u64),
+}
+
+/// The message types of the format.
+const TYPES: &[u8] = b"BFIMPQARDLCSO";
+
+/// The step at `at`: the hop and every part walk the messages the same way.
+fn step(win: &mut Window, at: u64, appended_at: Option<u64>) -> std::io::Result<Step> {
+    let Some(h) = win.get(at, 3)? else {
+        return Ok(Step::Cut(at));
+    };
+    let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
+    if !TYPES.contains(&ty) {
+        let n = WINDOW.min((win.len - at) as usize);
+        let rest = win.get(at, n)?.unwrap_or(&[]);
+        let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
+            Some(p) => p.saturating_sub(3),
+            None if at + (n as u64) < win.len => n - SYNC.len(),
+            None => n,
+        };
+        return Ok(Step::Skip(at, skip.max(1) as u64));
     }
-    Ok(n)
+    // a message cut by the start of appended data (the logger's DATA_APPENDED flag)
+    if let Some(ap) = appended_at
+        && at < ap
+        && at + 3 + size as u64 > ap
+        && ap <= win.len
+    {
+        return Ok(Step::Skip(at, ap - at));
+    }
+    if at + 3 + size as u64 > win.len {
+        return Ok(Step::Cut(at));
+    }
+    Ok(Step::Msg(at, ty, size))
+}
+
+/// An `A` message: multi_id, message id, format name.
+fn subscription(body: &[u8]) -> Option<(u8, u16, &str)> {
+    let mut m = Cursor::new(body);
+    let multi = m.le::<u8>("multi_id").ok()?;
+    let id = m.le::<u16>("msg_id").ok()?;
+    let n = m.remaining();
+    Some((multi, id, m.str(n, "message name").ok()?))
+}
+
+/// Subscriptions: message id → channel ([`NO_CHANNEL`] when none), a table for the hot loop.
+type Subs = Vec<u32>;
+/// A message id without a subscription.
+const NO_CHANNEL: u32 = u32::MAX;
+
+/// A part: its byte range and the subscriptions at its start.
+#[derive(Debug, Clone)]
+struct PartMap {
+    start: u64,
+    end: u64,
+    subs: Subs,
+}
+
+/// A PX4 ULog opened for reading: channels and parts from one hop over the file; each part
+/// is read and decoded on its own, in parallel.
+pub struct UlogReader {
+    file: std::fs::File,
+    len: u64,
+    contents: crate::source::Contents,
+    chans: Vec<Chan>,
+    by_key: HashMap<(String, u8), u32>,
+    parts: Vec<PartMap>,
+    appended_at: Option<u64>,
 }
 
 /// Opens a ULog file.
-pub fn open(path: &Path) -> Result<DecodedSource, Error> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-    read(
-        path,
-        Window {
-            file,
-            len,
-            buf: Vec::new(),
-            start: 0,
-        },
-    )
-}
-
-fn corrupt(path: &Path, e: CursorError) -> Error {
-    let offset = match &e {
-        CursorError::Short { offset, .. } | CursorError::Invalid { offset, .. } => *offset,
-    };
-    Error::Corrupt {
-        path: path.to_path_buf(),
-        offset,
-        what: format!("ULog: {e}"),
-    }
-}
-
-/// Reads a ULog through a window on it.
-fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
+pub fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let mut win = Window {
+        file: &file,
+        len,
+        buf: Vec::new(),
+        start: 0,
+    };
     let header = win
-        .get(0, HEADER_LEN.min(win.len as usize))
+        .get(0, HEADER_LEN.min(len as usize))
         .map_err(io)?
         .unwrap_or(&[]);
     let mut c = Cursor::new(header);
@@ -419,80 +463,60 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
     let mut formats = Formats {
         defs: HashMap::new(),
     };
-    let mut streams: Vec<Stream> = Vec::new();
-    let mut by_key: HashMap<(String, u8), usize> = HashMap::new();
+    let mut channels: Vec<crate::source::Channel> = Vec::new();
+    let mut chans: Vec<Chan> = Vec::new();
+    let mut by_key: HashMap<(String, u8), u32> = HashMap::new();
     let mut instances: HashMap<String, Vec<u8>> = HashMap::new();
-    let mut subs: HashMap<u16, Sub> = HashMap::new();
+    let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
     let mut found = Found::default();
     let mut last_t: u64 = 0;
     let mut appended_at: Option<u64> = None;
+    let mut parts: Vec<PartMap> = Vec::new();
+    let mut part_counts: Vec<Vec<u64>> = Vec::new();
+    let mut part_span: Vec<Option<(u64, u64)>> = Vec::new();
     let mut at = HEADER_LEN as u64;
-    // exact room for each subscription's messages (a hop over the message headers)
-    let counts = count_data(&mut win, at).map_err(io)?;
-    while at < win.len {
-        let Some(h) = win.get(at, 3).map_err(io)? else {
-            found.truncated = Some(at);
+    while at < len {
+        let (m_at, ty, size) = match step(&mut win, at, appended_at).map_err(io)? {
+            Step::Msg(a, t, n) => (a, t, n),
+            Step::Skip(a, n) => {
+                found.skipped.push((a, n));
+                at = a + n;
+                continue;
+            }
+            Step::Cut(a) => {
+                found.truncated = Some(a);
+                break;
+            }
+        };
+        at = m_at + 3 + size as u64;
+        // parts start at message boundaries in the data, each with the subscriptions then
+        if ty == b'D' && parts.last().is_none_or(|p| m_at - p.start >= PART_BYTES) {
+            if let Some(p) = parts.last_mut() {
+                p.end = m_at;
+            }
+            parts.push(PartMap {
+                start: m_at,
+                end: len,
+                subs: subs.clone(),
+            });
+            part_counts.push(Vec::new());
+            part_span.push(None);
+        }
+        let Some(body) = win.get(m_at + 3, size as usize).map_err(io)? else {
+            found.truncated = Some(m_at);
             break;
         };
-        let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
-        let known = matches!(
-            ty,
-            b'B' | b'F'
-                | b'I'
-                | b'M'
-                | b'P'
-                | b'Q'
-                | b'A'
-                | b'R'
-                | b'D'
-                | b'L'
-                | b'C'
-                | b'S'
-                | b'O'
-        );
-        if !known {
-            // resynchronise on the next sync marker
-            let n = WINDOW.min((win.len - at) as usize);
-            let rest = win.get(at, n).map_err(io)?.unwrap_or(&[]);
-            let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
-                Some(p) => p.saturating_sub(3),
-                None if at + (n as u64) < win.len => n - SYNC.len(),
-                None => n,
-            };
-            let skip = skip.max(1) as u64;
-            found.skipped.push((at, skip));
-            at += skip;
-            continue;
-        }
-        // a message cut by the start of appended data (the logger's DATA_APPENDED flag)
-        if let Some(ap) = appended_at
-            && at < ap
-            && at + 3 + size as u64 > ap
-            && ap <= win.len
-        {
-            found.skipped.push((at, ap - at));
-            at = ap;
-            continue;
-        }
-        let Some(body) = win.get(at + 3, size as usize).map_err(io)? else {
-            found.truncated = Some(at);
-            break;
-        };
-        let mut m = Cursor::at(body, at + 3);
-        let msg_at = at;
-        at += 3 + size as u64;
+        let mut m = Cursor::at(body, m_at + 3);
         match ty {
             b'B' => {
                 // flag bits: compat[8], incompat[8], appended offsets[3]
                 if let (Ok(_), Ok(incompat)) =
                     (m.take(8, "compat flags"), m.take(8, "incompat flags"))
+                    && incompat[0] & 1 != 0
+                    && let Ok(off) = m.le::<u64>("appended offset")
+                    && off > 0
                 {
-                    if incompat[0] & 1 != 0
-                        && let Ok(off) = m.le::<u64>("appended offset")
-                        && off > 0
-                    {
-                        appended_at = Some(off);
-                    }
+                    appended_at = Some(off);
                 }
             }
             b'F' => {
@@ -503,75 +527,72 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
                 }
             }
             b'A' => {
-                let parsed = (|| -> Result<(u8, u16, &str), CursorError> {
-                    let multi = m.le::<u8>("multi_id")?;
-                    let id = m.le::<u16>("msg_id")?;
-                    let n = m.remaining();
-                    Ok((multi, id, m.str(n, "message name")?))
-                })();
-                let Ok((multi, id, name)) = parsed else {
-                    found.skipped.push((msg_at, size as u64 + 3));
+                let Some((multi, id, name)) = subscription(body) else {
+                    found.skipped.push((m_at, size as u64 + 3));
                     continue;
                 };
                 let key = (name.to_string(), multi);
-                let slots = formats.slots(name);
-                let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
-                let stream = *by_key.entry(key).or_insert_with(|| {
-                    let v = instances.entry(name.to_string()).or_default();
-                    if !v.contains(&multi) {
-                        v.push(multi);
+                let ch = match by_key.get(&key) {
+                    Some(&ch) => ch,
+                    None => {
+                        let slots = formats.slots(name);
+                        let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
+                        let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
+                        let v = instances.entry(name.to_string()).or_default();
+                        if !v.contains(&multi) {
+                            v.push(multi);
+                        }
+                        let ch = channels.len() as u32;
+                        channels.push(crate::source::Channel {
+                            id: ch,
+                            topic: format!("{name}:{multi}"),
+                            msg_type: Decoder::msg_type(name),
+                            encoding: if decoder.is_some() {
+                                crate::source::Encoding::Row
+                            } else {
+                                crate::source::Encoding::Other("ulog".into())
+                            },
+                            md5sum: None,
+                            count: Some(0),
+                        });
+                        chans.push(Chan { decoder, ts });
+                        by_key.insert(key, ch);
+                        ch
                     }
-                    let topic = format!("{name}:{multi}");
-                    streams.push(if decoder.is_some() {
-                        Stream::imu(topic, Decoder::msg_type(name))
-                    } else {
-                        Stream::other(topic, Decoder::msg_type(name))
-                    });
-                    streams.len() - 1
-                });
-                let room = counts.get(&id).copied().unwrap_or(0);
-                streams[stream].reserve(room);
-                let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
-                subs.insert(
-                    id,
-                    Sub {
-                        stream,
-                        decoder,
-                        ts,
-                    },
-                );
+                };
+                subs[id as usize] = ch;
             }
             b'R' => {
                 if let Ok(id) = m.le::<u16>("msg_id") {
-                    subs.remove(&id);
+                    subs[id as usize] = NO_CHANNEL;
                 }
             }
             b'D' => {
                 let Ok(id) = m.le::<u16>("msg_id") else {
-                    found.skipped.push((msg_at, size as u64 + 3));
+                    found.skipped.push((m_at, size as u64 + 3));
                     continue;
                 };
-                let data = m.rest();
-                let Some(sub) = subs.get(&id) else {
+                let ch = subs[id as usize];
+                if ch == NO_CHANNEL {
                     found.orphans += 1;
                     continue;
-                };
-                let Some(t_us) = sub.ts.and_then(|s| s.get_u64(data)) else {
+                }
+                let Some(t_us) = chans[ch as usize].ts.and_then(|s| s.get_u64(m.rest())) else {
                     found.orphans += 1;
                     continue;
                 };
                 let t = t_us.saturating_mul(1000);
                 last_t = last_t.max(t);
-                let s = &mut streams[sub.stream];
-                match &sub.decoder {
-                    None => s.push_time(t),
-                    Some(d) => match d.row(t, data) {
-                        Ok(row) => s.push(t, &row),
-                        Err(why) => {
-                            let e = found.refused.entry(sub.stream).or_insert((0, why));
-                            e.0 += 1;
-                        }
-                    },
+                let k = parts.len() - 1;
+                let pc = &mut part_counts[k];
+                if pc.len() <= ch as usize {
+                    pc.resize(ch as usize + 1, 0);
+                }
+                pc[ch as usize] += 1;
+                let sp = &mut part_span[k];
+                *sp = Some(sp.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+                if let Some(c) = channels[ch as usize].count.as_mut() {
+                    *c += 1;
                 }
             }
             b'O' => {
@@ -582,7 +603,10 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
             _ => {} // info, parameters, log text, sync
         }
     }
-    if formats.defs.is_empty() && streams.is_empty() {
+    if let Some(p) = parts.last_mut() {
+        p.end = at.min(len);
+    }
+    if formats.defs.is_empty() && channels.is_empty() {
         return Err(Error::Corrupt {
             path: path.to_path_buf(),
             offset: HEADER_LEN as u64,
@@ -590,16 +614,69 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
         });
     }
     // Names: `name` when the log has only instance 0 of it, else `name:k`.
-    for s in &mut streams {
-        if let Some((name, k)) = s.topic.rsplit_once(':')
+    for c in &mut channels {
+        if let Some((name, k)) = c.topic.rsplit_once(':')
             && k == "0"
             && instances.get(name).is_some_and(|v| v.len() == 1)
         {
-            s.topic = name.to_string();
+            c.topic = name.to_string();
         }
     }
+    let mut contents = crate::source::Contents {
+        losses: losses(&found),
+        ..Default::default()
+    };
+    if let Some(at) = found.truncated {
+        contents.notes.push(format!(
+            "the log ends inside a message at byte {at} (cut short): read to there"
+        ));
+    }
+    for (i, p) in parts.iter().enumerate() {
+        let counts: Vec<(u32, u64)> = part_counts[i]
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| **n > 0)
+            .map(|(c, n)| (c as u32, *n))
+            .collect();
+        // what the part delivers: one Row payload per message of an IMU channel
+        let rows: u64 = counts
+            .iter()
+            .filter(|(c, _)| chans[*c as usize].decoder.is_some())
+            .map(|(_, n)| *n)
+            .sum();
+        contents.parts.push(crate::source::Part {
+            label: format!("bytes {}..{}", p.start, p.end),
+            span: part_span[i],
+            counts: Some(counts),
+            bytes: rows * crate::decoded::ROW_LEN as u64,
+        });
+    }
+    contents.channels = channels;
+    Ok(UlogReader {
+        file,
+        len,
+        contents,
+        chans,
+        by_key,
+        parts,
+        appended_at,
+    })
+}
+
+fn corrupt(path: &Path, e: CursorError) -> Error {
+    let offset = match &e {
+        CursorError::Short { offset, .. } | CursorError::Invalid { offset, .. } => *offset,
+    };
+    Error::Corrupt {
+        path: path.to_path_buf(),
+        offset,
+        what: format!("ULog: {e}"),
+    }
+}
+
+/// What the hop found lost, as losses.
+fn losses(found: &Found) -> Vec<Loss> {
     let mut losses = Vec::new();
-    let mut notes = Vec::new();
     if !found.dropouts.is_empty() {
         let total: u64 = found.dropouts.iter().map(|d| d.1 as u64).sum();
         let longest = found
@@ -626,17 +703,6 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
             channel: None,
         });
     }
-    for (id, (n, why)) in &found.refused {
-        losses.push(Loss {
-            what: format!(
-                "{n} messages of '{}' do not give a sample ({why})",
-                streams[*id].topic
-            ),
-            messages: Some(*n),
-            span: None,
-            channel: Some(*id as u32),
-        });
-    }
     if !found.skipped.is_empty() {
         let bytes: u64 = found.skipped.iter().map(|s| s.1).sum();
         losses.push(Loss::new(format!(
@@ -652,12 +718,107 @@ fn read(path: &Path, mut win: Window) -> Result<DecodedSource, Error> {
             found.orphans
         )));
     }
-    if let Some(at) = found.truncated {
-        notes.push(format!(
-            "the log ends inside a message at byte {at} (cut short): read to there"
-        ));
+    losses
+}
+
+impl crate::source::Source for UlogReader {
+    fn kind(&self) -> InputKind {
+        InputKind::Ulog
     }
-    Ok(DecodedSource::new(InputKind::Ulog, streams, notes, losses))
+    fn contents(&self) -> &crate::source::Contents {
+        &self.contents
+    }
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut crate::source::MessageSink<'_>,
+    ) -> crate::source::PartRead {
+        let mut r = crate::source::PartRead::default();
+        let Some(p) = self.parts.get(part) else {
+            r.error = Some(format!("no part {part}"));
+            return r;
+        };
+        // each thread's part buffer is reused from part to part
+        let buf = PART_BUF.with(|b| std::mem::take(&mut *b.borrow_mut()));
+        let mut win = Window {
+            file: &self.file,
+            len: p.end.min(self.len),
+            buf,
+            start: u64::MAX,
+        };
+        let mut subs = p.subs.clone();
+        let mut at = p.start;
+        while at < win.len {
+            let (m_at, ty, size) = match step(&mut win, at, self.appended_at) {
+                Ok(Step::Msg(a, t, n)) => (a, t, n),
+                Ok(Step::Skip(a, n)) => {
+                    at = a + n;
+                    continue;
+                }
+                Ok(Step::Cut(_)) => break,
+                Err(e) => {
+                    r.error = Some(format!("cannot read: {e}"));
+                    break;
+                }
+            };
+            at = m_at + 3 + size as u64;
+            let body = match win.get(m_at + 3, size as usize) {
+                Ok(Some(b)) => b,
+                _ => break,
+            };
+            match ty {
+                b'A' => {
+                    if let Some((multi, id, name)) = subscription(body)
+                        && let Some(&ch) = self.by_key.get(&(name.to_string(), multi))
+                    {
+                        subs[id as usize] = ch;
+                    }
+                }
+                b'R' if body.len() >= 2 => {
+                    subs[u16::from_le_bytes([body[0], body[1]]) as usize] = NO_CHANNEL;
+                }
+                b'D' if body.len() >= 2 => {
+                    let id = u16::from_le_bytes([body[0], body[1]]);
+                    let ch = subs[id as usize];
+                    if ch == NO_CHANNEL || !want(ch) {
+                        continue;
+                    }
+                    let data = &body[2..];
+                    let c = &self.chans[ch as usize];
+                    let Some(t_us) = c.ts.and_then(|s| s.get_u64(data)) else {
+                        continue;
+                    };
+                    let t = t_us.saturating_mul(1000);
+                    match &c.decoder {
+                        None => sink(ch, t, &[]),
+                        Some(d) => match d.row(t, data) {
+                            Ok(row) => sink(ch, t, &row.encode()),
+                            Err(why) => {
+                                r.skipped += 1;
+                                r.skip_reason.get_or_insert_with(|| {
+                                    format!(
+                                        "'{}': {why}",
+                                        self.contents.channels[ch as usize].topic
+                                    )
+                                });
+                                continue;
+                            }
+                        },
+                    }
+                    r.delivered += 1;
+                }
+                _ => {}
+            }
+        }
+        PART_BUF.with(|b| *b.borrow_mut() = win.buf);
+        r
+    }
+}
+
+thread_local! {
+    /// Each reading thread's part buffer.
+    static PART_BUF: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 #[cfg(test)]
