@@ -10,19 +10,12 @@ use crate::common::CASES;
 fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
     let case = &CASES[2];
     let dir = tempfile::tempdir().unwrap();
-    let csv = dir.path().join("x.csv");
-    let cfg = bag2mat::convert::Config {
-        bag: case.bag(),
-        topics: bag2mat::TopicSelector::one(case.topic),
-        output: Some(csv.clone()),
-        format: bag2mat::convert::Format::Csv,
-        time: bag2mat::TimeColumn::Header,
-        quiet: true,
-        input: Default::default(),
-    };
-    bag2mat::convert::run(&cfg).unwrap();
-    let root = dir.path().join("dataset");
-    bag2mat::test_tools::euroc_from_bag2mat_csv(&csv, &root);
+    let root = bag2mat::test_tools::euroc_dataset_from_bag(
+        &case.bag(),
+        case.topic,
+        bag2mat::TimeColumn::Header,
+        dir.path(),
+    );
     let analyse = |input: &std::path::Path, topic: &str, out: &str| {
         let out = dir.path().join(out);
         let args = allan_imu_utils::cli::Args::try_parse_from([

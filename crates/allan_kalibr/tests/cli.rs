@@ -244,6 +244,16 @@ fn unknown_extension_and_wrong_topic_are_clear_errors() {
     std::fs::write(&txt, "1 2 3\n").unwrap();
     let o = run(&[txt.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(!o.status.success());
+    // numbers in a text file are a text log (issue 20): the error says what to add
+    assert!(
+        s(&o.stderr).contains("no header line naming its 3 columns: give them with --columns"),
+        "{}",
+        s(&o.stderr)
+    );
+    let bin = tmp.path().join("data.bin");
+    std::fs::write(&bin, [0u8, 7, 200, 1]).unwrap();
+    let o = run(&[bin.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
     assert!(
         s(&o.stderr).contains("expected a .mat file or a bag"),
         "{}",

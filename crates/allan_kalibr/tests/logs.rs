@@ -37,19 +37,12 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
         panic!("not a bag command")
     };
     sim::bag_sim::run(&sim::bag_sim::BagConfig::try_from(*a).unwrap()).unwrap();
-    let csv = dir.path().join("x.csv");
-    let cfg = bag2mat::convert::Config {
-        bag: bag.clone(),
-        topics: bag2mat::TopicSelector::one("imu"),
-        output: Some(csv.clone()),
-        format: bag2mat::convert::Format::Csv,
-        time: bag2mat::TimeColumn::Record,
-        quiet: true,
-        input: Default::default(),
-    };
-    bag2mat::convert::run(&cfg).unwrap();
-    let root = dir.path().join("dataset");
-    bag2mat::test_tools::euroc_from_bag2mat_csv(&csv, &root);
+    let root = bag2mat::test_tools::euroc_dataset_from_bag(
+        &bag,
+        "imu",
+        bag2mat::TimeColumn::Record,
+        dir.path(),
+    );
     let analyse = |input: &std::path::Path, topic: &str, out: &str| {
         let out = dir.path().join(out);
         let args = allan_kalibr::cli::Args::try_parse_from([

@@ -53,13 +53,7 @@ fn euroc(path: &std::path::Path, seconds: f64, rate: f64) -> anyhow::Result<()> 
         "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"
     )?;
     let mut st = 20u64;
-    let mut next = || {
-        st = st.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = st;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
+    let mut next = || bag2mat::formats::synthetic_noise(&mut st);
     let n = (seconds * rate) as u64;
     let dt = (1e9 / rate).round() as u64;
     for i in 0..n {

@@ -168,3 +168,27 @@ pub fn euroc_from_bag2mat_csv(csv: &Path, root: &Path) -> PathBuf {
     std::fs::write(&p, out).expect("write data.csv");
     p
 }
+
+/// `bag2mat BAG TOPIC --time TIME -o DIR/x.csv`, then that CSV as an EuRoC/ASL dataset at
+/// `DIR/dataset` ([`euroc_from_bag2mat_csv`]); returns the dataset root.
+pub fn euroc_dataset_from_bag(
+    bag: &Path,
+    topic: &str,
+    time: crate::TimeColumn,
+    dir: &Path,
+) -> PathBuf {
+    let csv = dir.join("x.csv");
+    let cfg = crate::convert::Config {
+        bag: bag.to_path_buf(),
+        topics: crate::TopicSelector::one(topic),
+        output: Some(csv.clone()),
+        format: crate::convert::Format::Csv,
+        time,
+        quiet: true,
+        input: Default::default(),
+    };
+    crate::convert::run(&cfg).expect("bag2mat -o x.csv");
+    let root = dir.join("dataset");
+    euroc_from_bag2mat_csv(&csv, &root);
+    root
+}

@@ -85,6 +85,42 @@ impl InputArgs {
     }
 }
 
+/// The topic of instance `k` of a logged message `name`: `name` when the log holds only
+/// instance 0 of it, else `name:k` (ULog `multi_id`, DataFlash `I`/`instance`); `topics`
+/// come in as `name:k` and are renamed in place.
+pub fn instance_topics<'a>(topics: impl Iterator<Item = &'a mut String>) {
+    let topics: Vec<&mut String> = topics.collect();
+    let mut count: std::collections::HashMap<String, usize> = Default::default();
+    for t in &topics {
+        if let Some((name, _)) = t.rsplit_once(':') {
+            *count.entry(name.to_string()).or_default() += 1;
+        }
+    }
+    for t in topics {
+        if let Some((name, k)) = t.rsplit_once(':')
+            && k == "0"
+            && count.get(name) == Some(&1)
+        {
+            *t = name.to_string();
+        }
+    }
+}
+
+/// Bell-shaped deterministic noise (SplitMix64, a sum of four uniforms, variance 1/3) for
+/// the synthetic logs the test and benchmark writers make.
+pub fn synthetic_noise(state: &mut u64) -> f64 {
+    let mut s = 0.0;
+    for _ in 0..4 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        s += (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+    }
+    s
+}
+
 /// The formats of this module as [`crate::source::ACCEPTED`] lists them.
 pub const ACCEPTED: &str = "a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root), a CSV/TSV/whitespace text log, a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin), or a NumPy .npy (N x 7, bag2mat's layout)";
 

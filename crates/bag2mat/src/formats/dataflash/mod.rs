@@ -146,10 +146,8 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
     let mut defs: HashMap<u8, Def> = HashMap::new();
     let mut streams: Vec<Stream> = Vec::new();
     let mut by_key: HashMap<(String, u32), usize> = HashMap::new();
-    let mut instances: HashMap<String, Vec<u32>> = HashMap::new();
     let mut stream_of = |streams: &mut Vec<Stream>, name: &str, k: u32, imu: bool| -> usize {
         *by_key.entry((name.to_string(), k)).or_insert_with(|| {
-            instances.entry(name.to_string()).or_default().push(k);
             let topic = format!("{name}:{k}");
             let ty = format!("ardupilot/{name}");
             streams.push(if imu {
@@ -173,22 +171,14 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
         }
     };
     while i + 3 <= bytes.len() {
-        if bytes[i..i + 2] != HEAD {
-            if !in_skip {
-                skip_runs += 1;
-                first_skip.get_or_insert(i);
-                in_skip = true;
-            }
-            skipped += 1;
-            i += 1;
-            continue;
-        }
         let ty = bytes[i + 2];
-        let len = if ty == FMT_TYPE {
-            FMT_LEN
-        } else if let Some(d) = defs.get(&ty) {
-            d.len
-        } else {
+        let len = match (bytes[i..i + 2] == HEAD, ty == FMT_TYPE, defs.get(&ty)) {
+            (true, true, _) => Some(FMT_LEN),
+            (true, false, Some(d)) => Some(d.len),
+            _ => None,
+        };
+        let Some(len) = len else {
+            // no message here: skip a byte, counting the stretch once
             if !in_skip {
                 skip_runs += 1;
                 first_skip.get_or_insert(i);
@@ -354,14 +344,7 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
             what: "DataFlash: no FMT message could be read".into(),
         });
     }
-    for s in &mut streams {
-        if let Some((name, k)) = s.topic.rsplit_once(':')
-            && k == "0"
-            && instances.get(name).is_some_and(|v| v.len() == 1)
-        {
-            s.topic = name.to_string();
-        }
-    }
+    super::instance_topics(streams.iter_mut().map(|s| &mut s.topic));
     let mut losses = Vec::new();
     let mut notes = Vec::new();
     if skipped > 0 {

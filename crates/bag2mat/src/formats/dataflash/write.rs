@@ -68,20 +68,6 @@ impl<W: Write> Writer<W> {
     }
 }
 
-/// SplitMix64 noise, a sum of uniforms for a bell shape.
-fn noise(state: &mut u64) -> f64 {
-    let mut s = 0.0;
-    for _ in 0..4 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        s += (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-    }
-    s
-}
-
 /// Writes `seconds` of two `IMU` instances at `rate` Hz, `BARO` at 10 Hz, and instance 0's
 /// accelerometer and gyro batches (`ISBH`/`ISBD`, 4× the rate, 256 samples a batch; the
 /// last batch's data cut short, as a log stopped mid-batch is).
@@ -112,7 +98,10 @@ pub fn imu_log<W: Write>(w: W, seconds: f64, rate: f64, seed: u64) -> io::Result
             for a in 0..6 {
                 let base = if a == 5 { -9.80665 } else { 0.0 };
                 let scale = if a < 3 { 1e-3 } else { 2e-2 };
-                b.extend_from_slice(&((base + scale * noise(&mut st)) as f32).to_le_bytes());
+                b.extend_from_slice(
+                    &((base + scale * crate::formats::synthetic_noise(&mut st)) as f32)
+                        .to_le_bytes(),
+                );
             }
             b.extend_from_slice(&0u32.to_le_bytes());
             b.extend_from_slice(&0u32.to_le_bytes());
@@ -157,7 +146,8 @@ pub fn imu_log<W: Write>(w: W, seconds: f64, rate: f64, seed: u64) -> io::Result
                             } else {
                                 0.0
                             };
-                            let v = (g + 0.05 * noise(&mut st)) * mul as f64;
+                            let v =
+                                (g + 0.05 * crate::formats::synthetic_noise(&mut st)) * mul as f64;
                             b.extend_from_slice(&(v.round() as i16).to_le_bytes());
                         }
                     }

@@ -466,7 +466,6 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
     let mut channels: Vec<crate::source::Channel> = Vec::new();
     let mut chans: Vec<Chan> = Vec::new();
     let mut by_key: HashMap<(String, u8), u32> = HashMap::new();
-    let mut instances: HashMap<String, Vec<u8>> = HashMap::new();
     let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
     let mut found = Found::default();
     let mut last_t: u64 = 0;
@@ -538,10 +537,6 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
                         let slots = formats.slots(name);
                         let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
                         let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
-                        let v = instances.entry(name.to_string()).or_default();
-                        if !v.contains(&multi) {
-                            v.push(multi);
-                        }
                         let ch = channels.len() as u32;
                         channels.push(crate::source::Channel {
                             id: ch,
@@ -613,15 +608,7 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
             what: "ULog: no format or subscription could be read".into(),
         });
     }
-    // Names: `name` when the log has only instance 0 of it, else `name:k`.
-    for c in &mut channels {
-        if let Some((name, k)) = c.topic.rsplit_once(':')
-            && k == "0"
-            && instances.get(name).is_some_and(|v| v.len() == 1)
-        {
-            c.topic = name.to_string();
-        }
-    }
+    super::instance_topics(channels.iter_mut().map(|c| &mut c.topic));
     let mut contents = crate::source::Contents {
         losses: losses(&found),
         ..Default::default()

@@ -101,24 +101,6 @@ pub struct ImuLogSpec {
     pub seed: u64,
 }
 
-/// A deterministic noise source (SplitMix64, a sum of uniforms for a bell shape).
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> f64 {
-        let mut s = 0.0;
-        for _ in 0..4 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            s += (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-        }
-        s
-    }
-}
-
 /// Writes a log of PX4's IMU topics at `spec.rate`: `sensor_combined`, `spec.instances`
 /// instances of `sensor_gyro` and `sensor_accel`, `vehicle_imu` (deltas over two samples),
 /// and `vehicle_status` at 2 Hz, interleaved in time order as the logger writes them.
@@ -141,7 +123,8 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
     }
     u.add(0, 200, "vehicle_imu")?;
     u.add(0, 201, "vehicle_status")?;
-    let mut noise = Noise(spec.seed);
+    let mut state = spec.seed;
+    let mut noise = || crate::formats::synthetic_noise(&mut state);
     let n = (spec.seconds * spec.rate) as u64;
     let dt_us = (1e6 / spec.rate).round() as u64;
     let t0 = 10_000_000u64;
@@ -166,10 +149,9 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
             }
             continue;
         }
-        let gyro: [f32; 3] = std::array::from_fn(|_| (1e-3 * noise.next()) as f32);
-        let acc: [f32; 3] = std::array::from_fn(|k| {
-            (if k == 2 { -9.81 } else { 0.0 } + 0.02 * noise.next()) as f32
-        });
+        let gyro: [f32; 3] = std::array::from_fn(|_| (1e-3 * noise()) as f32);
+        let acc: [f32; 3] =
+            std::array::from_fn(|k| (if k == 2 { -9.81 } else { 0.0 } + 0.02 * noise()) as f32);
         b.clear();
         b.extend_from_slice(&t.to_le_bytes());
         f32s(&mut b, &gyro);
@@ -185,7 +167,7 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
                 b.extend_from_slice(&(t + 150).to_le_bytes());
                 b.extend_from_slice(&(t - 50 * k as u64).to_le_bytes());
                 b.extend_from_slice(&(0x0024_0000u32 + k as u32).to_le_bytes());
-                f32s(&mut b, &v.map(|x| x + (1e-4 * noise.next()) as f32));
+                f32s(&mut b, &v.map(|x| x + (1e-4 * noise()) as f32));
                 f32s(&mut b, &[35.5]);
                 b.extend_from_slice(&0u32.to_le_bytes());
                 b.extend_from_slice(&[0, 0, 0, 1]);
