@@ -268,10 +268,13 @@ fn run_series(
         files.extend(write_ieee952(an, config, &topic)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
+    let ieee952_text = ieee.as_ref().map(|a| {
+        imu::summary_text(a) + &allan_kalibr::ieee952::stated::beside_ours(a, &config.bag, &topic)
+    });
     Ok(Outcome {
         topic,
         stdout: report::stdout_text(&analysis),
-        ieee952_text: ieee.as_ref().map(imu::summary_text),
+        ieee952_text,
         notes,
         files,
         analysis,

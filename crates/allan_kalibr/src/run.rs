@@ -363,7 +363,10 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         analysis,
         rate,
         text,
-        ieee952_text: ieee.as_ref().map(crate::ieee952::imu::summary_text),
+        ieee952_text: ieee.as_ref().map(|a| {
+            crate::ieee952::imu::summary_text(a)
+                + &crate::ieee952::stated::beside_ours(a, &config.input, &topic)
+        }),
         notes,
         written,
         timings,

@@ -55,16 +55,34 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        allan_kalibr::run::run(&args.into()).unwrap();
+        let run = allan_kalibr::run::run(&args.into()).unwrap().remove(0);
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (
             read("ieee952_terms.csv"),
             values(&read("imu.yaml")),
             read("basalt_imu_noise_ieee952.json"),
+            run.ieee952_text.unwrap_or_default(),
         )
     };
     let from_bag = analyse(&bag, "imu", "bag");
+    // the dataset states its own figures: printed beside ours
+    std::fs::write(
+        root.join("mav0/imu0/sensor.yaml"),
+        "sensor_type: imu\nrate_hz: 100\ngyroscope_noise_density: 1.6968e-04\n",
+    )
+    .unwrap();
     let from_euroc = analyse(&root, "imu0", "euroc");
+    assert!(!from_bag.3.contains("sensor.yaml"));
+    let stated = &from_euroc.3[from_euroc
+        .3
+        .find("=> the dataset's sensor.yaml for 'imu0'")
+        .unwrap()..];
+    assert!(
+        stated.contains("gyroscope_noise_density      1.6968e-4")
+            && stated.contains("rate_hz                      100")
+            && !stated.contains("accelerometer"),
+        "{stated}"
+    );
     assert_eq!(from_bag.0, from_euroc.0, "IEEE 952 terms");
     assert_eq!(from_bag.1, from_euroc.1, "kalibr_allan's imu.yaml values");
     assert_eq!(from_bag.2, from_euroc.2, "Basalt's fields");
