@@ -301,8 +301,10 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
                     if j >= b.count {
                         break;
                     }
-                    let t =
-                        b.start_us.saturating_mul(1000) + (j as f64 * 1e9 / b.rate).round() as u64;
+                    let t = b
+                        .start_us
+                        .saturating_mul(1000)
+                        .saturating_add((j as f64 * 1e9 / b.rate).round() as u64);
                     let v = [
                         x[k] as f64 / b.mul,
                         y[k] as f64 / b.mul,

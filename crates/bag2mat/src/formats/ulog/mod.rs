@@ -676,7 +676,7 @@ fn losses(found: &Found) -> Vec<Loss> {
         let last = found
             .dropouts
             .last()
-            .map_or(0, |d| d.0 + d.1 as u64 * 1_000_000);
+            .map_or(0, |d| d.0.saturating_add(d.1 as u64 * 1_000_000));
         losses.push(Loss {
             what: format!(
                 "the logger recorded {} dropout{} totalling {total} ms (longest {} ms at {:.3} s): every topic lost its messages of that time",
