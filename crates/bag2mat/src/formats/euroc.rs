@@ -75,7 +75,11 @@ pub fn stated_for(path: &Path, topic: &str) -> Option<Stated> {
     let files = if path.is_dir() {
         imu_files(path)
     } else {
+        // only a data.csv in an EuRoC imuN folder has a sensor.yaml of its own
         let dir = path.parent()?;
+        if path.file_name()? != "data.csv" || !is_imu_folder(dir) {
+            return None;
+        }
         vec![(folder_topic(dir), path.to_path_buf())]
     };
     let (_, f) = files.into_iter().find(|(t, _)| t == topic)?;
