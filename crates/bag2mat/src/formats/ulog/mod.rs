@@ -13,9 +13,14 @@
 //! and times (`bag2mat info`). Dropouts the logger recorded (`O` messages) are losses;
 //! bytes that do not parse are skipped to the next sync marker and reported.
 //!
-//! Our own parser (with [`crate::cursor`]): PX4's `px4-ulog` crate and `yule_log` stream
-//! the file through callbacks in one pass and panic on some malformed lengths; the read
-//! path wants every message's record time, typed errors and the losses spelt out.
+//! Opening hops once over the message headers (definitions, subscriptions, dropouts, counts)
+//! and cuts the data into message-aligned byte ranges; each range is then read and decoded
+//! on its own, in parallel, straight into the read path (nothing is held but the result).
+//!
+//! Our own parser (with [`crate::cursor`]): PX4's `px4-ulog` crate (0.6) and `yule_log`
+//! (0.4) stream the whole file through callbacks in one pass (no ranges to decode in
+//! parallel), and `px4-ulog`'s unpack helpers panic on short slices by design; the read path
+//! wants every message's record time, typed errors and the losses spelt out.
 
 pub mod write;
 
