@@ -27,7 +27,8 @@ pub const DEFAULT_MAX_CLUSTER: usize = 100;
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version, allow_negative_numbers = true)]
 pub struct Args {
-    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3.
+    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3;
+    /// or an IMU log (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
     #[arg(required_unless_present = "curves")]
     pub bag: Option<PathBuf>,
     /// Analyse existing Allan curves instead of a bag: an imu_utils data directory (then
@@ -46,7 +47,8 @@ pub struct Args {
     /// Number of samples behind --curves (for the confidence intervals).
     #[arg(long, value_name = "N")]
     pub samples: Option<u64>,
-    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, Hz.
+    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, or of a text log
+    /// without a time column, Hz.
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
     /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
@@ -90,6 +92,8 @@ pub struct Args {
     /// Only what imu_utils produces: skip the IEEE 952 section and its files
     #[arg(long)]
     pub compat_only: bool,
+    #[command(flatten)]
+    pub input_args: bag2mat::formats::InputArgs,
 }
 
 /// The time column.
@@ -141,6 +145,9 @@ pub struct Config {
     pub timings: bool,
     /// Also run the IEEE 952 analysis (allan_kalibr::ieee952) beside the compat outputs.
     pub ieee952: bool,
+    /// What the user said about a log whose content does not say it all (a text log's
+    /// columns and units).
+    pub input_options: bag2mat::formats::InputOptions,
 }
 
 /// A positive whole number: "must be positive" for 0 and negatives (clap would otherwise
@@ -257,6 +264,10 @@ impl TryFrom<Args> for Config {
             plots: !a.no_plots,
             timings: a.timings,
             ieee952: !a.compat_only,
+            // a text log without a time column is sampled at --rate
+            input_options: a
+                .input_args
+                .options(if a.curves.is_empty() { a.rate } else { None }),
         })
     }
 }

@@ -115,7 +115,7 @@ pub struct CurvesOutcome {
 /// into `out_dir`; with several, into `out_dir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
-    let read = bag2mat::read_imu_topics(
+    let read = bag2mat::series::read_imu_topics_with(
         &config.bag,
         &bag2mat::TopicSelector {
             topics: config.topics.clone(),
@@ -124,7 +124,11 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
         &bag2mat::ReadOptions {
             quiet: config.quiet,
         },
+        &config.input_options,
     )?;
+    for s in &read.series {
+        s.require_both_sensors()?;
+    }
     let read_time = t0.elapsed();
     let several = read.series.len() > 1 || config.all_imu;
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
@@ -264,10 +268,13 @@ fn run_series(
         files.extend(write_ieee952(an, config, &topic)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
+    let ieee952_text = ieee.as_ref().map(|a| {
+        imu::summary_text(a) + &allan_kalibr::ieee952::stated::beside_ours(a, &config.bag, &topic)
+    });
     Ok(Outcome {
         topic,
         stdout: report::stdout_text(&analysis),
-        ieee952_text: ieee.as_ref().map(imu::summary_text),
+        ieee952_text,
         notes,
         files,
         analysis,

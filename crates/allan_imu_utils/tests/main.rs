@@ -11,5 +11,6 @@ mod cli;
 mod common;
 mod curves;
 mod fit_reference;
+mod logs;
 mod reference;
 mod ros2;

@@ -21,7 +21,8 @@ use crate::run::Config;
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {
-    /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
+    /// Input: a bag, a .mat holding data_imu (N x 7: t ax ay az wx wy wz), or an IMU log
+    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
     #[arg(required_unless_present = "curves")]
     pub input: Option<PathBuf>,
     /// Analyse existing Allan curves instead (IEEE 952 section only): an imu_utils data
@@ -84,6 +85,8 @@ pub struct Args {
     /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
     #[arg(long)]
     pub timings: bool,
+    #[command(flatten)]
+    pub input_args: bag2mat::formats::InputArgs,
 }
 
 /// The slowest update rate accepted, Hz: below it a τ grid of seconds-to-hours is meaningless
@@ -166,6 +169,8 @@ impl From<Args> for Config {
             quiet: a.quiet,
             ieee952: !a.compat_only,
             timings: a.timings,
+            // a text log without a time column is sampled at --update-rate
+            input_options: a.input_args.options(a.update_rate),
         }
     }
 }

@@ -102,25 +102,31 @@ fn is_mat(path: &Path) -> bool {
 /// Reads one topic of a bag (any format bag2mat reads) or a `.mat` (variable `data_imu`).
 pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
     let sel = bag2mat::TopicSelector::one(topic);
-    Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet)?.remove(0))
+    let opts = bag2mat::formats::InputOptions::default();
+    Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet, &opts)?.remove(0))
 }
 
-/// Reads the selected topics of a bag in one pass, or the one `data_imu` of a `.mat`.
+/// Reads the selected topics of a bag or log in one pass, or the one `data_imu` of a `.mat`.
 pub fn load_all(
     path: &Path,
     sel: &bag2mat::TopicSelector,
     time: bag2mat::TimeColumn,
     quiet: bool,
+    opts: &bag2mat::formats::InputOptions,
 ) -> Result<Vec<ImuData>, Error> {
     if is_mat(path) {
         return Ok(vec![load_mat(path)?]);
     }
-    match bag2mat::read_imu_topics(path, sel, &bag2mat::ReadOptions { quiet }) {
-        Ok(r) => Ok(r
-            .series
-            .into_iter()
-            .map(|s| ImuData::from_series(s, time))
-            .collect()),
+    match bag2mat::series::read_imu_topics_with(path, sel, &bag2mat::ReadOptions { quiet }, opts) {
+        Ok(r) => {
+            for s in &r.series {
+                s.require_both_sensors()?;
+            }
+            Ok(r.series
+                .into_iter()
+                .map(|s| ImuData::from_series(s, time))
+                .collect())
+        }
         Err(bag2mat::Error::NotABag { .. }) => Err(Error::UnknownInput {
             path: path.to_path_buf(),
         }),

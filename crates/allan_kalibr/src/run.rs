@@ -43,6 +43,9 @@ pub struct Config {
     pub skip_start: Option<f64>,
     /// Analyse other tools' Allan curves instead of samples (`--curves`).
     pub curves: Option<CurvesInput>,
+    /// What the user said about a log whose content does not say it all (a text log's
+    /// columns and units).
+    pub input_options: bag2mat::formats::InputOptions,
 }
 
 /// `--curves`: the files and what the user said about them.
@@ -141,7 +144,13 @@ impl std::fmt::Display for Timings {
 /// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     let start = Instant::now();
-    let datas = input::load_all(&config.input, &config.topics, config.time, config.quiet)?;
+    let datas = input::load_all(
+        &config.input,
+        &config.topics,
+        config.time,
+        config.quiet,
+        &config.input_options,
+    )?;
     let load = start.elapsed().as_secs_f64();
     let several = datas.len() > 1 || config.topics.all_imu;
     let names: Vec<String> = datas
@@ -354,7 +363,10 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         analysis,
         rate,
         text,
-        ieee952_text: ieee.as_ref().map(crate::ieee952::imu::summary_text),
+        ieee952_text: ieee.as_ref().map(|a| {
+            crate::ieee952::imu::summary_text(a)
+                + &crate::ieee952::stated::beside_ours(a, &config.input, &topic)
+        }),
         notes,
         written,
         timings,

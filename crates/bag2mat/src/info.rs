@@ -83,7 +83,16 @@ fn stats(t: &mut [u64]) -> (Option<f64>, Option<f64>, Option<f64>, u64, Option<f
 
 /// Reads every message's record time of `path` and summarises each topic.
 pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
-    let src = source::open(path)?;
+    info_with(path, quiet, &crate::formats::InputOptions::default())
+}
+
+/// [`info`], with what the user said about a log whose content does not say it all.
+pub fn info_with(
+    path: &Path,
+    quiet: bool,
+    opts: &crate::formats::InputOptions,
+) -> Result<InfoReport, Error> {
+    let src = source::open_with(path, opts)?;
     let parts = src.parts();
     let pb = crate::shared::progress::bar(parts.len().max(1) as u64, quiet, "parts");
     pb.set_message("reading");

@@ -21,6 +21,9 @@
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
 //! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
 //!   constant-rate segments of a series of stamps (info and both analysers use it).
+//! * [`formats`]: raw IMU logs from outside ROS — EuRoC/ASL and plain text, NumPy, PX4
+//!   ULog, ArduPilot DataFlash — each a [`source::Source`] over rows its reader decoded
+//!   ([`decoded`]); [`cursor`]: the bounds-checked byte reader the binary formats parse with.
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
 //!
@@ -31,7 +34,10 @@
 pub mod bag;
 pub mod cdr;
 pub mod convert;
+pub mod cursor;
+pub mod decoded;
 mod error;
+pub mod formats;
 pub mod imu_msg;
 pub mod info;
 pub mod mat;

@@ -122,6 +122,31 @@ impl ImuSeries {
         std::array::from_fn(|c| self.acc[c][i])
     }
 
+    /// The sensor this topic does not carry: its three columns NaN in every sample (PX4
+    /// `sensor_gyro`/`sensor_accel`, ArduPilot batches, a text log with one sensor).
+    pub fn absent_sensor(&self) -> Option<crate::Sensor> {
+        let none = |c: &[Vec<f64>; 3]| !self.is_empty() && c.iter().flatten().all(|v| v.is_nan());
+        if none(&self.acc) {
+            Some(crate::Sensor::Acc)
+        } else if none(&self.gyro) {
+            Some(crate::Sensor::Gyro)
+        } else {
+            None
+        }
+    }
+
+    /// Fails with [`Error::OneSensor`] when the topic lacks a sensor (for the analysers,
+    /// which fit both).
+    pub fn require_both_sensors(&self) -> Result<(), Error> {
+        match self.absent_sensor() {
+            Some(missing) => Err(Error::OneSensor {
+                topic: self.topic.clone(),
+                missing,
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// The chosen time column.
     pub fn time(&self, which: TimeColumn) -> &[RosTime] {
         match which {
@@ -150,10 +175,25 @@ pub struct ImuRead {
 enum Codec {
     Ros1,
     Cdr,
+    /// Rows a log reader decoded ([`crate::decoded::Row`]), whatever the topic's type.
+    Row,
+}
+
+impl Codec {
+    /// The smallest payload a message of this codec has.
+    fn min_payload(self) -> u64 {
+        match self {
+            Codec::Ros1 | Codec::Cdr => MIN_IMU_PAYLOAD,
+            Codec::Row => crate::decoded::ROW_LEN as u64,
+        }
+    }
 }
 
 /// The Imu codec for a channel, or `None` when it does not carry `sensor_msgs/Imu`.
 fn imu_codec(c: &Channel) -> Option<Codec> {
+    if c.encoding == Encoding::Row {
+        return Some(Codec::Row);
+    }
     let imu_type = c.msg_type == imu_msg::TYPE || c.msg_type == crate::cdr::TYPE;
     match (&c.encoding, imu_type) {
         (Encoding::Ros1, true) => match &c.md5sum {
@@ -174,6 +214,7 @@ fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
         Codec::Ros1 => ImuSample::decode(data),
         Codec::Cdr => crate::cdr::decode_sample(data),
+        Codec::Row => crate::decoded::Row::decode(data),
     }
 }
 
@@ -539,7 +580,18 @@ pub fn read_imu_topics(
     sel: &TopicSelector,
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
-    let src = source::open(path)?;
+    read_imu_topics_with(path, sel, opts, &crate::formats::InputOptions::default())
+}
+
+/// [`read_imu_topics`], with what the user said about a log whose content does not say it
+/// all (a text log's columns and units).
+pub fn read_imu_topics_with(
+    path: &Path,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+    input: &crate::formats::InputOptions,
+) -> Result<ImuRead, Error> {
+    let src = source::open_with(path, input)?;
     read_from(src.as_ref(), sel, opts)
 }
 
@@ -600,7 +652,12 @@ fn decode_all(
         .iter()
         .map(|p| {
             let counts = p.counts.as_ref()?;
-            let bound = p.bytes / MIN_IMU_PAYLOAD;
+            let min_payload = selected
+                .iter()
+                .flat_map(|s| s.channels.iter().map(|(_, k)| k.min_payload()))
+                .min()
+                .unwrap_or(MIN_IMU_PAYLOAD);
+            let bound = p.bytes / min_payload;
             Some(
                 selected
                     .iter()

@@ -142,3 +142,53 @@ pub fn string_message(text: &str) -> Vec<u8> {
     d.extend_from_slice(text.as_bytes());
     d
 }
+
+/// Rewrites a `bag2mat -o x.csv` file (`t,ax,ay,az,wx,wy,wz`, t in s) as an EuRoC/ASL
+/// dataset under `root` (`mav0/imu0/data.csv`: ns stamps, gyro before acc, the same
+/// decimals), as a user's script would; returns the `data.csv` path.
+pub fn euroc_from_bag2mat_csv(csv: &Path, root: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(csv).expect("read the bag2mat CSV");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,ax,ay,az,wx,wy,wz"));
+    let mut out = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let ns = crate::formats::text::parse_time_ns(f[0].as_bytes(), crate::formats::TimeUnit::S)
+            .expect("a time in seconds");
+        out.push_str(&format!(
+            "{ns},{},{},{},{},{},{}\n",
+            f[4], f[5], f[6], f[1], f[2], f[3]
+        ));
+    }
+    let dir = root.join("mav0/imu0");
+    std::fs::create_dir_all(&dir).expect("create mav0/imu0");
+    let p = dir.join("data.csv");
+    std::fs::write(&p, out).expect("write data.csv");
+    p
+}
+
+/// `bag2mat BAG TOPIC --time TIME -o DIR/x.csv`, then that CSV as an EuRoC/ASL dataset at
+/// `DIR/dataset` ([`euroc_from_bag2mat_csv`]); returns the dataset root.
+pub fn euroc_dataset_from_bag(
+    bag: &Path,
+    topic: &str,
+    time: crate::TimeColumn,
+    dir: &Path,
+) -> PathBuf {
+    let csv = dir.join("x.csv");
+    let cfg = crate::convert::Config {
+        bag: bag.to_path_buf(),
+        topics: crate::TopicSelector::one(topic),
+        output: Some(csv.clone()),
+        format: crate::convert::Format::Csv,
+        time,
+        quiet: true,
+        input: Default::default(),
+    };
+    crate::convert::run(&cfg).expect("bag2mat -o x.csv");
+    let root = dir.join("dataset");
+    euroc_from_bag2mat_csv(&csv, &root);
+    root
+}

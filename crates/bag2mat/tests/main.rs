@@ -4,6 +4,7 @@
 
 mod cli;
 mod defects;
+mod logs;
 mod real_tools;
 mod reference;
 mod ros2;

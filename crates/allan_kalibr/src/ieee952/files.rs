@@ -14,6 +14,8 @@
 //!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
 //!   are left out (with a comment) rather than written as a number.
+//! * OpenVINS' `kalibr_imu_chain.yaml` and Basalt's calibration noise fields:
+//!   [`super::vio_files`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -163,6 +165,14 @@ pub fn write_outputs(
     put(KALIBR_FILE, kalibr_yaml(a, rostopic))?;
     put(VINS_FILE, vins_yaml(a))?;
     put(ORBSLAM3_FILE, orbslam3_yaml(a))?;
+    put(
+        super::vio_files::OPENVINS_FILE,
+        super::vio_files::openvins_yaml(a, rostopic),
+    )?;
+    put(
+        super::vio_files::BASALT_FILE,
+        super::vio_files::basalt_json(a),
+    )?;
     Ok(files)
 }
 
@@ -329,7 +339,7 @@ fn note(name: &str, v: Option<SensorValue>) -> Option<String> {
     }
 }
 
-fn inline_note(v: Option<SensorValue>) -> &'static str {
+pub(super) fn inline_note(v: Option<SensorValue>) -> &'static str {
     match v {
         Some(SensorValue {
             upper_bound: true, ..
@@ -340,15 +350,15 @@ fn inline_note(v: Option<SensorValue>) -> &'static str {
 }
 
 /// The four values and the comments every configuration file carries.
-struct FileValues {
-    acc_n: Option<SensorValue>,
-    acc_w: Option<SensorValue>,
-    gyr_n: Option<SensorValue>,
-    gyr_w: Option<SensorValue>,
-    comments: Vec<String>,
+pub(super) struct FileValues {
+    pub(super) acc_n: Option<SensorValue>,
+    pub(super) acc_w: Option<SensorValue>,
+    pub(super) gyr_n: Option<SensorValue>,
+    pub(super) gyr_w: Option<SensorValue>,
+    pub(super) comments: Vec<String>,
 }
 
-fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
+pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
     let v = FileValues {
         acc_n: a.noise_density(Sensor::Acc),
         acc_w: a.random_walk(Sensor::Acc),

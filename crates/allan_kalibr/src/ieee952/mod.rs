@@ -74,8 +74,10 @@ pub mod noise_id;
 pub mod oadev;
 pub mod plot;
 pub mod region;
+pub mod stated;
 pub mod stationarity;
 pub mod tau_grid;
+pub mod vio_files;
 
 #[cfg(test)]
 mod tests_accuracy;

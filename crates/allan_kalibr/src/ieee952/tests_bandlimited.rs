@@ -183,6 +183,7 @@ fn mat_cases() -> Vec<Outcome> {
         timings: false,
         ieee952: true,
         skip_start: None,
+        input_options: Default::default(),
         curves: None,
     };
     crate::run::run(&config).expect("allan_kalibr run on the .mat");
