@@ -9,12 +9,13 @@
 # is often shared. Needs target/py-venv (scripts/test.sh installs pandas and pyulog).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 root=$(pwd)
 work=${1:-$(mktemp -d /tmp/imu-bench-logs.XXXXXX)}
 mkdir -p "$work"
 echo "work dir: $work"
 cargo build --release --quiet -p bag2mat --examples
-ex="$root/target/release/examples"
+ex="$(target_dir)/release/examples"
 py="$root/target/py-venv/bin/python"
 [ -x "$py" ] || { echo "target/py-venv is missing: run scripts/test.sh first" >&2; exit 1; }
 ratio() { /usr/bin/python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print('%.1f' % (a / b if b > 0 else float('inf')))" "$1" "$2"; }
