@@ -62,6 +62,9 @@ fn main() -> ExitCode {
         if several {
             text.push_str(&format!("===== topic {} =====\n", outcome.topic));
         }
+        for f in &outcome.findings {
+            eprintln!("{f}");
+        }
         for note in &outcome.notes {
             if note.to_ascii_lowercase().starts_with("warning") {
                 eprintln!("{note}");

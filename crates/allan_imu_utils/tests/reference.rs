@@ -44,6 +44,7 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
         ieee952: false,
         curves: None,
         skip_start: None,
+        drop_outliers: false,
     };
     run(&config)
         .unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))

@@ -26,6 +26,7 @@ fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
         ieee952: false,
         curves: None,
         skip_start: None,
+        drop_outliers: false,
     };
     let o = allan_imu_utils::run::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
@@ -47,6 +48,7 @@ fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
         timings: false,
         ieee952: false,
         skip_start: None,
+        drop_outliers: false,
         curves: None,
     };
     let o = allan_kalibr::run(&c)

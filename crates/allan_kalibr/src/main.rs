@@ -64,8 +64,12 @@ fn main() -> ExitCode {
                 out.topic.as_deref().unwrap_or("?")
             ));
         }
+        // The record check's findings always; the reader's warnings always, other notes
+        // (the estimated rate) only without --quiet.
+        for f in &out.findings {
+            eprintln!("{f}");
+        }
         for n in &out.notes {
-            // Warnings always; other notes (the estimated rate) only without --quiet.
             if !config.quiet || n.to_ascii_lowercase().starts_with("warning") {
                 eprintln!("{n}");
             }

@@ -19,8 +19,9 @@
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
-//!   constant-rate segments of a series of stamps (info and both analysers use it).
+//! * [`info`]: what an input holds (`bag2mat info`); [`record_check`]: is a record fit for
+//!   an Allan analysis (clocks, duplicates, gaps through [`timing`], the one gap rule;
+//!   outliers, warm-up, motion), typed findings every tool prints and the analysers obey.
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
 //!
@@ -36,6 +37,7 @@ pub mod imu_msg;
 pub mod info;
 pub mod mat;
 pub mod mcap;
+pub mod record_check;
 pub mod rosbag2;
 pub mod sensor;
 pub mod series;

@@ -74,7 +74,6 @@ pub mod noise_id;
 pub mod oadev;
 pub mod plot;
 pub mod region;
-pub mod stationarity;
 pub mod tau_grid;
 
 #[cfg(test)]

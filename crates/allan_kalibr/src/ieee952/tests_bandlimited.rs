@@ -183,6 +183,7 @@ fn mat_cases() -> Vec<Outcome> {
         timings: false,
         ieee952: true,
         skip_start: None,
+        drop_outliers: false,
         curves: None,
     };
     crate::run::run(&config).expect("allan_kalibr run on the .mat");
