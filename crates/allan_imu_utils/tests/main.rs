@@ -11,5 +11,6 @@ mod cli;
 mod common;
 mod curves;
 mod fit_reference;
+mod issue18;
 mod reference;
 mod ros2;

@@ -4,17 +4,15 @@
 //! and `allan_imu_utils`' tests), an unreadable curve file, the warm-up warning and
 //! `--skip-start`, and the gap warning.
 
-use std::path::Path;
 use std::process::{Command, Output};
 
-use allan_kalibr::ieee952::files::{
-    COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE,
-    TERMS_FILE,
-};
+use allan_kalibr::ieee952::files::{CURVES_FILE, TERMS_FILE};
 use bag2mat::mat::{DataImu, write_data_imu};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
+
+use crate::common::{term, terms};
 
 /// Sample rate of the simulated records, Hz.
 const RATE: f64 = 50.0;
@@ -78,55 +76,6 @@ fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> D
         m.push(row);
     }
     m
-}
-
-/// One row of ieee952_terms.csv.
-#[derive(Debug, Clone)]
-struct Row {
-    sensor: String,
-    axis: String,
-    term: String,
-    value: f64,
-    lo: f64,
-    hi: f64,
-    verdict: String,
-}
-
-fn terms(dir: &Path) -> Vec<Row> {
-    let text = std::fs::read_to_string(dir.join(TERMS_FILE)).expect("terms file");
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
-    let (cs, ca, ct, cv, cl, ch, cd) = (
-        col(COL_SENSOR),
-        col(COL_AXIS),
-        col(COL_TERM),
-        col(COL_VALUE),
-        col(COL_CI95_LO),
-        col(COL_CI95_HI),
-        col(COL_VERDICT),
-    );
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let num = |c: usize| f[c].parse::<f64>().expect("number");
-            Row {
-                sensor: f[cs].into(),
-                axis: f[ca].into(),
-                term: f[ct].into(),
-                value: num(cv),
-                lo: num(cl),
-                hi: num(ch),
-                verdict: f[cd].into(),
-            }
-        })
-        .collect()
-}
-
-fn term<'a>(rows: &'a [Row], sensor: &str, axis: &str, t: &str) -> &'a Row {
-    rows.iter()
-        .find(|r| r.sensor == sensor && r.axis == axis && r.term == t)
-        .unwrap_or_else(|| panic!("{sensor} {axis} {t} not in the terms file"))
 }
 
 /// The six (sensor, axis) of a run, with their true N.

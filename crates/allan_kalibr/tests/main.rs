@@ -6,4 +6,5 @@ mod cli;
 mod common;
 mod consumers;
 mod ieee952;
+mod issue18;
 mod reference;

@@ -371,7 +371,7 @@ mod tests {
     }
 
     #[test]
-    fn a_rate_change_splits_the_series_at_the_exact_sample() {
+    fn issue18_9_a_rate_change_is_cut_at_the_exact_sample() {
         // 200 Hz for 5000 samples (not a multiple of the block), then 100 Hz
         for first in [5000usize, 5120, 5133] {
             let mut t = grid(first);
@@ -386,6 +386,31 @@ mod tests {
             // the other-rate stretch is not a string of gaps
             assert!(tm.gaps.is_empty(), "{:?}", &tm.gaps[..3.min(tm.gaps.len())]);
         }
+    }
+
+    #[test]
+    fn issue18_9_every_clock_counts_the_same_gaps() {
+        // intervals of exactly 2.5 and 3 periods at absolute times: the same gaps from the
+        // stamps (ns) and from the seconds a .mat holds (before: 3 periods was a gap in one
+        // tool and not in the other, float seconds against integer nanoseconds)
+        let mut t = grid(20_000);
+        for (at, by) in [(5000usize, P / 2), (9000, P), (15_000, 2 * P)] {
+            for x in &mut t[at..] {
+                *x += by;
+            }
+        }
+        let secs: Vec<f64> = t
+            .iter()
+            .map(|&x| crate::RosTime::from_nanos(x as u64).to_sec())
+            .collect();
+        let a = analyse(&t);
+        let b = analyse(&ns_of_seconds(&secs));
+        let missing = |tm: &Timing| tm.gaps.iter().map(|g| g.missing).collect::<Vec<_>>();
+        // 1.5 periods round to 2 (one missing), 2 to 2, 3 to 3
+        assert_eq!(missing(&a), vec![1, 1, 2]);
+        assert_eq!(missing(&b), missing(&a));
+        assert_eq!(a.missing, 4);
+        assert_eq!(b.missing, a.missing);
     }
 
     #[test]

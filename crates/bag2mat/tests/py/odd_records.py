@@ -8,7 +8,8 @@ usage: odd_records.py rosbag|mcap OUT CASE [--seconds S] [--rate HZ] [--seed N]
 
 CASE (comma-separated, combined in order):
   clean       nothing odd
-  dropouts    2 % of the messages lost, one at a time (never two in a row)
+  dropouts    2 % of the messages lost, one at a time (never two in a row, never the first
+              or the last: the span holds every lost one)
   wrong_rate  nothing odd in the record (the test passes a wrong --update-rate)
   warmup      0.02 rad/s * exp(-t / 100 s) on the three gyro axes
   warmup5s    5 sigma (per sample) * exp(-t / 300 s) on all six axes
@@ -18,6 +19,7 @@ CASE (comma-separated, combined in order):
   dup2pct     2 % of the messages written twice (same stamps, same values)
   spike       one message with angular_velocity.x = 1e6 rad/s, at 40 % of the record
   header2x    record time at the rate, header.stamp advancing twice as fast
+  headerstep  header.stamp steps back 0.5 s at 60 % of the record (the record time does not)
 """
 import json
 import math
@@ -95,6 +97,8 @@ def samples(cases, seconds, rate, seed):
         hdr = rec
         if "header2x" in cases:
             hdr = T0_NS + i * period_ns // 2
+        if "headerstep" in cases and i >= int(0.6 * n):
+            hdr -= 500_000_000
         if "clockstep" in cases and i >= n // 2:
             step = int(min(1200.0, seconds / 3) * 1e9)
             rec -= step
@@ -103,9 +107,10 @@ def samples(cases, seconds, rate, seed):
     if "dropouts" in cases:
         keep = []
         last_dropped = False
-        for r in rows:
+        for idx, r in enumerate(rows):
             drop = not last_dropped and rng.random() < 0.02 / 0.98
-            if drop and 0 < len(keep):
+            # never the first or the last: every lost message is inside the span
+            if drop and 0 < len(keep) and idx < len(rows) - 1:
                 last_dropped = True
                 continue
             last_dropped = False
