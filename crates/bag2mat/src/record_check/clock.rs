@@ -10,6 +10,10 @@ use crate::timing::{self, GAP_FACTOR, Segment, Timing};
 /// both tick at the sensor's rate, whatever their offset and latency.
 pub const CLOCK_MISMATCH_REL: f64 = 0.01;
 
+/// A row is compared with at most this many rows of its stamp before it (a copy follows its
+/// original once the rows are sorted; a clock stuck at one value must not cost n²).
+const DUPLICATE_LOOKBACK: usize = 8;
+
 /// Gaps and steps listed at most (the counts are always given).
 pub const MAX_LISTED: usize = 3;
 
@@ -56,7 +60,7 @@ pub fn duplicates(r: &Record<'_>, keep: &mut Keep) -> Option<Finding> {
     for i in 1..n {
         if r.t[i] != r.t[i - 1] {
             group = i;
-        } else if (group..i).any(|j| same(i, j)) {
+        } else if (group.max(i.saturating_sub(DUPLICATE_LOOKBACK))..i).any(|j| same(i, j)) {
             dup.push(i);
         }
     }
@@ -111,6 +115,9 @@ pub fn equal_stamps(r: &Record<'_>, keep: &Keep) -> Option<Finding> {
 /// double the apparent rate where they overlap).
 pub fn steps(r: &Record<'_>, keep: &mut Keep) -> Option<Finding> {
     let n = r.t.len();
+    if r.storage_order.is_none() && r.t.windows(2).all(|w| w[0] <= w[1]) {
+        return None; // stored in time order: no step back
+    }
     let mut order = keep.rows(n);
     if let Some(so) = r.storage_order {
         order.sort_by_key(|&i| so[i]);

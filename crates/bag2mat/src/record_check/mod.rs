@@ -28,6 +28,8 @@ pub mod warmup;
 use std::borrow::Cow;
 use std::fmt;
 
+use rayon::prelude::*;
+
 use crate::Sensor;
 use crate::series::TimeColumn;
 use crate::timing::{self, Timing};
@@ -423,8 +425,9 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
     }
     // the values of the kept rows
     let tau0 = rate.map_or(0.0, |f| 1.0 / f);
-    let cols: Vec<Cow<[f64]>> = r.values.iter().map(|v| keep.apply(v)).collect();
-    let spikes: Vec<Vec<outliers::Spike>> = cols.iter().map(|c| outliers::find(c)).collect();
+    let cols: Vec<Cow<[f64]>> = r.values.par_iter().map(|v| keep.apply(v)).collect();
+    let (spikes, sigma): (Vec<Vec<outliers::Spike>>, Vec<f64>) =
+        cols.par_iter().map(|c| outliers::find(c)).unzip();
     let spike_rows: std::collections::BTreeSet<usize> = spikes
         .iter()
         .flatten()
@@ -440,24 +443,24 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
         let rows = keep.rows(n);
         keep = Keep::Rows(kept.iter().map(|&i| rows[i]).collect());
         t = keep.apply(r.t).into_owned();
-        r.values.iter().map(|v| keep.apply(v)).collect()
+        r.values.par_iter().map(|v| keep.apply(v)).collect()
     } else {
         cols.into_iter()
             .zip(&spikes)
             .map(|(c, sp)| Cow::Owned(outliers::patched(&c, sp)))
             .collect()
     };
-    let mut fits: Vec<Option<warmup::Fit>> = Vec::with_capacity(6);
     if tau0 > 0.0 {
-        for (a, c) in Axis::ALL.iter().zip(&clean) {
-            let fit = warmup::find(c, tau0);
-            if let Some(f) = &fit {
+        let fits: Vec<Option<warmup::Fit>> =
+            clean.par_iter().map(|c| warmup::find(c, tau0)).collect();
+        for (a, f) in Axis::ALL.iter().zip(&fits) {
+            if let Some(f) = f {
                 findings.push(warmup::finding(*a, f, t.len() as f64 * tau0));
             }
-            fits.push(fit);
         }
         let cols: [&[f64]; 6] = std::array::from_fn(|k| &clean[k][..]);
-        findings.extend(motion::find(&cols, tau0, &fits));
+        let sigma: [f64; 6] = std::array::from_fn(|k| sigma[k]);
+        findings.extend(motion::find(&cols, tau0, &sigma, &fits));
     }
     Check {
         findings,

@@ -38,8 +38,14 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 /// The motion finding of the six columns (gyro x y z, acc x y z) sampled `tau0` s apart,
-/// with each axis' fitted warm-up removed first.
-pub fn find(cols: &[&[f64]; 6], tau0: f64, warm: &[Option<warmup::Fit>]) -> Option<Finding> {
+/// with each axis' fitted warm-up removed first; `sigma` is each column's per-sample noise
+/// ([`super::outliers::noise_scale`]).
+pub fn find(
+    cols: &[&[f64]; 6],
+    tau0: f64,
+    sigma: &[f64; 6],
+    warm: &[Option<warmup::Fit>],
+) -> Option<Finding> {
     let n = cols[0].len();
     let w = ((MOTION_WINDOW_S / tau0).round() as usize).max(1);
     let j = n / w;
@@ -61,9 +67,7 @@ pub fn find(cols: &[&[f64]; 6], tau0: f64, warm: &[Option<warmup::Fit>]) -> Opti
                 .collect()
         })
         .collect();
-    let sigma: Vec<f64> = (0..6)
-        .map(|k| super::outliers::noise_scale(cols[k]) / (w as f64).sqrt())
-        .collect();
+    let sigma: Vec<f64> = sigma.iter().map(|s| s / (w as f64).sqrt()).collect();
     let reference: Vec<f64> = means.iter().map(|m| median(m.clone())).collect();
     let vec_at = |base: usize, i: usize| -> [f64; 3] {
         std::array::from_fn(|c| means[base + c][i] - reference[base + c])
@@ -158,10 +162,16 @@ mod tests {
         std::array::from_fn(|k| &c[k][..])
     }
 
+    /// The motion finding of `c` sampled at `tau0`, as the record check calls it.
+    fn motion(c: &[Vec<f64>; 6], tau0: f64) -> Option<Finding> {
+        let sigma = std::array::from_fn(|k| super::super::outliers::noise_scale(&c[k]));
+        find(&cols(c), tau0, &sigma, &[None; 6])
+    }
+
     #[test]
     fn a_still_record_is_static() {
         let c = still(60_000);
-        assert_eq!(find(&cols(&c), 0.01, &[None; 6]), None);
+        assert_eq!(motion(&c, 0.01), None);
     }
 
     #[test]
@@ -177,7 +187,7 @@ mod tests {
         add(&mut c[0], &|i| 0.1 * w * (w * t(i)).cos());
         add(&mut c[4], &|i| 9.81 * roll(i).sin());
         add(&mut c[5], &|i| 9.81 * (roll(i).cos() - 1.0));
-        let f = find(&cols(&c), 1.0 / rate, &[None; 6]).expect("motion");
+        let f = motion(&c, 1.0 / rate).expect("motion");
         assert_eq!(f.level, Level::Refusal, "{f}");
         // a ±5.7° roll: the specific force swings by g·sin(0.1) ≈ 1 m/s² around its median
         assert!(
@@ -188,7 +198,7 @@ mod tests {
         for v in &mut c[3][30_000..30_200] {
             *v += 1.0;
         }
-        let f = find(&cols(&c), 1.0 / rate, &[None; 6]).expect("a bump");
+        let f = motion(&c, 1.0 / rate).expect("a bump");
         assert_eq!(f.level, Level::Warning, "{f}");
         assert_eq!(f.time, Some(300.0));
     }
