@@ -195,7 +195,7 @@ fn issue18_3_warm_up_is_flagged_on_every_axis_and_the_skip_outlasts_it() {
     let w = warm_ups(&err);
     assert_eq!(w.len(), 6, "every axis flagged: {err}");
     let skip = w.iter().map(|x| x.1).fold(0.0, f64::max);
-    assert!(skip >= 4.0 * 300.0 && skip <= 2400.0, "{err}");
+    assert!((4.0 * 300.0..=2400.0).contains(&skip), "{err}");
     let (_, err) = analyse(
         &bag,
         &tmp.path().join("d"),
