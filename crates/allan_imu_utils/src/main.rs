@@ -62,15 +62,16 @@ fn main() -> ExitCode {
         if several {
             text.push_str(&format!("===== topic {} =====\n", outcome.topic));
         }
-        for f in &outcome.findings {
-            eprintln!("{f}");
-        }
         for note in &outcome.notes {
             if note.to_ascii_lowercase().starts_with("warning") {
                 eprintln!("{note}");
             } else {
                 eprintln!("warning: {note}");
             }
+        }
+        // the record check's findings, always
+        for f in &outcome.findings {
+            eprintln!("{}", f.line(several.then_some(outcome.topic.as_str())));
         }
         text.push_str(&outcome.stdout);
         if let Some(t) = &outcome.ieee952_text {

@@ -43,7 +43,7 @@ pub fn extra_rows(r: &Record<'_>) -> Option<Finding> {
                 delivered - promised
             ),
         )
-        .sized((delivered - promised) as f64, "")
+        .counted((delivered - promised) as f64, "rows")
     })
 }
 
@@ -80,7 +80,7 @@ pub fn duplicates(r: &Record<'_>, keep: &mut Keep) -> Option<Finding> {
                 ),
             )
             .at(secs(r.t[first] - t0), first)
-            .sized(dup.len() as f64, ""),
+            .counted(dup.len() as f64, "samples"),
     )
 }
 
@@ -105,7 +105,7 @@ pub fn equal_stamps(r: &Record<'_>, keep: &Keep) -> Option<Finding> {
                 ),
             )
             .at(secs(r.t[keep.row(first)] - t0), first)
-            .sized(equal.len() as f64, ""),
+            .counted(equal.len() as f64, "samples"),
     )
 }
 
@@ -245,7 +245,7 @@ pub fn gaps(tm: &Timing, t: &[i64], cut: Option<Segment>) -> Vec<Finding> {
                 ),
             )
             .at(longest.at, longest.after)
-            .sized(tm.missing as f64, ""),
+            .counted(tm.missing as f64, "samples missing"),
         );
     }
     if let Some(&first) = tm.rate_changes.first() {

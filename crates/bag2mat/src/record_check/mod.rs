@@ -145,10 +145,12 @@ pub struct Finding {
     pub time: Option<f64>,
     /// The sample (index among those checked) at that time.
     pub sample: Option<usize>,
-    /// How big, in [`Finding::unit`] (a count is a plain number).
+    /// How big, in [`Finding::unit`].
     pub size: Option<f64>,
-    /// The size's unit (`""` for a count).
+    /// The size's unit, or what a count counts (`samples`, `rows`).
     pub unit: &'static str,
+    /// The size is a count.
+    pub count: bool,
     /// For a warm-up: the `--skip-start` that outlasts it, s.
     pub skip_start: Option<f64>,
     /// What was found, what it does to the results and what was done or to do.
@@ -165,6 +167,7 @@ impl Finding {
             sample: None,
             size: None,
             unit: "",
+            count: false,
             skip_start: None,
             text,
         }
@@ -182,6 +185,13 @@ impl Finding {
         self
     }
 
+    fn counted(mut self, n: f64, what: &'static str) -> Finding {
+        self.size = Some(n);
+        self.unit = what;
+        self.count = true;
+        self
+    }
+
     fn on(mut self, axis: Axis) -> Finding {
         self.axis = Some(axis);
         self
@@ -196,13 +206,14 @@ impl Finding {
         }
         let mut parts: Vec<String> = Vec::new();
         if let Some(v) = self.size {
-            parts.push(if self.unit.is_empty() {
-                format!("{v}")
+            parts.push(if self.count {
+                format!("{v:.0} {}", self.unit)
             } else {
                 format!("{v:.3e} {}", self.unit)
             });
         }
-        if let Some(t) = self.time {
+        // a warm-up is at the start: its advice says more than its time
+        if let (Some(t), None) = (self.time, self.skip_start) {
             parts.push(format!("at t = {t:.3} s"));
         }
         if let Some(k) = self.skip_start {
@@ -215,13 +226,26 @@ impl Finding {
     }
 }
 
+impl Finding {
+    /// The stderr line, naming `topic` when a run analyses several.
+    pub fn line(&self, topic: Option<&str>) -> String {
+        let mut s = format!("{}: {}", self.level, self.kind.name());
+        if let Some(a) = self.axis {
+            s.push_str(" on ");
+            s.push_str(a.label());
+        }
+        if let Some(t) = topic {
+            s.push_str(&format!(" of topic '{}'", crate::shared::cli::escape(t)));
+        }
+        s.push_str(": ");
+        s.push_str(&self.text);
+        s
+    }
+}
+
 impl fmt::Display for Finding {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.level, self.kind.name())?;
-        if let Some(a) = self.axis {
-            write!(f, " on {}", a.label())?;
-        }
-        write!(f, ": {}", self.text)
+        f.write_str(&self.line(None))
     }
 }
 
@@ -509,6 +533,70 @@ mod tests {
         assert_eq!(skip_index(&t, 50.0), 10_000);
         assert_eq!(skip_index(&t, 0.0), 0);
         assert_eq!(skip_index(&t, 1e9), t.len());
+    }
+
+    /// White noise on six axes, gravity on acc z, stamps at 200 Hz from `T0`.
+    fn clean(n: usize) -> (Vec<i64>, Vec<Vec<f64>>) {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(0x18);
+        let t = (0..n as i64)
+            .map(|i| 1_700_000_000_000_000_000 + i * 5_000_000)
+            .collect();
+        let v = (0..6)
+            .map(|k| {
+                (0..n)
+                    .map(|_| {
+                        let z: f64 = StandardNormal.sample(&mut rng);
+                        (if k == 5 { 9.81 } else { 0.0 }) + 0.01 * z
+                    })
+                    .collect()
+            })
+            .collect();
+        (t, v)
+    }
+
+    fn record<'a>(t: &'a [i64], v: &'a [Vec<f64>]) -> Record<'a> {
+        Record {
+            time: TimeColumn::Record,
+            t,
+            other: Some(t),
+            storage_order: None,
+            values: std::array::from_fn(|k| &v[k][..]),
+            promised: Some((t.len() as u64, t.len() as u64)),
+        }
+    }
+
+    #[test]
+    fn a_clean_record_keeps_every_row_and_finds_nothing() {
+        let (t, v) = clean(100_000);
+        let c = check(&record(&t, &v), &Options::default());
+        assert_eq!(c.keep, Keep::All);
+        assert!(c.findings.is_empty(), "{:?}", c.findings);
+        assert_eq!(c.rate, Some(200.0));
+    }
+
+    #[test]
+    fn a_spike_is_dropped_only_on_request() {
+        let (t, mut v) = clean(100_000);
+        v[1][40_000] = 50.0;
+        let c = check(&record(&t, &v), &Options::default());
+        assert_eq!(c.keep, Keep::All);
+        let f = &c.findings;
+        assert!(
+            f.len() == 1 && f[0].kind == Kind::Outlier && f[0].level == Level::Warning,
+            "{f:?}"
+        );
+        assert_eq!(f[0].axis, Some(Axis::new(Sensor::Gyro, 1)));
+        assert_eq!((f[0].sample, f[0].time), (Some(40_000), Some(200.0)));
+        let c = check(
+            &record(&t, &v),
+            &Options {
+                drop_outliers: true,
+            },
+        );
+        assert_eq!(c.keep.len(t.len()), t.len() - 1);
+        assert_eq!(c.findings[0].level, Level::Note);
     }
 
     #[test]
