@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::Command;
 
 use bag2mat::record_check::{Finding, Kind};
-use bag2mat::test_tools::{OddRecord, OddWriter, odd_record};
+use bag2mat::test_tools::{OddRecord, OddWriter, odd_record, warnings};
 
 use crate::common::kalibr_config;
 
@@ -42,12 +42,6 @@ fn n_ratios(section: &str, truth: &OddRecord) -> Vec<f64> {
     assert_eq!(n.len(), 6, "{section}");
     (0..6)
         .map(|k| n[k] / if k < 3 { truth.gyro.0 } else { truth.acc.0 })
-        .collect()
-}
-
-fn warnings<'a>(err: &'a str, kind: &str) -> Vec<&'a str> {
-    err.lines()
-        .filter(|l| l.starts_with(&format!("warning: {kind}")))
         .collect()
 }
 

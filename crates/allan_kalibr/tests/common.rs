@@ -1,10 +1,6 @@
 //! Shared helpers: the reference cases and their files.
 
-use std::path::{Path, PathBuf};
-
-use allan_kalibr::ieee952::files::{
-    COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, TERMS_FILE,
-};
+use std::path::PathBuf;
 
 /// `testdata/` at the workspace top.
 pub fn testdata() -> PathBuf {
@@ -159,54 +155,4 @@ pub fn rel_err(a: f64, b: f64) -> f64 {
     } else {
         ((a - b) / b).abs()
     }
-}
-
-/// One row of ieee952_terms.csv.
-#[derive(Debug, Clone)]
-pub struct Row {
-    pub sensor: String,
-    pub axis: String,
-    pub term: String,
-    pub value: f64,
-    pub lo: f64,
-    pub hi: f64,
-    pub verdict: String,
-}
-
-/// The rows of the `ieee952_terms.csv` a run wrote into `dir`.
-pub fn terms(dir: &Path) -> Vec<Row> {
-    let text = std::fs::read_to_string(dir.join(TERMS_FILE)).expect("terms file");
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
-    let (cs, ca, ct, cv, cl, ch, cd) = (
-        col(COL_SENSOR),
-        col(COL_AXIS),
-        col(COL_TERM),
-        col(COL_VALUE),
-        col(COL_CI95_LO),
-        col(COL_CI95_HI),
-        col(COL_VERDICT),
-    );
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let num = |c: usize| f[c].parse::<f64>().expect("number");
-            Row {
-                sensor: f[cs].into(),
-                axis: f[ca].into(),
-                term: f[ct].into(),
-                value: num(cv),
-                lo: num(cl),
-                hi: num(ch),
-                verdict: f[cd].into(),
-            }
-        })
-        .collect()
-}
-
-pub fn term<'a>(rows: &'a [Row], sensor: &str, axis: &str, t: &str) -> &'a Row {
-    rows.iter()
-        .find(|r| r.sensor == sensor && r.axis == axis && r.term == t)
-        .unwrap_or_else(|| panic!("{sensor} {axis} {t} not in the terms file"))
 }

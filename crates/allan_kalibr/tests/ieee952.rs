@@ -4,15 +4,17 @@
 //! and `allan_imu_utils`' tests), an unreadable curve file, the warm-up warning and
 //! `--skip-start`, and the gap warning.
 
+use std::path::Path;
 use std::process::{Command, Output};
 
-use allan_kalibr::ieee952::files::{CURVES_FILE, TERMS_FILE};
+use allan_kalibr::ieee952::files::{
+    COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE,
+    TERMS_FILE,
+};
 use bag2mat::mat::{DataImu, write_data_imu};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, StandardNormal};
-
-use crate::common::{term, terms};
 
 /// Sample rate of the simulated records, Hz.
 const RATE: f64 = 50.0;
@@ -32,14 +34,14 @@ const ROUND_TRIP_REL_TOL: f64 = 0.005;
 /// N from a noise-free curve: exact up to the fit's convergence.
 const EXACT_REL_TOL: f64 = 1e-3;
 
-fn run(args: &[&str]) -> Output {
+pub(crate) fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
         .args(args)
         .output()
         .expect("run allan_kalibr")
 }
 
-fn s(b: &[u8]) -> String {
+pub(crate) fn s(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
@@ -76,6 +78,55 @@ fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> D
         m.push(row);
     }
     m
+}
+
+/// One row of ieee952_terms.csv.
+#[derive(Debug, Clone)]
+pub(crate) struct Row {
+    pub(crate) sensor: String,
+    pub(crate) axis: String,
+    pub(crate) term: String,
+    pub(crate) value: f64,
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
+    pub(crate) verdict: String,
+}
+
+pub(crate) fn terms(dir: &Path) -> Vec<Row> {
+    let text = std::fs::read_to_string(dir.join(TERMS_FILE)).expect("terms file");
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (cs, ca, ct, cv, cl, ch, cd) = (
+        col(COL_SENSOR),
+        col(COL_AXIS),
+        col(COL_TERM),
+        col(COL_VALUE),
+        col(COL_CI95_LO),
+        col(COL_CI95_HI),
+        col(COL_VERDICT),
+    );
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let num = |c: usize| f[c].parse::<f64>().expect("number");
+            Row {
+                sensor: f[cs].into(),
+                axis: f[ca].into(),
+                term: f[ct].into(),
+                value: num(cv),
+                lo: num(cl),
+                hi: num(ch),
+                verdict: f[cd].into(),
+            }
+        })
+        .collect()
+}
+
+pub(crate) fn term<'a>(rows: &'a [Row], sensor: &str, axis: &str, t: &str) -> &'a Row {
+    rows.iter()
+        .find(|r| r.sensor == sensor && r.axis == axis && r.term == t)
+        .unwrap_or_else(|| panic!("{sensor} {axis} {t} not in the terms file"))
 }
 
 /// The six (sensor, axis) of a run, with their true N.

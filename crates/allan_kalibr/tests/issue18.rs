@@ -5,11 +5,10 @@
 //! IEEE 952 section and its yaml files do with it, and the numbers against the truth.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-use bag2mat::test_tools::{OddRecord, OddWriter, odd_record};
+use bag2mat::test_tools::{OddRecord, OddWriter, odd_record, warnings};
 
-use crate::common::{term, terms};
+use crate::ieee952::{run, s, term, terms};
 
 /// The mean over six axes of N / truth. Five minutes at 200 Hz give each axis' N to ±0.6 %
 /// (95 %), so their mean to ±0.25 %; 0.5 % is twice that, and half the +1 % a mean-period
@@ -18,17 +17,6 @@ const N_MEAN_REL_TOL: f64 = 0.005;
 /// One axis' N against the truth on five minutes at 200 Hz (±0.6 % at 95 %; 3 % is issue
 /// 10's accuracy target).
 const N_REL_TOL: f64 = 0.03;
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
-        .args(args)
-        .output()
-        .expect("run allan_kalibr")
-}
-
-fn s(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
 
 /// Runs `allan_kalibr INPUT -o DIR -q EXTRA…`, which must succeed: (stdout, stderr).
 fn analyse(input: &Path, dir: &Path, extra: &[&str]) -> (String, String) {
@@ -63,13 +51,6 @@ fn n_ratios(dir: &Path, truth: &OddRecord) -> Vec<f64> {
 
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
-}
-
-/// The warnings of one kind on stderr.
-fn warnings<'a>(err: &'a str, kind: &str) -> Vec<&'a str> {
-    err.lines()
-        .filter(|l| l.starts_with(&format!("warning: {kind}")))
-        .collect()
 }
 
 /// The number after `--skip-start ` in a warning.

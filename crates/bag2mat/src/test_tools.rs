@@ -208,3 +208,12 @@ pub fn odd_record(
         acc: (num("acc_n"), num("acc_k")),
     }
 }
+
+/// The lines of a tool's stderr that are record-check warnings of `kind` (the start of the
+/// finding's line after `warning: `, e.g. `gaps`, `warm-up on gyro x`).
+pub fn warnings<'a>(stderr: &'a str, kind: &str) -> Vec<&'a str> {
+    stderr
+        .lines()
+        .filter(|l| l.starts_with(&format!("warning: {kind}")))
+        .collect()
+}
