@@ -200,7 +200,9 @@ fn run_series(
     // dropped when asked; what the record breaks of the analysis' assumptions is found.
     let (n, stop) = (collected.len(), collected.stop);
     drop(collected);
+    let t1 = Instant::now();
     let check = check_record(&series, n, config);
+    timings.push(("record_check", t1.elapsed()));
     let series = if check.keep.is_all() && n == series.len() {
         series
     } else {

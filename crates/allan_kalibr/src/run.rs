@@ -129,14 +129,16 @@ pub struct Timings {
     pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
+    /// The record check (`bag2mat::record_check`).
+    pub checks: f64,
 }
 
 impl std::fmt::Display for Timings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "timings: load {:.3} s, allan+fit {:.3} s, ieee952 {:.3} s, outputs {:.3} s",
-            self.load, self.analyse, self.ieee952, self.output
+            "timings: load {:.3} s, allan+fit {:.3} s, ieee952 {:.3} s, outputs {:.3} s, checks {:.3} s",
+            self.load, self.analyse, self.ieee952, self.output, self.checks
         )
     }
 }
@@ -187,12 +189,14 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // that is not one continuous stretch are cut, spikes dropped when asked, and what the
     // record breaks of the analysis' assumptions is found.
     let scans = data.scan_checked()?;
+    let checks_start = Instant::now();
     let check = bag2mat::record_check::check(
         &data.record(),
         &bag2mat::record_check::Options {
             drop_outliers: config.drop_outliers,
         },
     );
+    let checks_s = checks_start.elapsed().as_secs_f64();
     let mut findings = check.findings.clone();
     let whole = check.keep.is_all();
     let data = data.select(&check.keep);
@@ -340,6 +344,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         analyse: analyse_s,
         ieee952: ieee_s,
         output: start.elapsed().as_secs_f64(),
+        checks: checks_s,
     };
     Ok(RunOutput {
         topic: data_topic,
