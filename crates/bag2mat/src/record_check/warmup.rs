@@ -41,7 +41,9 @@ const GRID_POINTS: usize = 60;
 /// The fitted warm-up of one axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fit {
-    /// Start (first T/200) minus the second half's mean, in the signal's unit.
+    /// Length of the start compared, s (T/200, or 50 samples at least).
+    pub start: f64,
+    /// Its mean minus the second half's mean, in the signal's unit.
     pub start_offset: f64,
     /// That in standard deviations of the noise.
     pub sigmas: f64,
@@ -201,6 +203,7 @@ pub fn find(y: &[f64], tau0: f64) -> Option<Fit> {
         .max(WARMUP_MIN_CONSTANTS);
     let skip = tau * constants;
     Some(Fit {
+        start: wd,
         start_offset: d0,
         sigmas: z0.abs(),
         amplitude,
@@ -230,8 +233,8 @@ pub fn finding(axis: Axis, f: &Fit, record: f64) -> Finding {
         Level::Warning,
         Kind::WarmUp,
         format!(
-            "the first {:.0} s differ from the second half by {:+.3e} {unit} ({:.0} σ of the noise): a drift, fitted as {:+.3e}·exp(−t / {:.0} s) {unit}; the Allan analysis takes it for random walk or ramp. Rerun with --skip-start {skip:.0} ({:.1} time constants; {:.1e} {unit} left, {:.0} % of the noise's Allan deviation at τ = {:.0} s){short}",
-            (record / 200.0).max(1.0),
+            "the first {:.1} s differ from the second half by {:+.3e} {unit} ({:.0} σ of the noise): a drift, fitted as {:+.3e}·exp(−t / {:.0} s) {unit}; the Allan analysis takes it for random walk or ramp. Rerun with --skip-start {skip:.0} ({:.1} time constants; {:.1e} {unit} left, {:.0} % of the noise's Allan deviation at τ = {:.0} s){short}",
+            f.start,
             f.start_offset,
             f.sigmas,
             f.amplitude,
