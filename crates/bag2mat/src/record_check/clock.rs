@@ -132,7 +132,7 @@ pub fn steps(r: &Record<'_>, keep: &mut Keep) -> Option<Finding> {
     }
     let k = pos.len() / 2;
     let p = *pos.select_nth_unstable(k).1;
-    let limit = -(GAP_FACTOR as i64) * p;
+    let limit = (GAP_FACTOR as i64).saturating_mul(p).saturating_neg();
     let steps: Vec<usize> = (0..d.len()).filter(|&j| d[j] < limit).collect();
     if steps.is_empty() {
         return None;
@@ -281,7 +281,7 @@ pub fn gaps(tm: &Timing, t: &[i64], cut: Option<Segment>) -> Vec<Finding> {
 
 /// The other clock over the same samples: both must tick at the sensor's rate.
 pub fn cross_check(time: TimeColumn, rate: f64, other: &[i64]) -> Option<Finding> {
-    let r2 = timing::analyse(other).nominal_rate()?;
+    let r2 = timing::nominal_rate(other)?;
     let ratio = r2 / rate;
     ((ratio - 1.0).abs() > CLOCK_MISMATCH_REL).then(|| {
         let (this, that) = (clock_name(time), clock_name(other_column(time)));

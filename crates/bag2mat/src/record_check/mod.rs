@@ -426,7 +426,7 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
     findings.extend(clock::steps(r, &mut keep));
     findings.extend(clock::equal_stamps(r, &keep));
     // the gap rule on what is left; a broken record is cut to its longest stretch
-    let mut t = keep.apply(r.t).into_owned();
+    let mut t = keep.apply(r.t);
     let mut tm = timing::analyse(&t);
     if !tm.is_continuous()
         && let Some(seg) = tm.longest()
@@ -438,7 +438,7 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
         } else {
             Keep::Rows(rows)
         };
-        t = keep.apply(r.t).into_owned();
+        t = keep.apply(r.t);
         tm = timing::analyse(&t);
     } else {
         findings.extend(clock::gaps(&tm, &t, None));
@@ -466,7 +466,7 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
         let kept: Vec<usize> = (0..t.len()).filter(|i| !spike_rows.contains(i)).collect();
         let rows = keep.rows(n);
         keep = Keep::Rows(kept.iter().map(|&i| rows[i]).collect());
-        t = keep.apply(r.t).into_owned();
+        t = keep.apply(r.t);
         r.values.par_iter().map(|v| keep.apply(v)).collect()
     } else {
         cols.into_iter()
