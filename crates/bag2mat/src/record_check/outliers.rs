@@ -102,9 +102,16 @@ fn large_differences(y: &[f64], limit: f64) -> Vec<usize> {
             }
         }
         let tail = ra.iter().zip(rb).map(|(x, z)| (z - x).abs());
-        let screened = mx.iter().copied().chain(tail).any(|d| !(d <= limit));
+        let screened = mx
+            .iter()
+            .copied()
+            .chain(tail)
+            .any(|d| d > limit || d.is_nan());
         if screened {
-            out.extend((start..end).filter(|&i| !((y[i + 1] - y[i]).abs() <= limit)));
+            out.extend((start..end).filter(|&i| {
+                let d = (y[i + 1] - y[i]).abs();
+                d > limit || d.is_nan()
+            }));
         }
         start = end;
     }
