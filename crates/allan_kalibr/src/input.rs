@@ -2,15 +2,15 @@
 //! as bagconvert does) and choosing the update rate that drives the τ grid.
 //!
 //! Upstream never looks at the timestamps except to count them (kalibr_allan.md §2): the
-//! user types the rate into the script. Here the rate is estimated from the timestamps when
-//! not given, and a given rate that disagrees with them by more than 1 % gets a warning.
+//! user types the rate into the script. Here the rate is the stamps' nominal rate
+//! (`bag2mat::timing`: lost samples do not change it) when not given; a given rate the stamps
+//! contradict (`bag2mat::record_check::rate_argument`) still drives the upstream-compatible
+//! grid, as upstream, and the IEEE 952 section uses the measured one.
 
 use std::path::Path;
 
 use crate::error::Error;
 
-/// A relative disagreement between the given and the measured rate above which we warn.
-pub const RATE_WARN_REL: f64 = 0.01;
 /// An estimated rate within this relative distance of an integer is rounded to it
 /// (timestamps of a 200 Hz IMU give 199.99…, and the grid wants the nominal rate).
 pub const RATE_SNAP_REL: f64 = 0.005;
@@ -333,7 +333,8 @@ pub struct RateChoice {
     /// The nominal rate of the analysed stamps (`bag2mat::timing`), when they allow one.
     pub measured: Option<f64>,
     /// The rate the IEEE 952 section uses: the stamps' (snapped as [`snap_rate`]), unless
-    /// the given rate agrees with them within [`RATE_WARN_REL`] or they give none.
+    /// the given rate agrees with them (`bag2mat::record_check::RATE_ARGUMENT_REL`) or they
+    /// give none.
     pub section: f64,
     /// An info line (estimated), for stderr.
     pub message: Option<String>,

@@ -20,7 +20,7 @@ use super::{Axis, Finding, Kind, Level};
 
 /// A start this many standard deviations from the rest is not noise.
 pub const WARMUP_Z: f64 = 5.0;
-/// Window means over the record for the exponential fit (at least [`MIN_WINDOW`] samples).
+/// Window means over the record for the exponential fit (of at least 10 samples each).
 pub const WARMUP_WINDOWS: usize = 1000;
 /// Fine windows per detection window: the first T/200 of the record is compared.
 const DETECT_WINDOWS: usize = 5;
