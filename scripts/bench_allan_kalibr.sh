@@ -54,7 +54,7 @@ run_ak() {
   /usr/bin/time -f "%e %M" -o "$WORK/time.txt" \
     "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings --compat-only -o "$out" "$@" \
     >"$WORK/stdout.txt" 2>"$WORK/stderr.txt"
-  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \4/')"
+  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s, checks ([0-9.]+) s/\1 \2 \4/')"
   echo "$(cat "$WORK/time.txt") $t"
 }
 
@@ -92,7 +92,7 @@ for _ in $(seq "$RUNS"); do
   /usr/bin/time -f "%e %M" -o "$WORK/time.txt" \
     "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings -o "$WORK/outd" \
     >"$WORK/stdout.txt" 2>"$WORK/stderr.txt"
-  r="$(cat "$WORK/time.txt") $(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \3 \4/')"
+  r="$(cat "$WORK/time.txt") $(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s, checks ([0-9.]+) s/\1 \2 \3 \4/')"
   echo "   wall/maxrss/load/allan+fit/ieee952/outputs: $r"
   if [[ -z "$bestd" ]] || awk -v a="${r%% *}" -v b="${bestd%% *}" 'BEGIN{exit !(a<b)}'; then bestd="$r"; fi
 done

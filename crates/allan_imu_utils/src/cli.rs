@@ -54,6 +54,10 @@ pub struct Args {
     /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
     #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes (a sample far off its
+    /// neighbours, reported with its time) before the analysis.
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic then
     /// gets its own folder under the output directory [default: imu]
     #[arg(long = "topic", value_name = "TOPIC")]
@@ -123,6 +127,8 @@ pub struct Config {
     pub curves: Option<CurvesInput>,
     /// Seconds dropped at the start.
     pub skip_start: Option<f64>,
+    /// Drop the spikes the record check finds.
+    pub drop_outliers: bool,
     /// Topics (one unless several were asked for).
     pub topics: Vec<String>,
     /// Also every other Imu topic of the bag.
@@ -250,6 +256,7 @@ impl TryFrom<Args> for Config {
             bag: a.bag.unwrap_or_default(),
             curves,
             skip_start: a.skip_start,
+            drop_outliers: a.drop_outliers,
             topics,
             all_imu: a.all_imu_topics,
             time: match a.time {

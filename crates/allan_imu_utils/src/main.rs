@@ -69,6 +69,10 @@ fn main() -> ExitCode {
                 eprintln!("warning: {note}");
             }
         }
+        // the record check's findings, always
+        for f in &outcome.findings {
+            eprintln!("{}", f.line(several.then_some(outcome.topic.as_str())));
+        }
         text.push_str(&outcome.stdout);
         if let Some(t) = &outcome.ieee952_text {
             text.push_str(t);

@@ -11,6 +11,7 @@ mod cli;
 mod common;
 mod curves;
 mod fit_reference;
+mod issue18;
 mod logs;
 mod reference;
 mod ros2;

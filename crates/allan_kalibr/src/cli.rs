@@ -44,6 +44,10 @@ pub struct Args {
     /// Drop the first SECONDS of the record (a warm-up) before any analysis.
     #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes (a sample far off its
+    /// neighbours, reported with its time) before any analysis.
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml); repeatable,
     /// each topic then gets its own folder under the output directory [default: imu].
     #[arg(long = "topic", value_name = "TOPIC")]
@@ -144,6 +148,7 @@ impl From<Args> for Config {
         });
         Config {
             skip_start: a.skip_start,
+            drop_outliers: a.drop_outliers,
             curves,
             input,
             topics: bag2mat::TopicSelector {

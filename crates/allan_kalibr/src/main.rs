@@ -64,11 +64,15 @@ fn main() -> ExitCode {
                 out.topic.as_deref().unwrap_or("?")
             ));
         }
+        // The reader's warnings always, other notes (the estimated rate) only without
+        // --quiet; then the record check's findings, always.
         for n in &out.notes {
-            // Warnings always; other notes (the estimated rate) only without --quiet.
             if !config.quiet || n.to_ascii_lowercase().starts_with("warning") {
                 eprintln!("{n}");
             }
+        }
+        for f in &out.findings {
+            eprintln!("{}", f.line(out.topic.as_deref().filter(|_| several)));
         }
         text.push_str(&out.text);
         if let Some(t) = &out.ieee952_text {

@@ -212,7 +212,8 @@ fn mat_input_matches_bag_input() {
     ]);
     assert!(warn.status.success(), "stderr: {}", s(&warn.stderr));
     assert!(
-        s(&warn.stderr).contains("warning: --update-rate 100 Hz but the timestamps give 200"),
+        s(&warn.stderr)
+            .contains("warning: update rate: --update-rate 100 Hz but the stamps give 200"),
         "stderr: {}",
         s(&warn.stderr)
     );
@@ -554,8 +555,9 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
         "rate not from the median period: {err}"
     );
     assert!(
-        err.contains("warning: the timestamps are not one continuous record")
-            && err.contains("1 gap"),
+        err.contains("warning: gaps:")
+            && err.contains("in 1 gap(s)")
+            && err.contains("not one continuous record"),
         "{err}"
     );
     // The same numbers (the first line names the input file).

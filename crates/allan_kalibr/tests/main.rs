@@ -6,5 +6,6 @@ mod cli;
 mod common;
 mod consumers;
 mod ieee952;
+mod issue18;
 mod logs;
 mod reference;

@@ -19,8 +19,9 @@
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
-//!   constant-rate segments of a series of stamps (info and both analysers use it).
+//! * [`info`]: what an input holds (`bag2mat info`); [`record_check`]: is a record fit for
+//!   an Allan analysis (clocks, duplicates, gaps through [`timing`], the one gap rule;
+//!   outliers, warm-up, motion), typed findings every tool prints and the analysers obey.
 //! * [`formats`]: raw IMU logs from outside ROS — EuRoC/ASL and plain text, NumPy, PX4
 //!   ULog, ArduPilot DataFlash — each a [`source::Source`] over rows its reader decoded
 //!   ([`decoded`]); [`cursor`]: the bounds-checked byte reader the binary formats parse with.
@@ -42,6 +43,7 @@ pub mod imu_msg;
 pub mod info;
 pub mod mat;
 pub mod mcap;
+pub mod record_check;
 pub mod rosbag2;
 pub mod sensor;
 pub mod series;

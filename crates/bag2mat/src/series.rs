@@ -99,6 +99,9 @@ pub struct ImuSeries {
     pub notes: Vec<String>,
     /// Promised against delivered.
     pub report: TopicReport,
+    /// Where each row was stored, when the rows were sorted by record time (`None`: row
+    /// order is storage order); the record check finds a clock that steps back with it.
+    pub storage_order: Option<Vec<u32>>,
 }
 
 impl ImuSeries {
@@ -494,10 +497,11 @@ impl Rows {
             .collect()
     }
 
-    /// Sorts by record time (stable) when the storage order differs from it; true if it did.
-    fn sort_by_record_time(&mut self) -> bool {
+    /// Sorts by record time (stable) when the storage order differs from it; returns the
+    /// storage position of each row if it did.
+    fn sort_by_record_time(&mut self) -> Option<Vec<u32>> {
         if !self.record_time.windows(2).any(|w| w[1] < w[0]) {
-            return false;
+            return None;
         }
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_by_key(|&i| self.record_time[i]);
@@ -508,7 +512,7 @@ impl Rows {
             self.acc[c] = permute(&self.acc[c], &order);
             self.gyro[c] = permute(&self.gyro[c], &order);
         }
-        true
+        Some(order.into_iter().map(|i| i as u32).collect())
     }
 }
 
@@ -791,7 +795,8 @@ pub fn read_from(
     let mut series = Vec::with_capacity(n_sel);
     let mut dropped: Vec<String> = Vec::new();
     for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
-        let sorted = rows.sort_by_record_time();
+        let storage_order = rows.sort_by_record_time();
+        let sorted = storage_order.is_some();
         let Rows {
             record_time,
             stamp,
@@ -807,6 +812,7 @@ pub fn read_from(
             seq,
             acc,
             gyro,
+            storage_order,
             ..ImuSeries::default()
         };
         let r = &mut out.report;

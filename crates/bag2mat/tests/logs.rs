@@ -124,9 +124,8 @@ fn ulog_topics_match_pyulog_bit_for_bit_also_on_pyulogs_own_rewrite() {
             f.display()
         );
         // the gap it leaves is found where the analysers look for gaps
-        let t: Vec<f64> = series[0].record_time.iter().map(|r| r.to_sec()).collect();
-        let tm = bag2mat::timing::analyse(&t);
-        assert_eq!(tm.gaps.len(), 1, "{}", tm.describe());
+        let tm = bag2mat::timing::analyse(&bag2mat::timing::ns_of_times(&series[0].record_time));
+        assert_eq!(tm.gaps.len(), 1, "{tm:?}");
     }
 }
 

@@ -4,6 +4,7 @@
 
 mod cli;
 mod defects;
+mod issue18;
 mod logs;
 mod real_tools;
 mod reference;

@@ -13,7 +13,8 @@
 //!   is continuous-time (field.md §3–4). One value per sensor (the largest axis); a term no
 //!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
-//!   are left out (with a comment) rather than written as a number.
+//!   are left out (with a comment) rather than written as a number. Every warning of the
+//!   record check (`bag2mat::record_check`: warm-up, spike, gaps, clocks) is a caveat.
 //! * OpenVINS' `kalibr_imu_chain.yaml` and Basalt's calibration noise fields:
 //!   [`super::vio_files`].
 
@@ -392,6 +393,13 @@ pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
     }
     for (name, x) in names.iter().zip([v.acc_n, v.acc_w, v.gyr_n, v.gyr_w]) {
         comments.extend(note(name, x));
+    }
+    // what the record breaks of the analysis' assumptions (bag2mat::record_check)
+    for f in a.warnings() {
+        comments.push(format!(
+            "RECORD CHECK: {}; the values above carry it (the tool's warning says what to do).",
+            f.short()
+        ));
     }
     FileValues { comments, ..v }
 }

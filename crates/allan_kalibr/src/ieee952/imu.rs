@@ -1,7 +1,7 @@
 //! The IEEE 952 analysis of a whole IMU, as both analysers run it next to their compat
 //! outputs: up to six axes (gyro x y z, accelerometer x y z) from samples or from another
-//! tool's curves, the record-length advice per axis, the stationarity checks, and the
-//! printed section. The files it writes are in [`super::files`].
+//! tool's curves, the record-length advice per axis, the record check's findings
+//! (`bag2mat::record_check`, named in the verdicts), and the printed section. The files it writes are in [`super::files`].
 //!
 //! One value per sensor goes into the configuration files: the largest of the three axes
 //! (the conservative choice, as allan_variance_ros writes), and never a number the data do
@@ -12,12 +12,11 @@ use std::fmt::Write as _;
 use rayon::prelude::*;
 
 use super::advisor::{self, Advice};
-use super::stationarity::{self, StartStats, Warmup};
 use super::{
     Analysis, AxisVerdict, Config, CovBasis, CurveData, Ieee952Error, Term, Verdict, analyse_curve,
     short,
 };
-use bag2mat::timing::Timing;
+use bag2mat::record_check::{Finding, Level};
 
 /// τ/T_lo from which a flicker floor with lower corner T_lo is within 2 % of 0.664·B in
 /// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
@@ -36,8 +35,6 @@ pub struct AxisResult {
     pub analysis: Analysis,
     /// Record-length advice (None without a sample count).
     pub advice: Option<Advice>,
-    /// A warm-up or drift at the start (samples only).
-    pub warmup: Option<Warmup>,
 }
 
 /// The analysis of an IMU.
@@ -47,8 +44,8 @@ pub struct ImuAnalysis {
     pub rate: f64,
     /// The axes, gyro first, x y z.
     pub axes: Vec<AxisResult>,
-    /// The time stamps' gaps and rate changes (samples with stamps only).
-    pub timing: Option<Timing>,
+    /// What the record check found (samples only): gaps, clocks, outliers, warm-up, …
+    pub checks: Vec<Finding>,
     /// Where the curves came from and what was inferred (for the printed section).
     pub notes: Vec<String>,
 }
@@ -106,20 +103,18 @@ pub fn analyse_curves(
                 axis: *axis,
                 advice: advisor::advise(&analysis),
                 analysis,
-                warmup: None,
             }
         })
         .collect();
     ImuAnalysis {
         rate,
         axes,
-        timing: None,
+        checks: Vec::new(),
         notes: Vec::new(),
     }
 }
 
-/// The part of [`analyse_imu`] that reads the samples: each axis' curve and warm-up
-/// statistics. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
+/// The part of [`analyse_imu`] that reads the samples: each axis' curve. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
 /// the sample columns on (the compat path turns them into prefix sums in place) while the
 /// fits run.
 #[derive(Debug, Clone)]
@@ -128,87 +123,47 @@ pub struct ImuCurves {
     pub rate: f64,
     /// Gyro x y z, then acc x y z.
     pub sensors: [(Sensor, [CurveData; 3]); 2],
-    /// Each axis' start statistics, same order.
-    pub starts: Vec<Option<StartStats>>,
 }
 
 impl ImuCurves {
-    /// Curves and start statistics of six rate series (gyro x y z in rad/s, then acc x y z
-    /// in m/s²) at `rate` Hz, the axes in parallel.
+    /// Curves of six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate`
+    /// Hz, the axes in parallel.
     pub fn from_samples(
         series: [&[f64]; 6],
         rate: f64,
         cfg: &Config,
     ) -> Result<ImuCurves, Ieee952Error> {
         let tau0 = 1.0 / rate;
-        // The warm-up statistics are taken in the same parallel pass, while the axis is in cache.
-        let (data, starts): (Vec<_>, Vec<Option<StartStats>>) = series
+        let data: Vec<CurveData> = series
             .par_iter()
-            .map(|y| {
-                CurveData::from_samples(y, tau0, cfg)
-                    .map(|c| (c, StartStats::from_samples(y, tau0)))
-            })
-            .collect::<Result<Vec<_>, _>>()?
-            .into_iter()
-            .unzip();
+            .map(|y| CurveData::from_samples(y, tau0, cfg))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut it = data.into_iter();
         let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
         Ok(ImuCurves {
             rate,
             sensors: [(Sensor::Gyro, take3()), (Sensor::Acc, take3())],
-            starts,
         })
     }
 
-    /// The fits, the advice and the warm-up checks; `timing` as in [`analyse_imu`].
-    pub fn finish(&self, timing: Option<Timing>, cfg: &Config) -> ImuAnalysis {
+    /// The fits and the advice; `checks` as in [`analyse_imu`].
+    pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
-        add_stationarity(&mut an, &self.starts, timing);
+        an.checks = checks;
         an
     }
 }
 
-/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz,
-/// with the warm-up check on each; `timing` (`bag2mat::timing::analyse` of the series' time
-/// stamps, which the caller has already run to cut the record) adds the gap and rate checks.
+/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz;
+/// `checks` are the record check's findings on them (`bag2mat::record_check`, which the
+/// caller has run to cut the record), named by the section and the files.
 pub fn analyse_imu(
     series: [&[f64]; 6],
     rate: f64,
-    timing: Option<Timing>,
+    checks: Vec<Finding>,
     cfg: &Config,
 ) -> Result<ImuAnalysis, Ieee952Error> {
-    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(timing, cfg))
-}
-
-/// Adds the warm-up checks (each axis' start statistics, gyro x y z then acc x y z, against
-/// its fitted model) and the time-stamp checks (`bag2mat::timing::analyse` of the analysed
-/// stamps: the run has it already, from deciding whether to cut the record).
-pub fn add_stationarity(
-    an: &mut ImuAnalysis,
-    starts: &[Option<StartStats>],
-    timing: Option<Timing>,
-) {
-    for ax in an.axes.iter_mut() {
-        let k = match ax.sensor {
-            Sensor::Gyro => ax.axis,
-            Sensor::Acc => 3 + ax.axis,
-        };
-        let Some(Some(st)) = starts.get(k) else {
-            continue;
-        };
-        let Some(f) = ax
-            .analysis
-            .fit
-            .as_ref()
-            .filter(|_| ax.analysis.verdict.fits())
-        else {
-            continue;
-        };
-        let f = f.clone();
-        let model = move |tau: f64| f.predict(tau).max(0.0);
-        ax.warmup = stationarity::warmup(st, &model);
-    }
-    an.timing = timing;
+    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(checks, cfg))
 }
 
 /// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
@@ -217,10 +172,10 @@ pub fn add_stationarity(
 pub fn analyse_section(
     series: [&[f64]; 6],
     rate: f64,
-    timing: Option<Timing>,
+    checks: Vec<Finding>,
     notes: &mut Vec<String>,
 ) -> Option<ImuAnalysis> {
-    section_curves(series, rate, notes).map(|c| c.finish(timing, &Config::default()))
+    section_curves(series, rate, notes).map(|c| c.finish(checks, &Config::default()))
 }
 
 /// The sample-reading part of [`analyse_section`] ([`ImuCurves::from_samples`] with the
@@ -303,6 +258,20 @@ impl ImuAnalysis {
     /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
     pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
         self.sensor_value(s, |t| &t.k)
+    }
+
+    /// The record check's warnings on one axis (a warm-up, a spike).
+    pub fn axis_checks(&self, sensor: Sensor, axis: usize) -> impl Iterator<Item = &Finding> {
+        self.checks.iter().filter(move |f| {
+            f.level >= Level::Warning
+                && f.axis
+                    .is_some_and(|x| x.sensor == sensor && x.index == axis)
+        })
+    }
+
+    /// The record check's warnings, for the files' caveats.
+    pub fn warnings(&self) -> impl Iterator<Item = &Finding> {
+        self.checks.iter().filter(|f| f.level >= Level::Warning)
     }
 
     /// Axes without a reliable fit, as `gyro y` labels.
@@ -464,23 +433,17 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
                 rd(r.k)
             );
         }
-        if let Some(w) = &ax.warmup {
+        for f in a.axis_checks(sensor, ax.axis) {
             let _ = writeln!(
                 s,
-                "{:<7} WARNING: the first {} differ from the rest by {:.3e} {} ({:.0} σ of the noise): warm-up or drift; consider --skip-start {:.0}",
+                "{:<7} caveat: {} (see the warning on stderr)",
                 "",
-                advisor::duration_text(w.duration),
-                w.size,
-                sensor.unit(),
-                w.sigmas,
-                w.duration.ceil()
+                f.short()
             );
         }
     }
     s.push_str(&advice_text(a));
-    if let Some(t) = &a.timing {
-        s.push_str(&timing_text(t));
-    }
+    s.push_str(&checks_text(a));
     for sensor in a.sensors() {
         let fmt = |v: Option<SensorValue>, unit: &str| match v {
             Some(v) => format!(
@@ -555,47 +518,16 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
     s
 }
 
-/// The time-stamp findings (`bag2mat::timing`): gaps the analysers kept (too small to cut
-/// the record at) and rate changes, listed at most [`MAX_LISTED`] each.
-pub fn timing_text(t: &Timing) -> String {
+/// The record check's findings that concern no single axis (clocks, gaps, motion), one
+/// line each; the warnings themselves are on stderr.
+pub fn checks_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
-    let Some(period) = t.median_period.filter(|p| *p > 0.0) else {
-        return s;
-    };
-    if !t.gaps.is_empty() {
-        let mut longest: Vec<_> = t.gaps.iter().collect();
-        longest.sort_by(|a, b| b.length.total_cmp(&a.length));
-        longest.truncate(MAX_LISTED);
-        let list: Vec<String> = longest
-            .iter()
-            .map(|g| format!("{} s after sample {}", short(g.length), g.after))
-            .collect();
-        let _ = writeln!(
-            s,
-            "WARNING: {} gap(s) in the time stamps (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
-            t.gaps.len(),
-            t.gap_time() / period,
-            list.join(", ")
-        );
-    }
-    if !t.rate_changes.is_empty() {
-        let list: Vec<String> = t
-            .rate_changes
-            .iter()
-            .take(MAX_LISTED)
-            .map(|i| format!("sample {i}"))
-            .collect();
-        let _ = writeln!(
-            s,
-            "WARNING: the sample rate changes ({} change(s) off the median {:.3} Hz by > {:.0} %, at {})",
-            t.rate_changes.len(),
-            1.0 / period,
-            100.0 * bag2mat::timing::RATE_CHANGE_REL,
-            list.join(", ")
-        );
+    for f in a
+        .checks
+        .iter()
+        .filter(|f| f.axis.is_none() && f.level >= Level::Warning)
+    {
+        let _ = writeln!(s, "record check: {} (see the warning on stderr)", f.short());
     }
     s
 }
-
-/// Gaps and rate changes listed at most (the counts are always given).
-pub const MAX_LISTED: usize = 5;

@@ -184,6 +184,7 @@ fn mat_cases() -> Vec<Outcome> {
         ieee952: true,
         skip_start: None,
         input_options: Default::default(),
+        drop_outliers: false,
         curves: None,
     };
     crate::run::run(&config).expect("allan_kalibr run on the .mat");

@@ -9,7 +9,6 @@
 //! show: N is the long-τ white level of the whole chain (aliasing and the LSB rounding
 //! included, √(S₀·Δt + LSB²/12·Δt)); B, K, Q, R are the model's own figures.
 
-use super::stationarity::{self, StartStats};
 use super::{Analysis, Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::noise::generate::axis_series;
@@ -78,28 +77,21 @@ fn truth_of(
     )
 }
 
-/// Analyses `y` as the section does, and again after the start its warm-up check points
-/// at, if it warns. Returns the analysis and the seconds skipped.
+/// Analyses `y` as the section does, and again after the `--skip-start` the record
+/// check's warm-up advises, if it finds one. Returns the analysis and the seconds skipped.
 fn analyse_as_user(y: &[f64], tau0: f64, cfg: &Config) -> (Analysis, f64) {
     let run = |y: &[f64]| {
         let data = CurveData::from_samples(y, tau0, cfg).expect("simulated series");
         let basis = data.basis(cfg.fit.per_octave);
         analyse_curve(&data, cfg, basis.as_ref())
     };
-    let a = run(y);
-    let warm = a.fit.as_ref().filter(|_| a.verdict.fits()).and_then(|f| {
-        let st = StartStats::from_samples(y, tau0)?;
-        let f = f.clone();
-        let model = move |tau: f64| f.predict(tau).max(0.0);
-        stationarity::warmup(&st, &model)
-    });
-    match warm {
+    match bag2mat::record_check::warmup::find(y, tau0) {
         Some(w) => {
-            let skip = w.duration.ceil();
+            let skip = w.skip.ceil();
             let k = ((skip / tau0).round() as usize).min(y.len() / 2);
             (run(&y[k..]), skip)
         }
-        None => (a, 0.0),
+        None => (run(y), 0.0),
     }
 }
 
