@@ -21,11 +21,13 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
 fi
 
-# The ROS 2 cross-checks' tools, pinned (bag2mat::test_tools finds them here).
+# The ROS 2 cross-checks' tools and allantools (the IEEE 952 curve against its oadev),
+# pinned (bag2mat::test_tools finds them here).
 venv=target/py-venv
-pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0)
-if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2" >/dev/null 2>&1 \
-   || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icE '^(rosbags==0.11.9|mcap==1.6.0|mcap-ros2-support==0.6.0)$')" != 3 ]; then
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 allantools==2024.6)
+pinned=$(IFS='|'; echo "${pins[*]}")
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, allantools" >/dev/null 2>&1 \
+   || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icE "^(${pinned//./\\.})\$")" != ${#pins[@]} ]; then
   echo "installing ${pins[*]} into $venv"
   /usr/bin/python3 -m venv "$venv"
   "$venv/bin/python" -m pip install -q "${pins[@]}"

@@ -1,7 +1,7 @@
-//! The corrected estimator shared by both analysers: overlapping Allan deviation on a log
-//! grid of distinct cluster sizes (fully overlapping up to m = 256, every m/16-th start
-//! above: statistically the same estimate, [`oadev`]), Greenhall EDF confidence intervals, power-law noise
-//! identification, and a fit of the IEEE Std 952 terms that holds on real sensors — a τ range
+//! The corrected estimator shared by both analysers: the fully overlapping Allan deviation
+//! (every start index at every cluster size, [`oadev`]) on a log grid of distinct cluster
+//! sizes, Greenhall EDF confidence intervals, power-law noise identification, and a fit of
+//! the IEEE Std 952 terms that holds on real sensors — a τ range
 //! the model can describe, weights that survive model error, a goodness of fit and a verdict
 //! per axis, a 95 % interval and a verdict per term, and the classic region readings as a
 //! cross-check and fallback.
