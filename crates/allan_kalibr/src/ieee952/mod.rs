@@ -70,6 +70,7 @@ pub mod error;
 pub mod files;
 pub mod fit;
 pub mod imu;
+pub mod lines;
 pub mod noise_id;
 pub mod oadev;
 pub mod plot;
