@@ -66,12 +66,7 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool) -> CurveData {
             }
         })
         .collect();
-    CurveData {
-        tau0: a.period,
-        n: Some(a.n),
-        kind: Overlap::Overlapping,
-        points,
-    }
+    CurveData::from_points(a.period, Some(a.n), Overlap::Overlapping, points)
 }
 
 /// Drops the messages whose header stamp is within `seconds` of the first (a warm-up), as
@@ -215,10 +210,18 @@ fn run_series(
     // mean-period rate, plus the time-stamp checks.
     let t1 = Instant::now();
     let ieee = if config.ieee952 {
+        // with the PSD and the lines of the samples (in SI units)
         let curves: Vec<CurveData> = axes
-            .iter()
+            .par_iter()
             .enumerate()
-            .map(|(i, a)| ieee952_curve(a, i < 3))
+            .map(|(i, a)| {
+                let y = if i < 3 {
+                    collected.gyro_rad_s(i)
+                } else {
+                    collected.acc_m_s2(i - 3)
+                };
+                ieee952_curve(a, i < 3).with_spectrum(&y)
+            })
             .collect();
         let mut it = curves.into_iter();
         let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };

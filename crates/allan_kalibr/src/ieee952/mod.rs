@@ -74,6 +74,7 @@ pub mod lines;
 pub mod noise_id;
 pub mod oadev;
 pub mod plot;
+pub mod psd;
 pub mod region;
 pub mod stationarity;
 pub mod tau_grid;
@@ -82,6 +83,8 @@ pub mod tau_grid;
 mod tests_accuracy;
 #[cfg(test)]
 mod tests_bandlimited;
+#[cfg(test)]
+mod tests_lines;
 #[cfg(test)]
 mod tests_profiles;
 #[cfg(test)]
@@ -128,6 +131,10 @@ pub const SHORT_FEATURE_GAIN: f64 = 1.0;
 pub const N_READING_TAU: f64 = 1.0;
 /// A declared fit range spans at least this many decades of τ; shorter is "no reliable fit".
 pub const MIN_RANGE_DECADES: f64 = 1.0;
+/// A line of the PSD enters the model where its own Allan variance is at least this share
+/// of the measured one at some point (1 %: half a percent in deviation, about the precision
+/// of the short-τ points of a long record).
+pub const LINE_MIN_SHARE: f64 = 0.01;
 
 /// Analysis settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -192,9 +199,64 @@ pub struct CurveData {
     pub kind: Overlap,
     /// Points, ascending m.
     pub points: Vec<CurvePoint>,
+    /// The Welch PSD of the samples (none for a curve alone).
+    pub psd: Option<psd::Psd>,
+    /// The lines found in it, strongest first.
+    pub lines: Vec<psd::Line>,
 }
 
 impl CurveData {
+    /// A curve without samples behind it (no PSD, no lines).
+    pub fn from_points(
+        tau0: f64,
+        n: Option<usize>,
+        kind: Overlap,
+        points: Vec<CurvePoint>,
+    ) -> Self {
+        CurveData {
+            tau0,
+            n,
+            kind,
+            points,
+            psd: None,
+            lines: Vec::new(),
+        }
+    }
+
+    /// The same curve with the PSD and the lines of its samples `y` ([`psd`]).
+    pub fn with_spectrum(mut self, y: &[f64]) -> Self {
+        self.psd = psd::welch(y, 1.0 / self.tau0);
+        self.lines = self.psd.as_ref().map(psd::find_lines).unwrap_or_default();
+        self
+    }
+
+    /// The lines the model holds: the strongest ([`fit::LINE_SLOTS`] at most) whose own Allan
+    /// variance (as the PSD measured them) reaches [`LINE_MIN_SHARE`] of the curve at one of
+    /// its points at least; weaker ones leave the curve alone.
+    pub fn model_lines(&self) -> fit::LineSlots {
+        let mut out: fit::LineSlots = Default::default();
+        let mut k = 0;
+        for l in &self.lines {
+            if k == fit::LINE_SLOTS {
+                break;
+            }
+            let shape = fit::LineShape {
+                frequency: l.frequency,
+                bandwidth: l.bandwidth,
+                tau0: self.tau0,
+                psd_amp2: l.amplitude * l.amplitude,
+                record: self.n.unwrap_or(0) as f64 * self.tau0,
+            };
+            let matters = self.points.iter().any(|p| {
+                p.avar > 0.0 && shape.psd_amp2 * shape.avar(p.tau) >= LINE_MIN_SHARE * p.avar
+            });
+            if matters {
+                out[k] = Some(shape);
+                k += 1;
+            }
+        }
+        out
+    }
     /// Overlapping Allan variance of `y` on the grid of `cfg`, with the noise identification.
     pub fn from_samples(y: &[f64], tau0: f64, cfg: &Config) -> Result<CurveData, Ieee952Error> {
         check_config(tau0, cfg)?;
@@ -221,12 +283,10 @@ impl CurveData {
                 }
             })
             .collect();
-        Ok(CurveData {
-            tau0,
-            n: Some(y.len()),
-            kind: Overlap::Overlapping,
-            points,
-        })
+        Ok(
+            CurveData::from_points(tau0, Some(y.len()), Overlap::Overlapping, points)
+                .with_spectrum(y),
+        )
     }
 
     /// Cluster sizes of the fit grid (the valid points nearest 2^(k/p)).
@@ -315,6 +375,10 @@ pub enum Verdict {
     RegionReading,
     /// No reliable fit and no region for the term: only the 95 % upper bound is known.
     RegionBound,
+    /// Fitted, but the whole record does not agree with it: its value is above what every
+    /// point's upper 95 % band allows, or the model it lifts rises above the curve's upper
+    /// band beyond the fitted range. Only the record's 95 % upper bound is reported.
+    Contradicted,
     /// Not in the fitted model, or nothing could be computed.
     NotFitted,
 }
@@ -396,6 +460,22 @@ pub struct Terms {
     /// spectrum (0: IEEE 952's flat floor; see [`fit::flicker_band`]). The floor is within
     /// 2 % of 0.664·B from τ ≈ 40·T_lo on.
     pub b_corner: f64,
+    /// The lines in the model (IEEE 952 sinusoidal noise), by slot.
+    pub lines: [Option<LineTerm>; fit::LINE_SLOTS],
+}
+
+/// A vibration line of the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineTerm {
+    /// Frequency (from the PSD), Hz.
+    pub frequency: f64,
+    /// −3 dB bandwidth (from the PSD), Hz; 0 for a sinusoid.
+    pub bandwidth: f64,
+    /// Amplitude A the Allan fit gives (√ of its coefficient; 0 when the fit puts it at or
+    /// below 0), U.
+    pub amplitude: f64,
+    /// Amplitude the PSD gives (√(2·power)), U.
+    pub psd_amplitude: f64,
 }
 
 impl Terms {
@@ -413,10 +493,14 @@ pub enum AxisVerdict {
     Fits {
         /// Declared range, s.
         range: (f64, f64),
-        /// Shorter τ left out: band-limited (the sensor's low-pass filter or decimation).
+        /// Shorter τ left out.
         short_cut: bool,
-        /// Among the shorter τ left out, a bump above the white-noise line (a vibration).
+        /// Among the shorter τ left out, points above the model (a bump over the white-noise
+        /// line: a vibration, a resonance).
         short_feature: bool,
+        /// Among the shorter τ left out, points below the model's white-noise line: the
+        /// sensor's low-pass filter or decimation (the only case called "band-limited").
+        band_limited: bool,
         /// Longer τ left out: the curve does something the model has no term for there (a
         /// bump, a dip, a turn-down).
         long_cut: bool,
@@ -453,13 +537,15 @@ impl std::fmt::Display for AxisVerdict {
                 range,
                 short_cut,
                 short_feature,
+                band_limited,
                 long_cut,
                 approximate,
             } => {
-                let why_short = if *short_feature {
-                    "band-limited, and a bump above the white-noise line"
-                } else {
-                    "band-limited"
+                let why_short = match (band_limited, short_feature) {
+                    (true, true) => "band-limited, and a bump above the white-noise line",
+                    (true, false) => "band-limited",
+                    (false, true) => "a bump above the white-noise line",
+                    (false, false) => "its first points are out of line with the rest",
                 };
                 if let Some(d) = approximate {
                     write!(
@@ -568,6 +654,10 @@ pub struct Analysis {
     pub verdict: AxisVerdict,
     /// The region readings (cross-check; the terms when there is no reliable fit).
     pub region: region::Readings,
+    /// The Welch PSD of the samples (none for a curve alone).
+    pub psd: Option<psd::Psd>,
+    /// Every line the PSD shows, strongest first (those in the model are in `terms.lines`).
+    pub lines: Vec<psd::Line>,
 }
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
@@ -619,6 +709,7 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
             .iter()
             .map(|m| basis.map_or(0, |b| b.ms().binary_search(m).unwrap_or(0)))
             .collect(),
+        lines: data.model_lines(),
     };
     let n_phase = data.n.map(|n| n + 1);
 
@@ -671,6 +762,40 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         })
         .collect();
 
+    // what the left-out short τ are: below the model's white-noise line (band-limited), above
+    // it (a bump), or both — said from the points themselves, not from how the range was cut
+    let mut verdict = verdict;
+    if let (
+        AxisVerdict::Fits {
+            range,
+            short_cut: true,
+            short_feature,
+            band_limited,
+            ..
+        },
+        Some(f),
+    ) = (&mut verdict, &fitted)
+    {
+        let (mut above, mut below, mut lean) = (false, false, 0.0);
+        for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
+            let model = f.predict(p.tau).max(0.0).sqrt();
+            let band = (p.hi95 / p.adev - 1.0).max(0.0);
+            if !(model > 0.0) {
+                continue;
+            }
+            let mis = p.adev / model - 1.0;
+            lean += mis;
+            if band.is_finite() && mis > FIT_TOL.max(band) {
+                above = true;
+            } else if band.is_finite() && mis < -FIT_TOL.max(band) {
+                below = true;
+            }
+        }
+        // beyond the points' bands where they are; by the sign of the misses where not
+        *short_feature = above || (!below && lean > 0.0);
+        *band_limited = below || (!above && lean <= 0.0);
+    }
+    let verdict = verdict;
     // region readings on the fit grid of the declared range (all of it without a fit)
     let (rlo, rhi) = range.unwrap_or((0.0, f64::INFINITY));
     let region_pts: Vec<Point> = fd
@@ -683,16 +808,39 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
 
     let terms = match (&fitted, verdict.fits()) {
         (Some(f), true) => make_terms(f, &fd, &curve, cfg),
-        _ => Terms {
-            q: Term::not_fitted(),
-            n: Term::from_reading(region.n),
-            b: Term::from_reading(region.b),
-            k: Term::from_reading(region.k),
-            r: Term::not_fitted(),
-            g: Term::not_fitted(),
-            g_time: f64::NAN,
-            b_corner: 0.0,
-        },
+        _ => {
+            // a reading above what another point's upper band allows is that bound instead
+            let clamp = |j: usize, t: Term| -> Term {
+                let bound = region::upper_bound(curve.iter(), |tau| {
+                    fit::basis_at(j, tau, &fit::Shapes::FLAT).sqrt()
+                });
+                match t.verdict {
+                    Verdict::RegionReading if t.value > bound => Term {
+                        value: 0.0,
+                        std_err: f64::NAN,
+                        lo: 0.0,
+                        hi: bound,
+                        verdict: Verdict::RegionBound,
+                    },
+                    Verdict::RegionBound => Term {
+                        hi: t.hi.min(bound),
+                        ..t
+                    },
+                    _ => t,
+                }
+            };
+            Terms {
+                q: Term::not_fitted(),
+                n: clamp(1, Term::from_reading(region.n)),
+                b: clamp(2, Term::from_reading(region.b)),
+                k: clamp(3, Term::from_reading(region.k)),
+                r: Term::not_fitted(),
+                g: Term::not_fitted(),
+                g_time: f64::NAN,
+                b_corner: 0.0,
+                lines: [None; fit::LINE_SLOTS],
+            }
+        }
     };
     let fit = fitted.map(|f| FitSummary {
         coef: f.coef,
@@ -718,6 +866,8 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         fit,
         verdict,
         region,
+        psd: data.psd.clone(),
+        lines: data.lines.clone(),
     }
 }
 
@@ -838,6 +988,7 @@ fn declare_from(
                 range: (lo_t, hi_t),
                 short_cut: b.start > 0,
                 short_feature: b.feature,
+                band_limited: b.start > 0,
                 long_cut: end < np,
                 approximate: (f.delta > APPROX_DELTA).then_some(f.delta),
             };
@@ -1046,15 +1197,64 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
             verdict,
         }
     };
+    // The whole record's say (issue 17): every curve point bounds every term (its Allan
+    // deviation is at most the point's upper 95 % band), the points the range left out too;
+    // and a term that pushes the model up at long τ (B, K, R, a Gauss–Markov bias) is not
+    // resolved where the model then rises above the upper band of a point beyond the range
+    // and the term's own share is what lifts it there (a K fitted to the shoulder of a line,
+    // or to a bend the range cut, whose +½ line the long-τ curve does not follow).
+    let range_end = f.used.last().map_or(f64::INFINITY, |&i| fd.points[i].tau);
+    let long_cut = f.used.last().is_some_and(|&i| i + 1 < fd.points.len());
+    let record_bound =
+        |j: usize| region::upper_bound(curve.iter(), |tau| fit::basis_at(j, tau, &f.shapes).sqrt());
+    let contradicted = |j: usize| {
+        curve
+            .iter()
+            .filter(|p| p.tau > range_end * (1.0 + 1e-12) && p.hi95.is_finite())
+            .any(|p| {
+                let model = f.predict(p.tau);
+                let over = model - p.hi95 * p.hi95;
+                over > 0.0 && f.coef[j] * fit::basis_at(j, p.tau, &f.shapes) >= over
+            })
+    };
+    let bounded = |j: usize, mut t: Term| -> Term {
+        if !have_stats || matches!(t.verdict, Verdict::NotFitted) || j == 0 {
+            return t;
+        }
+        let bound = record_bound(j);
+        let pushes_long = matches!(j, 2 | 3 | 4 | fit::GM);
+        if t.verdict == Verdict::Resolved && (t.value > bound || (pushes_long && contradicted(j))) {
+            t.verdict = Verdict::Contradicted;
+        }
+        if t.verdict != Verdict::Resolved && bound.is_finite() {
+            // an unresolved term: its bound is the record's where the long end was cut (the
+            // fit's own interval then speaks for the range only), never looser than it
+            t.hi = if long_cut || !t.hi.is_finite() {
+                bound
+            } else {
+                t.hi.min(bound)
+            };
+            t.lo = t.lo.min(t.hi);
+        }
+        t
+    };
     Terms {
         q: one(0),
-        n: one(1),
-        b: one(2),
-        k: one(3),
-        r: one(4),
-        g: one(fit::GM),
+        n: bounded(1, one(1)),
+        b: bounded(2, one(2)),
+        k: bounded(3, one(3)),
+        r: bounded(4, one(4)),
+        g: bounded(fit::GM, one(fit::GM)),
         g_time: f.shapes.gm_t,
         b_corner: f.shapes.b_lo,
+        lines: std::array::from_fn(|k| {
+            f.shapes.lines[k].map(|l| LineTerm {
+                frequency: l.frequency,
+                bandwidth: l.bandwidth,
+                amplitude: f.coef[fit::LINE0 + k].max(0.0).sqrt(),
+                psd_amplitude: l.psd_amp2.sqrt(),
+            })
+        }),
     }
 }
 
@@ -1140,6 +1340,8 @@ mod tests {
             m *= 1.25;
         }
         CurveData {
+            psd: None,
+            lines: Vec::new(),
             tau0,
             n: Some(n),
             kind: Overlap::Overlapping,
