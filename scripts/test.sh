@@ -39,8 +39,11 @@ cargo test --workspace "$@"
 # about a minute on two cores in the optimised test build just made): every sim profile ×
 # 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
+# Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
+# runs beside them.
 cargo test -p allan_kalibr --lib -- --ignored --exact \
-  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study
+  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study \
+  ieee952::tests_lines::lines_study
 
 # Issue 12's seeded corruption campaign (>= 300 variants per input format through the real
 # bag2mat binary, each under an address-space limit and a timeout); its last line gives the

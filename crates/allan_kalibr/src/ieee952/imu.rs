@@ -257,10 +257,30 @@ impl ImuAnalysis {
     /// resolved axis value (or region reading, marked); when no axis has one, the largest
     /// 95 % upper bound, marked. `None` when the sensor is absent or nothing is known.
     pub fn sensor_value(&self, s: Sensor, term: fn(&super::Terms) -> &Term) -> Option<SensorValue> {
-        let terms: Vec<&Term> = self
+        self.sensor_value_within(s, term, |_| f64::INFINITY)
+    }
+
+    /// [`ImuAnalysis::sensor_value`] with every axis' value at most `bound` of its analysis
+    /// (the curve's own 95 % bound of the term, [`super::Analysis::bounds`]).
+    pub fn sensor_value_within(
+        &self,
+        s: Sensor,
+        term: fn(&super::Terms) -> &Term,
+        bound: fn(&super::Analysis) -> f64,
+    ) -> Option<SensorValue> {
+        let terms: Vec<Term> = self
             .sensor_axes(s)
-            .map(|a| term(&a.analysis.terms))
+            .map(|a| {
+                let mut t = *term(&a.analysis.terms);
+                let b = bound(&a.analysis);
+                if b.is_finite() {
+                    t.value = t.value.min(b);
+                    t.hi = t.hi.min(b);
+                }
+                t
+            })
             .collect();
+        let terms: Vec<&Term> = terms.iter().collect();
         if terms.is_empty() {
             return None;
         }
@@ -295,14 +315,16 @@ impl ImuAnalysis {
         })
     }
 
-    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
+    /// what the curve allows.
     pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.n)
+        self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
     }
 
-    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
+    /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
     pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.k)
+        self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
     }
 
     /// Axes without a reliable fit, as `gyro y` labels.

@@ -658,6 +658,10 @@ pub struct Analysis {
     pub psd: Option<psd::Psd>,
     /// Every line the PSD shows, strongest first (those in the model are in `terms.lines`).
     pub lines: Vec<psd::Line>,
+    /// The largest N and K every curve point allows at 95 % (its upper band over the
+    /// term's Allan deviation per unit, the minimum over the whole curve: for K,
+    /// min σ_hi95(τ)·√(3/τ)); the yaml files never write more.
+    pub bounds: (f64, f64),
 }
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
@@ -791,9 +795,15 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
                 below = true;
             }
         }
-        // beyond the points' bands where they are; by the sign of the misses where not
-        *short_feature = above || (!below && lean > 0.0);
-        *band_limited = below || (!above && lean <= 0.0);
+        // by the misses beyond the points' bands; without any, as the range was cut (a
+        // feature the start moved past, else the band limit of old)
+        if above || below {
+            *short_feature = above;
+            *band_limited = below;
+        } else {
+            // within their bands: below the model's white-noise line only if they lean below
+            *band_limited = lean < 0.0 && !*short_feature;
+        }
     }
     let verdict = verdict;
     // region readings on the fit grid of the declared range (all of it without a fit)
@@ -857,6 +867,10 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         points: f.used.len(),
         max_misfit,
     });
+    let bounds = (
+        region::upper_bound(curve.iter(), |t| fit::basis(1, t).sqrt()),
+        region::upper_bound(curve.iter(), |t| fit::basis(3, t).sqrt()),
+    );
     Analysis {
         n: data.n,
         tau0: data.tau0,
@@ -868,6 +882,7 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         region,
         psd: data.psd.clone(),
         lines: data.lines.clone(),
+        bounds,
     }
 }
 
@@ -1223,7 +1238,10 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
         }
         let bound = record_bound(j);
         let pushes_long = matches!(j, 2 | 3 | 4 | fit::GM);
-        if t.verdict == Verdict::Resolved && (t.value > bound || (pushes_long && contradicted(j))) {
+        // (a resolved value above the curve's bound stays resolved here — one point's band
+        // of many is below the truth by chance often enough — and the yaml files take the
+        // bound instead, [`imu::ImuAnalysis::sensor_value`])
+        if t.verdict == Verdict::Resolved && pushes_long && contradicted(j) {
             t.verdict = Verdict::Contradicted;
         }
         if t.verdict != Verdict::Resolved && bound.is_finite() {

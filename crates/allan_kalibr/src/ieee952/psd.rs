@@ -416,9 +416,25 @@ pub fn find_lines(p: &Psd) -> Vec<Line> {
             floor: fl[top],
         });
     }
-    out.sort_by(|a, b| b.allan_ratio().total_cmp(&a.allan_ratio()));
-    out
+    // a line is lightly damped (bandwidth below half its frequency), and the leftovers of a
+    // resonance's wings beside it are part of it, not lines of their own
+    out.retain(|l| l.bandwidth < RESONANCE_MAX_REL_WIDTH * l.frequency);
+    out.sort_by(|a, b| b.peak_ratio.total_cmp(&a.peak_ratio));
+    let mut kept: Vec<Line> = Vec::new();
+    for l in out {
+        let in_wing = kept.iter().any(|k| {
+            k.bandwidth > 0.0 && (l.frequency - k.frequency).abs() <= WING_TO * k.bandwidth
+        });
+        if !in_wing {
+            kept.push(l);
+        }
+    }
+    kept.sort_by(|a, b| b.allan_ratio().total_cmp(&a.allan_ratio()));
+    kept
 }
+
+/// A line's bandwidth is below this share of its frequency (a lightly damped resonance).
+const RESONANCE_MAX_REL_WIDTH: f64 = 0.5;
 
 /// A resonance's wings, for its bandwidth: from this many first estimates of its width …
 const WING_FROM: f64 = 2.0;
