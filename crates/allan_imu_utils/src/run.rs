@@ -220,7 +220,7 @@ fn run_series(
                 } else {
                     collected.acc_m_s2(i - 3)
                 };
-                ieee952_curve(a, i < 3).with_spectrum(&y)
+                ieee952_curve(a, i < 3).with_spectrum(y)
             })
             .collect();
         let mut it = curves.into_iter();

@@ -66,8 +66,15 @@
 //!   (the usual case) every plausible corner widens the intervals
 //!   ([`FitResult::alternatives`]).
 //!
+//! And the vibration lines the PSD finds (IEEE 952's sinusoidal noise, [`LineShape`]): their
+//! shapes are known, their A² fitted; in the enumeration of active sets they are in every
+//! set (2⁶ sets whatever the lines), and they take any sign.
+//!
 //! Their covariance: the shaped terms' AVAR is given, point by point, to the power law of
-//! its local slope (`effective_coef`).
+//! its local slope (`effective_coef`); a line's to white noise (plus, for a resonance, the
+//! variance of a narrow-band estimate), and a ramp's — deterministic, but its estimate
+//! carries the noise's cross term — to random walk, so that an R read off the longest
+//! points is as uncertain as those points are (issue 18.5).
 
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]

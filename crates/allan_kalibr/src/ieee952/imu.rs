@@ -557,6 +557,10 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     s
 }
 
+/// One line over a sensor's axes: (frequency, largest ratio, amplitude, axes, in the model
+/// on some axis, a resonance).
+type LineGroup = (f64, f64, f64, Vec<&'static str>, bool, bool);
+
 /// Lines of one sensor's axes whose frequencies agree within this fraction are one line.
 pub const SAME_LINE_REL: f64 = 0.02;
 
@@ -566,8 +570,7 @@ pub const SAME_LINE_REL: f64 = 0.02;
 pub fn lines_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     for sensor in a.sensors() {
-        // (frequency, largest ratio, amplitude, axes, in the model on some axis, resonance)
-        let mut groups: Vec<(f64, f64, f64, Vec<&'static str>, bool, bool)> = Vec::new();
+        let mut groups: Vec<LineGroup> = Vec::new();
         for ax in a.sensor_axes(sensor) {
             let modelled: Vec<f64> = ax
                 .analysis

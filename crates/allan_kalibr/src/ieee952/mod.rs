@@ -1,10 +1,10 @@
 //! The corrected estimator shared by both analysers: the fully overlapping Allan deviation
 //! (every start index at every cluster size, [`oadev`]) on a log grid of distinct cluster
-//! sizes, Greenhall EDF confidence intervals, power-law noise identification, and a fit of
-//! the IEEE Std 952 terms that holds on real sensors — a τ range
-//! the model can describe, weights that survive model error, a goodness of fit and a verdict
-//! per axis, a 95 % interval and a verdict per term, and the classic region readings as a
-//! cross-check and fallback.
+//! sizes, Greenhall EDF confidence intervals, power-law noise identification, a Welch PSD
+//! with the vibration lines in it ([`psd`]), and a fit of the IEEE Std 952 terms that holds
+//! on real sensors — a τ range the model can describe, weights that survive model error, a
+//! goodness of fit and a verdict per axis, a 95 % interval and a verdict per term, and the
+//! classic region readings as a cross-check and fallback.
 //!
 //! # Units
 //! The input is a rate series y in a unit U (rad/s for a gyro, m/s² for an accelerometer),
@@ -54,6 +54,24 @@
 //! in the text, the terms file (`source` = `region`) and the yaml files. The yaml files never
 //! carry a term as if it were measured when it is not: an unresolved term is written as its
 //! 95 % upper bound and marked so in a comment ([`files`]).
+//!
+//! # Vibration lines (issue 17)
+//! A line (a pump, a fan, a structural resonance: IEEE 952's sinusoidal noise) puts a bump
+//! of 0.725·A near τ = 0.37/f₀ on the curve and ripples decaying as A/(πf₀τ) for decades
+//! after it. Three ways to handle it were open; this one is a **term of the model**: the
+//! PSD of the samples ([`psd`]) finds each line (frequency, amplitude, bandwidth), and each
+//! that the Allan curve feels ([`CurveData::model_lines`]) enters the fit with its exact
+//! sampled Allan variance ([`lines`]; [`fit::LineShape`]), its A² a coefficient like the
+//! others. Why not the alternatives: removing the line before the Allan analysis needs the
+//! samples (not there for `--curves`), cannot remove a resonance without taking the white
+//! noise under it, and would label a cleaned curve as the record's; a fitted range with a
+//! hole loses exactly what the issue asks for, because the ripples' share of the variance
+//! falls only as 1/τ against the white noise while the points' precision falls as √τ, so
+//! the hole would eat two to three decades after a strong line. With the term the model
+//! describes the curve on both sides of the line, the line included, and the region of the
+//! curve the line dominates carries its own variance (a resonance's estimate has about
+//! 2πB·T degrees of freedom, [`fit::LineShape::edf`]). A curve without samples has no PSD:
+//! then lines are met as before (a short-τ bump is skipped, a long-τ one cuts the range).
 //!
 //! # How good can K be?
 //! For white noise N plus random walk K over T seconds no unbiased estimator beats
@@ -784,7 +802,7 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
             let model = f.predict(p.tau).max(0.0).sqrt();
             let band = (p.hi95 / p.adev - 1.0).max(0.0);
-            if !(model > 0.0) {
+            if !fit::is_positive(model) {
                 continue;
             }
             let mis = p.adev / model - 1.0;
@@ -1244,14 +1262,13 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
         if t.verdict == Verdict::Resolved && pushes_long && contradicted(j) {
             t.verdict = Verdict::Contradicted;
         }
-        if t.verdict != Verdict::Resolved && bound.is_finite() {
-            // an unresolved term: its bound is the record's where the long end was cut (the
-            // fit's own interval then speaks for the range only), never looser than it
-            t.hi = if long_cut || !t.hi.is_finite() {
-                bound
-            } else {
-                t.hi.min(bound)
-            };
+        if t.verdict != Verdict::Resolved && bound.is_finite() && (long_cut || !t.hi.is_finite()) {
+            // an unresolved term where the long end was cut: the fit's own interval speaks for
+            // the range only, the bound is the whole curve's. (Elsewhere the fit's inverted
+            // interval is the 95 % statement: the minimum of many points' 95 % bands is below
+            // the truth far more often than one in twenty — issue 18.5 — so it is not taken
+            // here; the yaml files never write more than it, [`imu::ImuAnalysis::random_walk`].)
+            t.hi = bound;
             t.lo = t.lo.min(t.hi);
         }
         t

@@ -24,6 +24,8 @@
 
 use std::f64::consts::PI;
 
+use super::fit::is_positive;
+
 /// Samples per Welch segment (2¹⁴: at 200 Hz a resolution of 0.012 Hz, so that a line at
 /// 0.002 of the rate lies 33 bins from zero and its frequency is read to a fraction of a
 /// percent).
@@ -293,7 +295,7 @@ fn running_median(d: &[f64], marked: &[bool]) -> Vec<f64> {
                 let lo = ((k / hw) as usize).min(i.saturating_sub(FLOOR_MIN_BINS));
                 let hi = ((k * hw) as usize).max(i + FLOOR_MIN_BINS).min(n - 1);
                 let mut w: Vec<f64> = (lo..=hi).filter(|&j| !marked[j]).map(|j| d[j]).collect();
-                if 3 * w.len() >= hi - lo + 1 || (lo == 0 && hi == n - 1) || widen > 8.0 {
+                if 3 * w.len() > hi - lo || (lo == 0 && hi == n - 1) || widen > 8.0 {
                     if w.is_empty() {
                         w = d[lo..=hi].to_vec();
                     }
@@ -368,7 +370,7 @@ pub fn find_lines(p: &Psd) -> Vec<Line> {
         );
         let excess: Vec<f64> = (lo..=hi).map(|i| (d[i] - fl[i]).max(0.0)).collect();
         let sum: f64 = excess.iter().sum();
-        if !(sum > 0.0) {
+        if !is_positive(sum) {
             continue;
         }
         let power = sum * df;
