@@ -88,25 +88,6 @@ impl Case {
     }
 }
 
-/// B dominates the truth's Allan variance over a decade of τ (then its value is checked).
-fn b_dominates_a_decade(at: &AxisTruth, n: usize) -> bool {
-    let mut run: Option<f64> = None;
-    let mut m = 1usize;
-    while 4 * m <= n {
-        let v = at.terms(m).values();
-        let top = v.iter().copied().fold(0.0, f64::max);
-        let tau = m as f64 / RATE;
-        match (v[3] >= top && v[3] > 0.0, run) {
-            (true, None) => run = Some(tau),
-            (true, Some(s)) if tau / s >= 10.0 => return true,
-            (false, _) => run = None,
-            _ => {}
-        }
-        m = ((m as f64) * 1.1).ceil() as usize;
-    }
-    false
-}
-
 fn run_case(frac: f64, k: f64, seed: u64, duration: f64) -> Case {
     let n = (duration * RATE) as usize;
     let a = base_axis();
@@ -137,7 +118,8 @@ fn run_case(frac: f64, k: f64, seed: u64, duration: f64) -> Case {
         label: format!("f0 {frac}·rate ({f0} Hz), {k}× the floor, seed {seed}"),
         f0,
         n_err: an.terms.n.value / n_eff - 1.0,
-        b: b_dominates_a_decade(&at, n).then_some((an.terms.b.value, an.terms.b.verdict)),
+        b: super::tests_profiles::b_dominates_a_decade(&at, b_true, RATE, n)
+            .then_some((an.terms.b.value, an.terms.b.verdict)),
         b_true,
         k: (
             an.terms.k.verdict,
@@ -310,39 +292,6 @@ fn lines_study() {
     // long end is cut where the curve dips under it (left open, see the report)
     for c in &short_range {
         println!("  NOT MET (T/20): {} ends at {} s", c.label, c.range_end);
-    }
-}
-
-#[test]
-#[ignore = "development: residuals of one case (LINE_FRAC, LINE_K, LINE_SEED); --ignored --nocapture"]
-fn lines_case_residuals() {
-    let env = |k: &str, d: f64| {
-        std::env::var(k)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(d)
-    };
-    let c = run_case(
-        env("LINE_FRAC", 0.002),
-        env("LINE_K", 6.0),
-        env("LINE_SEED", 5889.0) as u64,
-        7200.0,
-    );
-    print(&c);
-    if let Some(f) = &c.analysis.fit {
-        println!("coef {:?}\nshapes {:?}", f.coef, f.shapes);
-    }
-    for p in &c.analysis.curve {
-        println!(
-            "{:>10.4} {:.4e} [{:.3e},{:.3e}] model {:.4e} ratio {:+.4} {}",
-            p.tau,
-            p.adev,
-            p.lo95,
-            p.hi95,
-            p.model,
-            p.model / p.adev - 1.0,
-            if p.in_range { "*" } else { "" }
-        );
     }
 }
 

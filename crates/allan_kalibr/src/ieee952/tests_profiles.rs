@@ -252,10 +252,10 @@ const K_MIN_COVERAGE: f64 = 0.93;
 /// Issue 10: the median χ²/dof over the fitted ranges at most.
 const MAX_MEDIAN_CHI2: f64 = 2.0;
 
-/// Whether the truth's flicker term is the largest share of its Allan variance over a
-/// contiguous τ range of at least a decade within the record.
-fn b_dominates_a_decade(c: &Case, at: &AxisTruth, rate: f64, n: usize) -> bool {
-    if c.truth.b == 0.0 {
+/// Whether the truth's flicker term (B = `b`) is the largest share of its Allan variance
+/// over a contiguous τ range of at least a decade within the record of `n` samples.
+pub(super) fn b_dominates_a_decade(at: &AxisTruth, b: f64, rate: f64, n: usize) -> bool {
+    if b == 0.0 {
         return false;
     }
     let mut run_start: Option<f64> = None;
@@ -352,7 +352,7 @@ pub(super) fn score(cases: &[Case], rate: f64) -> Scores {
         let ax = "xyz".find(axis.chars().last().unwrap_or('x')).unwrap_or(0);
         let n = a.n.unwrap_or(0);
         let (_, at) = truth_of(&model, sens, ax, rate, n);
-        if b_dominates_a_decade(c, &at, rate, n) {
+        if b_dominates_a_decade(&at, c.truth.b, rate, n) {
             s.b_checked += 1;
             let b = a.terms.b;
             let err = b.value / c.truth.b - 1.0;
