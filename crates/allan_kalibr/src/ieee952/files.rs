@@ -332,7 +332,7 @@ pub fn psd_csv(a: &ImuAnalysis) -> String {
         if let Some(p) = &ax.analysis.psd {
             let _ = writeln!(
                 s,
-                "# {code}: {} segments of {} samples (Hann, half overlapping), resolution {} Hz",
+                "# {code}: {} segments of {} samples (Hann, back to back), resolution {} Hz",
                 p.segments,
                 p.segment,
                 p.resolution()

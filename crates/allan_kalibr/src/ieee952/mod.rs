@@ -806,10 +806,17 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
                 continue;
             }
             let mis = p.adev / model - 1.0;
-            lean += mis;
+            // below the white-noise line (with the quantization's): what a band limit does;
+            // a point under the model but over that line is the model's line or bump shape
+            let white = (f.coef[0].max(0.0) * fit::basis(0, p.tau)
+                + f.coef[1] * fit::basis(1, p.tau))
+            .max(0.0)
+            .sqrt();
+            let under_white = p.adev / white - 1.0;
+            lean += under_white.min(0.0) + mis.max(0.0);
             if band.is_finite() && mis > FIT_TOL.max(band) {
                 above = true;
-            } else if band.is_finite() && mis < -FIT_TOL.max(band) {
+            } else if band.is_finite() && under_white < -FIT_TOL.max(band) {
                 below = true;
             }
         }

@@ -1,7 +1,7 @@
 //! The power spectral density view of an axis and the vibration lines found in it.
 //!
 //! **PSD.** Welch's estimate: Hann-windowed segments of [`SEGMENT`] samples (fewer for a
-//! short record, at least [`MIN_SEGMENTS`] of them), half overlapping, one-sided, in U²/Hz
+//! short record, at least [`MIN_SEGMENTS`] of them), back to back, one-sided, in U²/Hz
 //! (rad²/s²/Hz, m²/s⁴/Hz): white noise of density N (the −½ line's N) has the level 2N², so
 //! N = √(S/2) reads the white-noise density straight off a flat floor — the cross-check the
 //! section prints beside the region readings.
@@ -62,6 +62,10 @@ pub struct Psd {
     pub segments: usize,
     /// Sample rate, Hz.
     pub rate: f64,
+    /// The local floor ([`floor`]), U²/Hz.
+    pub floor: Vec<f64>,
+    /// Bins that belong to lines.
+    marks: Vec<bool>,
 }
 
 impl Psd {
@@ -161,13 +165,15 @@ pub fn model_psd(
 pub fn welch(y: &[f64], rate: f64) -> Option<Psd> {
     let n = y.len();
     let mut seg = SEGMENT;
-    while seg > MIN_SEGMENT && n < seg * (MIN_SEGMENTS + 1) / 2 {
+    while seg > MIN_SEGMENT && n < seg * MIN_SEGMENTS {
         seg /= 2;
     }
-    if n < seg * (MIN_SEGMENTS + 1) / 2 {
+    if n < seg * MIN_SEGMENTS {
         return None;
     }
-    let hop = seg / 2;
+    // segments back to back: half the transforms of a half-overlapping average, for a
+    // floor whose scatter is still a few percent over a record of minutes
+    let hop = seg;
     let starts: Vec<usize> = (0..=(n - seg) / hop).map(|i| i * hop).collect();
     let window: Vec<f64> = (0..seg)
         .map(|i| 0.5 - 0.5 * (2.0 * PI * i as f64 / seg as f64).cos())
@@ -204,13 +210,19 @@ pub fn welch(y: &[f64], rate: f64) -> Option<Psd> {
     let density = (1..=half)
         .map(|k| acc[k] * scale * if k == half { 0.5 } else { 1.0 })
         .collect();
-    Some(Psd {
+    let mut p = Psd {
         freq,
         density,
         segment: seg,
         segments: starts.len(),
         rate,
-    })
+        floor: Vec::new(),
+        marks: Vec::new(),
+    };
+    let (fl, marks) = floor_and_marks(&p);
+    p.floor = fl;
+    p.marks = marks;
+    Some(p)
 }
 
 /// The local floor at every bin: the running median within ±[`FLOOR_HALF_WIDTH`] in
@@ -220,7 +232,7 @@ pub fn welch(y: &[f64], rate: f64) -> Option<Psd> {
 /// floor that counts them hides the resonance). Where lines cover most of a window it is
 /// widened until a third of its bins are free.
 pub fn floor(p: &Psd) -> Vec<f64> {
-    floor_and_marks(p).0
+    p.floor.clone()
 }
 
 /// Passes of [`floor`]'s take-out-and-retake.
@@ -299,8 +311,8 @@ fn running_median(d: &[f64], marked: &[bool]) -> Vec<f64> {
                     if w.is_empty() {
                         w = d[lo..=hi].to_vec();
                     }
-                    w.sort_by(f64::total_cmp);
-                    return w[w.len() / 2];
+                    let mid = w.len() / 2;
+                    return *w.select_nth_unstable_by(mid, f64::total_cmp).1;
                 }
                 widen *= 2.0;
             }
@@ -322,9 +334,9 @@ fn running_median(d: &[f64], marked: &[bool]) -> Vec<f64> {
 
 /// The peak-over-floor ratio a line must reach (module docs).
 fn line_threshold(p: &Psd) -> f64 {
-    // a Welch average of K half-overlapping Hann segments has about 1.9·K degrees of
-    // freedom per bin (Welch 1967); the threshold is its quantile at the per-bin rate
-    let nu = (2.0 * p.segments as f64 * 0.95).max(2.0);
+    // a Welch average of K disjoint segments has 2K degrees of freedom per bin; the
+    // threshold is its quantile at the per-bin rate
+    let nu = (2.0 * p.segments as f64).max(2.0);
     let per_bin = LINE_FALSE_ALARM / p.density.len().max(1) as f64;
     chi2_ratio_quantile(nu, 1.0 - per_bin).max(LINE_MIN_RATIO)
 }
@@ -338,7 +350,7 @@ pub fn find_lines(p: &Psd) -> Vec<Line> {
     if n < 2 * FLOOR_MIN_BINS {
         return Vec::new();
     }
-    let (fl, marked) = floor_and_marks(p);
+    let (fl, marked) = (&p.floor, &p.marks);
     let threshold = line_threshold(p);
     let d = &p.density;
     let df = p.resolution();
