@@ -22,11 +22,12 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 
 # The independent readers the cross-checks run, pinned (bag2mat::test_tools finds them
-# here): the ROS 2 implementations, and for the logs from outside ROS pyulog (ULog, also
-# its writer), pymavlink's DFReader (DataFlash) and pandas/numpy (CSV layouts).
+# here): the ROS 2 implementations; for the logs from outside ROS pyulog (ULog, also its
+# writer), pymavlink's DFReader (DataFlash) and pandas/numpy (CSV layouts); allantools (the
+# IEEE 952 curve against its oadev).
 venv=target/py-venv
-pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6)
-if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy" >/dev/null 2>&1 \
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6)
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools" >/dev/null 2>&1 \
    || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icxF "$(printf '%s\n' "${pins[@]}")")" != ${#pins[@]} ]; then
   echo "installing ${pins[*]} into $venv"
   /usr/bin/python3 -m venv "$venv"
@@ -39,8 +40,11 @@ cargo test --workspace "$@"
 # about a minute on two cores in the optimised test build just made): every sim profile ×
 # 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
+# Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
+# runs beside them.
 cargo test -p allan_kalibr --lib -- --ignored --exact \
-  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study
+  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study \
+  ieee952::tests_lines::lines_study
 
 # Issue 12's seeded corruption campaign (>= 300 variants per input format through the real
 # bag2mat binary, each under an address-space limit and a timeout); its last line gives the

@@ -70,12 +70,7 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool, tau0: f64) -> CurveData {
             }
         })
         .collect();
-    CurveData {
-        tau0,
-        n: Some(a.n),
-        kind: Overlap::Overlapping,
-        points,
-    }
+    CurveData::from_points(tau0, Some(a.n), Overlap::Overlapping, points)
 }
 
 /// The record check of the first `n` messages of `series` on the chosen clock, the other
@@ -250,10 +245,18 @@ fn run_series(
         ));
     }
     let ieee = if config.ieee952 && check.refusal().is_none() {
+        // with the PSD and the lines of the samples (in SI units)
         let curves: Vec<CurveData> = axes
-            .iter()
+            .par_iter()
             .enumerate()
-            .map(|(i, a)| ieee952_curve(a, i < 3, 1.0 / section_rate))
+            .map(|(i, a)| {
+                let y = if i < 3 {
+                    collected.gyro_rad_s(i)
+                } else {
+                    collected.acc_m_s2(i - 3)
+                };
+                ieee952_curve(a, i < 3, 1.0 / section_rate).with_spectrum(y)
+            })
             .collect();
         let mut it = curves.into_iter();
         let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };

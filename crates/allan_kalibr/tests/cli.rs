@@ -63,9 +63,10 @@ fn assert_no_outputs(dir: &Path) {
 /// The line that opens the IEEE 952 section after upstream's text.
 const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
 /// What the IEEE 952 section writes beside the compat outputs.
-const IEEE_OUTPUTS: [&str; 9] = [
+const IEEE_OUTPUTS: [&str; 10] = [
     "ieee952_terms.csv",
     "ieee952_curves.csv",
+    "ieee952_psd.csv",
     "kalibr_imu_ieee952.yaml",
     "vins_imu_ieee952.yaml",
     "orbslam3_imu_ieee952.yaml",

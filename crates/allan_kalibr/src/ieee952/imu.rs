@@ -212,10 +212,30 @@ impl ImuAnalysis {
     /// resolved axis value (or region reading, marked); when no axis has one, the largest
     /// 95 % upper bound, marked. `None` when the sensor is absent or nothing is known.
     pub fn sensor_value(&self, s: Sensor, term: fn(&super::Terms) -> &Term) -> Option<SensorValue> {
-        let terms: Vec<&Term> = self
+        self.sensor_value_within(s, term, |_| f64::INFINITY)
+    }
+
+    /// [`ImuAnalysis::sensor_value`] with every axis' value at most `bound` of its analysis
+    /// (the curve's own 95 % bound of the term, [`super::Analysis::bounds`]).
+    pub fn sensor_value_within(
+        &self,
+        s: Sensor,
+        term: fn(&super::Terms) -> &Term,
+        bound: fn(&super::Analysis) -> f64,
+    ) -> Option<SensorValue> {
+        let terms: Vec<Term> = self
             .sensor_axes(s)
-            .map(|a| term(&a.analysis.terms))
+            .map(|a| {
+                let mut t = *term(&a.analysis.terms);
+                let b = bound(&a.analysis);
+                if b.is_finite() {
+                    t.value = t.value.min(b);
+                    t.hi = t.hi.min(b);
+                }
+                t
+            })
             .collect();
+        let terms: Vec<&Term> = terms.iter().collect();
         if terms.is_empty() {
             return None;
         }
@@ -250,14 +270,16 @@ impl ImuAnalysis {
         })
     }
 
-    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
+    /// what the curve allows.
     pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.n)
+        self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
     }
 
-    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
+    /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
     pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.k)
+        self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
     }
 
     /// The record check's warnings on one axis (a warm-up, a spike).
@@ -279,6 +301,25 @@ impl ImuAnalysis {
         self.sensor_axes(s)
             .filter(|a| !a.analysis.verdict.fits())
             .map(|a| a.sensor.axis_label(a.axis))
+            .collect()
+    }
+
+    /// Axes of one sensor whose fitted range was cut at the long end, by label, with the
+    /// range's last τ.
+    pub fn truncated_axes(&self, s: Sensor) -> Vec<String> {
+        self.sensor_axes(s)
+            .filter_map(|a| match a.analysis.verdict {
+                AxisVerdict::Fits {
+                    long_cut: true,
+                    range,
+                    ..
+                } => Some(format!(
+                    "{} (τ ≤ {} s)",
+                    a.sensor.axis_label(a.axis),
+                    short(range.1)
+                )),
+                _ => None,
+            })
             .collect()
     }
 
@@ -320,9 +361,12 @@ fn term_text(t: &Term, unit: &str) -> String {
             }
         }
         Verdict::NeverDominant => format!(
-            "not resolved: the curve never shows it on its own ({:.2e} {unit}{})",
-            t.value,
-            iv(t)
+            "not resolved: the curve never shows it on its own (fit {:.2e} {unit}; 95 % upper bound {:.2e} {unit})",
+            t.value, t.hi
+        ),
+        Verdict::Contradicted => format!(
+            "not resolved: the whole record does not agree with the fit's {:.2e} {unit} (95 % upper bound from the curve {:.2e} {unit})",
+            t.value, t.hi
         ),
         Verdict::RegionReading => {
             format!("{:.4e} {unit}{} (IEEE 952 region reading)", t.value, iv(t))
@@ -365,6 +409,7 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     for n in &a.notes {
         let _ = writeln!(s, "   note: {n}");
     }
+    s.push_str(&lines_text(a));
     for ax in &a.axes {
         let an = &ax.analysis;
         let sensor = ax.sensor;
@@ -424,9 +469,14 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
                 Some(x) => format!("< {:.2e}", x.hi),
                 None => "-".into(),
             };
+            let psd_n = an
+                .psd
+                .as_ref()
+                .and_then(super::psd::white_density)
+                .map_or("-".into(), |v| format!("{v:.3e}"));
             let _ = writeln!(
                 s,
-                "{:<7} region readings (cross-check): N {}  B {}  K {}",
+                "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
                 "",
                 rd(r.n),
                 rd(r.b),
@@ -465,6 +515,90 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
             fmt(a.noise_density(sensor), sensor.n_unit()),
             sensor.name(),
             fmt(a.random_walk(sensor), sensor.k_unit()),
+        );
+    }
+    s
+}
+
+/// One line over a sensor's axes: (frequency, largest ratio, amplitude, axes, in the model
+/// on some axis, a resonance).
+type LineGroup = (f64, f64, f64, Vec<&'static str>, bool, bool);
+
+/// Lines of one sensor's axes whose frequencies agree within this fraction are one line.
+pub const SAME_LINE_REL: f64 = 0.02;
+
+/// The vibration lines the PSDs show, per sensor: "a line at 0.52 Hz, 6× the floor, on acc x
+/// y z" (× the floor: the line's Allan bump over the white noise's deviation there, the
+/// largest of its axes), and whether the model holds it.
+pub fn lines_text(a: &ImuAnalysis) -> String {
+    let mut s = String::new();
+    for sensor in a.sensors() {
+        let mut groups: Vec<LineGroup> = Vec::new();
+        for ax in a.sensor_axes(sensor) {
+            let modelled: Vec<f64> = ax
+                .analysis
+                .terms
+                .lines
+                .iter()
+                .flatten()
+                .map(|l| l.frequency)
+                .collect();
+            for l in &ax.analysis.lines {
+                let in_model = modelled.contains(&l.frequency);
+                let axis = ["x", "y", "z"][ax.axis];
+                match groups
+                    .iter_mut()
+                    .find(|g| (g.0 / l.frequency - 1.0).abs() <= SAME_LINE_REL)
+                {
+                    Some(g) => {
+                        if !g.3.contains(&axis) {
+                            g.3.push(axis);
+                        }
+                        g.1 = g.1.max(l.allan_ratio());
+                        g.2 = g.2.max(l.amplitude);
+                        g.4 |= in_model;
+                        g.5 |= l.bandwidth > 0.0;
+                    }
+                    None => groups.push((
+                        l.frequency,
+                        l.allan_ratio(),
+                        l.amplitude,
+                        vec![axis],
+                        in_model,
+                        l.bandwidth > 0.0,
+                    )),
+                }
+            }
+        }
+        if groups.is_empty() {
+            continue;
+        }
+        groups.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let list: Vec<String> = groups
+            .iter()
+            .map(|(f, r, amp, axes, m, res)| {
+                format!(
+                    "a {} at {} Hz, {:.1}× the floor (amplitude {:.2e} {}), on {} {}{}",
+                    if *res { "resonance" } else { "line" },
+                    short(*f),
+                    r,
+                    amp,
+                    sensor.unit(),
+                    sensor.short(),
+                    axes.join(" "),
+                    if *m {
+                        ""
+                    } else {
+                        " (too weak to move the Allan curve)"
+                    }
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "{} PSD lines: {} — fitted as IEEE 952 sinusoidal terms, so the model describes the curve on both sides",
+            sensor.name(),
+            list.join("; ")
         );
     }
     s

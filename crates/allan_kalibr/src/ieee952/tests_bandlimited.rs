@@ -223,6 +223,7 @@ fn mat_cases() -> Vec<Outcome> {
                 "NeverDominant" => Verdict::NeverDominant,
                 "RegionReading" => Verdict::RegionReading,
                 "RegionBound" => Verdict::RegionBound,
+                "Contradicted" => Verdict::Contradicted,
                 other => panic!("verdict {other}"),
             };
             let (n_true, k_true) = truth(&m, s, a, n);
