@@ -16,8 +16,8 @@ use crate::run::Config;
 ///
 /// Then the IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted
 /// range and fit quality per axis, recording-length advice, warm-up and gap checks,
-/// ieee952_terms.csv, ieee952_curves.csv, ieee952_allan.{png,svg} and Kalibr/VINS/ORB-SLAM3
-/// yaml files. With --curves it analyses Allan curves another tool wrote instead of samples.
+/// ieee952_terms.csv, ieee952_curves.csv, ieee952_psd.csv, ieee952_allan.{png,svg},
+/// ieee952_psd.{png,svg} and Kalibr/VINS/ORB-SLAM3/OpenVINS/Basalt files. With --curves it analyses Allan curves another tool wrote instead of samples.
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {

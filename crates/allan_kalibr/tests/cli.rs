@@ -63,7 +63,7 @@ fn assert_no_outputs(dir: &Path) {
 /// The line that opens the IEEE 952 section after upstream's text.
 const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
 /// What the IEEE 952 section writes beside the compat outputs.
-const IEEE_OUTPUTS: [&str; 10] = [
+const IEEE_OUTPUTS: [&str; 12] = [
     "ieee952_terms.csv",
     "ieee952_curves.csv",
     "ieee952_psd.csv",
@@ -74,6 +74,8 @@ const IEEE_OUTPUTS: [&str; 10] = [
     "basalt_imu_noise_ieee952.json",
     "ieee952_allan.png",
     "ieee952_allan.svg",
+    "ieee952_psd.png",
+    "ieee952_psd.svg",
 ];
 
 /// p3 (uncompressed, 61 s): stdout is upstream's text, imu.yaml holds the four numbers.

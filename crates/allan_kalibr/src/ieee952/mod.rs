@@ -94,6 +94,7 @@ pub mod noise_id;
 pub mod oadev;
 pub mod plot;
 pub mod psd;
+pub mod psd_plot;
 pub mod region;
 pub mod stated;
 pub mod tau_grid;
