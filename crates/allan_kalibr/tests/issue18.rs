@@ -318,3 +318,105 @@ fn issue18_8_one_spike_is_reported_with_its_time_and_dropped_on_request() {
         "N / truth: {r:?}"
     );
 }
+
+/// Per axis of a terms file (gyro x y z, acc x y z): the fit code, the fitted range's long
+/// end and χ²/dof (from the N rows).
+fn fit_columns(dir: &Path) -> Vec<(String, f64, f64)> {
+    let text = std::fs::read_to_string(dir.join("ieee952_terms.csv")).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (ct, cf, chi, cx) = (
+        col("term"),
+        col("fit"),
+        col("fit_tau_hi"),
+        col("chi2_per_dof"),
+    );
+    lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f[ct] == "N")
+        .map(|f| {
+            (
+                f[cf].to_string(),
+                f[chi].parse().unwrap(),
+                f[cx].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Issue 18.10: a fit of a clean record's curve is as good as its statistics; χ²/dof this
+/// far above 1 is a model or covariance that does not describe the points (before the fix:
+/// 8–37 on allan_variance_ros' curve of white noise and random walk).
+const MAX_CLEAN_CHI2: f64 = 3.0;
+
+#[test]
+fn issue18_10_allan_variance_ros_curves_fit_like_the_samples() {
+    // 30 min at 100 Hz of white noise + random walk (python3-rosbag), and the
+    // allan_variance.csv allan_variance_ros computes from that bag (tests/py/avr_curve.py:
+    // its algorithm, independently written; non-overlapping, every 0.1 s to 999.9 s)
+    let tmp = tempfile::tempdir().unwrap();
+    let bag = tmp.path().join("clean.bag");
+    let seconds = 1800.0;
+    let truth = odd_record(OddWriter::Rosbag, &bag, "clean", seconds, 100.0);
+    let csv = tmp.path().join("allan_variance.csv");
+    bag2mat::test_tools::run_ok(
+        std::process::Command::new("/usr/bin/python3")
+            .arg(bag2mat::test_tools::workspace().join("crates/allan_kalibr/tests/py/avr_curve.py"))
+            .arg(&bag)
+            .arg("imu")
+            .arg(&csv)
+            .args(["100", "100"]),
+    );
+    let from_bag = tmp.path().join("bag");
+    analyse(&bag, &from_bag, &[]);
+    let from_csv = tmp.path().join("csv");
+    let o = run(&[
+        "--curves",
+        csv.to_str().unwrap(),
+        "--duration",
+        &seconds.to_string(),
+        "-o",
+        from_csv.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", s(&o.stderr));
+    // before: fits cut at 3–18 s ("the curve bends where the model has no term") with
+    // χ²/dof 8–37 on every axis
+    for (i, (code, hi, chi2)) in fit_columns(&from_csv).into_iter().enumerate() {
+        assert!(code.starts_with("fits"), "axis {i}: {code}");
+        assert!(hi >= seconds / 20.0, "axis {i}: fitted to {hi} s only");
+        assert!(chi2 <= MAX_CLEAN_CHI2, "axis {i}: χ²/dof {chi2}");
+    }
+    let r = n_ratios(&from_csv, &truth);
+    assert!(
+        r.iter().all(|x| (x - 1.0).abs() < N_REL_TOL),
+        "N / truth: {r:?}"
+    );
+    // K: wherever the curve resolves it, its interval holds the samples' own estimate (the
+    // same record through the section's overlapping estimator) and, on all but at most one
+    // axis of six (95 % each), the truth; wherever the samples resolve it, the curve resolves
+    // it too or bounds it at or above the truth
+    let (bag_rows, csv_rows) = (terms(&from_bag), terms(&from_csv));
+    let mut truth_missed = Vec::new();
+    for (sensor, k) in [("gyroscope", truth.gyro.1), ("accelerometer", truth.acc.1)] {
+        for axis in ["x", "y", "z"] {
+            let (c, b) = (
+                term(&csv_rows, sensor, axis, "K"),
+                term(&bag_rows, sensor, axis, "K"),
+            );
+            if c.verdict == "Resolved" {
+                assert!(
+                    c.lo <= b.value && b.value <= c.hi,
+                    "{sensor} {axis}: K {c:?} vs the samples' {b:?}"
+                );
+                if !(c.lo <= k && k <= c.hi) {
+                    truth_missed.push(format!("{sensor} {axis}: {c:?} vs {k}"));
+                }
+            } else if b.verdict == "Resolved" {
+                assert!(c.hi >= k, "{sensor} {axis}: K bound {c:?} below {k}");
+            }
+        }
+    }
+    assert!(truth_missed.len() <= 1, "{truth_missed:?}");
+}
