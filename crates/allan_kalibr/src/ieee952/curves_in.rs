@@ -360,16 +360,12 @@ fn point_list(ms: &[usize], tau0: f64, adev: &[f64]) -> Vec<CurvePoint> {
         .collect()
 }
 
-/// The rows of a dense non-overlapping curve (allan_variance_ros: every 0.1 s) whose m lies
-/// on the section's log grid ([`super::tau_grid::GridSpec`]'s points per octave); returns
-/// them and how many rows were left out. The fit uses that grid anyway
-/// ([`CurveData::fit_ms`]); the range check visits every point of the curve, and on a dense
-/// curve its thousands of points would be thousands of chances for a chance miss.
-fn thin_to_log_grid(
-    ms: Vec<usize>,
-    acc: Vec<[f64; 3]>,
-    gyr: Vec<[f64; 3]>,
-) -> (Vec<usize>, Vec<[f64; 3]>, Vec<[f64; 3]>, usize) {
+/// Which rows of a dense non-overlapping curve (allan_variance_ros: every 0.1 s) have an m
+/// on the section's log grid ([`super::tau_grid::GridSpec`]'s points per octave). The fit
+/// uses that grid anyway ([`CurveData::fit_ms`]); the range check visits every point of the
+/// curve, and on a dense curve its thousands of points would be thousands of chances for a
+/// chance miss.
+fn on_log_grid(ms: &[usize]) -> Vec<bool> {
     let top = ms.iter().copied().max().unwrap_or(0);
     let spec = super::tau_grid::GridSpec::default();
     // the grid up to the largest m present (cluster_sizes(n) stops at n / min_clusters)
@@ -377,22 +373,16 @@ fn thin_to_log_grid(
         .cluster_sizes(top.saturating_mul(spec.min_clusters.max(3)))
         .into_iter()
         .collect();
-    let keep: Vec<bool> = ms.iter().map(|m| grid.contains(m)).collect();
-    let dropped = keep.iter().filter(|k| !**k).count();
-    let pick = |v: Vec<[f64; 3]>| -> Vec<[f64; 3]> {
-        v.into_iter()
-            .zip(&keep)
-            .filter(|(_, k)| **k)
-            .map(|(r, _)| r)
-            .collect()
-    };
-    let m2 = ms
-        .iter()
-        .zip(&keep)
+    ms.iter().map(|m| grid.contains(m)).collect()
+}
+
+/// The items of `v` whose `keep` is true.
+fn kept<T>(v: Vec<T>, keep: &[bool]) -> Vec<T> {
+    v.into_iter()
+        .zip(keep)
         .filter(|(_, k)| **k)
-        .map(|(m, _)| *m)
-        .collect();
-    (m2, pick(acc), pick(gyr), dropped)
+        .map(|(r, _)| r)
+        .collect()
 }
 
 /// Distinct ascending m with the first row of each m kept.
@@ -649,7 +639,13 @@ fn read_avr(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesErr
             }
         }
     };
-    let (ms, acc_rows, gyr_rows, dropped) = thin_to_log_grid(ms, acc_rows, gyr_rows);
+    let keep = on_log_grid(&ms);
+    let dropped = keep.iter().filter(|k| !**k).count();
+    let (ms, acc_rows, gyr_rows) = (
+        kept(ms, &keep),
+        kept(acc_rows, &keep),
+        kept(gyr_rows, &keep),
+    );
     if dropped > 0 {
         notes.push(format!(
             "allan_variance_ros' dense 0.1 s grid thinned to the section's {} points per octave ({dropped} periods left out: the fit uses that grid, and neighbouring periods share most of their bins)",
