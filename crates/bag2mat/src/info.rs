@@ -106,6 +106,7 @@ pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
                 messages: None,
                 span: parts[i].span,
                 channel: None,
+                ..Loss::default()
             });
         }
         for (c, v) in m {

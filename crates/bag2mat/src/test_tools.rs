@@ -142,3 +142,186 @@ pub fn string_message(text: &str) -> Vec<u8> {
     d.extend_from_slice(text.as_bytes());
     d
 }
+
+/// One b-tree page of a SQLite file: what the page-level damage of the tests and the fuzz
+/// campaign aims at (index pages, row ids, cell counts, child pointers).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BtreePage {
+    /// The table or index it belongs to.
+    pub tree: String,
+    /// Page number (1-based).
+    pub number: u32,
+    /// File offset of its b-tree header (100 bytes into page 1).
+    pub header: usize,
+    /// 0x0D table leaf, 0x05 table interior, 0x0A index leaf, 0x02 index interior.
+    pub kind: u8,
+    /// Its cell count.
+    pub cells: u16,
+    /// File offsets of its cells, in cell-pointer order.
+    pub cell_offsets: Vec<usize>,
+}
+
+impl BtreePage {
+    /// True for a leaf page.
+    pub fn is_leaf(&self) -> bool {
+        self.kind == 0x0D || self.kind == 0x0A
+    }
+
+    /// File offset of its cell count (big-endian u16).
+    pub fn cell_count_at(&self) -> usize {
+        self.header + 3
+    }
+
+    /// File offsets of its child pointers (big-endian u32: one per cell, then the
+    /// right-most one in the header) when it is an interior page.
+    pub fn child_pointers(&self) -> Vec<usize> {
+        if self.is_leaf() {
+            return Vec::new();
+        }
+        let mut v = self.cell_offsets.clone();
+        v.push(self.header + 8);
+        v
+    }
+}
+
+/// A SQLite varint at `at`: its value and length.
+pub fn sqlite_varint(b: &[u8], at: usize) -> (u64, usize) {
+    let mut v = 0u64;
+    for k in 0..9 {
+        let c = b[at + k];
+        if k == 8 {
+            return ((v << 8) | c as u64, 9);
+        }
+        v = (v << 7) | (c & 0x7f) as u64;
+        if c < 0x80 {
+            return (v, k + 1);
+        }
+    }
+    (v, 9)
+}
+
+/// File offset and length of the row id of each cell of a table leaf page.
+pub fn rowid_fields(bytes: &[u8], page: &BtreePage) -> Vec<(usize, usize)> {
+    if page.kind != 0x0D {
+        return Vec::new();
+    }
+    page.cell_offsets
+        .iter()
+        .map(|&c| {
+            let (_, n) = sqlite_varint(bytes, c);
+            let (_, m) = sqlite_varint(bytes, c + n);
+            (c + n, m)
+        })
+        .collect()
+}
+
+/// Every b-tree page of every table and index of an undamaged SQLite file, root first.
+pub fn btree_pages(path: &Path) -> Vec<BtreePage> {
+    let bytes = std::fs::read(path).expect("read sqlite file");
+    let page_size = match u16::from_be_bytes([bytes[16], bytes[17]]) {
+        1 => 65536,
+        n => n as usize,
+    };
+    let conn =
+        rusqlite::Connection::open_with_flags(path, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY)
+            .expect("open sqlite file");
+    let roots: Vec<(String, u32)> = conn
+        .prepare("SELECT name, rootpage FROM sqlite_master WHERE rootpage > 0")
+        .and_then(|mut s| {
+            s.query_map([], |r| Ok((r.get(0)?, r.get(1)?)))?
+                .collect::<Result<_, _>>()
+        })
+        .expect("sqlite_master");
+    let mut out = Vec::new();
+    for (tree, root) in roots {
+        let mut todo = vec![root];
+        while let Some(p) = todo.pop() {
+            let start = (p as usize - 1) * page_size;
+            let header = start + if p == 1 { 100 } else { 0 };
+            let kind = bytes[header];
+            let cells = u16::from_be_bytes([bytes[header + 3], bytes[header + 4]]);
+            let ptrs = header + if kind == 0x0D || kind == 0x0A { 8 } else { 12 };
+            let cell_offsets: Vec<usize> = (0..cells as usize)
+                .map(|k| {
+                    start
+                        + u16::from_be_bytes([bytes[ptrs + 2 * k], bytes[ptrs + 2 * k + 1]])
+                            as usize
+                })
+                .collect();
+            let page = BtreePage {
+                tree: tree.clone(),
+                number: p,
+                header,
+                kind,
+                cells,
+                cell_offsets,
+            };
+            let mut children: Vec<u32> = page
+                .child_pointers()
+                .iter()
+                .map(|&o| u32::from_be_bytes(bytes[o..o + 4].try_into().expect("4 bytes")))
+                .collect();
+            children.reverse();
+            todo.extend(children);
+            out.push(page);
+        }
+    }
+    out
+}
+
+/// What a run's warnings say was lost on one topic: the per-topic summary line the read
+/// path ends with (`N of M messages on 'T' were lost`, `, and up to K more`, `up to K
+/// messages on 'T'`, or that the damaged data does not count them).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Reported {
+    /// Messages said lost on the topic.
+    pub lost: u64,
+    /// Messages of unknown topic said lost besides (they may be the topic's).
+    pub more: u64,
+    /// A loss the warnings cannot count.
+    pub uncounted: bool,
+    /// A summary line was found.
+    pub said: bool,
+}
+
+/// Reads the per-topic loss summary of `topic` from a run's stderr.
+pub fn reported_losses(stderr: &str, topic: &str) -> Reported {
+    let mut r = Reported::default();
+    let on = format!(" messages on '{topic}' ");
+    for line in stderr.lines() {
+        let Some(l) = line.strip_prefix("warning: ") else {
+            continue;
+        };
+        if l.starts_with("messages on '") && l.contains(&format!("'{topic}' may have been lost")) {
+            r.said = true;
+            r.uncounted = true;
+            continue;
+        }
+        let Some(i) = l.find(&on) else { continue };
+        let head = &l[..i];
+        let rest = &l[i + on.len()..];
+        if !rest.starts_with("were lost") {
+            continue;
+        }
+        let num = |s: &str| s.trim().parse::<u64>().ok();
+        if let Some(n) = head.strip_prefix("up to ").and_then(num) {
+            r.more = r.more.max(n);
+        } else if let Some((n, _)) = head.split_once(" of ")
+            && let Some(n) = num(n)
+        {
+            r.lost = r.lost.max(n);
+            if let Some(k) = rest
+                .split_once(", and up to ")
+                .and_then(|(_, x)| x.split_whitespace().next())
+                .and_then(num)
+            {
+                r.more = r.more.max(k);
+            }
+        } else {
+            continue;
+        }
+        r.said = true;
+        r.uncounted |= rest.contains("does not count");
+    }
+    r
+}

@@ -4,6 +4,7 @@
 
 mod cli;
 mod defects;
+mod defects19;
 mod real_tools;
 mod reference;
 mod ros2;

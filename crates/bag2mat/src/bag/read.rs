@@ -549,6 +549,7 @@ impl BagReader {
                             messages: Some(info.counts.iter().map(|&(_, n)| n as u64).sum()),
                             span: Some((info.start_time.as_nanos(), info.end_time.as_nanos())),
                             channel: None,
+                            ..Loss::default()
                         }),
                     }
                 }
@@ -804,6 +805,7 @@ impl BagReader {
                     messages: Some(n),
                     span: Some((a, b)),
                     channel: Some(conn),
+                    ..Loss::default()
                 });
             }
         }

@@ -341,12 +341,14 @@ impl McapReader {
                             messages: None,
                             span: Some((h.message_start_time, h.message_end_time)),
                             channel: None,
+                            ..Loss::default()
                         }),
                         Err(e) => self.contents.losses.push(Loss {
                             what: format!("chunk at byte {pos} has an unreadable header ({e}); skipped"),
                             messages: None,
                             span: None,
                             channel: None,
+                            ..Loss::default()
                         }),
                     }
                 }
@@ -446,6 +448,7 @@ impl McapReader {
             messages,
             span,
             channel: None,
+            ..Loss::default()
         });
     }
 
@@ -500,6 +503,7 @@ impl McapReader {
                     messages: None,
                     span: Some((ci.message_start_time, ci.message_end_time)),
                     channel: None,
+                    ..Loss::default()
                 });
             }
         }

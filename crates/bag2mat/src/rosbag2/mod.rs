@@ -10,6 +10,7 @@
 
 pub mod metadata;
 pub mod sqlite;
+mod table_walk;
 
 pub use sqlite::{Sqlite3Reader, Sqlite3Writer};
 
@@ -118,6 +119,7 @@ impl BagDir {
                     messages: None,
                     span: None,
                     channel: None,
+                    ..Loss::default()
                 });
                 continue;
             }
@@ -206,7 +208,10 @@ impl BagDir {
                 parts.push(p);
             }
             notes.extend(src.notes().iter().cloned());
-            losses.extend(src.losses().iter().cloned());
+            losses.extend(src.losses().iter().map(|l| Loss {
+                channel: l.channel.and_then(|c| ids.get(&c).copied()),
+                ..l.clone()
+            }));
             out_files.push(FileSource {
                 src,
                 ids,
@@ -287,7 +292,24 @@ impl Source for BagDir {
         if r.skip_reason.is_none() {
             r.skip_reason = skip_reason;
         }
+        for l in r.lost.iter_mut() {
+            l.channel = l.channel.and_then(|c| f.ids.get(&c).copied());
+        }
         r
+    }
+    fn losses_after_read(&self) -> Vec<Loss> {
+        let multi = self.files.len() > 1;
+        let mut out = Vec::new();
+        for (fi, f) in self.files.iter().enumerate() {
+            for mut l in f.src.losses_after_read() {
+                l.channel = l.channel.and_then(|c| f.ids.get(&c).copied());
+                if multi {
+                    l.what = format!("file {}: {}", fi + 1, l.what);
+                }
+                out.push(l);
+            }
+        }
+        out
     }
 }
 
