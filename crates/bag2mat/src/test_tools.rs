@@ -325,3 +325,54 @@ pub fn reported_losses(stderr: &str, topic: &str) -> Reported {
     }
     r
 }
+
+/// A top-level record of an MCAP file: where it starts, its opcode and its content.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct McapRecord {
+    /// File offset of its opcode.
+    pub pos: usize,
+    /// Opcode.
+    pub op: u8,
+    /// File offsets of its content.
+    pub content: std::ops::Range<usize>,
+}
+
+/// The top-level records of an undamaged MCAP file, in file order (up to the footer).
+pub fn mcap_records(b: &[u8]) -> Vec<McapRecord> {
+    let mut out = Vec::new();
+    let mut pos = 8;
+    while pos + 9 <= b.len() {
+        let op = b[pos];
+        let len = u64::from_le_bytes(b[pos + 1..pos + 9].try_into().expect("8 bytes")) as usize;
+        let Some(end) = (pos + 9).checked_add(len).filter(|&e| e <= b.len()) else {
+            break;
+        };
+        out.push(McapRecord {
+            pos,
+            op,
+            content: pos + 9..end,
+        });
+        if op == 0x02 {
+            break;
+        }
+        pos = end;
+    }
+    out
+}
+
+/// The records of an uncompressed chunk's content: (file offset, opcode, content range).
+pub fn mcap_chunk_records(
+    b: &[u8],
+    chunk: &McapRecord,
+) -> Vec<(usize, u8, std::ops::Range<usize>)> {
+    let c = chunk.content.start;
+    let slen = u32::from_le_bytes(b[c + 28..c + 32].try_into().expect("4 bytes")) as usize;
+    let mut pos = c + 32 + slen + 8;
+    let mut out = Vec::new();
+    while pos + 9 <= chunk.content.end {
+        let len = u64::from_le_bytes(b[pos + 1..pos + 9].try_into().expect("8 bytes")) as usize;
+        out.push((pos, b[pos], pos + 9..pos + 9 + len));
+        pos += 9 + len;
+    }
+    out
+}

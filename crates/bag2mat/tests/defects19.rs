@@ -6,8 +6,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use bag2mat::mcap::ChunkCompression;
 use bag2mat::rosbag2::{Ros2BagWriter, Storage};
-use bag2mat::test_tools::{BtreePage, btree_pages, reported_losses, rowid_fields};
+use bag2mat::test_tools::{
+    BtreePage, McapRecord, btree_pages, mcap_chunk_records, mcap_records, reported_losses,
+    rowid_fields,
+};
 
 use crate::util::{run, synthetic};
 
@@ -258,4 +262,238 @@ fn defect_19_1c_db3_lowered_cell_count_is_reported_with_count_and_span() {
         }
         std::fs::write(&in_bag, &bytes).unwrap();
     }
+}
+
+/// A bare `.mcap` (uncompressed 8 KiB chunks with CRCs, an intact summary) and its clean
+/// rows.
+fn mcap_case(dir: &Path) -> (PathBuf, Vec<String>, Vec<u8>, Vec<McapRecord>) {
+    let file = ros2_bag(&dir.join("mbag"), Storage::Mcap(ChunkCompression::None));
+    let bare = dir.join("bare.mcap");
+    std::fs::copy(&file, &bare).unwrap();
+    let clean = convert(&bare, &dir.join("clean.csv"));
+    assert!(clean.ok && clean.stderr.is_empty(), "{}", clean.stderr);
+    assert_eq!(clean.rows.len(), N as usize);
+    let bytes = std::fs::read(&bare).unwrap();
+    let records = mcap_records(&bytes);
+    (bare, clean.rows, bytes, records)
+}
+
+/// What Foxglove's reader (CRCs checked) recovers of the clean messages on `imu` from each
+/// file (tests/py/mcap_recover.py).
+fn foxglove_recovers(clean: &Path, files: &[PathBuf]) -> Vec<u64> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/mcap_recover.py");
+    let out = bag2mat::test_tools::run_ok(
+        Command::new(bag2mat::test_tools::venv_python())
+            .arg(script)
+            .arg("imu")
+            .arg(clean)
+            .args(files),
+    );
+    out.lines().map(|l| l.trim().parse().unwrap()).collect()
+}
+
+fn chunks(records: &[McapRecord]) -> Vec<&McapRecord> {
+    records.iter().filter(|r| r.op == 0x06).collect()
+}
+
+/// 2: an MCAP cut short (no footer, no summary): an unknown opcode, a Data End or Footer
+/// opcode in mid-file, a message whose channel id changed — each is counted (or read),
+/// never a silent loss of a chunk, a message or the rest of the file.
+#[test]
+fn defect_19_2_mcap_cut_short_opcode_and_channel_damage_is_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_bare, clean, bytes, records) = mcap_case(dir.path());
+    let ch = chunks(&records);
+    // Cut inside the chunk at 70 %: no footer, no summary, the tail chunk incomplete.
+    let cut_chunk = ch[ch.len() * 7 / 10];
+    let cut = &bytes[..cut_chunk.content.start + 100];
+    let victim = ch[ch.len() / 3];
+    let damaged = dir.path().join("d.mcap");
+    let out = dir.path().join("d.csv");
+    // What the undamaged cut file gives is the baseline: its tail is gone either way.
+    let baseline = |b: &[u8]| {
+        std::fs::write(&damaged, b).unwrap();
+        let got = convert(&damaged, &out);
+        assert!(got.ok && got.rows.len() < clean.len(), "{}", got.stderr);
+        got.rows
+    };
+    let cut_rows = baseline(cut);
+    let check = |what: &str, b: &[u8], base: &[String]| {
+        std::fs::write(&damaged, b).unwrap();
+        let got = convert(&damaged, &out);
+        let missing = check_by_value(base, &got, what);
+        (got, missing)
+    };
+    // 2a: an unknown opcode on a chunk.
+    let mut b = cut.to_vec();
+    b[victim.pos] = 0x42;
+    let (got, _) = check("2a unknown opcode", &b, &cut_rows);
+    assert!(got.stderr.contains("0x42"), "{}", got.stderr);
+    // 2b: a Data End, then a Footer opcode, in mid-file.
+    for op in [0x0F, 0x02] {
+        let mut b = cut.to_vec();
+        b[victim.pos] = op;
+        let (got, _) = check(&format!("2b opcode {op:#x} in mid-file"), &b, &cut_rows);
+        assert!(
+            got.rows.len() > cut_rows.len() / 2,
+            "opcode {op:#x}: the rest of the file was dropped: {}",
+            got.stderr
+        );
+    }
+    // 2c: a message's channel id changed, in a chunk without CRC (as rosbags writes) whose
+    // Message Index records the cut took.
+    let last = ch
+        .iter()
+        .rev()
+        .find(|c| c.content.end <= cut.len())
+        .unwrap();
+    let mut b = bytes[..last.content.end].to_vec();
+    let upto_last = baseline(&b);
+    let c = last.content.start;
+    b[c + 24..c + 28].fill(0);
+    let (at, _, content) = mcap_chunk_records(&b, last)
+        .into_iter()
+        .filter(|r| r.1 == 0x05)
+        .nth(3)
+        .unwrap();
+    let _ = at;
+    b[content.start] = 0x77;
+    let (got, missing) = check("2c changed channel id", &b, &upto_last);
+    assert!(missing >= 1, "{}", got.stderr);
+    assert!(got.stderr.contains("channel"), "{}", got.stderr);
+}
+
+/// 3: an MCAP with an intact summary: a damaged record length or opcode of a chunk (the
+/// first one too) does not abandon the rest of the file — the summary locates every chunk,
+/// and bag2mat recovers at least what Foxglove's reader does.
+#[test]
+fn defect_19_3_mcap_damaged_record_header_does_not_abandon_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bare, clean, bytes, records) = mcap_case(dir.path());
+    let ch = chunks(&records);
+    let cases: Vec<(&str, ByteEdit)> = vec![
+        (
+            "a middle chunk's length set huge",
+            Box::new(|b: &mut Vec<u8>| {
+                let p = ch[ch.len() / 2].pos;
+                b[p + 1..p + 9].copy_from_slice(&u64::MAX.to_le_bytes());
+            }),
+        ),
+        (
+            "a middle chunk's length off by 5",
+            Box::new(|b: &mut Vec<u8>| {
+                let p = ch[ch.len() / 2].pos;
+                let l = u64::from_le_bytes(b[p + 1..p + 9].try_into().unwrap());
+                b[p + 1..p + 9].copy_from_slice(&(l + 5).to_le_bytes());
+            }),
+        ),
+        (
+            "the first chunk's opcode changed",
+            Box::new(|b: &mut Vec<u8>| b[ch[0].pos] = 0x2A),
+        ),
+        (
+            "the first chunk's length zeroed",
+            Box::new(|b: &mut Vec<u8>| {
+                let p = ch[0].pos;
+                b[p + 1..p + 9].fill(0);
+            }),
+        ),
+    ];
+    let mut files = Vec::new();
+    let mut ours = Vec::new();
+    for (k, (what, edit)) in cases.iter().enumerate() {
+        let mut b = bytes.clone();
+        edit(&mut b);
+        let p = dir.path().join(format!("d{k}.mcap"));
+        std::fs::write(&p, &b).unwrap();
+        let got = convert(&p, &dir.path().join(format!("d{k}.csv")));
+        let missing = check_by_value(&clean, &got, what);
+        assert!(
+            missing <= 40,
+            "{what}: {missing} rows lost where the summary locates every chunk: {}",
+            got.stderr
+        );
+        ours.push(got.rows.len() as u64);
+        files.push(p);
+    }
+    let theirs = foxglove_recovers(&bare, &files);
+    for ((what, _), (o, t)) in cases.iter().zip(ours.iter().zip(&theirs)) {
+        assert!(
+            o >= t,
+            "{what}: Foxglove's reader recovers {t}, bag2mat {o}"
+        );
+    }
+}
+
+/// 4: loss counts are exact, with time spans (a chunk that fails its CRC counts what its
+/// message index lists), and counts a damaged index states are bounded by what the file
+/// can hold (a message index count of 0x08000000, a metadata.yaml count of i64::MAX).
+#[test]
+fn defect_19_4_loss_counts_are_exact_and_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_bare, clean, bytes, records) = mcap_case(dir.path());
+    let ch = chunks(&records);
+    let damaged = dir.path().join("d.mcap");
+    let out = dir.path().join("d.csv");
+    // A chunk body damaged in a file cut short: its message index counts what it held.
+    let victim = ch[ch.len() / 4];
+    let keep = ch[ch.len() / 2].pos;
+    let mut b = bytes[..keep + 20].to_vec();
+    std::fs::write(&damaged, &b).unwrap();
+    let cut_rows = convert(&damaged, &out).rows;
+    b[victim.content.start + 200] ^= 0xFF;
+    std::fs::write(&damaged, &b).unwrap();
+    let got = convert(&damaged, &out);
+    let missing = check_by_value(&cut_rows, &got, "chunk CRC");
+    let in_victim = mcap_chunk_records(&bytes, victim)
+        .iter()
+        .filter(|r| {
+            r.1 == 0x05 && u16::from_le_bytes([bytes[r.2.start], bytes[r.2.start + 1]]) == 1
+        })
+        .count() as u64;
+    assert!(
+        got.stderr
+            .contains(&format!("{in_victim} messages lost (record time")),
+        "the chunk's {in_victim} messages are not counted with their span: {}",
+        got.stderr
+    );
+    assert!(missing >= in_victim);
+    // A message index count of 0x08000000 where every row is delivered: no loss is claimed.
+    let mi = records
+        .iter()
+        .find(|r| r.op == 0x07 && r.pos > ch[ch.len() / 2].pos)
+        .unwrap();
+    let mut b = bytes.clone();
+    b[mi.content.start + 2..mi.content.start + 6].copy_from_slice(&0x0800_0000u32.to_le_bytes());
+    std::fs::write(&damaged, &b).unwrap();
+    let got = convert(&damaged, &out);
+    assert_eq!(check_by_value(&clean, &got, "index count"), 0);
+    let rep = reported_losses(&got.stderr, "imu");
+    assert!(rep.lost + rep.more < N as u64, "{rep:?}: {}", got.stderr);
+    // metadata.yaml promising i64::MAX messages: bounded, no impossible count.
+    let bag = dir.path().join("mbag");
+    let meta = std::fs::read_to_string(bag.join("metadata.yaml")).unwrap();
+    let edited = meta.replacen(
+        &format!("message_count: {N}"),
+        "message_count: 9223372036854775807",
+        2,
+    );
+    assert_ne!(edited, meta);
+    std::fs::write(bag.join("metadata.yaml"), edited).unwrap();
+    let got = convert(&bag, &out);
+    assert_eq!(check_by_value(&clean, &got, "metadata count"), 0);
+    assert!(
+        !got.stderr
+            .lines()
+            .any(|l| l.contains("922337203685477") && l.contains("lost")),
+        "an impossible count: {}",
+        got.stderr
+    );
+    assert!(
+        got.stderr.contains("the count is damaged"),
+        "{}",
+        got.stderr
+    );
+    let rep = reported_losses(&got.stderr, "imu");
+    assert!(rep.lost < N as u64, "{rep:?}: {}", got.stderr);
 }

@@ -30,6 +30,10 @@ thread_local! {
     static PAYLOAD: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
+/// Fewer bytes than any stored message takes (a sqlite3 row's least): bounds the messages
+/// storage files can hold.
+const MIN_STORED_MESSAGE: u64 = 8;
+
 /// Largest decompressed message accepted in MESSAGE mode (a damaged frame cannot make the
 /// reader allocate more).
 const MAX_MESSAGE_BYTES: u64 = 1 << 30;
@@ -46,6 +50,8 @@ pub struct BagDir {
     files: Vec<FileSource>,
     /// Part in the bag → (file, part in the file).
     part_map: Vec<(usize, usize)>,
+    /// Each channel's count as its storage files state it (before metadata.yaml's).
+    file_counts: BTreeMap<u32, Option<u64>>,
     message_zstd: bool,
     contents: source::Contents,
     /// The parsed `metadata.yaml`, when there is one.
@@ -142,13 +148,42 @@ impl BagDir {
                 ),
             });
         }
-        Ok(Self::assemble(
-            files,
-            Some(info),
-            message_zstd,
-            notes,
-            losses,
-        ))
+        // What the storage files can hold bounds the counts metadata.yaml states.
+        let stored: u64 = paths
+            .iter()
+            .filter_map(|p| std::fs::metadata(p).ok())
+            .map(|m| m.len())
+            .sum();
+        let held = if info.compression_mode().is_empty() {
+            stored
+        } else {
+            stored.saturating_mul(source::MAX_EXPANSION)
+        };
+        let mut d = Self::assemble(files, Some(info), message_zstd, notes, losses);
+        d.bound_promises(held);
+        Ok(d)
+    }
+
+    /// Drops a count of `metadata.yaml` that is more than `bytes` of storage can hold (a
+    /// damaged count), with a note; the storage's own count stands.
+    fn bound_promises(&mut self, bytes: u64) {
+        for c in self.contents.channels.iter_mut() {
+            let least = if crate::series::is_imu(c) {
+                crate::series::MIN_IMU_PAYLOAD
+            } else {
+                MIN_STORED_MESSAGE
+            };
+            let most = bytes / least;
+            if let Some(n) = c.count
+                && n > most
+            {
+                self.contents.notes.push(format!(
+                    "metadata.yaml promises {n} messages on '{}', more than its storage files can hold (at most {most}): the count is damaged and not used",
+                    crate::shared::cli::escape(&c.topic)
+                ));
+                c.count = self.file_counts.get(&c.id).copied().flatten();
+            }
+        }
     }
 
     /// Opens a bare FILE-mode compressed storage file (`.mcap.zstd`, `.db3.zstd`).
@@ -218,6 +253,8 @@ impl BagDir {
                 _tmp: tmp,
             });
         }
+        let file_counts: BTreeMap<u32, Option<u64>> =
+            channels.iter().map(|c| (c.id, c.count)).collect();
         // metadata.yaml's counts are what the recorder promised for the whole bag.
         if let Some(info) = &info {
             for c in channels.iter_mut() {
@@ -230,6 +267,7 @@ impl BagDir {
         }
         BagDir {
             files: out_files,
+            file_counts,
             part_map,
             message_zstd,
             contents: source::Contents {
