@@ -863,8 +863,13 @@ pub fn read_from(
             None => exact,
         };
         // Without a promise, losses of unknown topic may be this topic's: said as a bound.
+        // With a promise, what it finds missing beyond the counted losses may be those of
+        // unknown topic; the rest of them are said as a bound.
         let (more, uncounted) = match r.promised {
-            Some(_) => (0, false),
+            Some(_) => (
+                unknown_topic.saturating_sub(missing.saturating_sub(exact)),
+                false,
+            ),
             None => (unknown_topic, uncounted),
         };
         let see = if r.losses.is_empty() && container.is_empty() {

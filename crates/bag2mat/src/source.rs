@@ -128,7 +128,8 @@ pub struct Loss {
     pub what: String,
     /// Messages lost, when known.
     pub messages: Option<u64>,
-    /// When the exact count is not known: the most messages the lost bytes can hold.
+    /// When the exact count is not known: the most `sensor_msgs/Imu` messages the lost
+    /// bytes can hold (the tools read Imu topics; other topics' messages may be more).
     pub at_most: Option<u64>,
     /// Record-time span (ns) of the lost data, when known.
     pub span: Option<(u64, u64)>,

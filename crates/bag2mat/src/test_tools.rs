@@ -271,7 +271,8 @@ pub fn btree_pages(path: &Path) -> Vec<BtreePage> {
 
 /// What a run's warnings say was lost on one topic: the per-topic summary line the read
 /// path ends with (`N of M messages on 'T' were lost`, `, and up to K more`, `up to K
-/// messages on 'T'`, or that the damaged data does not count them).
+/// messages on 'T'`, or that the damaged data does not count them), and the messages it
+/// says do not decode.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Reported {
     /// Messages said lost on the topic.
@@ -280,6 +281,8 @@ pub struct Reported {
     pub more: u64,
     /// A loss the warnings cannot count.
     pub uncounted: bool,
+    /// Messages said not to decode as Imu (found, but lost as rows).
+    pub undecodable: u64,
     /// A summary line was found.
     pub said: bool,
 }
@@ -300,6 +303,13 @@ pub fn reported_losses(stderr: &str, topic: &str) -> Reported {
         let Some(i) = l.find(&on) else { continue };
         let head = &l[..i];
         let rest = &l[i + on.len()..];
+        if rest.starts_with("do not decode")
+            && let Ok(n) = head.trim().parse::<u64>()
+        {
+            r.undecodable = r.undecodable.max(n);
+            r.said = true;
+            continue;
+        }
         if !rest.starts_with("were lost") {
             continue;
         }
@@ -375,4 +385,11 @@ pub fn mcap_chunk_records(
         pos += 9 + len;
     }
     out
+}
+
+impl Reported {
+    /// Rows the warnings account for at most: lost, of unknown topic, undecodable.
+    pub fn total(&self) -> u64 {
+        self.lost + self.more + self.undecodable
+    }
 }

@@ -165,6 +165,45 @@ fn op_name(op: u8) -> String {
     }
 }
 
+/// The header of the chunk whose content (`clen` bytes) starts at `content_pos`, when it
+/// frames the record: its stored length fills the record and its compression is known.
+fn chunk_header(w: &mut Window, content_pos: u64, clen: u64) -> Option<ChunkHeader> {
+    let avail = clen.min(4096) as usize;
+    let b = w.get(content_pos, avail).ok()?;
+    let (h, off) = ChunkHeader::decode(b).ok()?;
+    (h.compressed_size == clen - off as u64
+        && ["", "lz4", "zstd"].contains(&h.compression.as_str()))
+    .then_some(h)
+}
+
+/// Keeps the first record of an id, unless it is implausible (damaged) and a later copy
+/// (summary and data section each hold one) is not.
+fn offer<T>(m: &mut BTreeMap<u16, T>, id: u16, v: T, plausible: fn(&T) -> bool) {
+    match m.get(&id) {
+        Some(old) if plausible(old) || !plausible(&v) => {}
+        _ => {
+            m.insert(id, v);
+        }
+    }
+}
+
+/// A name as writers spell them: printable, no spaces.
+fn name_like(s: &str) -> bool {
+    !s.is_empty() && s.chars().all(|c| c.is_ascii_graphic())
+}
+
+fn schema_plausible(s: &Schema) -> bool {
+    name_like(&s.name) && name_like(&s.encoding)
+}
+
+fn channel_plausible(c: &record::Channel) -> bool {
+    name_like(&c.topic)
+        && !c.message_encoding.is_empty()
+        && c.message_encoding
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit())
+}
+
 /// What the Message Index records the walk meets next belong to.
 #[derive(Clone, Copy)]
 enum After {
@@ -224,8 +263,11 @@ impl McapReader {
                 match r.read_summary(footer_pos, &f) {
                     Ok(s) => {
                         r.summary_used = true;
-                        data_end = f.summary_start;
-                        if !s.trusted {
+                        if s.trusted {
+                            data_end = f.summary_start;
+                        } else {
+                            // A damaged footer may misplace the summary: the walk goes on
+                            // to the footer and ends at the Data End record.
                             r.statistics = None;
                         }
                         summary = Some(s);
@@ -263,6 +305,7 @@ impl McapReader {
         if let Some(s) = &summary {
             r.chunks_from_summary(&s.chunk_indexes);
         }
+        r.complete_channels();
         r.account_lost();
         r.build_channels();
         Ok(r)
@@ -335,17 +378,23 @@ impl McapReader {
         let mut c = Cursor::new(b);
         let mut chunk_indexes = Vec::new();
         while c.pos() < b.len() {
+            // Framing first: an untrusted summary skips a record whose content does not
+            // parse, and ends at framing that does not hold.
+            let framed = c.u8().and_then(|op| Ok((op, c.bytes64()?)));
+            let (op, content) = match framed {
+                Ok(x) => x,
+                Err(e) if trusted => return Err(e),
+                Err(_) => break,
+            };
             let rec = (|| -> Result<(), String> {
-                let op = c.u8()?;
-                let content = c.bytes64()?;
                 match Op::from_byte(op) {
                     Some(Op::Schema) => {
                         let s = Schema::decode(content)?;
-                        self.schemas.entry(s.id).or_insert(s);
+                        offer(&mut self.schemas, s.id, s, schema_plausible);
                     }
                     Some(Op::Channel) => {
                         let ch = record::Channel::decode(content)?;
-                        self.mcap_channels.entry(ch.id).or_insert(ch);
+                        offer(&mut self.mcap_channels, ch.id, ch, channel_plausible);
                     }
                     Some(Op::Statistics) => self.statistics = Some(Statistics::decode(content)?),
                     Some(Op::ChunkIndex) => {
@@ -358,10 +407,10 @@ impl McapReader {
                 }
                 Ok(())
             })();
-            match rec {
-                Ok(()) => {}
-                Err(e) if trusted => return Err(e),
-                Err(_) => break,
+            if let Err(e) = rec
+                && trusted
+            {
+                return Err(e);
             }
         }
         Ok(chunk_indexes)
@@ -375,13 +424,9 @@ impl McapReader {
         let rec_end = content_pos.checked_add(clen).filter(|&e| e <= end)?;
         match Op::from_byte(op)? {
             Op::Chunk => {
-                let avail = clen.min(4096) as usize;
-                let b = w.get(content_pos, avail).ok()?;
-                let (h, off) = ChunkHeader::decode(b).ok()?;
-                (h.compressed_size == clen - off as u64
-                    && ["", "lz4", "zstd"].contains(&h.compression.as_str())
-                    && h.message_start_time <= h.message_end_time)
-                    .then_some(rec_end)
+                // Landing on bytes that only look like a chunk is ruled out by its times too.
+                let h = chunk_header(w, content_pos, clen)?;
+                (h.message_start_time <= h.message_end_time).then_some(rec_end)
             }
             Op::MessageIndex => {
                 let b = w.get(content_pos, 6.min(clen as usize)).ok()?;
@@ -472,7 +517,6 @@ impl McapReader {
         let mut any = false;
         let mut seen_data_end = false;
         let mut after = After::Other;
-        let need_inner_channels = !self.summary_used;
         let mut found_summary = None;
         while pos < end {
             let landing = if self.locs.iter().any(|l| matches!(l, Loc::Chunk { .. })) {
@@ -488,6 +532,12 @@ impl McapReader {
             let rec_end = content_pos.checked_add(clen).filter(|&e| e <= end);
             let Some(rec_end) = rec_end else {
                 // A length past the end: truncation, or a damaged length with records after.
+                // A chunk's own records are never landed on (they frame as loose ones).
+                let is_chunk = op == Op::Chunk as u8
+                    && w.get(content_pos, (end - content_pos).min(4096) as usize)
+                        .ok()
+                        .is_some_and(|b| ChunkHeader::decode(b).is_ok());
+                let landing = if is_chunk { Landing::Chunked } else { landing };
                 match self.resync(&mut w, pos + 1, end, hints, landing) {
                     Some(next) => {
                         after = self.damaged(
@@ -533,7 +583,7 @@ impl McapReader {
                 }
                 Some(Op::Schema) => {
                     if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {
-                        self.schemas.entry(s.id).or_insert(s);
+                        offer(&mut self.schemas, s.id, s, schema_plausible);
                     } else {
                         self.contents
                             .notes
@@ -543,7 +593,7 @@ impl McapReader {
                 }
                 Some(Op::Channel) => {
                     if let Some(Ok(c)) = small(&mut w)?.map(|b| record::Channel::decode(&b)) {
-                        self.mcap_channels.entry(c.id).or_insert(c);
+                        offer(&mut self.mcap_channels, c.id, c, channel_plausible);
                     } else {
                         self.contents
                             .notes
@@ -552,11 +602,9 @@ impl McapReader {
                     after = After::Other;
                 }
                 Some(Op::Chunk) => {
-                    if self.frames(&mut w, pos, end, landing).is_some() {
+                    // Its stored length and compression frame it (its times may be damaged).
+                    if chunk_header(&mut w, content_pos, clen).is_some() {
                         let k = self.add_chunk(&mut w, pos, clen, None)?;
-                        if need_inner_channels {
-                            self.collect_inner_channels(k);
-                        }
                         after = After::Chunk(k);
                     } else {
                         let next = self.resync(&mut w, pos + 1, end, hints, landing);
@@ -666,15 +714,17 @@ impl McapReader {
                             "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
                         ));
                         let k = self.add_chunk(&mut w, pos, clen, None)?;
-                        if need_inner_channels {
-                            self.collect_inner_channels(k);
-                        }
                         after = After::Chunk(k);
-                    } else if op >= 0x80 {
-                        after = After::Other;
                     } else {
                         let next_ok =
                             rec_end == end || self.frames(&mut w, rec_end, end, landing).is_some();
+                        if op >= 0x80 && next_ok {
+                            // A private record followed by a whole one.
+                            after = After::Other;
+                            any = true;
+                            pos = rec_end;
+                            continue;
+                        }
                         let to = if next_ok {
                             rec_end
                         } else {
@@ -720,12 +770,16 @@ impl McapReader {
                 ChunkHeader::decode(&b).ok().map(|(h, _)| h)
             })
             .flatten();
+        // What the stretch held: a chunk's stated records, bounded by what the rest of the
+        // file can hold; else what its own bytes can hold.
         let stored = to.saturating_sub(pos);
+        let rest = self.len.saturating_sub(pos);
         let bytes = match &header {
-            Some(h) if h.compression.is_empty() => stored,
+            Some(h) if h.compression.is_empty() => h.uncompressed_size.min(rest).max(stored),
             Some(h) => h
                 .uncompressed_size
-                .min(stored.saturating_mul(source::MAX_EXPANSION)),
+                .min(rest.saturating_mul(source::MAX_EXPANSION))
+                .max(stored),
             None => stored.saturating_mul(source::MAX_EXPANSION),
         };
         self.lost.push(Lost {
@@ -853,7 +907,6 @@ impl McapReader {
                 ChunkHeader::decode(&b).ok().map(|(h, _)| h)
             })
             .flatten();
-        let stored = end.saturating_sub(pos);
         // What the incomplete record can have held: a chunk its stated records (bounded by
         // what its stored bytes decompress to), a message one.
         let (messages, at_most) = match (op, &header) {
@@ -867,10 +920,8 @@ impl McapReader {
                 };
                 (None, Some(bytes / MIN_IMU_RECORD))
             }
-            _ => (
-                None,
-                Some(stored.saturating_mul(source::MAX_EXPANSION) / MIN_IMU_RECORD),
-            ),
+            // A header cut short says nothing of the records after it.
+            _ => (None, None),
         };
         self.contents.losses.push(Loss {
             what,
@@ -1029,7 +1080,33 @@ impl McapReader {
             .collect()
     }
 
-    /// Without a summary, the schemas and channels may live only inside chunks.
+    /// Schemas and channels may live only inside chunks: without a summary they are
+    /// collected from every chunk; with one, from the chunks in order while a channel the
+    /// message indexes name, or a channel's schema, is missing or damaged in it.
+    fn complete_channels(&mut self) {
+        let needed = |r: &McapReader| -> bool {
+            r.mcap_channels.is_empty()
+                || r.indexes
+                    .iter()
+                    .flatten()
+                    .any(|i| !r.mcap_channels.contains_key(&i.channel))
+                || r.mcap_channels.values().any(|c| {
+                    !channel_plausible(c)
+                        || (c.schema_id != 0
+                            && !r.schemas.get(&c.schema_id).is_some_and(schema_plausible))
+                })
+        };
+        for k in 0..self.locs.len() {
+            if self.summary_used && !needed(self) {
+                break;
+            }
+            if matches!(self.locs[k], Loc::Chunk { .. }) {
+                self.collect_inner_channels(k);
+            }
+        }
+    }
+
+    /// Collects the schemas and channels inside part `loc`.
     fn collect_inner_channels(&mut self, loc: usize) {
         let mut found = Vec::new();
         let _ = self.with_records(
@@ -1054,10 +1131,10 @@ impl McapReader {
         );
         for (s, c) in found {
             if let Some(s) = s {
-                self.schemas.entry(s.id).or_insert(s);
+                offer(&mut self.schemas, s.id, s, schema_plausible);
             }
             if let Some(c) = c {
-                self.mcap_channels.entry(c.id).or_insert(c);
+                offer(&mut self.mcap_channels, c.id, c, channel_plausible);
             }
         }
     }
@@ -1091,6 +1168,7 @@ impl McapReader {
                 }
                 m
             });
+        let mut notes = Vec::new();
         self.contents.channels = self
             .mcap_channels
             .values()
@@ -1101,11 +1179,26 @@ impl McapReader {
                     (None, Some(m)) => Some(m.get(&c.id).copied().unwrap_or(0)),
                     _ => None,
                 };
+                // A damaged encoding name in a ROS 2 file (profile `ros2`, a `ros2msg`
+                // schema) is CDR, the one encoding rosbag2 writes.
+                let encoding = if !channel_plausible(c)
+                    && (self.header.profile == "ros2"
+                        || schema.is_some_and(|s| s.encoding == "ros2msg"))
+                {
+                    notes.push(format!(
+                        "the Channel record of '{}' names the encoding {:?} (damaged); read as cdr, the encoding of ROS 2 files",
+                        crate::shared::cli::escape(&c.topic),
+                        c.message_encoding
+                    ));
+                    Encoding::Cdr
+                } else {
+                    Encoding::from_name(&c.message_encoding)
+                };
                 source::Channel {
                     id: c.id as u32,
                     topic: c.topic.clone(),
                     msg_type: schema.map(|s| s.name.clone()).unwrap_or_default(),
-                    encoding: Encoding::from_name(&c.message_encoding),
+                    encoding,
                     md5sum: c
                         .metadata
                         .iter()
@@ -1115,6 +1208,7 @@ impl McapReader {
                 }
             })
             .collect();
+        self.contents.notes.extend(notes);
     }
 
     /// Calls `f(offset, opcode, content)` for each record of part `loc`, in order. A record
@@ -1153,35 +1247,42 @@ impl McapReader {
                     self.file
                         .read_exact_at(raw, *records_pos)
                         .map_err(|e| e.to_string())?;
+                    // A damaged size field must not fail records the CRC vouches for: the
+                    // output is bounded by what the stored bytes decompress to (or the size
+                    // stated, if larger), never preallocated.
+                    let limit = (*uncompressed_size)
+                        .max(compressed_size.saturating_mul(source::MAX_EXPANSION));
                     let records: &[u8] = match compression.as_str() {
                         "" => raw,
                         "lz4" => {
                             body.clear();
                             lz4_flex::frame::FrameDecoder::new(&raw[..])
-                                .take(uncompressed_size.saturating_add(1))
+                                .take(limit.saturating_add(1))
                                 .read_to_end(body)
                                 .map_err(|e| format!("lz4: {e}"))?;
                             body
                         }
                         "zstd" => {
-                            crate::zstd::decompress_into(raw, body, *uncompressed_size)?;
+                            crate::zstd::decompress_into(raw, body, limit)?;
                             body
                         }
                         other => return Err(format!("unsupported chunk compression '{other}'")),
                     };
-                    if records.len() as u64 != *uncompressed_size {
+                    let crc_ok = *crc != 0 && crc32fast::hash(records) == *crc;
+                    // Without a CRC, the stored records of an uncompressed chunk are what
+                    // its record length frames, whatever its size field says.
+                    let framed = *crc == 0 && compression.is_empty();
+                    if records.len() as u64 != *uncompressed_size && !crc_ok && !framed {
                         return Err(format!(
                             "chunk records are {} bytes, its header says {uncompressed_size}",
                             records.len()
                         ));
                     }
-                    if *crc != 0 {
-                        let got = crc32fast::hash(records);
-                        if got != *crc {
-                            return Err(format!(
-                                "chunk CRC {got:08x} differs from the stored {crc:08x}"
-                            ));
-                        }
+                    if *crc != 0 && !crc_ok {
+                        return Err(format!(
+                            "chunk CRC {:08x} differs from the stored {crc:08x}",
+                            crc32fast::hash(records)
+                        ));
                     }
                     records
                 }

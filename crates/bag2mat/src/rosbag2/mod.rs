@@ -87,19 +87,25 @@ impl BagDir {
     pub fn open(dir: &Path) -> Result<BagDir, Error> {
         let meta_path = dir.join("metadata.yaml");
         let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
-        let info = BagInfo::parse(&text).map_err(|e| Error::Storage {
-            path: meta_path.clone(),
-            what: format!("not a rosbag2 metadata.yaml: {e}"),
-        })?;
         let mut notes = Vec::new();
         let mut losses = Vec::new();
+        // A damaged metadata.yaml costs its promises, not the storage files beside it.
+        let info = BagInfo::parse(&text).unwrap_or_else(|e| {
+            notes.push(format!(
+                "{} is damaged ({e}); the storage files in the directory were read without it (it promises no counts)",
+                meta_path.display()
+            ));
+            BagInfo::default()
+        });
         let mut paths: Vec<PathBuf> = info
             .relative_file_paths
             .iter()
             .map(|r| dir.join(r))
             .collect();
-        if paths.is_empty() {
-            // Some tools leave the list empty; take the storage files in name order.
+        let listed = paths.len();
+        if !paths.iter().any(|p| p.exists()) {
+            // Some tools leave the list empty; take the storage files in name order (also
+            // when none of those listed is there).
             let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
                 .map_err(|e| Error::io(dir, e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
@@ -111,10 +117,23 @@ impl BagDir {
                 })
                 .collect();
             found.sort();
-            notes.push(format!(
-                "metadata.yaml lists no storage files; reading the {} found in the directory",
-                found.len()
-            ));
+            if listed == 0 {
+                notes.push(format!(
+                    "metadata.yaml lists no storage files; reading the {} found in the directory",
+                    found.len()
+                ));
+            } else if !found.is_empty() {
+                notes.push(format!(
+                    "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
+                    found.len()
+                ));
+            }
+            for p in &paths {
+                losses.push(Loss::new(format!(
+                    "{} is listed in metadata.yaml but missing",
+                    p.display()
+                )));
+            }
             paths = found;
         }
         let mut files = Vec::new();
@@ -149,16 +168,20 @@ impl BagDir {
             });
         }
         // What the storage files can hold bounds the counts metadata.yaml states.
-        let stored: u64 = paths
+        // (compressed data, MCAP chunks included, expands by at most MAX_EXPANSION).
+        let held: u64 = paths
             .iter()
-            .filter_map(|p| std::fs::metadata(p).ok())
-            .map(|m| m.len())
-            .sum();
-        let held = if info.compression_mode().is_empty() {
-            stored
-        } else {
-            stored.saturating_mul(source::MAX_EXPANSION)
-        };
+            .filter_map(|p| {
+                let len = std::fs::metadata(p).ok()?.len();
+                let raw = source::detect(p).ok()? == InputKind::Sqlite3
+                    && info.compression_mode().is_empty();
+                Some(if raw {
+                    len
+                } else {
+                    len.saturating_mul(source::MAX_EXPANSION)
+                })
+            })
+            .fold(0u64, |a, b| a.saturating_add(b));
         let mut d = Self::assemble(files, Some(info), message_zstd, notes, losses);
         d.bound_promises(held);
         Ok(d)

@@ -20,6 +20,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use rusqlite::types::ValueRef;
 use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
 
 use super::table_walk::{self, Walk};
@@ -38,7 +39,9 @@ const SEEK_SQL: &str = "SELECT id FROM messages NOT INDEXED WHERE id >= ?1 LIMIT
 
 /// An open `.db3`.
 pub struct Sqlite3Reader {
+    /// The file SQLite reads (a private copy when the input is truncated).
     path: PathBuf,
+    _copy: Option<tempfile::TempDir>,
     pool: Mutex<Vec<Connection>>,
     /// First id of each part (parallel to the contents' parts); part `k` ends before
     /// `starts[k + 1]`.
@@ -82,6 +85,52 @@ fn connect(path: &Path) -> Result<Connection, rusqlite::Error> {
     )
 }
 
+/// A private copy of a truncated sqlite3 file that SQLite accepts: its whole pages, the
+/// header's page count set to them. `None` when the file is not shorter than its header
+/// says (or its header is not whole). Returns the copy's directory, the pages kept, the
+/// pages the header announces and the page size.
+type TruncatedCopy = (tempfile::TempDir, u32, u32, u64);
+
+fn truncated_copy(path: &Path) -> Result<Option<TruncatedCopy>, Error> {
+    let b = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    if b.len() < 100 || !b.starts_with(source::SQLITE_MAGIC) {
+        return Ok(None);
+    }
+    let page = match u16::from_be_bytes([b[16], b[17]]) {
+        1 => 65536usize,
+        n if n >= 512 && n.is_power_of_two() => n as usize,
+        _ => return Ok(None),
+    };
+    let announced = u32::from_be_bytes(b[28..32].try_into().expect("4 bytes"));
+    let kept = (b.len() / page) as u32;
+    if kept == 0 || announced <= kept && b.len() % page == 0 {
+        return Ok(None);
+    }
+    let dir = tempfile::Builder::new()
+        .prefix("bag2mat-db3.")
+        .tempdir()
+        .map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let mut c = b[..kept as usize * page].to_vec();
+    c[28..32].copy_from_slice(&kept.to_be_bytes());
+    // The count is valid only with the version-valid-for number equal to the change counter.
+    let counter: [u8; 4] = c[24..28].try_into().expect("4 bytes");
+    c[92..96].copy_from_slice(&counter);
+    let to = dir.path().join("truncated.db3");
+    std::fs::write(&to, &c).map_err(|e| Error::io(&to, e))?;
+    // Indexes whose pages the cut took would fail every statement: the copy drops them.
+    let dropped = Connection::open(&to).and_then(|rw| {
+        rw.execute_batch("PRAGMA writable_schema = ON;")?;
+        rw.execute(
+            "DELETE FROM sqlite_master WHERE type = 'index' AND rootpage > ?1",
+            params![kept],
+        )
+    });
+    if let Err(e) = dropped {
+        return Err(sql_err(path, e));
+    }
+    Ok(Some((dir, kept, announced.max(kept), page as u64)))
+}
+
 /// The first id at or after `at` the table's b-tree finds; `Err` when a damaged page is in
 /// the way.
 fn seek(conn: &Connection, at: i64) -> Result<Option<i64>, rusqlite::Error> {
@@ -110,14 +159,43 @@ fn seek_past(conn: &Connection, after: i64, stop: Option<i64>, capacity: u64) ->
 impl Sqlite3Reader {
     /// Opens a rosbag2 `.db3` read-only, lists its topics and plans its parts.
     pub fn open(path: &Path) -> Result<Sqlite3Reader, Error> {
-        let conn = connect(path).map_err(|e| sql_err(path, e))?;
-        let tables: Vec<String> = conn
-            .prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
-            .and_then(|mut s| {
-                s.query_map([], |r| r.get::<_, String>(0))?
-                    .collect::<Result<_, _>>()
-            })
-            .map_err(|e| sql_err(path, e))?;
+        let tables_of = |conn: &Connection| -> Result<Vec<String>, rusqlite::Error> {
+            conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
+                .and_then(|mut s| {
+                    s.query_map([], |r| r.get::<_, String>(0))?
+                        .collect::<Result<_, _>>()
+                })
+        };
+        let mut notes = Vec::new();
+        let mut losses = Vec::new();
+        let mut read_path = path.to_path_buf();
+        let mut copy = None;
+        let mut conn = connect(path).map_err(|e| sql_err(path, e))?;
+        let mut tables = tables_of(&conn);
+        if tables.is_err()
+            && let Some((tmp, kept, pages, page)) = truncated_copy(path)?
+        {
+            // SQLite refuses a file shorter than its header says; its whole pages are read
+            // from a private copy that says what it holds.
+            notes.push(format!(
+                "the file is truncated: it holds {kept} of the {pages} pages its header announces; they were read from a private copy"
+            ));
+            losses.push(Loss {
+                what: format!(
+                    "the last {} page(s) of the file are missing (truncated)",
+                    pages - kept
+                ),
+                at_most: Some(
+                    ((pages - kept) as u64).saturating_mul(page) / crate::series::MIN_IMU_PAYLOAD,
+                ),
+                ..Loss::default()
+            });
+            read_path = tmp.path().join("truncated.db3");
+            conn = connect(&read_path).map_err(|e| sql_err(path, e))?;
+            tables = tables_of(&conn);
+            copy = Some(tmp);
+        }
+        let tables = tables.map_err(|e| sql_err(path, e))?;
         for t in ["topics", "messages"] {
             if !tables.iter().any(|x| x == t) {
                 return Err(Error::NotABag {
@@ -167,8 +245,6 @@ impl Sqlite3Reader {
             .map_err(|e| Error::io(path, e))?
             .len();
         let capacity = (len / MIN_ROW_BYTES).max(1);
-        let mut notes = Vec::new();
-        let mut losses = Vec::new();
         let starts = plan_parts(&conn, capacity, &mut notes, &mut losses);
         let parts = starts
             .iter()
@@ -185,7 +261,8 @@ impl Sqlite3Reader {
             })
             .collect();
         Ok(Sqlite3Reader {
-            path: path.to_path_buf(),
+            path: read_path,
+            _copy: copy,
             pool: Mutex::new(vec![conn]),
             starts,
             capacity,
@@ -249,31 +326,50 @@ impl Sqlite3Reader {
                     if Some(id) == stop {
                         return Ok(());
                     }
-                    let ts: i64 = row.get::<_, Option<i64>>(1)?.unwrap_or(0);
+                    // A field of the wrong type is this row's damage, not the page's.
+                    let ts = match row.get_ref(1)? {
+                        ValueRef::Integer(v) => Some(v),
+                        _ => None,
+                    };
+                    let topic = match row.get_ref(2)? {
+                        ValueRef::Integer(v) => u32::try_from(v).ok(),
+                        _ => None,
+                    };
                     let pos = w.walk.rows();
-                    w.walk.push(id, ts);
+                    w.walk.push(id, ts.unwrap_or(0));
                     rows += 1;
                     if id >= start && stop.is_none_or(|s| id < s) {
                         last_in_window = Some(id);
                     }
+                    let (Some(ts), Some(topic)) = (ts, topic) else {
+                        w.bad_fields.push((
+                            pos,
+                            topic,
+                            format!("row {id}: its topic_id or timestamp is not an integer"),
+                        ));
+                        continue;
+                    };
                     // A field that does not read is this row's loss only.
                     let fields = (|| -> Result<(), rusqlite::Error> {
-                        let topic = row.get::<_, i64>(2)?;
-                        let topic = u32::try_from(topic).unwrap_or(u32::MAX);
                         if let Some(data) = row.get_ref(3)?.as_blob_or_null()? {
                             let a = w.arena.len();
                             w.arena.extend_from_slice(data);
                             w.rows
                                 .push((pos, topic, ts.max(0) as u64, a..w.arena.len()));
-                        } else if !wanted.contains(&topic)
-                            && !self.contents.channels.iter().any(|c| c.id == topic)
-                        {
+                        } else if wanted.contains(&topic) {
+                            return Err(rusqlite::Error::InvalidColumnType(
+                                3,
+                                "data".into(),
+                                rusqlite::types::Type::Null,
+                            ));
+                        } else if !self.contents.channels.iter().any(|c| c.id == topic) {
                             w.stray_topic.push((pos, topic));
                         }
                         Ok(())
                     })();
                     if let Err(e) = fields {
-                        w.bad_fields.push((pos, format!("row {id}: sqlite3: {e}")));
+                        w.bad_fields
+                            .push((pos, Some(topic), format!("row {id}: sqlite3: {e}")));
                     }
                     if w.walk.rows() >= limit {
                         return Ok(());
@@ -306,8 +402,8 @@ struct Walked2 {
     arena: Vec<u8>,
     /// Rows naming no topic of the topics table: (walk position, topic id).
     stray_topic: Vec<(u64, u32)>,
-    /// Rows whose fields did not read: (walk position, why).
-    bad_fields: Vec<(u64, String)>,
+    /// Rows whose fields did not read: (walk position, topic if it read, why).
+    bad_fields: Vec<(u64, Option<u32>, String)>,
 }
 
 /// The first id of each part: the table's first id, then one id sought every
@@ -418,11 +514,23 @@ impl Source for Sqlite3Reader {
                 out.delivered += 1;
             }
         }
-        for (pos, why) in &w.bad_fields {
-            if kept(*pos) {
-                out.skipped += 1;
-                out.skip_reason.get_or_insert_with(|| why.clone());
+        // Rows whose fields do not read are lost, on their topic when it reads.
+        let mut bad: std::collections::BTreeMap<Option<u32>, (u64, &str)> = Default::default();
+        for (pos, topic, why) in &w.bad_fields {
+            if kept(*pos) && topic.is_none_or(want) {
+                let e = bad.entry(*topic).or_insert((0, why.as_str()));
+                e.0 += 1;
             }
+        }
+        for (topic, (n, why)) in bad {
+            out.lost.push(Loss {
+                what: format!(
+                    "message rows {start}..: {n} row(s) whose fields do not read (first: {why})"
+                ),
+                messages: Some(n),
+                channel: topic,
+                ..Loss::default()
+            });
         }
         let strays: Vec<u32> = w
             .stray_topic
@@ -506,14 +614,23 @@ impl Source for Sqlite3Reader {
             }
             None => {
                 let r: Result<Vec<String>, _> = conn
-                    .prepare("PRAGMA quick_check(5)")
+                    .prepare("PRAGMA quick_check(3)")
                     .and_then(|mut s| s.query_map([], |r| r.get(0))?.collect());
                 match r {
                     Ok(v) if v.len() == 1 && v[0] == "ok" => {}
-                    Ok(v) => out.push(Loss::new(format!(
-                        "the file is damaged (sqlite3 quick_check: {}); the table keeps no index to count the rows it may have lost",
-                        v.join("; ").replace('\n', " ")
-                    ))),
+                    Ok(v) => {
+                        // Its first findings, on one line.
+                        let said: Vec<&str> = v
+                            .iter()
+                            .flat_map(|x| x.lines())
+                            .filter(|l| !l.starts_with("***"))
+                            .take(2)
+                            .collect();
+                        out.push(Loss::new(format!(
+                            "the file is damaged (sqlite3 quick_check: {}); the table keeps no index to count the rows it may have lost",
+                            said.join("; ")
+                        )))
+                    }
                     Err(e) => out.push(Loss::new(format!(
                         "the file is damaged (sqlite3 quick_check: {e}); the table keeps no index to count the rows it may have lost"
                     ))),

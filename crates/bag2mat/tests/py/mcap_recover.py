@@ -2,8 +2,8 @@
 
 Usage: mcap_recover.py TOPIC CLEAN.mcap DAMAGED.mcap...
 For each damaged file, prints one line: the number of messages on TOPIC that the better of
-Foxglove's two readers yields and that are messages of the clean file (same log time, same
-bytes): its seeking reader (summary and chunk indexes, falling back to a linear pass when
+Foxglove's two readers yields under the clean file's schema name (what a typed decoder such
+as mcap_ros2 needs) and that are messages of the clean file (same log time, same bytes): its seeking reader (summary and chunk indexes, falling back to a linear pass when
 there is none) and its non-seeking reader (one linear pass), both with CRCs checked, each
 stopping at its first error. The Rust tests and the fuzz campaign require bag2mat to recover
 at least as many."""
@@ -12,17 +12,18 @@ import sys
 from mcap.reader import NonSeekingReader, SeekingReader
 
 
-def recovered(path, topic, clean):
+def recovered(path, topic, clean, schema_name):
     best = 0
     for make in (SeekingReader, NonSeekingReader):
         got = set()
         try:
             with open(path, "rb") as f:
-                for _, channel, msg in make(f, validate_crcs=True).iter_messages(
+                for schema, channel, msg in make(f, validate_crcs=True).iter_messages(
                     topics=[topic], log_time_order=False
                 ):
                     key = (msg.log_time, bytes(msg.data))
-                    if channel.topic == topic and key in clean:
+                    name = schema.name if schema is not None else None
+                    if channel.topic == topic and name == schema_name and key in clean:
                         got.add(key)
         except Exception:
             pass
@@ -32,13 +33,21 @@ def recovered(path, topic, clean):
 
 def main():
     topic, clean_path = sys.argv[1], sys.argv[2]
-    with open(clean_path, "rb") as f:
-        clean = {
-            (m.log_time, bytes(m.data))
-            for _, _, m in SeekingReader(f, validate_crcs=True).iter_messages(topics=[topic])
-        }
+    # The clean file may itself be cut short: what either reader reads of it.
+    clean = set()
+    schema_name = None
+    for make in (SeekingReader, NonSeekingReader):
+        try:
+            with open(clean_path, "rb") as f:
+                for s, _, m in make(f, validate_crcs=True).iter_messages(
+                    topics=[topic], log_time_order=False
+                ):
+                    clean.add((m.log_time, bytes(m.data)))
+                    schema_name = s.name if s is not None else None
+        except Exception:
+            pass
     for p in sys.argv[3:]:
-        print(recovered(p, topic, clean))
+        print(recovered(p, topic, clean, schema_name))
 
 
 main()
