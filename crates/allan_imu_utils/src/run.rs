@@ -247,10 +247,7 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
-        path: config.out_dir.clone(),
-        cause: e,
-    })?;
+    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
     let mut files = report::write_curve_files(&analysis, &config.name, &config.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {
         let p = config.out_dir.join(mode.file_name(&config.name));
@@ -304,10 +301,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
-    std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
-        path: config.out_dir.clone(),
-        cause: e,
-    })?;
+    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {
         let freq = 1.0 / raw.gyr_t[0];

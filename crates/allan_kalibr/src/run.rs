@@ -304,7 +304,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
 
     let dir = &config.outdir;
-    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    bag2mat::shared::output::ensure_dir(dir)?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
     bag2mat::shared::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
@@ -416,7 +416,7 @@ pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput,
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let dir = &config.outdir;
-    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    bag2mat::shared::output::ensure_dir(dir)?;
     let title = if config.title.is_empty() {
         config
             .input

@@ -5,5 +5,6 @@
 mod cli;
 mod common;
 mod consumers;
+mod defects19;
 mod ieee952;
 mod reference;

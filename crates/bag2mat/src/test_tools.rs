@@ -115,9 +115,11 @@ pub const ROS2_MODES: [(&str, &[&str]); 7] = [
 /// [`crate::shared::output`]) left in `dir`: a test of an interrupted or failed run expects
 /// none.
 pub fn temp_files_in(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        // No directory (a failed run made none): nothing left in it.
+        return Vec::new();
+    };
+    rd.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| n.starts_with('.') && n.contains(".tmp"))
         .collect()
 }

@@ -7,3 +7,4 @@ pub mod cli;
 pub mod output;
 pub mod plot;
 pub mod progress;
+pub mod staging;
