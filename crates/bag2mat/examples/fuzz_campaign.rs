@@ -718,6 +718,10 @@ fn classify(expected: &[bool], r: &ChildRun, out: &Path) -> (Result<Outcome, Str
     if r.stderr.contains("panicked") || r.stderr.contains("memory allocation") {
         return (Err(format!("panic or abort: {}", r.stderr.trim())), 0);
     }
+    // The clean read takes a few MB: running out of the limit is a count sizing memory.
+    if r.stderr.contains("out of memory") {
+        return (Err(format!("memory blow-up: {}", r.stderr.trim())), 0);
+    }
     match r.code {
         Some(0) => {}
         Some(1) => {

@@ -41,19 +41,26 @@ fn install_signal_cleanup() {
         let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
             return;
         };
-        std::thread::spawn(move || {
+        // Without the thread (no memory left to start one) only the cleanup on signals is lost.
+        let _ = std::thread::Builder::new().spawn(move || {
             if let Some(sig) = signals.forever().next() {
                 for p in lock(&LIVE).drain(..) {
-                    if p.is_dir() {
-                        let _ = std::fs::remove_dir_all(&p);
-                    } else {
-                        let _ = std::fs::remove_file(&p);
-                    }
+                    remove(&p);
                 }
                 std::process::exit(128 + sig);
             }
         });
     });
+}
+
+/// Removes every live temporary path, after a failed allocation ([`super::alloc`]): the
+/// lock is only tried (the failing thread may hold it).
+pub(super) fn remove_live_paths() {
+    if let Ok(mut v) = LIVE.try_lock() {
+        for p in v.drain(..) {
+            remove(&p);
+        }
+    }
 }
 
 pub(super) fn register(p: &Path) {
@@ -97,13 +104,15 @@ pub fn describe(e: &std::io::Error) -> String {
         K::StorageFull => "no space left on the device".into(),
         K::ReadOnlyFilesystem => "the file system is read-only".into(),
         K::DirectoryNotEmpty => "a directory that is not empty is in the way".into(),
-        _ => {
-            let s = e.to_string();
-            match s.find(" (os error") {
-                Some(i) => s[..i].to_string(),
-                None => s,
-            }
-        }
+        _ => without_errno(&e.to_string()),
+    }
+}
+
+/// An OS error's text without its "(os error N)".
+pub fn without_errno(s: &str) -> String {
+    match s.find(" (os error") {
+        Some(i) => s[..i].to_string(),
+        None => s.to_string(),
     }
 }
 
