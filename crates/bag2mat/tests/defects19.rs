@@ -497,3 +497,58 @@ fn defect_19_4_loss_counts_are_exact_and_bounded() {
     let rep = reported_losses(&got.stderr, "imu");
     assert!(rep.lost < N as u64, "{rep:?}: {}", got.stderr);
 }
+
+/// 8: a symlink loop given as the output is refused (an error, nothing written, the links
+/// left as they are), not turned into a regular file.
+#[test]
+fn defect_19_8_a_symlink_loop_as_output_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = ros2_bag(&dir.path().join("bag"), Storage::Sqlite3);
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    std::os::unix::fs::symlink(&b, &a).unwrap();
+    std::os::unix::fs::symlink(&a, &b).unwrap();
+    let (ok, _, err) = run(bag2mat().arg(&db).arg("imu").arg("-o").arg(&a).arg("-q"));
+    assert!(!ok, "{err}");
+    assert!(
+        err.starts_with("bag2mat: error:") && err.contains("loop of symbolic links"),
+        "{err}"
+    );
+    for l in [&a, &b] {
+        assert!(
+            std::fs::symlink_metadata(l)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+    }
+    assert!(bag2mat::test_tools::temp_files_in(dir.path()).is_empty());
+}
+
+/// 9: a damaged metadata.yaml is said in one line (no doubled "error:", no excerpt of the
+/// file), and the storage files beside it are still read.
+#[test]
+fn defect_19_9_a_damaged_metadata_yaml_is_one_plain_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("bag");
+    ros2_bag(&bag, Storage::Sqlite3);
+    let clean = convert(&bag, &dir.path().join("clean.csv"));
+    let meta = bag.join("metadata.yaml");
+    let text = std::fs::read_to_string(&meta).unwrap();
+    std::fs::write(
+        &meta,
+        text.replacen("message_count: ", "message_count: [", 1),
+    )
+    .unwrap();
+    let got = convert(&bag, &dir.path().join("d.csv"));
+    assert!(got.ok, "{}", got.stderr);
+    assert_eq!(got.rows, clean.rows);
+    let lines: Vec<&str> = got.stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{}", got.stderr);
+    assert!(
+        lines[0].starts_with("warning: ")
+            && lines[0].contains("metadata.yaml is damaged")
+            && !lines[0].contains("error:"),
+        "{}",
+        got.stderr
+    );
+}

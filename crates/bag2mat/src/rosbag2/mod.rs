@@ -90,7 +90,9 @@ impl BagDir {
         let mut notes = Vec::new();
         let mut losses = Vec::new();
         // A damaged metadata.yaml costs its promises, not the storage files beside it.
+        let mut damaged = false;
         let info = BagInfo::parse(&text).unwrap_or_else(|e| {
+            damaged = true;
             notes.push(format!(
                 "{} is damaged ({e}); the storage files in the directory were read without it (it promises no counts)",
                 meta_path.display()
@@ -117,12 +119,12 @@ impl BagDir {
                 })
                 .collect();
             found.sort();
-            if listed == 0 {
+            if listed == 0 && !damaged {
                 notes.push(format!(
                     "metadata.yaml lists no storage files; reading the {} found in the directory",
                     found.len()
                 ));
-            } else if !found.is_empty() {
+            } else if listed > 0 && !found.is_empty() {
                 notes.push(format!(
                     "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
                     found.len()
