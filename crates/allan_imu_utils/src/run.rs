@@ -76,21 +76,20 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool) -> CurveData {
 
 /// Drops the messages whose header stamp is within `seconds` of the first (a warm-up), as
 /// `rosbag play --start` would before imu_utils saw them; returns how many.
-fn skip_start(series: &mut bag2mat::ImuSeries, seconds: f64) -> Result<usize, Error> {
-    if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(Error::Config(format!(
-            "--skip-start must be a non-negative number of seconds, got {seconds}"
-        )));
-    }
+fn skip_start(
+    series: &mut bag2mat::ImuSeries,
+    seconds: f64,
+) -> Result<(usize, Option<String>), Error> {
     let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
-    let k = allan_kalibr::ieee952::stationarity::skip_index(&t, seconds);
+    let (k, warning) =
+        allan_kalibr::ieee952::stationarity::checked_skip(&t, seconds).map_err(Error::Config)?;
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);
     for c in series.acc.iter_mut().chain(series.gyro.iter_mut()) {
         c.drain(..k);
     }
-    Ok(k)
+    Ok((k, warning))
 }
 
 /// What `--curves` produced.
@@ -151,7 +150,8 @@ fn run_series(
     let topic = series.topic.clone();
     let mut notes = series.notes.clone();
     if let Some(s) = config.skip_start {
-        let k = skip_start(&mut series, s)?;
+        let (k, warning) = skip_start(&mut series, s)?;
+        notes.extend(warning);
         notes.push(format!(
             "--skip-start {s}: dropped the first {k} messages ({} left)",
             series.len()
@@ -230,6 +230,11 @@ fn run_series(
         );
         let starts: Vec<_> = axes.iter().map(|a| a.start.clone()).collect();
         imu::add_stationarity(&mut an, &starts, Some(tm));
+        notes.extend(
+            imu::warnings(&an)
+                .into_iter()
+                .map(|w| format!("warning: {w}")),
+        );
         Some(an)
     } else {
         None

@@ -169,7 +169,8 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let mut notes: Vec<String> = data.notes.iter().map(|n| format!("warning: {n}")).collect();
     let data_topic = data.topic.clone();
     if let Some(skip) = config.skip_start {
-        let k = skip_start(&mut data, skip)?;
+        let (k, warning) = skip_start(&mut data, skip)?;
+        notes.extend(warning.map(|w| format!("warning: {w}")));
         notes.push(format!(
             "--skip-start {skip}: dropped the first {k} samples ({} left)",
             data.len()
@@ -341,6 +342,13 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             Ok(w)
         },
     );
+    if let Some(an) = &ieee {
+        notes.extend(
+            crate::ieee952::imu::warnings(an)
+                .into_iter()
+                .map(|w| format!("warning: {w}")),
+        );
+    }
     written.extend(compat_plots?);
     written.extend(section_files?);
     let timings = Timings {
@@ -361,28 +369,16 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     })
 }
 
-/// Drops the samples of the first `seconds` of the record; returns how many.
-fn skip_start(data: &mut ImuData, seconds: f64) -> Result<usize, Error> {
-    if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(Error::BadData {
-            what: format!("--skip-start must be a non-negative number of seconds, got {seconds}"),
-        });
-    }
-    let k = crate::ieee952::stationarity::skip_index(&data.t, seconds);
-    if k + 3 > data.len() {
-        return Err(Error::BadData {
-            what: format!(
-                "--skip-start {seconds} leaves {} of {} samples",
-                data.len().saturating_sub(k),
-                data.len()
-            ),
-        });
-    }
+/// Drops the samples of the first `seconds` of the record; returns how many, and a
+/// warning when that is most of it.
+fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
+    let (k, warning) = crate::ieee952::stationarity::checked_skip(&data.t, seconds)
+        .map_err(|what| Error::BadData { what })?;
     data.t.drain(..k);
     for c in data.axes.iter_mut() {
         c.drain(..k);
     }
-    Ok(k)
+    Ok((k, warning))
 }
 
 /// Result of [`run_curves`].

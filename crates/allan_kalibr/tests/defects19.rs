@@ -6,34 +6,10 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use bag2mat::mat::{DataImu, write_data_imu};
-
 /// Slows every step of an output commit (bag2mat's test hook), as a slow file system would.
 const SLOW_COMMIT_MS: &str = "400";
 
-/// A small .mat of white noise at 100 Hz (seeded LCG), `n` rows.
-fn noise_mat(path: &Path, n: usize, seed: u64) {
-    let mut d = DataImu::with_capacity(n);
-    let mut s: u64 = seed;
-    let mut next = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-    };
-    for i in 0..n {
-        d.push([
-            1.7e9 + i as f64 * 0.01,
-            next(),
-            next(),
-            9.81 + next(),
-            next() * 1e-3,
-            next() * 1e-3,
-            next() * 1e-3,
-        ]);
-    }
-    write_data_imu(path, &d).unwrap();
-}
+use crate::cli::noise_mat_seeded as noise_mat;
 
 fn kalibr(input: &Path, out: &Path, delay: Option<&str>) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"));
@@ -230,4 +206,160 @@ fn defect_19_5_all_or_none_across_concurrent_runs_and_a_kill() {
         true,
         "after a run killed mid-commit",
     );
+}
+
+/// `allan_kalibr ARGS` with files limited to `kib` KiB (`ulimit -f`, SIGXFSZ ignored): every
+/// write past it fails as on a full disk.
+fn small_disk(kib: u64, args: &[&str]) -> std::process::Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("trap '' XFSZ; ulimit -f {kib}; exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// File-size limits that fail the run at its outputs (the yaml, the curves CSV, a PNG; the
+/// largest fits them all), KiB, for the 60 s record of the test.
+const DISK_KIB: [u64; 8] = [2, 16, 64, 128, 256, 400, 700, 1200];
+
+/// 9 and 10: a full disk (at whichever output) is one plain error — no raw
+/// `ImageError(IoError(Custom {…}))`, no "os error" — and leaves no output directory and no
+/// temporary path; a missing --curves path is described plainly.
+#[test]
+fn defect_19_9_10_a_full_disk_is_a_plain_error_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("n.mat");
+    noise_mat(&mat, 6000, 0x5EED);
+    let (mut failures, mut png) = (0, false);
+    for kib in DISK_KIB {
+        let out = dir.path().join(format!("o{kib}"));
+        let o = small_disk(
+            kib,
+            &[
+                mat.to_str().unwrap(),
+                "--update-rate",
+                "100",
+                "-q",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        if o.status.success() {
+            continue;
+        }
+        failures += 1;
+        assert_eq!(o.status.code(), Some(1), "{kib} KiB: {err}");
+        let line = err.lines().last().unwrap_or("");
+        png |= line.contains(".png:");
+        assert!(
+            line.starts_with("allan_kalibr: error: "),
+            "{kib} KiB: {err}"
+        );
+        for raw in [
+            "ImageError",
+            "IoError",
+            "Custom",
+            "os error",
+            "error: error",
+        ] {
+            assert!(!err.contains(raw), "{kib} KiB: {err}");
+        }
+        assert!(
+            !out.exists(),
+            "{kib} KiB: a failed run left its output directory"
+        );
+        assert!(
+            hidden(dir.path()).is_empty(),
+            "{kib} KiB: {:?}",
+            hidden(dir.path())
+        );
+    }
+    assert!(
+        failures >= 3,
+        "the limits {DISK_KIB:?} should fail several outputs"
+    );
+    assert!(png, "no limit of {DISK_KIB:?} failed a PNG");
+    let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .args(["--curves", "/nonexistent/curves.csv"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("os error"), "{err}");
+}
+
+/// 10: `--skip-start` that leaves almost nothing of the record (29.9 s of 30 s) is an error,
+/// not 10 samples analysed into plausible yaml; --duration, --units, --samples without
+/// --curves are a usage error, not ignored.
+#[test]
+fn defect_19_10_skip_start_and_curve_flags_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("n.mat");
+    noise_mat(&mat, 3000, 0x5EED); // 30 s at 100 Hz
+    let out = dir.path().join("o");
+    let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .arg(&mat)
+        .args(["--update-rate", "100", "--skip-start", "29.9", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("--skip-start 29.9 leaves"), "{err}");
+    assert!(!out.exists());
+    for flags in [
+        &["--duration", "3600"][..],
+        &["--units", "g"],
+        &["--samples", "1000"],
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+            .arg(&mat)
+            .args(flags)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(
+            err.starts_with("allan_kalibr: error:") && err.contains("--curves"),
+            "{flags:?}: {err}"
+        );
+    }
+}
+
+/// 9: a warm-up and a gap in the stamps are warned on stderr as lowercase `warning:` lines;
+/// stdout (the report) holds no `WARNING:` (it keeps them as findings).
+#[test]
+fn defect_19_9_warnings_go_to_stderr_in_lowercase() {
+    let dir = tempfile::tempdir().unwrap();
+    let mat = dir.path().join("w.mat");
+    bag2mat::mat::write_data_imu(
+        &mat,
+        &crate::ieee952::simulate(4, Some((0.02, 300.0)), Some((3000.0, 20.0))),
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .arg(&mat)
+        .args(["-q", "-o"])
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{err}");
+    assert!(
+        !out.to_lowercase().contains("warning") && !err.contains("WARNING"),
+        "{out}\n{err}"
+    );
+    for what in ["gap", "the first"] {
+        assert!(
+            err.lines()
+                .any(|l| l.starts_with("warning: ") && l.contains(what)),
+            "no warning about {what}: {err}"
+        );
+    }
 }

@@ -52,7 +52,7 @@ fn ok(o: &Output) -> String {
 
 /// White noise + random walk on each axis, optionally a warm-up on gyro x (amplitude, time
 /// constant) and a gap in the stamps (at, seconds).
-fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> DataImu {
+pub fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> DataImu {
     let n = (DURATION * RATE) as usize;
     let mut rng = StdRng::seed_from_u64(seed);
     let mut m = DataImu::with_capacity(n);
@@ -357,16 +357,20 @@ fn warm_up_is_reported_and_skip_start_drops_it() {
     let mat = tmp.path().join("warm.mat");
     // 0.02 rad/s settling in 300 s: far beyond the noise of a minute's mean (1.3e-4 rad/s)
     write_data_imu(&mat, &simulate(2, Some((0.02, 300.0)), None)).unwrap();
-    let text = ok(&run(&[
+    let o = run(&[
         mat.to_str().unwrap(),
         "-o",
         tmp.path().join("a").to_str().unwrap(),
         "-q",
-    ]));
-    let warn = text
+    ]);
+    let text = ok(&o);
+    assert!(text.contains("warm-up: the first"), "{text}");
+    let err = s(&o.stderr);
+    // A warning: on stderr (issue 19 #9), the report keeps the finding.
+    let warn = err
         .lines()
-        .find(|l| l.contains("WARNING: the first"))
-        .unwrap_or_else(|| panic!("no warm-up warning:\n{text}"));
+        .find(|l| l.starts_with("warning: gyro") && l.contains("the first"))
+        .unwrap_or_else(|| panic!("no warm-up warning:\n{err}"));
     assert!(warn.contains("--skip-start"), "{warn}");
     // the suggested skip, as the user would type it
     let skip = warn
@@ -375,16 +379,17 @@ fn warm_up_is_reported_and_skip_start_drops_it() {
         .and_then(|v| v.trim().parse::<f64>().ok())
         .unwrap_or_else(|| panic!("no number in {warn}"));
     assert!(skip > 300.0 && skip < 3600.0, "{warn}");
-    let text = ok(&run(&[
+    let o = run(&[
         mat.to_str().unwrap(),
         "--skip-start",
         &skip.to_string(),
         "-o",
         tmp.path().join("b").to_str().unwrap(),
         "-q",
-    ]));
+    ]);
+    let text = ok(&o) + &s(&o.stderr);
     assert!(
-        !text.contains("WARNING: the first"),
+        !text.contains("the first"),
         "the warm-up is gone after --skip-start {skip}:\n{text}"
     );
     let bad = run(&[
@@ -415,8 +420,8 @@ fn gaps_in_the_stamps_are_reported() {
     ]));
     let warn = text
         .lines()
-        .find(|l| l.contains("gap(s) in the time stamps"))
+        .find(|l| l.contains("time stamps: "))
         .unwrap_or_else(|| panic!("no gap warning:\n{text}"));
-    assert!(warn.contains("WARNING: 1 gap(s)"), "{warn}");
+    assert!(warn.contains("time stamps: 1 gap(s)"), "{warn}");
     assert!(warn.contains("≈ 1000 samples missing"), "{warn}");
 }

@@ -465,16 +465,7 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
             );
         }
         if let Some(w) = &ax.warmup {
-            let _ = writeln!(
-                s,
-                "{:<7} WARNING: the first {} differ from the rest by {:.3e} {} ({:.0} σ of the noise): warm-up or drift; consider --skip-start {:.0}",
-                "",
-                advisor::duration_text(w.duration),
-                w.size,
-                sensor.unit(),
-                w.sigmas,
-                w.duration.ceil()
-            );
+            let _ = writeln!(s, "{:<7} warm-up: {}", "", warmup_text(w, sensor.unit()));
         }
     }
     s.push_str(&advice_text(a));
@@ -505,6 +496,36 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
         );
     }
     s
+}
+
+/// What a warm-up found at the start of one axis says (the report's line and the warning).
+fn warmup_text(w: &Warmup, unit: &str) -> String {
+    format!(
+        "the first {} differ from the rest by {:.3e} {unit} ({:.0} σ of the noise): warm-up or drift; consider --skip-start {:.0}",
+        advisor::duration_text(w.duration),
+        w.size,
+        w.sigmas,
+        w.duration.ceil()
+    )
+}
+
+/// The findings of the analysis that are warnings (a warm-up or drift at the start of an
+/// axis), for the binaries to print on stderr as `warning:` lines; the report on stdout
+/// keeps them as findings. (The time stamps' gaps and rate changes are warned by the runs
+/// that found them, before the analysis.)
+pub fn warnings(a: &ImuAnalysis) -> Vec<String> {
+    a.axes
+        .iter()
+        .filter_map(|ax| {
+            ax.warmup.as_ref().map(|w| {
+                format!(
+                    "{}: {}",
+                    ax.sensor.axis_label(ax.axis),
+                    warmup_text(w, ax.sensor.unit())
+                )
+            })
+        })
+        .collect()
 }
 
 /// The record-length advice lines.
@@ -572,7 +593,7 @@ pub fn timing_text(t: &Timing) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "WARNING: {} gap(s) in the time stamps (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
+            "time stamps: {} gap(s) (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
             t.gaps.len(),
             t.gap_time() / period,
             list.join(", ")
@@ -587,7 +608,7 @@ pub fn timing_text(t: &Timing) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "WARNING: the sample rate changes ({} change(s) off the median {:.3} Hz by > {:.0} %, at {})",
+            "time stamps: the sample rate changes ({} change(s) off the median {:.3} Hz by > {:.0} %, at {})",
             t.rate_changes.len(),
             1.0 / period,
             100.0 * bag2mat::timing::RATE_CHANGE_REL,
