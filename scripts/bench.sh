@@ -11,17 +11,19 @@
 #     `cat` of the storage file (targets: MCAP < 3x, sqlite3 < 10x) and vs the rosbags Python
 #     library reading the same messages (target: >= 30x), extrapolated from
 #     BENCH_ROSBAGS_MSGS messages (needs target/py-venv from scripts/test.sh);
-#   * then each analyser's own benchmark script, on the same bag.
+#   * then each analyser's own benchmark script, on the same bag;
+#   * scripts/bench_logs.sh: reading a 4 h EuRoC CSV and a 4 h ULog (issue 20).
 # Environment: BENCH_PY_WRITE_MSGS (default: all 2,880,001), BENCH_PY_READ_MSGS (200000),
 # BENCH_ROSBAGS_MSGS (300000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 root=$(pwd)
 work=${1:-$(mktemp -d /tmp/imu-bench.XXXXXX)}
 mkdir -p "$work"
 echo "work dir: $work"
-cargo build --release --quiet -p sim -p bag2mat -p allan_kalibr -p allan_imu_utils
-bin="$root/target/release"
+build_release sim bag2mat allan_kalibr allan_imu_utils
+bin="$(target_dir)/release"
 N=2880001
 py_write=${BENCH_PY_WRITE_MSGS:-$N}
 py_read=${BENCH_PY_READ_MSGS:-200000}
@@ -99,3 +101,7 @@ echo "== the IEEE 952 section (not part of the upstream tools; both analysers ru
 /usr/bin/time -f "%e %M" -o "$work/.time" "$bin/allan_kalibr" "$work/imu.mat" --update-rate 200 -q --timings \
   -o "$work/kalibr_ieee" >/dev/null 2>"$work/.ieee"
 echo "allan_kalibr with the section: $(grep '^timings:' "$work/.ieee")   wall s / peak KB: $(cat "$work/.time")"
+
+echo
+echo "== scripts/bench_logs.sh (logs from outside ROS)"
+scripts/bench_logs.sh "$work/logs"

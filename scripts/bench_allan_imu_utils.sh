@@ -12,9 +12,10 @@
 # (with the IEEE 952 section) < 1.0 s, peak memory < 2x the sample columns (issue 10).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 runs="${2:-5}"
-target="${CARGO_TARGET_DIR:-target}"
-cargo build --release -q -p allan_imu_utils
+target=$(target_dir)
+build_release allan_imu_utils
 bin="$target/release/allan_imu_utils"
 bag="${1:-}"
 if [ -z "$bag" ]; then

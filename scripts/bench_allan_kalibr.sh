@@ -6,7 +6,7 @@
 # samples). No pass/fail: figures only.
 #
 # usage: scripts/bench_allan_kalibr.sh INPUT [--topic imu] [--update-rate HZ] [--no-bit-exact]
-# env:   CARGO_TARGET_DIR (default <repo>/target), BENCH_VENV (default $CARGO_TARGET_DIR/bench-venv),
+# env:   BENCH_VENV (default $CARGO_TARGET_DIR/bench-venv),
 #        BENCH_RUNS (default 3: best of N for the default path)
 set -euo pipefail
 
@@ -25,13 +25,13 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ -f "$INPUT" ]] || { echo "no such file: $INPUT" >&2; exit 2; }
-TARGET="${CARGO_TARGET_DIR:-$ROOT/target}"
+TARGET=$(cd "$ROOT" && . scripts/lib.sh && target_dir)
 VENV="${BENCH_VENV:-$TARGET/bench-venv}"
 RUNS="${BENCH_RUNS:-3}"
 PY=/usr/bin/python3 # Debian python: numpy/scipy come from the system (--system-site-packages)
 
 echo "== building (release)"
-(cd "$ROOT" && CARGO_TARGET_DIR="$TARGET" cargo build --release -q -p allan_kalibr -p bag2mat)
+(cd "$ROOT" && . scripts/lib.sh && build_release allan_kalibr bag2mat)
 AK="$TARGET/release/allan_kalibr"
 B2M="$TARGET/release/bag2mat"
 
@@ -54,7 +54,7 @@ run_ak() {
   /usr/bin/time -f "%e %M" -o "$WORK/time.txt" \
     "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings --compat-only -o "$out" "$@" \
     >"$WORK/stdout.txt" 2>"$WORK/stderr.txt"
-  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \4/')"
+  local t; t="$(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s, checks ([0-9.]+) s/\1 \2 \4/')"
   echo "$(cat "$WORK/time.txt") $t"
 }
 
@@ -92,7 +92,7 @@ for _ in $(seq "$RUNS"); do
   /usr/bin/time -f "%e %M" -o "$WORK/time.txt" \
     "$AK" "$INPUT" --topic "$TOPIC" "${RATE_ARGS[@]}" -q --timings -o "$WORK/outd" \
     >"$WORK/stdout.txt" 2>"$WORK/stderr.txt"
-  r="$(cat "$WORK/time.txt") $(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s/\1 \2 \3 \4/')"
+  r="$(cat "$WORK/time.txt") $(grep '^timings:' "$WORK/stderr.txt" | sed -E 's/timings: load ([0-9.]+) s, allan\+fit ([0-9.]+) s, ieee952 ([0-9.]+) s, outputs ([0-9.]+) s, checks ([0-9.]+) s/\1 \2 \3 \4/')"
   echo "   wall/maxrss/load/allan+fit/ieee952/outputs: $r"
   if [[ -z "$bestd" ]] || awk -v a="${r%% *}" -v b="${bestd%% *}" 'BEGIN{exit !(a<b)}'; then bestd="$r"; fi
 done

@@ -5,14 +5,14 @@
 # trajectory, integration and spline commands.
 #
 # usage: scripts/bench_sim.sh [WORKDIR]
-# env:   CARGO_TARGET_DIR (default <repo>/target), BENCH_RUNS (default 3)
+# env:   BENCH_RUNS (default 3)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WORK="${1:-$(mktemp -d /tmp/sim-bench.XXXXXX)}"
 mkdir -p "$WORK"
-TARGET="${CARGO_TARGET_DIR:-$ROOT/target}"
+TARGET=$(cd "$ROOT" && . scripts/lib.sh && target_dir)
 RUNS="${BENCH_RUNS:-3}"
-(cd "$ROOT" && cargo build --release --quiet -p sim)
+(cd "$ROOT" && . scripts/lib.sh && build_release sim)
 SIM="$TARGET/release/sim"
 echo "work dir: $WORK"
 

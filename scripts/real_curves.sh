@@ -6,9 +6,10 @@
 # IEEE 952 region readings) in DIR/real_curves.md; the charts are DIR/<IMU>/ieee952_allan.png.
 #
 # usage: scripts/real_curves.sh [--out DIR]   (default out/real_curves)
-# env: BIN_DIR: use these binaries instead of building target/release.
+# env: BIN_DIR: use these binaries instead of building the release ones (in cargo's target dir).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib.sh
 out=out/real_curves
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -17,8 +18,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 if [ -z "${BIN_DIR:-}" ]; then
-  cargo build --release --quiet -p allan_kalibr
-  BIN_DIR=target/release
+  build_release allan_kalibr
+  BIN_DIR="$(target_dir)/release"
 fi
 mkdir -p "$out"
 args=()

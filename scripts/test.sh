@@ -3,7 +3,7 @@
 # files with: Debian's python3-rosbag (rosbag info/check, python API), GNU Octave, scipy,
 # numpy, OpenCV's python bindings (cv2.FileStorage) and PyYAML; and, in a virtual environment
 # at target/py-venv, the independent ROS 2 implementations (rosbags, Foxglove's mcap and
-# mcap-ros2-support), pinned. Tests never skip for a missing tool: they fail.
+# mcap-ros2-support), pyulog, pymavlink and pandas, pinned. Tests never skip for a missing tool: they fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,11 +21,14 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need[@]}" >/dev/null
 fi
 
-# The ROS 2 cross-checks' tools, pinned (bag2mat::test_tools finds them here).
+# The independent readers the cross-checks run, pinned (bag2mat::test_tools finds them
+# here): the ROS 2 implementations; for the logs from outside ROS pyulog (ULog, also its
+# writer), pymavlink's DFReader (DataFlash) and pandas/numpy (CSV layouts); allantools (the
+# IEEE 952 curve against its oadev).
 venv=target/py-venv
-pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0)
-if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2" >/dev/null 2>&1 \
-   || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icE '^(rosbags==0.11.9|mcap==1.6.0|mcap-ros2-support==0.6.0)$')" != 3 ]; then
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6)
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools" >/dev/null 2>&1 \
+   || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icxF "$(printf '%s\n' "${pins[@]}")")" != ${#pins[@]} ]; then
   echo "installing ${pins[*]} into $venv"
   /usr/bin/python3 -m venv "$venv"
   "$venv/bin/python" -m pip install -q "${pins[@]}"
@@ -37,8 +40,11 @@ cargo test --workspace "$@"
 # about a minute on two cores in the optimised test build just made): every sim profile ×
 # 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
+# Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
+# runs beside them.
 cargo test -p allan_kalibr --lib -- --ignored --exact \
-  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study
+  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study \
+  ieee952::tests_lines::lines_study
 
 # Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
 # with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,

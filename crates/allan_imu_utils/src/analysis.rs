@@ -8,7 +8,7 @@ use crate::collect::Collected;
 use crate::error::Error;
 use crate::estimator;
 use crate::factors;
-use crate::fit::{AxisFit, IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR, Sensor};
+use crate::fit::{AxisFit, Sensor};
 
 /// Upstream's accumulator names, in creation order.
 pub const AXIS_NAMES: [&str; 6] = ["gyr x", "gyr y", "gyr z", "acc x", "acc y", "acc z"];
@@ -39,8 +39,6 @@ pub struct AxisAllan {
     pub variance: Vec<f64>,
     /// The IEEE 952 section's noise identification at each factor (empty unless asked for).
     pub noise_ids: Vec<allan_kalibr::ieee952::noise_id::NoiseId>,
-    /// The IEEE 952 warm-up check's statistics, in rad/s or m/s² (None unless asked for).
-    pub start: Option<allan_kalibr::ieee952::stationarity::StartStats>,
 }
 
 impl AxisAllan {
@@ -55,13 +53,13 @@ impl AxisAllan {
 /// non-finite value. One axis at a time: its θ (23 MB for a 4 h 200 Hz bag) stays in cache
 /// while both cores sweep the factors, and only one θ is alive. With `ieee`, also what the
 /// IEEE 952 section takes from θ while it is there: the noise identification at each factor
-/// and the warm-up statistics (no second pass over the samples).
+/// (no second pass over the samples).
 pub fn allan_step(
     c: &Collected<'_>,
     max_cluster: usize,
     ieee: bool,
 ) -> Result<(Vec<AxisAllan>, [f64; 3]), Error> {
-    use allan_kalibr::ieee952::{noise_id, stationarity::StartStats};
+    use allan_kalibr::ieee952::noise_id;
     let n = c.len();
     let period = estimator::mean_period(&c.t);
     let freq = 1.0 / period;
@@ -86,27 +84,12 @@ pub fn allan_step(
             continue;
         }
         let variance = estimator::allan_variance(&theta, &f, period);
-        let (noise_ids, start) = if ieee {
-            // θ[k] = (x[0] + … + x[k])/freq in the internal unit: back to SI running sums
-            let to_si = if axis < 3 {
-                IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR
-            } else {
-                1.0
-            };
-            let ids = f
-                .par_iter()
+        let noise_ids = if ieee {
+            f.par_iter()
                 .map(|&m| noise_id::identify_on(&theta, m))
-                .collect();
-            let start = StartStats::from_cumsum(n, period, |k| {
-                if k == 0 {
-                    0.0
-                } else {
-                    theta[k - 1] * freq / to_si
-                }
-            });
-            (ids, start)
+                .collect()
         } else {
-            (Vec::new(), None)
+            Vec::new()
         };
         axes.push(AxisAllan {
             name,
@@ -119,7 +102,6 @@ pub fn allan_step(
             taus: taus.clone(),
             variance,
             noise_ids,
-            start,
         });
     }
     if let Some((index, axis)) = first_bad {
@@ -163,7 +145,6 @@ impl Analysis {
             taus: t.to_vec(),
             variance: dev.iter().map(|d| d * d).collect(),
             noise_ids: Vec::new(),
-            start: None,
         };
         let axes = (0..3)
             .map(|k| axis(AXIS_NAMES[k], &raw.gyr_t, &raw.gyr[k]))

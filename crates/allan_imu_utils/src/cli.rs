@@ -27,7 +27,8 @@ pub const DEFAULT_MAX_CLUSTER: usize = 100;
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version, allow_negative_numbers = true)]
 pub struct Args {
-    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3.
+    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3;
+    /// or an IMU log (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
     #[arg(required_unless_present = "curves")]
     pub bag: Option<PathBuf>,
     /// Analyse existing Allan curves instead of a bag: an imu_utils data directory (then
@@ -46,12 +47,17 @@ pub struct Args {
     /// Number of samples behind --curves (for the confidence intervals).
     #[arg(long, value_name = "N")]
     pub samples: Option<u64>,
-    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, Hz.
+    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, or of a text log
+    /// without a time column, Hz.
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
     /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
     #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes (a sample far off its
+    /// neighbours, reported with its time) before the analysis.
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic then
     /// gets its own folder under the output directory [default: imu]
     #[arg(long = "topic", value_name = "TOPIC")]
@@ -90,6 +96,8 @@ pub struct Args {
     /// Only what imu_utils produces: skip the IEEE 952 section and its files
     #[arg(long)]
     pub compat_only: bool,
+    #[command(flatten)]
+    pub input_args: bag2mat::formats::InputArgs,
 }
 
 /// The time column.
@@ -119,6 +127,8 @@ pub struct Config {
     pub curves: Option<CurvesInput>,
     /// Seconds dropped at the start.
     pub skip_start: Option<f64>,
+    /// Drop the spikes the record check finds.
+    pub drop_outliers: bool,
     /// Topics (one unless several were asked for).
     pub topics: Vec<String>,
     /// Also every other Imu topic of the bag.
@@ -141,6 +151,9 @@ pub struct Config {
     pub timings: bool,
     /// Also run the IEEE 952 analysis (allan_kalibr::ieee952) beside the compat outputs.
     pub ieee952: bool,
+    /// What the user said about a log whose content does not say it all (a text log's
+    /// columns and units).
+    pub input_options: bag2mat::formats::InputOptions,
 }
 
 /// A positive whole number: "must be positive" for 0 and negatives (clap would otherwise
@@ -258,6 +271,7 @@ impl TryFrom<Args> for Config {
             bag: a.bag.unwrap_or_default(),
             curves,
             skip_start: a.skip_start,
+            drop_outliers: a.drop_outliers,
             topics,
             all_imu: a.all_imu_topics,
             time: match a.time {
@@ -272,6 +286,10 @@ impl TryFrom<Args> for Config {
             plots: !a.no_plots,
             timings: a.timings,
             ieee952: !a.compat_only,
+            // a text log without a time column is sampled at --rate
+            input_options: a
+                .input_args
+                .options(if a.curves.is_empty() { a.rate } else { None }),
         })
     }
 }

@@ -48,17 +48,26 @@ pub struct Collected<'a> {
     pub stop: Stop,
 }
 
-impl Collected<'_> {
+impl<'a> Collected<'a> {
     /// Number of samples used.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
-    /// The samples `range` (indices into the collected ones) only: a continuous stretch
-    /// when the record has gaps or rate changes (see [`bag2mat::timing`]).
-    pub fn restrict(&mut self, range: std::ops::Range<usize>) {
-        self.t = self.t[range.clone()].to_vec();
-        self.offset += range.start;
+    /// The first `n` messages of `series` on the chosen clock, collection having ended as
+    /// `stop` says (the messages the record check kept of a collection).
+    pub fn first(
+        series: &'a bag2mat::ImuSeries,
+        n: usize,
+        time: bag2mat::TimeColumn,
+        stop: Stop,
+    ) -> Collected<'a> {
+        Collected {
+            series,
+            offset: 0,
+            t: series.time(time)[..n].iter().map(|s| s.to_sec()).collect(),
+            stop,
+        }
     }
 
     fn used(&self) -> std::ops::Range<usize> {

@@ -72,6 +72,10 @@ fn main() -> ExitCode {
         for note in &outcome.notes {
             eprintln!("{}", cli::warning_line(note));
         }
+        // the record check's findings, always
+        for f in &outcome.findings {
+            eprintln!("{}", f.line(several.then_some(outcome.topic.as_str())));
+        }
         text.push_str(&outcome.stdout);
         if let Some(t) = &outcome.ieee952_text {
             text.push_str(t);

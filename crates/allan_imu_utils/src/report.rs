@@ -212,7 +212,6 @@ mod tests {
                     taus,
                     variance,
                     noise_ids: Vec::new(),
-                    start: None,
                 }
             })
             .collect();

@@ -26,6 +26,8 @@ pub struct Outcome {
     pub stdout: String,
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
     pub ieee952_text: Option<String>,
+    /// What the record check found (stderr, always).
+    pub findings: Vec<bag2mat::record_check::Finding>,
     /// Things to say on stderr (end of bag, topic fallback, …).
     pub notes: Vec<String>,
     /// Files written.
@@ -40,8 +42,10 @@ pub struct Outcome {
 
 /// The IEEE 952 curve of one axis from imu_utils' own Allan variances: the same overlapping
 /// estimator on its cluster grid, converted to SI (the gyro from pseudo-deg/h), with the
-/// noise identification the Allan step made on θ. No second pass over the samples.
-pub fn ieee952_curve(a: &AxisAllan, gyro: bool) -> CurveData {
+/// noise identification the Allan step made on θ, at the sample period `tau0` (the stamps'
+/// nominal one: imu_utils' variances at cluster m do not depend on the period it assumed,
+/// only their τ = m·period does). No second pass over the samples.
+pub fn ieee952_curve(a: &AxisAllan, gyro: bool, tau0: f64) -> CurveData {
     let scale = if gyro {
         1.0 / (IMU_UTILS_DEG_PER_RAD * SECONDS_PER_HOUR).powi(2)
     } else {
@@ -55,23 +59,44 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool) -> CurveData {
         .enumerate()
         // N − 2m ≤ 0 (the knife-edge last factor) has no estimate
         .filter(|(_, ((m, _), v))| 2 * **m < a.n && v.is_finite() && **v > 0.0)
-        .map(|(i, ((&m, &tau), &v))| {
+        .map(|(i, ((&m, _), &v))| {
             let id = a.noise_ids.get(i).copied();
             CurvePoint {
                 m,
-                tau,
+                tau: m as f64 * tau0,
                 avar: v * scale,
                 id: id.and_then(|x| x.alpha),
                 id_method: id.map_or(allan_kalibr::ieee952::IdMethod::None, |x| x.method),
             }
         })
         .collect();
-    CurveData {
-        tau0: a.period,
-        n: Some(a.n),
-        kind: Overlap::Overlapping,
-        points,
+    CurveData::from_points(tau0, Some(a.n), Overlap::Overlapping, points)
+}
+
+/// The record check of the first `n` messages of `series` on the chosen clock, the other
+/// cross-checked.
+fn check_record(
+    series: &bag2mat::ImuSeries,
+    n: usize,
+    config: &Config,
+) -> bag2mat::record_check::Check {
+    let (used, other) = match config.time {
+        bag2mat::TimeColumn::Header => (&series.stamp, &series.record_time),
+        bag2mat::TimeColumn::Record => (&series.record_time, &series.stamp),
+    };
+    let t = bag2mat::timing::ns_of_times(&used[..n]);
+    let o = bag2mat::timing::ns_of_times(&other[..n]);
+    let mut rec = bag2mat::record_check::Record::of_series(series, config.time, &t, &o);
+    rec.storage_order = rec.storage_order.map(|s| &s[..n]);
+    for v in rec.values.iter_mut() {
+        *v = &v[..n];
     }
+    bag2mat::record_check::check(
+        &rec,
+        &bag2mat::record_check::Options {
+            drop_outliers: config.drop_outliers,
+        },
+    )
 }
 
 /// Drops the messages whose header stamp is within `seconds` of the first (a warm-up), as
@@ -81,8 +106,7 @@ fn skip_start(
     seconds: f64,
 ) -> Result<(usize, Option<String>), Error> {
     let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
-    let (k, warning) =
-        allan_kalibr::ieee952::stationarity::checked_skip(&t, seconds).map_err(Error::Config)?;
+    let (k, warning) = bag2mat::record_check::checked_skip(&t, seconds).map_err(Error::Config)?;
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);
@@ -114,7 +138,7 @@ pub struct CurvesOutcome {
 /// into `out_dir`; with several, into `out_dir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
-    let read = bag2mat::read_imu_topics(
+    let read = bag2mat::series::read_imu_topics_with(
         &config.bag,
         &bag2mat::TopicSelector {
             topics: config.topics.clone(),
@@ -123,7 +147,11 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
         &bag2mat::ReadOptions {
             quiet: config.quiet,
         },
+        &config.input_options,
     )?;
+    for s in &read.series {
+        s.require_both_sensors()?;
+    }
     let read_time = t0.elapsed();
     let several = read.series.len() > 1 || config.all_imu;
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
@@ -165,30 +193,20 @@ fn run_series(
             config.max_time_min
         ));
     }
-    // The Allan variance assumes one constant rate with no gap: a record that is not one
-    // continuous stretch is cut to its longest (bag2mat::timing finds gaps and rate changes).
-    let mut collected = collected;
-    let mut tm = bag2mat::timing::analyse(&collected.t);
-    if !tm.is_continuous()
-        && let Some(seg) = tm.longest()
-    {
-        notes.push(format!(
-            "warning: the stamps of '{topic}' are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: messages {}..{} ({} of {})",
-            tm.describe(),
-            seg.start,
-            seg.end,
-            seg.len(),
-            collected.len()
-        ));
-        collected.restrict(seg.start..seg.end);
-        // the section reports the stamps of the analysed stretch
-        tm = bag2mat::timing::analyse(&collected.t);
-    } else if !tm.gaps.is_empty() {
-        notes.push(format!(
-            "warning: the stamps of '{topic}' have small gaps ({}); analysed as one record",
-            tm.describe()
-        ));
-    }
+    // The record check (bag2mat::record_check) on the collected messages: duplicates, a
+    // clock that steps back and a record that is not one continuous stretch are cut, spikes
+    // dropped when asked; what the record breaks of the analysis' assumptions is found.
+    let (n, stop) = (collected.len(), collected.stop);
+    drop(collected);
+    let t1 = Instant::now();
+    let check = check_record(&series, n, config);
+    timings.push(("record_check", t1.elapsed()));
+    let series = if check.keep.is_all() && n == series.len() {
+        series
+    } else {
+        check.keep.select_series(&series, n)
+    };
+    let collected = collect::Collected::first(&series, series.len(), config.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     let problems: Vec<_> = (0..collect::FIELDS.len())
         .into_par_iter()
@@ -211,30 +229,43 @@ fn run_series(
     let t1 = Instant::now();
     let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster, config.ieee952)?;
     timings.push(("allan", t1.elapsed()));
-    // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at its
-    // mean-period rate, plus the time-stamp checks.
+    // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at the stamps'
+    // nominal rate (lost samples do not change it; imu_utils' mean period does), with the
+    // record check's findings; not on a record that breaks its assumptions.
     let t1 = Instant::now();
-    let ieee = if config.ieee952 {
+    let section_rate = check
+        .rate
+        .map(allan_kalibr::input::snap_rate)
+        .unwrap_or(axes[0].freq);
+    if let (true, Some(r)) = (config.ieee952, check.refusal()) {
+        notes.push(format!(
+            "IEEE 952 section not computed: the record breaks its assumptions ({})",
+            r.short()
+        ));
+    }
+    let ieee = if config.ieee952 && check.refusal().is_none() {
+        // with the PSD and the lines of the samples (in SI units)
         let curves: Vec<CurveData> = axes
-            .iter()
+            .par_iter()
             .enumerate()
-            .map(|(i, a)| ieee952_curve(a, i < 3))
+            .map(|(i, a)| {
+                let y = if i < 3 {
+                    collected.gyro_rad_s(i)
+                } else {
+                    collected.acc_m_s2(i - 3)
+                };
+                ieee952_curve(a, i < 3, 1.0 / section_rate).with_spectrum(y)
+            })
             .collect();
         let mut it = curves.into_iter();
         let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
         let sensors = [(Sensor::Gyro, take3()), (Sensor::Acc, take3())];
         let mut an = imu::analyse_curves(
             &sensors,
-            axes[0].freq,
+            section_rate,
             &allan_kalibr::ieee952::Config::default(),
         );
-        let starts: Vec<_> = axes.iter().map(|a| a.start.clone()).collect();
-        imu::add_stationarity(&mut an, &starts, Some(tm));
-        notes.extend(
-            imu::warnings(&an)
-                .into_iter()
-                .map(|w| format!("warning: {w}")),
-        );
+        an.checks = check.findings.clone();
         Some(an)
     } else {
         None
@@ -266,10 +297,14 @@ fn run_series(
         files.extend(write_ieee952(an, config, &topic)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
+    let ieee952_text = ieee.as_ref().map(|a| {
+        imu::summary_text(a) + &allan_kalibr::ieee952::stated::beside_ours(a, &config.bag, &topic)
+    });
     Ok(Outcome {
         topic,
         stdout: report::stdout_text(&analysis),
-        ieee952_text: ieee.as_ref().map(imu::summary_text),
+        ieee952_text,
+        findings: check.findings,
         notes,
         files,
         analysis,

@@ -1,6 +1,6 @@
 //! Shared helpers: where the reference cases live and how their dumps are parsed.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The workspace's testdata directory.
 pub fn testdata() -> PathBuf {
@@ -119,4 +119,48 @@ pub fn rel_err(actual: f64, expected: f64) -> f64 {
         return 0.0;
     }
     ((actual - expected) / expected).abs()
+}
+
+/// allan_imu_utils' settings for `topic` of `bag` into `out` (IMU name `x`, header time,
+/// quiet, no plots), as the command line would give them.
+pub fn imu_utils_config(bag: &Path, topic: &str, out: &Path) -> allan_imu_utils::cli::Config {
+    allan_imu_utils::cli::Config {
+        bag: bag.to_path_buf(),
+        topics: vec![topic.into()],
+        all_imu: false,
+        time: bag2mat::TimeColumn::Header,
+        name: "x".into(),
+        out_dir: out.to_path_buf(),
+        max_time_min: 120,
+        max_cluster: 100,
+        quiet: true,
+        plots: false,
+        timings: false,
+        ieee952: true,
+        curves: None,
+        skip_start: None,
+        drop_outliers: false,
+        input_options: Default::default(),
+    }
+}
+
+/// allan_kalibr's settings for `topic` of `bag` into `out` (record time, rate from the
+/// stamps, quiet), as the command line would give them.
+pub fn kalibr_config(bag: &Path, topic: &str, out: &Path) -> allan_kalibr::Config {
+    allan_kalibr::Config {
+        input: bag.to_path_buf(),
+        topics: bag2mat::TopicSelector::one(topic),
+        time: bag2mat::TimeColumn::Record,
+        update_rate: None,
+        title: "t".into(),
+        estimator: allan_kalibr::estimator::Estimator::PrefixSum,
+        outdir: out.to_path_buf(),
+        quiet: true,
+        timings: false,
+        ieee952: true,
+        skip_start: None,
+        drop_outliers: false,
+        curves: None,
+        input_options: Default::default(),
+    }
 }

@@ -44,6 +44,8 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
         ieee952: false,
         curves: None,
         skip_start: None,
+        input_options: Default::default(),
+        drop_outliers: false,
     };
     run(&config)
         .unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))

@@ -8,24 +8,12 @@ use std::path::Path;
 use allan_imu_utils::cli::Config;
 use bag2mat::test_tools::{ROS2_MODES, rosbags_convert};
 
-use crate::common::CASES;
+use crate::common::{CASES, imu_utils_config, kalibr_config};
 
 fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let c = Config {
-        bag: bag.to_path_buf(),
-        topics: vec![topic.into()],
-        all_imu: false,
-        time: bag2mat::TimeColumn::Header,
-        name: "x".into(),
-        out_dir: out.to_path_buf(),
-        max_time_min: 120,
-        max_cluster: 100,
-        quiet: true,
-        plots: false,
-        timings: false,
         ieee952: false,
-        curves: None,
-        skip_start: None,
+        ..imu_utils_config(bag, topic, out)
     };
     let o = allan_imu_utils::run::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
@@ -36,18 +24,8 @@ fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
 
 fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let c = allan_kalibr::Config {
-        input: bag.to_path_buf(),
-        topics: bag2mat::TopicSelector::one(topic),
-        time: bag2mat::TimeColumn::Record,
-        update_rate: None,
-        title: "t".into(),
-        estimator: allan_kalibr::estimator::Estimator::PrefixSum,
-        outdir: out.to_path_buf(),
-        quiet: true,
-        timings: false,
         ieee952: false,
-        skip_start: None,
-        curves: None,
+        ..kalibr_config(bag, topic, out)
     };
     let o = allan_kalibr::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))

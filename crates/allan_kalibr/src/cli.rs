@@ -16,12 +16,13 @@ use crate::run::Config;
 ///
 /// Then the IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted
 /// range and fit quality per axis, recording-length advice, warm-up and gap checks,
-/// ieee952_terms.csv, ieee952_curves.csv, ieee952_allan.{png,svg} and Kalibr/VINS/ORB-SLAM3
-/// yaml files. With --curves it analyses Allan curves another tool wrote instead of samples.
+/// ieee952_terms.csv, ieee952_curves.csv, ieee952_psd.csv, ieee952_allan.{png,svg},
+/// ieee952_psd.{png,svg} and Kalibr/VINS/ORB-SLAM3/OpenVINS/Basalt files. With --curves it analyses Allan curves another tool wrote instead of samples.
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {
-    /// Input: a .bag or a .mat holding data_imu (N x 7: t ax ay az wx wy wz).
+    /// Input: a bag, a .mat holding data_imu (N x 7: t ax ay az wx wy wz), or an IMU log
+    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
     #[arg(required_unless_present = "curves")]
     pub input: Option<PathBuf>,
     /// Analyse existing Allan curves instead (IEEE 952 section only): an imu_utils data
@@ -43,6 +44,10 @@ pub struct Args {
     /// Drop the first SECONDS of the record (a warm-up) before any analysis.
     #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
     pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes (a sample far off its
+    /// neighbours, reported with its time) before any analysis.
+    #[arg(long)]
+    pub drop_outliers: bool,
     /// IMU topic in the bag (ignored for .mat except as rostopic in imu.yaml); repeatable,
     /// each topic then gets its own folder under the output directory [default: imu].
     #[arg(long = "topic", value_name = "TOPIC")]
@@ -84,6 +89,8 @@ pub struct Args {
     /// Print the wall time of each phase (load, allan+fit, outputs) on stderr.
     #[arg(long)]
     pub timings: bool,
+    #[command(flatten)]
+    pub input_args: bag2mat::formats::InputArgs,
 }
 
 /// The slowest update rate accepted, Hz: below it a τ grid of seconds-to-hours is meaningless
@@ -166,6 +173,7 @@ impl From<Args> for Config {
         });
         Config {
             skip_start: a.skip_start,
+            drop_outliers: a.drop_outliers,
             curves,
             input,
             topics: bag2mat::TopicSelector {
@@ -191,6 +199,8 @@ impl From<Args> for Config {
             quiet: a.quiet,
             ieee952: !a.compat_only,
             timings: a.timings,
+            // a text log without a time column is sampled at --update-rate
+            input_options: a.input_args.options(a.update_rate),
         }
     }
 }

@@ -2,15 +2,15 @@
 //! as bagconvert does) and choosing the update rate that drives the τ grid.
 //!
 //! Upstream never looks at the timestamps except to count them (kalibr_allan.md §2): the
-//! user types the rate into the script. Here the rate is estimated from the timestamps when
-//! not given, and a given rate that disagrees with them by more than 1 % gets a warning.
+//! user types the rate into the script. Here the rate is the stamps' nominal rate
+//! (`bag2mat::timing`: lost samples do not change it) when not given; a given rate the stamps
+//! contradict (`bag2mat::record_check::rate_argument`) still drives the upstream-compatible
+//! grid, as upstream, and the IEEE 952 section uses the measured one.
 
 use std::path::Path;
 
 use crate::error::Error;
 
-/// A relative disagreement between the given and the measured rate above which we warn.
-pub const RATE_WARN_REL: f64 = 0.01;
 /// An estimated rate within this relative distance of an integer is rounded to it
 /// (timestamps of a 200 Hz IMU give 199.99…, and the grid wants the nominal rate).
 pub const RATE_SNAP_REL: f64 = 0.005;
@@ -26,6 +26,25 @@ pub struct ImuData {
     pub topic: Option<String>,
     /// Messages for the user (bag2mat's notes).
     pub notes: Vec<String>,
+    /// The stamps in nanoseconds and what the record check needs besides the samples.
+    pub clock: Clock,
+}
+
+/// The clock side of [`ImuData`], for `bag2mat::record_check`: the time column in exact
+/// nanoseconds (a bag's stamps; a `.mat`'s seconds as they are), the other clock of a bag,
+/// the storage order when the reader sorted, and the container's promised count.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Clock {
+    /// Which clock `t` is.
+    pub time: bag2mat::TimeColumn,
+    /// `t` in ns.
+    pub t_ns: Vec<i64>,
+    /// The other clock (header.stamp beside the record time, or the other way), ns.
+    pub other_ns: Option<Vec<i64>>,
+    /// Storage position of each sample, when the reader sorted them by record time.
+    pub storage_order: Option<Vec<u32>>,
+    /// Messages promised and rows delivered on the topic.
+    pub promised: Option<(u64, u64)>,
 }
 
 impl ImuData {
@@ -41,25 +60,77 @@ impl ImuData {
 
     /// Builds the columns from a bag2mat series with the chosen time column (bagconvert's
     /// record time by default), through bag2mat's one series-to-matrix conversion.
-    pub fn from_series(s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
+    pub fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
         let topic = s.topic.clone();
         let notes = s.notes.clone();
+        let (used, other) = match time {
+            bag2mat::TimeColumn::Record => (&s.record_time, &s.stamp),
+            bag2mat::TimeColumn::Header => (&s.stamp, &s.record_time),
+        };
+        let clock = Clock {
+            time,
+            t_ns: bag2mat::timing::ns_of_times(used),
+            other_ns: Some(bag2mat::timing::ns_of_times(other)),
+            storage_order: s.storage_order.take(),
+            promised: s.report.promised.map(|p| (p, s.report.delivered)),
+        };
         let [t, ax, ay, az, wx, wy, wz] = bag2mat::convert::into_data_imu(s, time).columns;
         ImuData {
             t,
             axes: [ax, ay, az, wx, wy, wz],
             topic: Some(topic),
             notes,
+            clock,
         }
     }
 
-    /// Samples `range` only.
-    pub fn slice(&self, range: std::ops::Range<usize>) -> ImuData {
+    /// The samples `keep` names (all of them: unchanged).
+    pub fn select(self, keep: &bag2mat::record_check::Keep) -> ImuData {
+        if keep.is_all() {
+            return self;
+        }
+        let c = &self.clock;
         ImuData {
-            t: self.t[range.clone()].to_vec(),
-            axes: std::array::from_fn(|a| self.axes[a][range.clone()].to_vec()),
+            t: keep.apply(&self.t).into_owned(),
+            axes: std::array::from_fn(|a| keep.apply(&self.axes[a]).into_owned()),
             topic: self.topic.clone(),
             notes: self.notes.clone(),
+            clock: Clock {
+                time: c.time,
+                t_ns: keep.apply(&c.t_ns).into_owned(),
+                other_ns: c.other_ns.as_ref().map(|o| keep.apply(o).into_owned()),
+                storage_order: None,
+                promised: c.promised,
+            },
+        }
+    }
+
+    /// Drops the first `k` samples.
+    pub fn drop_first(&mut self, k: usize) {
+        self.t.drain(..k);
+        for c in self.axes.iter_mut() {
+            c.drain(..k);
+        }
+        let c = &mut self.clock;
+        c.t_ns.drain(..k.min(c.t_ns.len()));
+        if let Some(o) = c.other_ns.as_mut() {
+            o.drain(..k.min(o.len()));
+        }
+        if let Some(o) = c.storage_order.as_mut() {
+            o.drain(..k.min(o.len()));
+        }
+    }
+
+    /// The record the check reads: gyro x y z, then acc x y z, with the clock.
+    pub fn record(&self) -> bag2mat::record_check::Record<'_> {
+        let a = &self.axes;
+        bag2mat::record_check::Record {
+            time: self.clock.time,
+            t: &self.clock.t_ns,
+            other: self.clock.other_ns.as_deref(),
+            storage_order: self.clock.storage_order.as_deref(),
+            values: [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]],
+            promised: self.clock.promised,
         }
     }
 
@@ -102,25 +173,31 @@ fn is_mat(path: &Path) -> bool {
 /// Reads one topic of a bag (any format bag2mat reads) or a `.mat` (variable `data_imu`).
 pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
     let sel = bag2mat::TopicSelector::one(topic);
-    Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet)?.remove(0))
+    let opts = bag2mat::formats::InputOptions::default();
+    Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet, &opts)?.remove(0))
 }
 
-/// Reads the selected topics of a bag in one pass, or the one `data_imu` of a `.mat`.
+/// Reads the selected topics of a bag or log in one pass, or the one `data_imu` of a `.mat`.
 pub fn load_all(
     path: &Path,
     sel: &bag2mat::TopicSelector,
     time: bag2mat::TimeColumn,
     quiet: bool,
+    opts: &bag2mat::formats::InputOptions,
 ) -> Result<Vec<ImuData>, Error> {
     if is_mat(path) {
         return Ok(vec![load_mat(path)?]);
     }
-    match bag2mat::read_imu_topics(path, sel, &bag2mat::ReadOptions { quiet }) {
-        Ok(r) => Ok(r
-            .series
-            .into_iter()
-            .map(|s| ImuData::from_series(s, time))
-            .collect()),
+    match bag2mat::series::read_imu_topics_with(path, sel, &bag2mat::ReadOptions { quiet }, opts) {
+        Ok(r) => {
+            for s in &r.series {
+                s.require_both_sensors()?;
+            }
+            Ok(r.series
+                .into_iter()
+                .map(|s| ImuData::from_series(s, time))
+                .collect())
+        }
         Err(bag2mat::Error::NotABag { .. }) => Err(Error::UnknownInput {
             path: path.to_path_buf(),
         }),
@@ -131,11 +208,17 @@ pub fn load_all(
 fn load_mat(path: &Path) -> Result<ImuData, Error> {
     let d = bag2mat::mat::read_data_imu(path)?;
     let [t, ax, ay, az, wx, wy, wz] = d.columns;
+    let clock = Clock {
+        time: bag2mat::TimeColumn::Record,
+        t_ns: bag2mat::timing::ns_of_seconds(&t),
+        ..Clock::default()
+    };
     Ok(ImuData {
         t,
         axes: [ax, ay, az, wx, wy, wz],
         topic: None,
         notes: Vec::new(),
+        clock,
     })
 }
 
@@ -251,65 +334,79 @@ fn value_problem_slow(axis: &str, col: &[f64]) -> Option<(bool, String)> {
 /// The rate used for the grid and what to tell the user about it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RateChoice {
-    /// Hz, drives the τ grid.
+    /// Hz, drives the τ grid of the upstream-compatible part.
     pub used: f64,
-    /// `(N-1)/(t_N - t_1)` of the analysed stretch, when the timestamps allow it.
+    /// The nominal rate of the analysed stamps (`bag2mat::timing`), when they allow one.
     pub measured: Option<f64>,
-    /// An info line (estimated) or a warning (disagreement), for stderr.
+    /// The rate the IEEE 952 section uses: the stamps' (snapped as [`snap_rate`]), unless
+    /// the given rate agrees with them (`bag2mat::record_check::RATE_ARGUMENT_REL`) or they
+    /// give none.
+    pub section: f64,
+    /// An info line (estimated), for stderr.
     pub message: Option<String>,
+    /// A given rate the stamps contradict.
+    pub finding: Option<bag2mat::record_check::Finding>,
 }
 
-/// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span. The run
-/// first cuts a record with gaps or rate changes to its longest continuous stretch
-/// (bag2mat::timing, median period), so a gap never lowers this; on continuous data the
-/// mean is exact where a median of intervals of large absolute times is quantised.
+/// A rate from the stamps within [`RATE_SNAP_REL`] of an integer is that integer.
+pub fn snap_rate(m: f64) -> f64 {
+    let r = m.round();
+    if r >= 1.0 && ((m - r) / r).abs() <= RATE_SNAP_REL {
+        r
+    } else {
+        m
+    }
+}
+
+/// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span (the
+/// obviously correct reference of the nominal rate on a record without gaps).
 pub fn measured_rate(t: &[f64]) -> Option<f64> {
     let (first, last) = (t.first()?, t.last()?);
     let span = last - first;
     (t.len() >= 2 && span.is_finite() && span > 0.0).then(|| (t.len() - 1) as f64 / span)
 }
 
-/// Chooses the update rate: the given one (warning if the timestamps disagree by more than
-/// [`RATE_WARN_REL`]) or the measured one, snapped to an integer within [`RATE_SNAP_REL`].
-pub fn choose_rate(given: Option<f64>, t: &[f64]) -> Result<RateChoice, Error> {
-    let measured = measured_rate(t);
+/// Chooses the update rate from the given one and the stamps' nominal rate `measured`
+/// (`bag2mat::timing`: lost samples do not change it): the given one for the
+/// upstream-compatible grid (as upstream), the measured one, snapped to an integer within
+/// [`RATE_SNAP_REL`], otherwise and for the IEEE 952 section.
+pub fn choose_rate(
+    given: Option<f64>,
+    measured: Option<f64>,
+    n: usize,
+) -> Result<RateChoice, Error> {
     match given {
         Some(rate) => {
             if !(rate.is_finite() && rate > 0.0) {
                 return Err(Error::BadRate(rate));
             }
-            let message = measured
-                .filter(|m| ((m - rate) / rate).abs() > RATE_WARN_REL)
-                .map(|m| {
-                    format!(
-                        "warning: --update-rate {rate} Hz but the timestamps give {m:.4} Hz \
-                     ({:+.2} %); the grid uses {rate} Hz as upstream would",
-                        (m - rate) / rate * 100.0
-                    )
-                });
+            let finding = measured.and_then(|m| bag2mat::record_check::rate_argument(rate, m));
+            let section = match (measured, &finding) {
+                (Some(m), Some(_)) => snap_rate(m),
+                _ => rate,
+            };
             Ok(RateChoice {
                 used: rate,
                 measured,
-                message,
+                section,
+                message: None,
+                finding,
             })
         }
         None => {
             let m = measured.ok_or_else(|| Error::NoRate {
-                what: format!("{} samples, no positive time span", t.len()),
+                what: format!("{n} samples, no positive time span"),
             })?;
-            let r = m.round();
-            let used = if r >= 1.0 && ((m - r) / r).abs() <= RATE_SNAP_REL {
-                r
-            } else {
-                m
-            };
+            let used = snap_rate(m);
             let message = Some(format!(
                 "update rate: {used} Hz (estimated from the timestamps: {m:.4} Hz; pass --update-rate to override)"
             ));
             Ok(RateChoice {
                 used,
                 measured,
+                section: used,
                 message,
+                finding: None,
             })
         }
     }
@@ -321,6 +418,11 @@ mod tests {
 
     fn times(n: usize, rate: f64) -> Vec<f64> {
         (0..n).map(|i| 1.6e9 + i as f64 / rate).collect()
+    }
+
+    /// The nominal rate of `t`, as the run measures it.
+    fn nominal(t: &[f64]) -> Option<f64> {
+        bag2mat::timing::analyse(&bag2mat::timing::ns_of_seconds(t)).nominal_rate()
     }
 
     #[test]
@@ -359,10 +461,12 @@ mod tests {
 
     #[test]
     fn estimated_rate_snaps_to_integer() {
-        let c = choose_rate(None, &times(1000, 200.0)).unwrap();
+        let t = times(1000, 200.0);
+        let c = choose_rate(None, nominal(&t), t.len()).unwrap();
         assert_eq!(c.used, 200.0);
         assert!(c.message.unwrap().contains("estimated"));
-        let c = choose_rate(None, &times(1000, 12.34)).unwrap();
+        let t = times(1000, 12.34);
+        let c = choose_rate(None, nominal(&t), t.len()).unwrap();
         // Absolute times near 1.6e9 s carry ~2.4e-7 s of rounding each.
         const ABS_TIME_REL_TOL: f64 = 1e-7;
         assert!(
@@ -375,27 +479,31 @@ mod tests {
     #[test]
     fn given_rate_warns_only_beyond_one_percent() {
         let t = times(1000, 200.0);
-        assert!(choose_rate(Some(200.0), &t).unwrap().message.is_none());
-        assert!(choose_rate(Some(201.0), &t).unwrap().message.is_none());
-        let c = choose_rate(Some(100.0), &t).unwrap();
+        let m = nominal(&t);
+        assert!(choose_rate(Some(200.0), m, 1000).unwrap().finding.is_none());
+        let c = choose_rate(Some(201.0), m, 1000).unwrap();
+        assert!(c.finding.is_none());
+        assert_eq!(c.section, 201.0);
+        let c = choose_rate(Some(100.0), m, 1000).unwrap();
         assert_eq!(c.used, 100.0);
-        assert!(c.message.unwrap().starts_with("warning"));
+        assert_eq!(c.section, 200.0);
+        assert!(c.finding.is_some());
     }
 
     #[test]
     fn no_rate_without_span() {
         assert!(matches!(
-            choose_rate(None, &[1.0]),
+            choose_rate(None, nominal(&[1.0]), 1),
             Err(Error::NoRate { .. })
         ));
         assert!(matches!(
-            choose_rate(None, &[1.0, 1.0]),
+            choose_rate(None, nominal(&[1.0, 1.0]), 2),
             Err(Error::NoRate { .. })
         ));
         assert!(matches!(
-            choose_rate(Some(-1.0), &[]),
+            choose_rate(Some(-1.0), None, 0),
             Err(Error::BadRate(_))
         ));
-        assert_eq!(choose_rate(Some(50.0), &[]).unwrap().used, 50.0);
+        assert_eq!(choose_rate(Some(50.0), None, 0).unwrap().used, 50.0);
     }
 }

@@ -23,7 +23,8 @@
 //!   ([`ieee952::avar_cov`]) with a model-discrepancy component, on the τ range the model
 //!   can describe ([`ieee952::fit`]); per-axis verdicts and per-term 95 % intervals, the IEEE
 //!   952 region readings as cross-check and fallback ([`ieee952::region`]); record-length
-//!   advice ([`ieee952::advisor`]); warm-up, gap and rate checks ([`ieee952::stationarity`]);
+//!   advice ([`ieee952::advisor`]); the record check's findings named in the verdicts
+//!   (`bag2mat::record_check`: clocks, gaps, outliers, warm-up, motion);
 //!   other tools' Allan curves (`--curves`, [`ieee952::curves_in`]); the section's text
 //!   ([`ieee952::imu`]), its files (terms and curves CSV, Kalibr/VINS/ORB-SLAM3 yaml, with
 //!   named columns `sim compare` reads: [`ieee952::files`]) and chart ([`ieee952::plot`]).

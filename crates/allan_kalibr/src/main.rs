@@ -72,13 +72,17 @@ fn main() -> ExitCode {
                 out.topic.as_deref().unwrap_or("?")
             ));
         }
+        // The reader's warnings always, other notes (the estimated rate) only without
+        // --quiet; then the record check's findings, always.
         for n in &out.notes {
-            // Warnings always; other notes (the estimated rate) only without --quiet.
             if n.to_ascii_lowercase().starts_with("warning") {
                 eprintln!("{}", cli::warning_line(n));
             } else if !config.quiet {
                 eprintln!("{n}");
             }
+        }
+        for f in &out.findings {
+            eprintln!("{}", f.line(out.topic.as_deref().filter(|_| several)));
         }
         text.push_str(&out.text);
         if let Some(t) = &out.ieee952_text {

@@ -41,8 +41,13 @@ pub struct Config {
     pub ieee952: bool,
     /// Seconds dropped at the start of the record (a warm-up), before everything.
     pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes, before everything else.
+    pub drop_outliers: bool,
     /// Analyse other tools' Allan curves instead of samples (`--curves`).
     pub curves: Option<CurvesInput>,
+    /// What the user said about a log whose content does not say it all (a text log's
+    /// columns and units).
+    pub input_options: bag2mat::formats::InputOptions,
 }
 
 /// `--curves`: the files and what the user said about them.
@@ -105,6 +110,8 @@ pub struct RunOutput {
     pub text: String,
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
     pub ieee952_text: Option<String>,
+    /// What the record check found (stderr, always).
+    pub findings: Vec<bag2mat::record_check::Finding>,
     /// Notes and warnings (stderr), in order.
     pub notes: Vec<String>,
     /// Files written.
@@ -125,14 +132,16 @@ pub struct Timings {
     pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
+    /// The record check (`bag2mat::record_check`).
+    pub checks: f64,
 }
 
 impl std::fmt::Display for Timings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "timings: load {:.3} s, allan+fit {:.3} s, ieee952 {:.3} s, outputs {:.3} s",
-            self.load, self.analyse, self.ieee952, self.output
+            "timings: load {:.3} s, allan+fit {:.3} s, ieee952 {:.3} s, outputs {:.3} s, checks {:.3} s",
+            self.load, self.analyse, self.ieee952, self.output, self.checks
         )
     }
 }
@@ -141,7 +150,13 @@ impl std::fmt::Display for Timings {
 /// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     let start = Instant::now();
-    let datas = input::load_all(&config.input, &config.topics, config.time, config.quiet)?;
+    let datas = input::load_all(
+        &config.input,
+        &config.topics,
+        config.time,
+        config.quiet,
+        &config.input_options,
+    )?;
     let load = start.elapsed().as_secs_f64();
     let several = datas.len() > 1 || config.topics.all_imu;
     let names: Vec<String> = datas
@@ -179,48 +194,30 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
     }
-    // One pass per column for the finiteness check and the value checks below, beside the
-    // stamps' analysis: the Allan variance assumes one constant rate with no gap, so a record
-    // that is not one continuous stretch is cut to its longest (bag2mat::timing finds gaps
-    // and rate changes).
-    let (scans, tm) = rayon::join(|| data.scan_checked(), || bag2mat::timing::analyse(&data.t));
-    let scans = scans?;
-    let cut = tm.longest().filter(|_| !tm.is_continuous());
-    let data = match cut {
-        Some(seg) => {
-            notes.push(format!(
-                "warning: the timestamps are not one continuous record ({}); an Allan variance across it would be meaningless, so only its longest continuous stretch is analysed: samples {}..{} ({} of {})",
-                tm.describe(),
-                seg.start,
-                seg.end,
-                seg.len(),
-                data.len()
-            ));
-            let d = data.slice(seg.start..seg.end);
-            if d.len() < 3 {
-                return Err(Error::TooShort { n: d.len() });
-            }
-            d
-        }
-        _ => {
-            if !tm.gaps.is_empty() {
-                notes.push(format!(
-                    "warning: the timestamps have small gaps ({}); analysed as one record",
-                    tm.describe()
-                ));
-            }
-            data
-        }
-    };
-    // The stamps' analysis and the column scans describe the analysed samples unless the
-    // record was cut (then the stretch is looked at again).
-    let (tm, scans) = if cut.is_none() {
-        (tm, scans)
+    // One pass per column for the finiteness check and the value checks below; then the
+    // record check (bag2mat::record_check): duplicates, a clock that steps back and a record
+    // that is not one continuous stretch are cut, spikes dropped when asked, and what the
+    // record breaks of the analysis' assumptions is found.
+    let scans = data.scan_checked()?;
+    let checks_start = Instant::now();
+    let check = bag2mat::record_check::check(
+        &data.record(),
+        &bag2mat::record_check::Options {
+            drop_outliers: config.drop_outliers,
+        },
+    );
+    let checks_s = checks_start.elapsed().as_secs_f64();
+    let mut findings = check.findings.clone();
+    let whole = check.keep.is_all();
+    let data = data.select(&check.keep);
+    if data.len() < 3 {
+        return Err(Error::TooShort { n: data.len() });
+    }
+    // the column scans describe the analysed samples unless some were left out
+    let scans = if whole {
+        scans
     } else {
-        (
-            bag2mat::timing::analyse(&data.t),
-            std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a])),
-        )
+        std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a]))
     };
     for (name, scan) in input::AXIS_NAMES.iter().zip(&scans) {
         match scan.problem(name) {
@@ -229,8 +226,9 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             None => {}
         }
     }
-    let rate = input::choose_rate(config.update_rate, &data.t)?;
+    let rate = input::choose_rate(config.update_rate, check.rate, data.len())?;
     notes.extend(rate.message.clone());
+    findings.extend(rate.finding.clone());
     let topic = data.topic.clone().unwrap_or_else(|| {
         config
             .topics
@@ -243,7 +241,14 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // path turns them into prefix sums; its fits then run beside the compat path. Data too
     // short for it only cost the section, with a note.
     let start = Instant::now();
-    let curves = if config.ieee952 {
+    let refusal = check.refusal().cloned();
+    if let (true, Some(r)) = (config.ieee952, &refusal) {
+        notes.push(format!(
+            "IEEE 952 section not computed: the record breaks its assumptions ({})",
+            r.short()
+        ));
+    }
+    let curves = if config.ieee952 && refusal.is_none() {
         let a = &data.axes;
         let series = [
             &a[3][..],
@@ -253,7 +258,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             &a[1][..],
             &a[2][..],
         ];
-        crate::ieee952::imu::section_curves(series, rate.used, &mut notes)
+        crate::ieee952::imu::section_curves(series, rate.section, &mut notes)
     } else {
         None
     };
@@ -264,7 +269,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             let start = Instant::now();
             let an = curves
                 .as_ref()
-                .map(|c| c.finish(Some(tm), &crate::ieee952::Config::default()));
+                .map(|c| c.finish(findings.clone(), &crate::ieee952::Config::default()));
             (an, start.elapsed().as_secs_f64())
         },
         || {
@@ -342,13 +347,6 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             Ok(w)
         },
     );
-    if let Some(an) = &ieee {
-        notes.extend(
-            crate::ieee952::imu::warnings(an)
-                .into_iter()
-                .map(|w| format!("warning: {w}")),
-        );
-    }
     written.extend(compat_plots?);
     written.extend(section_files?);
     let timings = Timings {
@@ -356,13 +354,18 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         analyse: analyse_s,
         ieee952: ieee_s,
         output: start.elapsed().as_secs_f64(),
+        checks: checks_s,
     };
     Ok(RunOutput {
         topic: data_topic,
         analysis,
         rate,
         text,
-        ieee952_text: ieee.as_ref().map(crate::ieee952::imu::summary_text),
+        ieee952_text: ieee.as_ref().map(|a| {
+            crate::ieee952::imu::summary_text(a)
+                + &crate::ieee952::stated::beside_ours(a, &config.input, &topic)
+        }),
+        findings,
         notes,
         written,
         timings,
@@ -372,12 +375,9 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
 /// Drops the samples of the first `seconds` of the record; returns how many, and a
 /// warning when that is most of it.
 fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
-    let (k, warning) = crate::ieee952::stationarity::checked_skip(&data.t, seconds)
+    let (k, warning) = bag2mat::record_check::checked_skip(&data.t, seconds)
         .map_err(|what| Error::BadData { what })?;
-    data.t.drain(..k);
-    for c in data.axes.iter_mut() {
-        c.drain(..k);
-    }
+    data.drop_first(k);
     Ok((k, warning))
 }
 

@@ -63,14 +63,19 @@ fn assert_no_outputs(dir: &Path) {
 /// The line that opens the IEEE 952 section after upstream's text.
 const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
 /// What the IEEE 952 section writes beside the compat outputs.
-const IEEE_OUTPUTS: [&str; 7] = [
+const IEEE_OUTPUTS: [&str; 12] = [
     "ieee952_terms.csv",
     "ieee952_curves.csv",
+    "ieee952_psd.csv",
     "kalibr_imu_ieee952.yaml",
     "vins_imu_ieee952.yaml",
     "orbslam3_imu_ieee952.yaml",
+    "openvins_kalibr_imu_chain_ieee952.yaml",
+    "basalt_imu_noise_ieee952.json",
     "ieee952_allan.png",
     "ieee952_allan.svg",
+    "ieee952_psd.png",
+    "ieee952_psd.svg",
 ];
 
 /// p3 (uncompressed, 61 s): stdout is upstream's text, imu.yaml holds the four numbers.
@@ -210,7 +215,8 @@ fn mat_input_matches_bag_input() {
     ]);
     assert!(warn.status.success(), "stderr: {}", s(&warn.stderr));
     assert!(
-        s(&warn.stderr).contains("warning: --update-rate 100 Hz but the timestamps give 200"),
+        s(&warn.stderr)
+            .contains("warning: update rate: --update-rate 100 Hz but the stamps give 200"),
         "stderr: {}",
         s(&warn.stderr)
     );
@@ -241,6 +247,16 @@ fn unknown_extension_and_wrong_topic_are_clear_errors() {
     let txt = tmp.path().join("data.txt");
     std::fs::write(&txt, "1 2 3\n").unwrap();
     let o = run(&[txt.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    // numbers in a text file are a text log (issue 20): the error says what to add
+    assert!(
+        s(&o.stderr).contains("no header line naming its 3 columns: give them with --columns"),
+        "{}",
+        s(&o.stderr)
+    );
+    let bin = tmp.path().join("data.bin");
+    std::fs::write(&bin, [0u8, 7, 200, 1]).unwrap();
+    let o = run(&[bin.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(
         s(&o.stderr).contains("expected a .mat file or a bag"),
@@ -547,8 +563,9 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
         "rate not from the median period: {err}"
     );
     assert!(
-        err.contains("warning: the timestamps are not one continuous record")
-            && err.contains("1 gap"),
+        err.contains("warning: gaps:")
+            && err.contains("in 1 gap(s)")
+            && err.contains("not one continuous record"),
         "{err}"
     );
     // The same numbers (the first line names the input file).

@@ -1,6 +1,7 @@
 //! The IEEE 952 configuration files read by the parsers their consumers use: Kalibr loads
 //! `imu.yaml` with PyYAML; VINS-Mono/VINS-Fusion and ORB-SLAM3 read their settings with
-//! OpenCV's `cv2.FileStorage`. Run on p4 (60 min at 100 Hz), whose terms are all resolved
+//! OpenCV's `cv2.FileStorage`, and so does OpenVINS for its `kalibr_imu_chain.yaml`; Basalt's
+//! noise fields are JSON (Python's `json`). Run on p4 (60 min at 100 Hz), whose terms are all resolved
 //! except where the record is too short; the values read back must be the ones in
 //! `ieee952_terms.csv` (largest axis), exactly.
 
@@ -121,4 +122,57 @@ fn pyyaml_and_opencv_read_the_ieee952_files() {
         ),
         vec![gn, an, gk, ak, 100.0]
     );
+
+    // OpenVINS reads kalibr_imu_chain.yaml with cv::FileStorage: the imu0 block, T_i_b
+    // element by element as its parser does, the four values, the rate and the model.
+    let ov = python(&format!(
+        "import cv2; fs = cv2.FileStorage('{}', cv2.FILE_STORAGE_READ); n = fs.getNode('imu0'); t = n.getNode('T_i_b'); print(' '.join(repr(t.at(r).at(c).real()) for r in range(4) for c in range(4)), ' '.join(repr(n.getNode(k).real()) for k in ['accelerometer_noise_density', 'accelerometer_random_walk', 'gyroscope_noise_density', 'gyroscope_random_walk', 'update_rate', 'time_offset']), n.getNode('rostopic').string(), n.getNode('model').string())",
+        out.join("openvins_kalibr_imu_chain_ieee952.yaml").display()
+    ));
+    let v: Vec<&str> = ov.split_whitespace().collect();
+    let f: Vec<f64> = v[..22].iter().map(|x| x.parse().unwrap()).collect();
+    let identity: Vec<f64> = (0..16).map(|i| f64::from(i % 5 == 0)).collect();
+    assert_eq!(&f[..16], &identity[..], "{ov}");
+    assert_eq!(&f[16..], &[an, ak, gn, gk, 100.0, 0.0], "{ov}");
+    assert_eq!(&v[22..], ["imu", "kalibr"], "{ov}");
+
+    // Basalt's noise fields, per axis, read as JSON: each axis' value from the terms table
+    // (resolved, else its 95 % upper bound, named in _not_resolved), the convention stated.
+    let axis = |sensor: &str, term: &str| -> Vec<f64> {
+        ["x", "y", "z"]
+            .iter()
+            .map(|a| {
+                let f: Vec<&str> = csv
+                    .lines()
+                    .map(|l| l.split(',').collect::<Vec<_>>())
+                    .find(|f| f.len() > 7 && f[0] == sensor && f[1] == *a && f[2] == term)
+                    .unwrap();
+                f[if f[7] == "true" { 3 } else { 6 }].parse().unwrap()
+            })
+            .collect()
+    };
+    let b = python(&format!(
+        "import json; d = json.load(open('{}'))['value0']; print(' '.join(repr(x) for k in ['accel_noise_std', 'gyro_noise_std', 'accel_bias_std', 'gyro_bias_std'] for x in d[k]), repr(d['imu_update_rate']), 'CONTINUOUS-TIME' in d['_convention'] and 'sqrt(imu_update_rate)' in d['_convention'], len(d['_not_resolved']))",
+        out.join("basalt_imu_noise_ieee952.json").display()
+    ));
+    let v: Vec<&str> = b.split_whitespace().collect();
+    let f: Vec<f64> = v[..13].iter().map(|x| x.parse().unwrap()).collect();
+    let want: Vec<f64> = [
+        axis("accelerometer", "N"),
+        axis("gyroscope", "N"),
+        axis("accelerometer", "K"),
+        axis("gyroscope", "K"),
+    ]
+    .concat();
+    assert_eq!(&f[..12], &want[..], "{b}");
+    assert_eq!(f[12], 100.0);
+    assert_eq!(v[13], "True", "{b}");
+    let unresolved = csv
+        .lines()
+        .filter(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f.len() > 7 && (f[2] == "N" || f[2] == "K") && f[7] == "false"
+        })
+        .count();
+    assert_eq!(v[14].parse::<usize>().unwrap(), unresolved, "{b}");
 }

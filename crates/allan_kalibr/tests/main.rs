@@ -7,4 +7,6 @@ mod common;
 mod consumers;
 mod defects19;
 mod ieee952;
+mod issue18;
+mod logs;
 mod reference;

@@ -15,8 +15,7 @@ use crate::bag::RosTime;
 use crate::error::Error;
 use crate::mat::{self, COLS, DataImu};
 use crate::series::{
-    ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, read_imu_topics,
-    topic_folder_names,
+    ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, topic_folder_names,
 };
 use crate::shared::output::write_atomic;
 
@@ -239,6 +238,8 @@ pub struct Config {
     pub time: TimeColumn,
     /// No progress bar, no log lines.
     pub quiet: bool,
+    /// What the user said about a log whose content does not say it all.
+    pub input: crate::formats::InputOptions,
 }
 
 /// Where each topic's file goes: with one topic, bagconvert's path (or `-o FILE`); with
@@ -289,7 +290,12 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
     }
     log("Reading in rosbag file...");
     crate::shared::output::protect_input(&cfg.bag);
-    let read = read_imu_topics(&cfg.bag, &cfg.topics, &ReadOptions { quiet: cfg.quiet })?;
+    let read = crate::series::read_imu_topics_with(
+        &cfg.bag,
+        &cfg.topics,
+        &ReadOptions { quiet: cfg.quiet },
+        &cfg.input,
+    )?;
     if read.series.len() > 1 && cfg.output.as_deref() == Some(Path::new(STDOUT)) {
         return Err(Error::Output {
             path: PathBuf::from(STDOUT),
@@ -369,6 +375,7 @@ mod tests {
             format: Format::Mat,
             time: TimeColumn::Record,
             quiet: true,
+            input: Default::default(),
         };
         assert_eq!(
             output_paths(&cfg, &["/imu0", "/imu1"]),

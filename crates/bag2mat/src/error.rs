@@ -43,6 +43,28 @@ pub enum Error {
         /// What was found instead.
         what: String,
     },
+    /// A log (text, ULog, DataFlash, NumPy) was recognised but cannot be read as asked: what
+    /// to add or change is in the message.
+    #[error("{}: {what}", .path.display())]
+    Log {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, and what to add.
+        what: String,
+    },
+    /// A topic that carries one sensor only (its other sensor's columns are NaN) was given to
+    /// an analysis that needs both.
+    #[error(
+        "topic '{}' carries no {} (a topic of one sensor: PX4 sensor_gyro/sensor_accel, ArduPilot ISB batches, a text log without those columns); the analysers fit both sensors together: analyse a topic with both (sensor_combined, vehicle_imu, IMU), or convert this one with bag2mat",
+        crate::shared::cli::escape(.topic),
+        .missing.name()
+    )]
+    OneSensor {
+        /// The topic.
+        topic: String,
+        /// The sensor it lacks.
+        missing: crate::Sensor,
+    },
     /// A storage file (sqlite3, metadata.yaml) could not be read.
     #[error("{path}: {what}")]
     Storage {

@@ -1,6 +1,8 @@
 //! `bag2mat info BAG`: what an input holds, for any format — every topic with its type,
-//! encoding, message count, mean rate, rate jitter, time span and gaps (from the record
-//! times of every message), the Imu topics flagged, and what the container reports lost.
+//! encoding, message count, nominal rate, rate jitter, time span and gaps (from the record
+//! times of every message, by [`crate::timing`]'s rule), the Imu topics flagged and checked
+//! as the analysers check them ([`crate::record_check`]: their findings under the topic),
+//! and what the container reports lost.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -9,10 +11,9 @@ use rayon::prelude::*;
 
 use crate::bag::RosTime;
 use crate::error::Error;
+use crate::record_check::{self, Finding, Record};
 use crate::series::is_imu;
 use crate::source::{self, InputKind, Loss};
-
-pub use crate::timing::GAP_FACTOR;
 
 /// One topic (and type) of an input.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,16 +32,22 @@ pub struct TopicInfo {
     pub promised: Option<u64>,
     /// First and last record time, ns.
     pub span: Option<(u64, u64)>,
-    /// `(count − 1) / span`, Hz.
-    pub mean_rate: Option<f64>,
+    /// Nominal rate of the record times (span over the sample periods it holds, so lost
+    /// and duplicated messages do not change it), Hz; for an Imu topic, of the samples the
+    /// analysers keep ([`crate::record_check`]).
+    pub rate: Option<f64>,
     /// Median interval between consecutive messages, s.
     pub median_period: Option<f64>,
     /// Standard deviation of the intervals over their mean (relative jitter).
     pub jitter: Option<f64>,
-    /// Intervals longer than [`GAP_FACTOR`] median periods.
+    /// Gaps (intervals with at least one message missing), by [`crate::timing`]'s rule.
     pub gaps: u64,
+    /// Messages missing in them.
+    pub missing: u64,
     /// The longest interval, s.
     pub longest_gap: Option<f64>,
+    /// What the record check finds on an Imu topic (record time), as the analysers do.
+    pub findings: Vec<Finding>,
 }
 
 /// What `bag2mat info` prints.
@@ -56,34 +63,41 @@ pub struct InfoReport {
     pub losses: Vec<Loss>,
 }
 
-fn stats(t: &mut [u64]) -> (Option<f64>, Option<f64>, Option<f64>, u64, Option<f64>) {
-    t.sort_unstable();
+/// Rate, median period, jitter, gaps, missing and longest interval of sorted times `t` (ns).
+fn stats(t: &[i64]) -> (Option<f64>, Option<f64>, Option<f64>, u64, u64, Option<f64>) {
     if t.len() < 2 {
-        return (None, None, None, 0, None);
+        return (None, None, None, 0, 0, None);
     }
-    let span = (t[t.len() - 1] - t[0]) as f64 * 1e-9;
-    let mean_rate = (span > 0.0).then(|| (t.len() - 1) as f64 / span);
-    // Seconds from the first stamp: exact to the ns for any recording shorter than 100 days.
-    let secs: Vec<f64> = t.iter().map(|&x| (x - t[0]) as f64 * 1e-9).collect();
-    let d: Vec<f64> = secs.windows(2).map(|w| w[1] - w[0]).collect();
+    let d: Vec<f64> = t.windows(2).map(|w| (w[1] - w[0]) as f64 * 1e-9).collect();
     let mean = d.iter().sum::<f64>() / d.len() as f64;
     let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / d.len() as f64;
     let jitter = (mean > 0.0).then(|| var.sqrt() / mean);
     let longest = d.iter().cloned().fold(0.0, f64::max);
     // Gaps are found where the analysers find them.
-    let tm = crate::timing::analyse(&secs);
+    let tm = crate::timing::analyse(t);
     (
-        mean_rate,
-        tm.median_period,
+        tm.nominal_rate(),
+        tm.median_period_ns.map(|p| p as f64 * 1e-9),
         jitter,
         tm.gaps.len() as u64,
+        tm.missing,
         Some(longest),
     )
 }
 
-/// Reads every message's record time of `path` and summarises each topic.
+/// Reads every message's record time of `path` and summarises each topic; the Imu topics
+/// are read whole and checked as the analysers check them.
 pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
-    let src = source::open(path)?;
+    info_with(path, quiet, &crate::formats::InputOptions::default())
+}
+
+/// [`info`], with what the user said about a log whose content does not say it all.
+pub fn info_with(
+    path: &Path,
+    quiet: bool,
+    opts: &crate::formats::InputOptions,
+) -> Result<InfoReport, Error> {
+    let src = source::open_with(path, opts)?;
     let parts = src.parts();
     let pb = crate::shared::progress::bar(parts.len().max(1) as u64, quiet, "parts");
     pb.set_message("reading");
@@ -127,11 +141,13 @@ pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
             count: 0,
             promised: Some(0),
             span: None,
-            mean_rate: None,
+            rate: None,
             median_period: None,
             jitter: None,
             gaps: 0,
+            missing: 0,
             longest_gap: None,
+            findings: Vec::new(),
         });
         e.imu &= is_imu(c);
         e.promised = e.promised.zip(c.count).map(|(a, b)| a + b);
@@ -143,20 +159,50 @@ pub fn info(path: &Path, quiet: bool) -> Result<InfoReport, Error> {
     for (key, mut t) in topic_times {
         let e = by.get_mut(&key).expect("same keys");
         e.count = t.len() as u64;
-        let (rate, median, jitter, gaps, longest) = stats(&mut t);
+        t.sort_unstable();
+        let ns: Vec<i64> = t.iter().map(|&x| x as i64).collect();
+        let (rate, median, jitter, gaps, missing, longest) = stats(&ns);
         e.span = t.first().zip(t.last()).map(|(a, b)| (*a, *b));
-        e.mean_rate = rate;
+        e.rate = rate;
         e.median_period = median;
         e.jitter = jitter;
         e.gaps = gaps;
+        e.missing = missing;
         e.longest_gap = longest;
     }
+    check_imu_topics(src.as_ref(), &mut by);
     Ok(InfoReport {
         kind: src.kind(),
         topics: by.into_values().collect(),
         notes: src.notes().to_vec(),
         losses,
     })
+}
+
+/// The record check of every Imu topic on its record time, as `allan_kalibr` runs it: its
+/// findings, and the rate and gaps of the samples it keeps.
+fn check_imu_topics(src: &dyn source::Source, by: &mut BTreeMap<(String, String), TopicInfo>) {
+    let sel = crate::TopicSelector {
+        topics: Vec::new(),
+        all_imu: true,
+    };
+    // a topic that cannot be read as Imu keeps its plain summary (the read says why)
+    let Ok(read) = crate::series::read_from(src, &sel, &crate::ReadOptions { quiet: true }) else {
+        return;
+    };
+    for s in &read.series {
+        let Some(e) = by.get_mut(&(s.topic.clone(), s.msg_type.clone())) else {
+            continue;
+        };
+        let t = crate::timing::ns_of_times(&s.record_time);
+        let other = crate::timing::ns_of_times(&s.stamp);
+        let rec = Record::of_series(s, crate::TimeColumn::Record, &t, &other);
+        let c = record_check::check(&rec, &record_check::Options::default());
+        e.rate = c.rate;
+        e.gaps = c.timing.gaps.len() as u64;
+        e.missing = c.timing.missing;
+        e.findings = c.findings;
+    }
 }
 
 impl InfoReport {
@@ -185,27 +231,40 @@ impl InfoReport {
             self.topics.len()
         ));
         s.push_str(&format!(
-            "  {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>10}\n",
-            "topic", "type", "enc", "msgs", "rate Hz", "jitter", "span s", "gaps", "longest s"
+            "  {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>8} {:>10}\n",
+            "topic",
+            "type",
+            "enc",
+            "msgs",
+            "rate Hz",
+            "jitter",
+            "span s",
+            "gaps",
+            "missing",
+            "longest s"
         ));
         let opt =
             |v: Option<f64>, p: usize| v.map(|x| format!("{x:.p$}")).unwrap_or_else(|| "-".into());
         for t in &self.topics {
             s.push_str(&format!(
-                "{} {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>10}\n",
+                "{} {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>8} {:>10}\n",
                 if t.imu { "*" } else { " " },
                 crate::shared::cli::escape(&t.topic),
                 crate::shared::cli::escape(&t.msg_type),
                 t.encoding,
                 t.count,
-                opt(t.mean_rate, 3),
+                opt(t.rate, 3),
                 t.jitter
                     .map(|j| format!("{:.2}%", j * 100.0))
                     .unwrap_or_else(|| "-".into()),
                 opt(t.span.map(|(a, b)| (b - a) as f64 * 1e-9), 3),
                 t.gaps,
+                t.missing,
                 opt(t.longest_gap, 4),
             ));
+            for f in &t.findings {
+                s.push_str(&format!("    {f}\n"));
+            }
             if let Some(p) = t.promised
                 && p != t.count
             {

@@ -19,8 +19,12 @@
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`); [`timing`]: gaps, rate changes and
-//!   constant-rate segments of a series of stamps (info and both analysers use it).
+//! * [`info`]: what an input holds (`bag2mat info`); [`record_check`]: is a record fit for
+//!   an Allan analysis (clocks, duplicates, gaps through [`timing`], the one gap rule;
+//!   outliers, warm-up, motion), typed findings every tool prints and the analysers obey.
+//! * [`formats`]: raw IMU logs from outside ROS — EuRoC/ASL and plain text, NumPy, PX4
+//!   ULog, ArduPilot DataFlash — each a [`source::Source`] over rows its reader decoded
+//!   ([`decoded`]); [`cursor`]: the bounds-checked byte reader the binary formats parse with.
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
 //!
@@ -31,11 +35,15 @@
 pub mod bag;
 pub mod cdr;
 pub mod convert;
+pub mod cursor;
+pub mod decoded;
 mod error;
+pub mod formats;
 pub mod imu_msg;
 pub mod info;
 pub mod mat;
 pub mod mcap;
+pub mod record_check;
 pub mod rosbag2;
 pub mod sensor;
 pub mod series;

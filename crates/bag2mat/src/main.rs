@@ -14,8 +14,9 @@ use clap::{Parser, Subcommand, ValueEnum};
 /// variable data_imu, N×7, columns t ax ay az wx wy wz, t = record time in seconds).
 ///
 /// Reads ROS 1 bags, ROS 2 bag directories (sqlite3 or MCAP, split, zstd-compressed), bare
-/// .mcap and .db3 files, recognised from their content. `bag2mat info BAG` lists what a bag
-/// holds.
+/// .mcap and .db3 files, and IMU logs from outside ROS (EuRoC/ASL datasets, CSV/TSV text,
+/// PX4 ULog, ArduPilot DataFlash .bin, NumPy .npy), recognised from their content.
+/// `bag2mat info BAG` lists what an input holds.
 #[derive(Parser, Debug)]
 #[command(version, about, args_conflicts_with_subcommands = true)]
 struct Args {
@@ -44,6 +45,11 @@ struct Args {
     /// Only errors and warnings: no progress bar, no log lines.
     #[arg(short, long)]
     quiet: bool,
+    /// Text logs without a time column: the sample rate, Hz.
+    #[arg(long, value_name = "HZ", value_parser = cli::positive_f64)]
+    rate: Option<f64>,
+    #[command(flatten)]
+    input: bag2mat::formats::InputArgs,
 }
 
 #[derive(Subcommand, Debug)]
@@ -56,6 +62,11 @@ enum Command {
         /// No progress bar.
         #[arg(short, long)]
         quiet: bool,
+        /// Text logs without a time column: the sample rate, Hz.
+        #[arg(long, value_name = "HZ", value_parser = cli::positive_f64)]
+        rate: Option<f64>,
+        #[command(flatten)]
+        input: bag2mat::formats::InputArgs,
     },
 }
 
@@ -96,7 +107,12 @@ fn main() -> ExitCode {
         Err(e) => return cli::usage(TOOL, &e.render().to_string()),
     };
     let result = match a.command {
-        Some(Command::Info { bag, quiet }) => match bag2mat::info::info(&bag, quiet) {
+        Some(Command::Info {
+            bag,
+            quiet,
+            rate,
+            input,
+        }) => match bag2mat::info::info_with(&bag, quiet, &input.options(rate)) {
             Ok(r) => {
                 if let Err(e) = cli::print(&r.text(&bag)) {
                     return cli::fail(TOOL, &e);
@@ -145,6 +161,7 @@ fn main() -> ExitCode {
                     TimeArg::Header => TimeColumn::Header,
                 },
                 quiet: a.quiet,
+                input: a.input.options(a.rate),
             };
             run(&cfg).map(|_| ())
         }

@@ -99,6 +99,9 @@ pub struct ImuSeries {
     pub notes: Vec<String>,
     /// Promised against delivered.
     pub report: TopicReport,
+    /// Where each row was stored, when the rows were sorted by record time (`None`: row
+    /// order is storage order); the record check finds a clock that steps back with it.
+    pub storage_order: Option<Vec<u32>>,
 }
 
 impl ImuSeries {
@@ -120,6 +123,31 @@ impl ImuSeries {
     /// Linear acceleration `[x, y, z]` of sample `i`, m/s².
     pub fn acc_at(&self, i: usize) -> [f64; 3] {
         std::array::from_fn(|c| self.acc[c][i])
+    }
+
+    /// The sensor this topic does not carry: its three columns NaN in every sample (PX4
+    /// `sensor_gyro`/`sensor_accel`, ArduPilot batches, a text log with one sensor).
+    pub fn absent_sensor(&self) -> Option<crate::Sensor> {
+        let none = |c: &[Vec<f64>; 3]| !self.is_empty() && c.iter().flatten().all(|v| v.is_nan());
+        if none(&self.acc) {
+            Some(crate::Sensor::Acc)
+        } else if none(&self.gyro) {
+            Some(crate::Sensor::Gyro)
+        } else {
+            None
+        }
+    }
+
+    /// Fails with [`Error::OneSensor`] when the topic lacks a sensor (for the analysers,
+    /// which fit both).
+    pub fn require_both_sensors(&self) -> Result<(), Error> {
+        match self.absent_sensor() {
+            Some(missing) => Err(Error::OneSensor {
+                topic: self.topic.clone(),
+                missing,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The chosen time column.
@@ -150,10 +178,25 @@ pub struct ImuRead {
 enum Codec {
     Ros1,
     Cdr,
+    /// Rows a log reader decoded ([`crate::decoded::Row`]), whatever the topic's type.
+    Row,
+}
+
+impl Codec {
+    /// The smallest payload a message of this codec has.
+    fn min_payload(self) -> u64 {
+        match self {
+            Codec::Ros1 | Codec::Cdr => MIN_IMU_PAYLOAD,
+            Codec::Row => crate::decoded::ROW_LEN as u64,
+        }
+    }
 }
 
 /// The Imu codec for a channel, or `None` when it does not carry `sensor_msgs/Imu`.
 fn imu_codec(c: &Channel) -> Option<Codec> {
+    if c.encoding == Encoding::Row {
+        return Some(Codec::Row);
+    }
     let imu_type = c.msg_type == imu_msg::TYPE || c.msg_type == crate::cdr::TYPE;
     match (&c.encoding, imu_type) {
         (Encoding::Ros1, true) => match &c.md5sum {
@@ -174,6 +217,7 @@ fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
         Codec::Ros1 => ImuSample::decode(data),
         Codec::Cdr => crate::cdr::decode_sample(data),
+        Codec::Row => crate::decoded::Row::decode(data),
     }
 }
 
@@ -453,10 +497,11 @@ impl Rows {
             .collect()
     }
 
-    /// Sorts by record time (stable) when the storage order differs from it; true if it did.
-    fn sort_by_record_time(&mut self) -> bool {
+    /// Sorts by record time (stable) when the storage order differs from it; returns the
+    /// storage position of each row if it did.
+    fn sort_by_record_time(&mut self) -> Option<Vec<u32>> {
         if !self.record_time.windows(2).any(|w| w[1] < w[0]) {
-            return false;
+            return None;
         }
         let mut order: Vec<usize> = (0..self.len()).collect();
         order.sort_by_key(|&i| self.record_time[i]);
@@ -467,7 +512,7 @@ impl Rows {
             self.acc[c] = permute(&self.acc[c], &order);
             self.gyro[c] = permute(&self.gyro[c], &order);
         }
-        true
+        Some(order.into_iter().map(|i| i as u32).collect())
     }
 }
 
@@ -539,7 +584,18 @@ pub fn read_imu_topics(
     sel: &TopicSelector,
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
-    let src = source::open(path)?;
+    read_imu_topics_with(path, sel, opts, &crate::formats::InputOptions::default())
+}
+
+/// [`read_imu_topics`], with what the user said about a log whose content does not say it
+/// all (a text log's columns and units).
+pub fn read_imu_topics_with(
+    path: &Path,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+    input: &crate::formats::InputOptions,
+) -> Result<ImuRead, Error> {
+    let src = source::open_with(path, input)?;
     read_from(src.as_ref(), sel, opts)
 }
 
@@ -600,7 +656,12 @@ fn decode_all(
         .iter()
         .map(|p| {
             let counts = p.counts.as_ref()?;
-            let bound = p.bytes / MIN_IMU_PAYLOAD;
+            let min_payload = selected
+                .iter()
+                .flat_map(|s| s.channels.iter().map(|(_, k)| k.min_payload()))
+                .min()
+                .unwrap_or(MIN_IMU_PAYLOAD);
+            let bound = p.bytes / min_payload;
             Some(
                 selected
                     .iter()
@@ -735,7 +796,8 @@ pub fn read_from(
     let mut series = Vec::with_capacity(n_sel);
     let mut dropped: Vec<String> = Vec::new();
     for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
-        let sorted = rows.sort_by_record_time();
+        let storage_order = rows.sort_by_record_time();
+        let sorted = storage_order.is_some();
         let Rows {
             record_time,
             stamp,
@@ -751,6 +813,7 @@ pub fn read_from(
             seq,
             acc,
             gyro,
+            storage_order,
             ..ImuSeries::default()
         };
         let r = &mut out.report;

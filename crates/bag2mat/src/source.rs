@@ -28,6 +28,16 @@ pub enum InputKind {
     Rosbag2Dir,
     /// A zstd frame: a FILE-mode compressed `.mcap.zstd` or `.db3.zstd`.
     Zstd,
+    /// Delimited text (CSV, TSV, whitespace; EuRoC/ASL `data.csv`): [`crate::formats::text`].
+    Text,
+    /// An EuRoC/ASL dataset folder: [`crate::formats::euroc`].
+    EurocDir,
+    /// `\x93NUMPY`: [`crate::formats::npy`].
+    Npy,
+    /// `ULog\x01\x12\x35`: a PX4 log, [`crate::formats::ulog`].
+    Ulog,
+    /// `\xA3\x95\x80`: an ArduPilot DataFlash log, [`crate::formats::dataflash`].
+    DataFlash,
 }
 
 impl InputKind {
@@ -39,12 +49,17 @@ impl InputKind {
             InputKind::Sqlite3 => "rosbag2 sqlite3 file",
             InputKind::Rosbag2Dir => "ROS 2 bag directory",
             InputKind::Zstd => "zstd-compressed file",
+            InputKind::Text => "text log",
+            InputKind::EurocDir => "EuRoC/ASL dataset",
+            InputKind::Npy => "NumPy .npy",
+            InputKind::Ulog => "PX4 ULog",
+            InputKind::DataFlash => "ArduPilot DataFlash log",
         }
     }
 }
 
 /// Every kind of input accepted, for error messages.
-pub const ACCEPTED: &str = "a ROS 1 bag (format 2.0), a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files), an .mcap file, a rosbag2 .db3 (sqlite3) file, or a zstd-compressed .mcap/.db3";
+pub const ACCEPTED: &str = "a ROS 1 bag (format 2.0), a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files), an .mcap file, a rosbag2 .db3 (sqlite3) file, a zstd-compressed .mcap/.db3, a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root), a CSV/TSV/whitespace text log, a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin), or a NumPy .npy (N x 7, bag2mat's layout)";
 
 /// The magic line of a ROS 1 bag.
 pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
@@ -60,6 +75,8 @@ pub enum Encoding {
     Ros1,
     /// CDR (ROS 2).
     Cdr,
+    /// Samples a log reader already decoded ([`crate::decoded::Row`]).
+    Row,
     /// Anything else, named as the container names it.
     Other(String),
 }
@@ -78,6 +95,7 @@ impl Encoding {
         match self {
             Encoding::Ros1 => "ros1",
             Encoding::Cdr => "cdr",
+            Encoding::Row => "row",
             Encoding::Other(s) => s,
         }
     }
@@ -247,9 +265,14 @@ pub fn detect(path: &Path) -> Result<InputKind, Error> {
         if path.join("metadata.yaml").is_file() {
             return Ok(InputKind::Rosbag2Dir);
         }
+        if let Some(kind) = crate::formats::detect_dir(path) {
+            return Ok(kind);
+        }
         return Err(Error::NotABag {
             path: path.to_path_buf(),
-            what: format!("a directory without metadata.yaml. Accepted: {ACCEPTED}"),
+            what: format!(
+                "a directory without metadata.yaml or an EuRoC/ASL imuN/data.csv. Accepted: {ACCEPTED}"
+            ),
         });
     }
     let mut head = [0u8; 16];
@@ -274,6 +297,9 @@ pub fn detect(path: &Path) -> Result<InputKind, Error> {
     }
     if head.starts_with(ZSTD_MAGIC) {
         return Ok(InputKind::Zstd);
+    }
+    if let Some(kind) = crate::formats::detect_file(path, head) {
+        return Ok(kind);
     }
     let what = if head.is_empty() {
         "the file is empty".to_string()
@@ -304,6 +330,14 @@ pub fn detect(path: &Path) -> Result<InputKind, Error> {
 
 /// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
 pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
+    open_with(path, &crate::formats::InputOptions::default())
+}
+
+/// [`open`], with what the user said about a log whose content does not say it all.
+pub fn open_with(
+    path: &Path,
+    opts: &crate::formats::InputOptions,
+) -> Result<Box<dyn Source>, Error> {
     if path.file_name().is_some_and(|n| n == "metadata.yaml")
         && path.is_file()
         && let Some(dir) = path.parent()
@@ -321,6 +355,7 @@ pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
         InputKind::Sqlite3 => Box::new(crate::rosbag2::Sqlite3Reader::open(path)?),
         InputKind::Rosbag2Dir => Box::new(crate::rosbag2::BagDir::open(path)?),
         InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
+        kind => crate::formats::open(kind, path, opts)?,
     })
 }
 

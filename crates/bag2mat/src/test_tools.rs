@@ -395,3 +395,128 @@ impl Reported {
         self.lost + self.more + self.undecodable
     }
 }
+
+/// Rewrites a `bag2mat -o x.csv` file (`t,ax,ay,az,wx,wy,wz`, t in s) as an EuRoC/ASL
+/// dataset under `root` (`mav0/imu0/data.csv`: ns stamps, gyro before acc, the same
+/// decimals), as a user's script would; returns the `data.csv` path.
+pub fn euroc_from_bag2mat_csv(csv: &Path, root: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(csv).expect("read the bag2mat CSV");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,ax,ay,az,wx,wy,wz"));
+    let mut out = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let ns = crate::formats::text::parse_time_ns(f[0].as_bytes(), crate::formats::TimeUnit::S)
+            .expect("a time in seconds");
+        out.push_str(&format!(
+            "{ns},{},{},{},{},{},{}\n",
+            f[4], f[5], f[6], f[1], f[2], f[3]
+        ));
+    }
+    let dir = root.join("mav0/imu0");
+    std::fs::create_dir_all(&dir).expect("create mav0/imu0");
+    let p = dir.join("data.csv");
+    std::fs::write(&p, out).expect("write data.csv");
+    p
+}
+
+/// `bag2mat BAG TOPIC --time TIME -o DIR/x.csv`, then that CSV as an EuRoC/ASL dataset at
+/// `DIR/dataset` ([`euroc_from_bag2mat_csv`]); returns the dataset root.
+pub fn euroc_dataset_from_bag(
+    bag: &Path,
+    topic: &str,
+    time: crate::TimeColumn,
+    dir: &Path,
+) -> PathBuf {
+    let csv = dir.join("x.csv");
+    let cfg = crate::convert::Config {
+        bag: bag.to_path_buf(),
+        topics: crate::TopicSelector::one(topic),
+        output: Some(csv.clone()),
+        format: crate::convert::Format::Csv,
+        time,
+        quiet: true,
+        input: Default::default(),
+    };
+    crate::convert::run(&cfg).expect("bag2mat -o x.csv");
+    let root = dir.join("dataset");
+    euroc_from_bag2mat_csv(&csv, &root);
+    root
+}
+
+/// What [`odd_record`] wrote: the message count and the continuous-time truth of its noise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OddRecord {
+    /// Messages written.
+    pub messages: usize,
+    /// Gyro white noise N (rad/s/√Hz) and random walk K (rad/s²/√Hz).
+    pub gyro: (f64, f64),
+    /// Accelerometer N (m/s²/√Hz) and K (m/s³/√Hz).
+    pub acc: (f64, f64),
+}
+
+/// Which independent writer [`odd_record`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OddWriter {
+    /// Debian's python3-rosbag: a ROS 1 bag, topic `imu`.
+    Rosbag,
+    /// Foxglove's mcap_ros2 writer (venv): a bare `.mcap`, topic `/imu`, with header jitter
+    /// and transport latency.
+    Mcap,
+}
+
+/// Writes an IMU record that breaks what an Allan analysis assumes (`cases`, see
+/// `tests/py/odd_records.py`) with an independent writer: `seconds` at `rate` Hz.
+pub fn odd_record(
+    writer: OddWriter,
+    out: &Path,
+    cases: &str,
+    seconds: f64,
+    rate: f64,
+) -> OddRecord {
+    let script = workspace().join("crates/bag2mat/tests/py/odd_records.py");
+    let (python, name) = match writer {
+        OddWriter::Rosbag => (PathBuf::from("/usr/bin/python3"), "rosbag"),
+        OddWriter::Mcap => (venv_python(), "mcap"),
+    };
+    let json = run_ok(
+        Command::new(python)
+            .arg(script)
+            .arg(name)
+            .arg(out)
+            .arg(cases)
+            .args([
+                "--seconds",
+                &seconds.to_string(),
+                "--rate",
+                &rate.to_string(),
+            ]),
+    );
+    // a flat JSON object of numbers (and the case list): read by key
+    let num = |key: &str| -> f64 {
+        let at = json
+            .find(&format!("\"{key}\": "))
+            .unwrap_or_else(|| panic!("no {key} in {json}"));
+        json[at + key.len() + 4..]
+            .split([',', '}'])
+            .next()
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or_else(|| panic!("bad {key} in {json}"))
+    };
+    OddRecord {
+        messages: num("messages") as usize,
+        gyro: (num("gyro_n"), num("gyro_k")),
+        acc: (num("acc_n"), num("acc_k")),
+    }
+}
+
+/// The lines of a tool's stderr that are record-check warnings of `kind` (the start of the
+/// finding's line after `warning: `, e.g. `gaps`, `warm-up on gyro x`).
+pub fn warnings<'a>(stderr: &'a str, kind: &str) -> Vec<&'a str> {
+    stderr
+        .lines()
+        .filter(|l| l.starts_with(&format!("warning: {kind}")))
+        .collect()
+}

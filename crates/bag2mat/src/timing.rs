@@ -1,44 +1,61 @@
-//! Gaps and rate changes in a series of timestamps — the one place the workspace finds
-//! them: `bag2mat info` prints them, and both analysers check their samples with
-//! [`analyse`] before an Allan variance that assumes one constant rate.
+//! The gap rule: missing samples, gaps and rate changes in a series of time stamps, in
+//! integer nanoseconds — the one place the workspace finds them (`bag2mat info` and both
+//! analysers, through [`crate::record_check`], which also judges the clock and the values).
 //!
-//! The period is the **median** interval (a 1 h gap in a 60 s recording leaves it at the
-//! sensor's period, where span/N would be 60× too long). A gap is an interval longer than
-//! [`GAP_FACTOR`] median periods. A rate change is a block of [`RATE_BLOCK`] intervals whose
-//! median period differs from the series' by more than [`RATE_CHANGE_REL`]. The series is
-//! cut at every gap and rate change into [`Segment`]s of one constant rate.
+//! * The **median period** is the median of the positive intervals (of a quarter million
+//!   of them, evenly spread, in a longer record; a 1 h gap in a 60 s recording, or 2 % of
+//!   duplicated stamps, leave it at the sensor's period).
+//! * Each interval is a whole number of periods `k = round(d / median)` (integer arithmetic:
+//!   an interval of exactly 2.5 periods is 3 the same way in every tool); `k − 1` samples are
+//!   missing behind it. A **gap** is an interval with at least one sample missing; the
+//!   missing count is exact (2 % single-sample dropouts of 360,000 samples are 7,200 missing
+//!   in 7,200 gaps).
+//! * The **nominal period** is the span over the number of periods it holds, Σ k: the
+//!   sensor's sampling period, which lost samples do not change (the mean interval does).
+//! * A **rate change** is a block of [`RATE_BLOCK`] intervals whose median differs from the
+//!   series' by more than [`RATE_CHANGE_REL`]; the change is placed at the exact interval
+//!   where the period changes (not at the block boundary).
+//! * The series is **one continuous record** unless the rate changes or the gaps longer than
+//!   [`GAP_FACTOR`] periods ("long gaps") add up to more than [`MAX_GAP_FRACTION`] of the
+//!   span; otherwise it is cut at every rate change and long gap into [`Segment`]s, each at
+//!   one rate. Shorter gaps (one or two samples lost in a row, as USB IMUs lose them) are
+//!   bridged: the samples around them are analysed as consecutive at the nominal period.
 
-/// An interval longer than this many median periods is a gap (a dropped message or two is
-/// not: 3 periods is two messages lost in a row).
-pub const GAP_FACTOR: f64 = 3.0;
+/// A gap longer than this many nominal periods (more than two samples lost in a row) is a
+/// "long gap": it may break the record (see [`MAX_GAP_FRACTION`]).
+pub const GAP_FACTOR: u64 = 3;
 /// Intervals per block when looking for a rate change.
 pub const RATE_BLOCK: usize = 256;
 /// A block whose median period differs from the series' by more than this (relative) is at
 /// another rate (IMU clocks drift by ppm, not percent).
 pub const RATE_CHANGE_REL: f64 = 0.05;
-/// Gaps adding up to more than this fraction of the span make an Allan variance over the
-/// whole series meaningless: the τ grid assumes samples at one rate with none missing.
+/// Long gaps adding up to more than this fraction of the span make an Allan variance over
+/// the whole series meaningless: the τ grid assumes samples at one rate with none missing.
 pub const MAX_GAP_FRACTION: f64 = 0.01;
 
-/// One gap.
-#[derive(Debug, Clone, PartialEq)]
+const NS: f64 = 1e-9;
+
+/// One gap: an interval with at least one sample missing.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gap {
     /// Index of the sample before the gap.
     pub after: usize,
-    /// Time of that sample (as given).
+    /// Its time from the first sample, s.
     pub at: f64,
     /// Length of the interval, s.
     pub length: f64,
+    /// Samples missing in it (periods in the interval − 1).
+    pub missing: u64,
 }
 
-/// A stretch of samples at one rate with no gap: indices `start..end`.
+/// A stretch of samples at one rate: indices `start..end`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment {
     /// First index.
     pub start: usize,
     /// One past the last index.
     pub end: usize,
-    /// Its median period, s.
+    /// Its nominal period (span / periods in it), s.
     pub period: f64,
 }
 
@@ -59,30 +76,51 @@ impl Segment {
 pub struct Timing {
     /// Samples.
     pub n: usize,
-    /// Median interval, s (`None` with fewer than two samples).
-    pub median_period: Option<f64>,
+    /// Median positive interval, ns (`None` without one).
+    pub median_period_ns: Option<i64>,
+    /// Nominal period of the whole series (span / Σ k), s; `None` without a period.
+    pub nominal_period: Option<f64>,
     /// Last minus first time, s.
     pub span: f64,
     /// Every gap, in order.
     pub gaps: Vec<Gap>,
-    /// Indices where the rate changes (start of a block at another rate).
+    /// Samples missing in all the gaps.
+    pub missing: u64,
+    /// Intervals of zero or negative length (equal or reversed stamps).
+    pub not_increasing: u64,
+    /// Indices where the rate changes (the first sample at the other rate).
     pub rate_changes: Vec<usize>,
-    /// The constant-rate, gap-free stretches, in order.
+    /// The stretches to analyse apart, in order: the whole series when it is one continuous
+    /// record, else cut at every rate change and long gap.
     pub segments: Vec<Segment>,
 }
 
 impl Timing {
-    /// Total time in gaps beyond one period each, s.
-    pub fn gap_time(&self) -> f64 {
-        let p = self.median_period.unwrap_or(0.0);
-        self.gaps.iter().map(|g| g.length - p).sum()
+    /// Total time in long gaps (beyond one period each), s.
+    pub fn long_gap_time(&self) -> f64 {
+        let p = self.nominal_period.unwrap_or(0.0);
+        self.gaps
+            .iter()
+            .filter(|g| g.missing >= GAP_FACTOR)
+            .map(|g| g.length - p)
+            .sum()
+    }
+
+    /// Missing samples as a fraction of the samples the span should hold.
+    pub fn missing_fraction(&self) -> f64 {
+        let expected = self.n as f64 + self.missing as f64;
+        if expected > 0.0 {
+            self.missing as f64 / expected
+        } else {
+            0.0
+        }
     }
 
     /// True when an Allan variance over the whole series is meaningful: no rate change and
-    /// gaps adding up to at most [`MAX_GAP_FRACTION`] of the span.
+    /// long gaps adding up to at most [`MAX_GAP_FRACTION`] of the span.
     pub fn is_continuous(&self) -> bool {
         self.rate_changes.is_empty()
-            && (self.span <= 0.0 || self.gap_time() <= MAX_GAP_FRACTION * self.span)
+            && (self.span <= 0.0 || self.long_gap_time() <= MAX_GAP_FRACTION * self.span)
     }
 
     /// The longest segment.
@@ -90,119 +128,210 @@ impl Timing {
         self.segments.iter().copied().max_by_key(|s| s.len())
     }
 
-    /// One line per finding (at most a few gaps listed), for warnings.
-    pub fn describe(&self) -> String {
-        let mut s = String::new();
-        if let Some(p) = self.median_period {
-            s.push_str(&format!(
-                "median period {p:.6} s ({:.4} Hz)",
-                if p > 0.0 { 1.0 / p } else { f64::NAN }
-            ));
-        }
-        if !self.gaps.is_empty() {
-            let longest = self.gaps.iter().map(|g| g.length).fold(0.0, f64::max);
-            s.push_str(&format!(
-                "; {} gap(s) totalling {:.3} s over a {:.3} s span (longest {:.3} s",
-                self.gaps.len(),
-                self.gap_time(),
-                self.span,
-                longest
-            ));
-            for g in self.gaps.iter().take(3) {
-                s.push_str(&format!(", {:.3} s after sample {}", g.length, g.after));
-            }
-            s.push(')');
-        }
-        if !self.rate_changes.is_empty() {
-            s.push_str(&format!(
-                "; the rate changes near sample(s) {:?}",
-                &self.rate_changes[..self.rate_changes.len().min(5)]
-            ));
-        }
-        s
+    /// The longest gap (the first of equals).
+    pub fn longest_gap(&self) -> Option<Gap> {
+        self.gaps
+            .iter()
+            .copied()
+            .reduce(|a, b| if b.length > a.length { b } else { a })
+    }
+
+    /// Nominal rate of the whole series, Hz.
+    pub fn nominal_rate(&self) -> Option<f64> {
+        self.nominal_period.filter(|p| *p > 0.0).map(|p| 1.0 / p)
     }
 }
 
-/// The element at `len / 2` of `v` in sorted order (selection in linear time: the 4 h bag's
-/// 2.9 M intervals would otherwise be sorted three times per call).
-fn median(v: &mut [f64]) -> f64 {
+/// The element at `len / 2` of `v` in sorted order (selection in linear time).
+fn median(v: &mut [i64]) -> i64 {
     let k = v.len() / 2;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
+    *v.select_nth_unstable(k).1
 }
 
-/// Finds the gaps, rate changes and constant-rate segments of `t` (seconds, in order).
-pub fn analyse(t: &[f64]) -> Timing {
+/// Intervals a median period is taken over at most, evenly spread (it rounds each interval to
+/// whole periods; the median of a quarter million intervals is the median of millions to
+/// within their jitter, and costs no copy of a 4 h record).
+const MEDIAN_INTERVALS: usize = 1 << 18;
+
+/// Median of the positive values of `d` (of at most [`MEDIAN_INTERVALS`] of them, evenly
+/// spread), `None` without one.
+fn median_positive(d: &[i64]) -> Option<i64> {
+    let stride = d.len().div_ceil(MEDIAN_INTERVALS).max(1);
+    let mut pos: Vec<i64> = d
+        .iter()
+        .step_by(stride)
+        .copied()
+        .filter(|&x| x > 0)
+        .collect();
+    if pos.is_empty() && stride > 1 {
+        pos = d.iter().copied().filter(|&x| x > 0).collect();
+    }
+    (!pos.is_empty()).then(|| median(&mut pos))
+}
+
+/// Whole periods in an interval of `d` ns at median period `p` ns: `round(d / p)` with halves
+/// up, in integers; 0 for an interval that is not positive.
+pub fn periods(d: i64, p: i64) -> u64 {
+    if d <= 0 || p <= 0 {
+        return 0;
+    }
+    if d < i64::MAX / 4 && p < i64::MAX / 4 {
+        return ((2 * d + p) / (2 * p)) as u64;
+    }
+    let (d, p) = (d as i128, p as i128);
+    ((2 * d + p) / (2 * p)) as u64
+}
+
+/// The sample where the rate changes near the boundary `b` between two blocks of medians
+/// `pa` (before) and `pb` (after): the `c` that minimises Σ_{i<c} |d_i − pa| + Σ_{i≥c}
+/// |d_i − pb| over the two blocks around `b` (exact on a clean change).
+fn refine_change(d: &[i64], b: usize, pa: i64, pb: i64) -> usize {
+    let lo = b.saturating_sub(RATE_BLOCK);
+    let hi = (b + RATE_BLOCK).min(d.len());
+    let cost_b: i128 = d[lo..hi]
+        .iter()
+        .map(|&x| (x as i128 - pb as i128).abs())
+        .sum();
+    let (mut best, mut best_c) = (cost_b, lo);
+    let mut cost = cost_b;
+    for (i, &x) in d.iter().enumerate().take(hi).skip(lo) {
+        cost += (x as i128 - pa as i128).abs() - (x as i128 - pb as i128).abs();
+        if cost < best {
+            best = cost;
+            best_c = i + 1;
+        }
+    }
+    best_c
+}
+
+/// Finds the gaps, rate changes and segments of `t` (ns, in the order analysed).
+pub fn analyse(t: &[i64]) -> Timing {
     let n = t.len();
     let mut out = Timing {
         n,
-        median_period: None,
-        span: if n > 1 { t[n - 1] - t[0] } else { 0.0 },
+        median_period_ns: None,
+        nominal_period: None,
+        span: if n > 1 {
+            (t[n - 1] - t[0]) as f64 * NS
+        } else {
+            0.0
+        },
         gaps: Vec::new(),
+        missing: 0,
+        not_increasing: 0,
         rate_changes: Vec::new(),
         segments: Vec::new(),
     };
-    if n < 2 {
-        if n == 1 {
+    let d: Vec<i64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    out.not_increasing = d.iter().filter(|&&x| x <= 0).count() as u64;
+    let Some(p) = median_positive(&d) else {
+        if n > 0 {
             out.segments.push(Segment {
                 start: 0,
-                end: 1,
+                end: n,
                 period: 0.0,
             });
         }
         return out;
+    };
+    out.median_period_ns = Some(p);
+    // Rate segments: blocks at another rate, the change placed exactly.
+    let mut changes: Vec<usize> = Vec::new();
+    let mut prev: Option<(bool, i64)> = None;
+    let mut buf: Vec<i64> = Vec::with_capacity(RATE_BLOCK);
+    for (b, block) in d.chunks(RATE_BLOCK).enumerate() {
+        if block.len() < RATE_BLOCK / 4 {
+            continue;
+        }
+        buf.clear();
+        buf.extend(block.iter().copied().filter(|&x| x > 0));
+        if buf.is_empty() {
+            continue;
+        }
+        let m = median(&mut buf);
+        let other = ((m - p) as f64 / p as f64).abs() > RATE_CHANGE_REL;
+        match prev {
+            Some((was, pm)) if was != other => {
+                changes.push(refine_change(&d, b * RATE_BLOCK, pm, m));
+            }
+            None if other => changes.push(0),
+            _ => {}
+        }
+        prev = Some((other, m));
     }
-    let d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let period = median(&mut d.clone());
-    out.median_period = Some(period);
-    // Cuts: after a gap, and at the start of a block at another rate.
-    let mut cuts: Vec<usize> = Vec::new();
-    if period > 0.0 {
-        for (i, &x) in d.iter().enumerate() {
-            if x > GAP_FACTOR * period {
+    changes.retain(|&c| c > 0 && c < n);
+    changes.dedup();
+    out.rate_changes = changes.clone();
+    // Within each rate segment, the intervals in whole periods of its own median.
+    let bounds: Vec<usize> = std::iter::once(0)
+        .chain(changes.iter().copied())
+        .chain([n])
+        .collect();
+    let mut long_cuts: Vec<usize> = Vec::new();
+    let mut rate_segments: Vec<(usize, usize, u64)> = Vec::new();
+    let mut total_periods = 0u64;
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        // the intervals inside [a, b): a .. b-1
+        let inner = &d[a..b.saturating_sub(1).max(a)];
+        // one rate throughout: the series' median (no second selection)
+        let ps = if changes.is_empty() {
+            p
+        } else {
+            median_positive(inner).unwrap_or(p)
+        };
+        let mut periods_in = 0u64;
+        for (j, &x) in inner.iter().enumerate() {
+            // most intervals are one period: no division for them
+            let k = if x.saturating_sub(ps).saturating_abs().saturating_mul(2) < ps {
+                1
+            } else {
+                periods(x, ps)
+            };
+            periods_in += k;
+            if k >= 2 {
+                let i = a + j;
                 out.gaps.push(Gap {
                     after: i,
-                    at: t[i],
-                    length: x,
+                    at: (t[i] - t[0]) as f64 * NS,
+                    length: x as f64 * NS,
+                    missing: k - 1,
                 });
-                cuts.push(i + 1);
+                out.missing += k - 1;
+                if k > GAP_FACTOR {
+                    long_cuts.push(i + 1);
+                }
             }
         }
-        let mut prev_other = false;
-        for (b, block) in d.chunks(RATE_BLOCK).enumerate() {
-            if block.len() < RATE_BLOCK / 4 {
-                continue;
-            }
-            let m = median(&mut block.to_vec());
-            let other = ((m - period) / period).abs() > RATE_CHANGE_REL;
-            if other != prev_other {
-                out.rate_changes.push(b * RATE_BLOCK);
-                cuts.push(b * RATE_BLOCK);
-            }
-            prev_other = other;
-        }
+        total_periods += periods_in;
+        rate_segments.push((a, b, periods_in));
     }
+    if total_periods > 0 {
+        out.nominal_period = Some(out.span / total_periods as f64);
+    }
+    let continuous = out.is_continuous();
+    let mut cuts: Vec<usize> = if continuous {
+        Vec::new()
+    } else {
+        changes.iter().copied().chain(long_cuts).collect()
+    };
     cuts.sort_unstable();
     cuts.dedup();
-    let mut start = 0;
     if cuts.is_empty() {
         out.segments.push(Segment {
             start: 0,
             end: n,
-            period,
+            period: out.nominal_period.unwrap_or(0.0),
         });
         return out;
     }
+    let mut start = 0;
     for c in cuts.into_iter().chain([n]) {
         if c > start {
-            let mut seg: Vec<f64> = d[start..c.saturating_sub(1).max(start)].to_vec();
             out.segments.push(Segment {
                 start,
                 end: c,
-                period: if seg.is_empty() {
-                    period
-                } else {
-                    median(&mut seg)
-                },
+                period: nominal_period(&t[start..c], &d[start..c - 1]),
             });
             start = c;
         }
@@ -210,56 +339,180 @@ pub fn analyse(t: &[f64]) -> Timing {
     out
 }
 
+/// The nominal rate of `t` (ns, in order), Hz, without the rest of [`analyse`]: the span over
+/// the whole periods it holds (the cross-check of a second clock).
+pub fn nominal_rate(t: &[i64]) -> Option<f64> {
+    if t.len() < 2 {
+        return None;
+    }
+    let d: Vec<i64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let p = median_positive(&d)?;
+    let k: u64 = t.windows(2).map(|w| periods(w[1] - w[0], p)).sum();
+    let span = (t[t.len() - 1] - t[0]) as f64 * NS;
+    (k > 0 && span > 0.0).then(|| k as f64 / span)
+}
+
+/// Span over Σ k of one stretch (its own median), s; 0 for fewer than two samples.
+fn nominal_period(t: &[i64], d: &[i64]) -> f64 {
+    let Some(p) = median_positive(d) else {
+        return 0.0;
+    };
+    let k: u64 = d.iter().map(|&x| periods(x, p)).sum();
+    if k == 0 {
+        return 0.0;
+    }
+    (t[t.len() - 1] - t[0]) as f64 * NS / k as f64
+}
+
+/// Nanoseconds of each time (ROS time, exact).
+pub fn ns_of_times(t: &[crate::RosTime]) -> Vec<i64> {
+    t.iter().map(|x| x.as_nanos() as i64).collect()
+}
+
+/// Nanoseconds of each time given in seconds (a `.mat`'s column): the first rounded, the
+/// others from their difference to it, so the intervals keep the resolution the seconds
+/// have (a product with 1e9 of absolute times near 1.7e9 s would round each to 256 ns).
+pub fn ns_of_seconds(t: &[f64]) -> Vec<i64> {
+    // within ±(2^62 − 1) ns (146 years): any two differ by less than an i64 holds
+    const LIMIT: i64 = (1 << 62) - 1;
+    let ns = |x: f64| ((x * 1e9).round() as i64).clamp(-LIMIT, LIMIT);
+    let t0 = t.first().copied().unwrap_or(0.0);
+    let t0_ns = ns(t0);
+    t.iter()
+        .map(|&x| t0_ns.saturating_add(ns(x - t0)).clamp(-LIMIT, LIMIT))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    const P: i64 = 5_000_000; // 200 Hz
+    const T0: i64 = 1_700_000_000_000_000_000;
+
+    fn grid(n: usize) -> Vec<i64> {
+        (0..n as i64).map(|i| T0 + i * P).collect()
+    }
+
     #[test]
     fn median_by_selection_is_the_middle_of_the_sorted_values() {
-        // A deterministic scramble (multiplicative hash) of values with ties, odd and even
-        // lengths, checked against the obvious sort.
         for n in [1usize, 2, 3, 10, 1001, 4096] {
-            let v: Vec<f64> = (0..n as u64)
-                .map(|i| ((i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40) % 97) as f64 * 0.25)
+            let v: Vec<i64> = (0..n as u64)
+                .map(|i| ((i.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40) % 97) as i64)
                 .collect();
             let mut sorted = v.clone();
-            sorted.sort_by(f64::total_cmp);
+            sorted.sort();
             assert_eq!(median(&mut v.clone()), sorted[n / 2], "n = {n}");
         }
     }
 
     #[test]
+    fn periods_round_half_up_in_integers() {
+        assert_eq!(periods(P, P), 1);
+        assert_eq!(periods(3 * P, P), 3);
+        assert_eq!(periods(3 * P / 2, P), 2);
+        assert_eq!(periods(3 * P / 2 - 1, P), 1);
+        assert_eq!(periods(0, P), 0);
+        assert_eq!(periods(-P, P), 0);
+    }
+
+    #[test]
     fn a_one_hour_gap_in_a_minute_is_found_and_the_rate_is_the_median() {
-        // 60 s at 200 Hz, then a 1 h gap, then 60 s more.
-        let mut t: Vec<f64> = (0..12_000).map(|i| i as f64 * 0.005).collect();
-        t.extend((0..12_000).map(|i| 3660.0 + i as f64 * 0.005));
+        let mut t = grid(12_000);
+        t.extend((0..12_000).map(|i| T0 + 3_660_000_000_000 + i * P));
         let tm = analyse(&t);
-        assert!((tm.median_period.unwrap() - 0.005).abs() < 1e-12);
+        assert_eq!(tm.median_period_ns, Some(P));
         assert_eq!(tm.gaps.len(), 1);
         assert_eq!(tm.gaps[0].after, 11_999);
         assert!(!tm.is_continuous());
         assert_eq!(tm.segments.len(), 2);
         assert_eq!(tm.longest().unwrap().len(), 12_000);
+        assert!((tm.segments[0].period - 0.005).abs() < 1e-15);
     }
 
     #[test]
-    fn a_rate_change_splits_the_series() {
-        let mut t: Vec<f64> = (0..5000).map(|i| i as f64 * 0.005).collect();
-        let t0 = t[4999];
-        t.extend((1..5000).map(|i| t0 + i as f64 * 0.01));
-        let tm = analyse(&t);
-        assert!(!tm.rate_changes.is_empty());
-        assert!(!tm.is_continuous());
-        assert!(tm.segments.len() >= 2);
+    fn issue18_9_a_rate_change_is_cut_at_the_exact_sample() {
+        // 200 Hz for 5000 samples (not a multiple of the block), then 100 Hz
+        for first in [5000usize, 5120, 5133] {
+            let mut t = grid(first);
+            let t0 = t[first - 1];
+            t.extend((1..5000).map(|i| t0 + i * 2 * P));
+            let tm = analyse(&t);
+            assert_eq!(tm.rate_changes, vec![first - 1], "first {first}");
+            assert!(!tm.is_continuous());
+            assert_eq!(tm.segments.len(), 2);
+            assert_eq!(tm.segments[1].start, first - 1);
+            assert!((tm.segments[1].period - 0.01).abs() < 1e-15);
+            // the other-rate stretch is not a string of gaps
+            assert!(tm.gaps.is_empty(), "{:?}", &tm.gaps[..3.min(tm.gaps.len())]);
+        }
+    }
+
+    #[test]
+    fn issue18_9_every_clock_counts_the_same_gaps() {
+        // intervals of exactly 2.5 and 3 periods at absolute times: the same gaps from the
+        // stamps (ns) and from the seconds a .mat holds (before: 3 periods was a gap in one
+        // tool and not in the other, float seconds against integer nanoseconds)
+        let mut t = grid(20_000);
+        for (at, by) in [(5000usize, P / 2), (9000, P), (15_000, 2 * P)] {
+            for x in &mut t[at..] {
+                *x += by;
+            }
+        }
+        let secs: Vec<f64> = t
+            .iter()
+            .map(|&x| crate::RosTime::from_nanos(x as u64).to_sec())
+            .collect();
+        let a = analyse(&t);
+        let b = analyse(&ns_of_seconds(&secs));
+        let missing = |tm: &Timing| tm.gaps.iter().map(|g| g.missing).collect::<Vec<_>>();
+        // 1.5 periods round to 2 (one missing), 2 to 2, 3 to 3
+        assert_eq!(missing(&a), vec![1, 1, 2]);
+        assert_eq!(missing(&b), missing(&a));
+        assert_eq!(a.missing, 4);
+        assert_eq!(b.missing, a.missing);
     }
 
     #[test]
     fn a_steady_series_with_a_dropped_message_is_continuous() {
-        let mut t: Vec<f64> = (0..10_000).map(|i| i as f64 * 0.01).collect();
+        let mut t = grid(10_000);
         t.remove(5000);
         let tm = analyse(&t);
-        assert!(tm.gaps.is_empty() && tm.rate_changes.is_empty());
+        assert_eq!(tm.missing, 1);
+        assert_eq!(tm.gaps.len(), 1);
+        assert!(tm.rate_changes.is_empty());
         assert!(tm.is_continuous());
         assert_eq!(tm.segments.len(), 1);
+        assert!((tm.nominal_period.unwrap() - 0.005).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_light_nominal_rate_is_the_analysis_one() {
+        let mut t = grid(300_000);
+        for i in (1000..299_000).rev().step_by(97) {
+            t.remove(i);
+        }
+        let full = analyse(&t).nominal_rate().unwrap();
+        assert!((nominal_rate(&t).unwrap() - full).abs() < 1e-9 * full);
+        assert!((full - 200.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn absurd_seconds_stay_comparable() {
+        let t = ns_of_seconds(&[1e300, -1e300, f64::NAN, 0.0, f64::INFINITY]);
+        let tm = analyse(&t);
+        assert_eq!(tm.n, 5);
+    }
+
+    #[test]
+    fn duplicated_stamps_leave_the_period_alone() {
+        let mut t = grid(10_000);
+        for i in (0..10_000).step_by(50).rev() {
+            t.insert(i, t[i]);
+        }
+        let tm = analyse(&t);
+        assert_eq!(tm.not_increasing, 200);
+        assert_eq!(tm.missing, 0);
+        assert!((tm.nominal_period.unwrap() - 0.005).abs() < 1e-15);
     }
 }

@@ -22,15 +22,15 @@ type ByteEdit<'a> = Box<dyn Fn(&mut Vec<u8>) + 'a>;
 
 /// A top-level record of a ROS 1 bag: where it starts, its op, and its header and data ranges.
 #[derive(Debug, Clone)]
-struct Rec {
-    pos: usize,
-    op: Op,
-    header: std::ops::Range<usize>,
-    data: std::ops::Range<usize>,
+pub(crate) struct Rec {
+    pub(crate) pos: usize,
+    pub(crate) op: Op,
+    pub(crate) header: std::ops::Range<usize>,
+    pub(crate) data: std::ops::Range<usize>,
 }
 
 /// The top-level records of a well-formed bag, in file order.
-fn records(bytes: &[u8]) -> Vec<Rec> {
+pub(crate) fn records(bytes: &[u8]) -> Vec<Rec> {
     let mut pos = 13;
     let mut out = Vec::new();
     while let Some(r) = raw_record(bytes, pos) {
@@ -49,7 +49,7 @@ fn records(bytes: &[u8]) -> Vec<Rec> {
 }
 
 /// Offset of field `name`'s value inside the record header `range`.
-fn field(bytes: &[u8], range: &std::ops::Range<usize>, name: &str) -> usize {
+pub(crate) fn field(bytes: &[u8], range: &std::ops::Range<usize>, name: &str) -> usize {
     let mut pos = range.start;
     while pos < range.end {
         let len = read_u32(bytes, pos).unwrap() as usize;

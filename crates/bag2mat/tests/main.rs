@@ -5,6 +5,8 @@
 mod cli;
 mod defects;
 mod defects19;
+mod issue18;
+mod logs;
 mod real_tools;
 mod reference;
 mod ros2;

@@ -25,6 +25,8 @@ pub enum SensorArg {
     Adis16470,
     /// Safran Sensonor STIM300 (tactical grade).
     Stim300,
+    /// The ADIS16470 with vibration lines (mid-curve and short-τ; assumed).
+    Vibration,
 }
 
 impl SensorArg {
@@ -37,6 +39,7 @@ impl SensorArg {
             SensorArg::Bmi088 => Profile::Bmi088,
             SensorArg::Adis16470 => Profile::Adis16470,
             SensorArg::Stim300 => Profile::Stim300,
+            SensorArg::Vibration => Profile::Vibration,
         }
     }
 }
@@ -296,10 +299,14 @@ gyroscope:
   quantization: 0.0          # Q [rad] (integrated angle in steps of sqrt(12)*Q)
   resolution: 1.065e-3       # output LSB [rad/s]; 0 = none
   warmup: {temperature_rise_k: 1, tau_s: 300, bias_per_k: 2.6e-4}   # or {amplitude: A, tau_s: T}
+  lines: [{frequency_hz: 17, amplitude: 1.0e-3, bandwidth_hz: 0.5}]   # vibration lines at the output:
+                             # amplitude A [rad/s] of A*sin(2*pi*f*t + random phase); bandwidth_hz
+                             # > 0: a 2nd-order resonance of that -3 dB width (rms A/sqrt(2)); [] = none
   axes:                      # per-axis overrides, same keys
     z: {white_noise: 3.0e-4}
 accelerometer:
   white_noise: 1.57e-3       # N [m/s^2/sqrt(Hz)]
   random_walk: 1.0e-5        # K [m/s^3/sqrt(Hz)]
   resolution: 1.8e-3         # LSB [m/s^2]
+  lines: [{frequency_hz: 0.5, amplitude: 2.0e-3}]   # a pump or fan at 0.5 Hz [Hz, m/s^2]
 ";

@@ -40,7 +40,7 @@ for s in ('gyroscope', 'accelerometer'):
     assert set(t['units'][s]) >= {'white_noise', 'random_walk', 'bias_instability', 'rate_ramp', 'quantization', 'resolution'}
     for ax in 'xyz':
         a = t['model'][s]['axes'][ax]
-        assert set(a) == {'white_noise', 'random_walk', 'bias_instability', 'gauss_markov', 'rate_ramp', 'quantization', 'resolution', 'warmup'}, a
+        assert set(a) == {'white_noise', 'random_walk', 'bias_instability', 'gauss_markov', 'rate_ramp', 'quantization', 'resolution', 'warmup', 'lines'}, a
         dd = t['discrete'][s]['axes'][ax]
         assert dd['white_per_sample_sigma'] < dd['white_per_sample_sigma_naive'], dd
 print(t['model']['accelerometer']['axes']['z']['white_noise'])

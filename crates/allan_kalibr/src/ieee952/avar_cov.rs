@@ -248,7 +248,7 @@ fn normal_var_sums(m: usize, big_m: usize, tau0: f64) -> [f64; 10] {
 }
 
 /// Evaluates a ten-entry basis at coefficients (Q², N², B², K²).
-fn quad(s: &[f64; 10], c: &[f64; TERM_COUNT]) -> f64 {
+fn quad(s: &[f64; 10], c: &[f64]) -> f64 {
     let mut v = 0.0;
     for (k, &(t, u)) in PAIRS.iter().enumerate() {
         let f = if t == u { 1.0 } else { 2.0 };
@@ -259,7 +259,7 @@ fn quad(s: &[f64; 10], c: &[f64; TERM_COUNT]) -> f64 {
 
 /// The bilinear form of a ten-entry basis with different coefficients on each side (the
 /// covariance between two points whose effective coefficients differ).
-fn bilinear(s: &[f64; 10], ci: &[f64; TERM_COUNT], cj: &[f64; TERM_COUNT]) -> f64 {
+fn bilinear(s: &[f64; 10], ci: &[f64], cj: &[f64]) -> f64 {
     let mut v = 0.0;
     for (k, &(t, u)) in PAIRS.iter().enumerate() {
         v += if t == u {
@@ -323,7 +323,7 @@ impl CovBasis {
     }
 
     /// Variance of point `i` for coefficients `c` (Q², N², B², K², R²).
-    pub fn var(&self, i: usize, c: &[f64; TERM_COUNT]) -> f64 {
+    pub fn var(&self, i: usize, c: &[f64]) -> f64 {
         match self.kind {
             Overlap::Overlapping => quad(&self.sums[self.tri(i, i)], c),
             Overlap::Normal => quad(&self.normal_var[i], c),
@@ -331,8 +331,12 @@ impl CovBasis {
     }
 
     /// Covariance matrix of the points `idx` (indices into [`CovBasis::ms`]) for `c`.
-    pub fn cov(&self, idx: &[usize], c: &[f64; TERM_COUNT]) -> Vec<Vec<f64>> {
-        let per: Vec<[f64; TERM_COUNT]> = vec![*c; idx.len()];
+    pub fn cov(&self, idx: &[usize], c: &[f64]) -> Vec<Vec<f64>> {
+        let mut one = [0.0; TERM_COUNT];
+        for (o, v) in one.iter_mut().zip(c) {
+            *o = *v;
+        }
+        let per: Vec<[f64; TERM_COUNT]> = vec![one; idx.len()];
         self.cov_pointwise(idx, &per)
     }
 
@@ -382,7 +386,7 @@ pub fn avar_cov_pair_exact(
     big_mi: usize,
     big_mj: usize,
     tau0: f64,
-    c: &[f64; TERM_COUNT],
+    c: &[f64],
 ) -> f64 {
     let reach = 8 * (mi + mj) as i64;
     let h_lo = (-reach).max(-(big_mi as i64) + 1);

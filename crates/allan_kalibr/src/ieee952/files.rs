@@ -13,7 +13,10 @@
 //!   is continuous-time (field.md §3–4). One value per sensor (the largest axis); a term no
 //!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
-//!   are left out (with a comment) rather than written as a number.
+//!   are left out (with a comment) rather than written as a number. Every warning of the
+//!   record check (`bag2mat::record_check`: warm-up, spike, gaps, clocks) is a caveat.
+//! * OpenVINS' `kalibr_imu_chain.yaml` and Basalt's calibration noise fields:
+//!   [`super::vio_files`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -121,6 +124,11 @@ pub const CURVES_COLUMNS: [&str; 12] = [
     "model_adev",
 ];
 
+/// `ieee952_psd.csv`: the columns, in order (one-sided PSD in the axis' unit²/Hz).
+pub const PSD_COLUMNS: [&str; 5] = ["axis", "freq_hz", "psd", "floor", "model_psd"];
+/// PSD file name.
+pub const PSD_FILE: &str = "ieee952_psd.csv";
+
 /// File names (before the caller's prefix).
 pub const TERMS_FILE: &str = "ieee952_terms.csv";
 /// Curves file name.
@@ -160,9 +168,20 @@ pub fn write_outputs(
     };
     put(TERMS_FILE, terms_csv(a))?;
     put(CURVES_FILE, curves_csv(a))?;
+    if a.axes.iter().any(|x| x.analysis.psd.is_some()) {
+        put(PSD_FILE, psd_csv(a))?;
+    }
     put(KALIBR_FILE, kalibr_yaml(a, rostopic))?;
     put(VINS_FILE, vins_yaml(a))?;
     put(ORBSLAM3_FILE, orbslam3_yaml(a))?;
+    put(
+        super::vio_files::OPENVINS_FILE,
+        super::vio_files::openvins_yaml(a, rostopic),
+    )?;
+    put(
+        super::vio_files::BASALT_FILE,
+        super::vio_files::basalt_json(a),
+    )?;
     Ok(files)
 }
 
@@ -313,6 +332,57 @@ pub fn curves_csv(a: &ImuAnalysis) -> String {
     s
 }
 
+/// The Welch PSD of every axis (one-sided, unit²/Hz: rad²/s²/Hz, m²/s⁴/Hz), its local
+/// floor, and the fitted model's PSD; comment lines list the lines found per axis.
+pub fn psd_csv(a: &ImuAnalysis) -> String {
+    let mut s = String::from(
+        "# Welch PSD per axis: one-sided, in the axis unit squared per Hz (gyro rad^2/s^2/Hz, accelerometer m^2/s^4/Hz); white noise of density N has the level 2*N^2. floor: the running median the lines are found against; model_psd: the fitted IEEE 952 terms (a sinusoidal line has no density: listed below)\n",
+    );
+    for ax in &a.axes {
+        let code = ax.sensor.axis_code(ax.axis);
+        if let Some(p) = &ax.analysis.psd {
+            let _ = writeln!(
+                s,
+                "# {code}: {} segments of {} samples (Hann, back to back), resolution {} Hz",
+                p.segments,
+                p.segment,
+                p.resolution()
+            );
+        }
+        for l in &ax.analysis.lines {
+            let _ = writeln!(
+                s,
+                "# {code}: line at {} Hz, amplitude {} {}, bandwidth {} Hz, peak {}x the floor, Allan bump {}x the white noise's",
+                l.frequency,
+                l.amplitude,
+                ax.sensor.unit(),
+                l.bandwidth,
+                l.peak_ratio,
+                l.allan_ratio()
+            );
+        }
+    }
+    s.push_str(&PSD_COLUMNS.join(","));
+    s.push('\n');
+    for ax in &a.axes {
+        let Some(p) = &ax.analysis.psd else { continue };
+        let code = ax.sensor.axis_code(ax.axis);
+        let fl = super::psd::floor(p);
+        let fit = ax
+            .analysis
+            .fit
+            .as_ref()
+            .filter(|_| ax.analysis.verdict.fits());
+        for ((f, d), fl) in p.freq.iter().zip(&p.density).zip(&fl) {
+            let model = fit.map_or(f64::NAN, |x| {
+                super::psd::model_psd(*f, &x.coef, &x.shapes, ax.analysis.tau0)
+            });
+            let _ = writeln!(s, "{code},{f},{d},{fl},{model}");
+        }
+    }
+    s
+}
+
 fn note(name: &str, v: Option<SensorValue>) -> Option<String> {
     let v = v?;
     match (v.upper_bound, v.region) {
@@ -329,7 +399,7 @@ fn note(name: &str, v: Option<SensorValue>) -> Option<String> {
     }
 }
 
-fn inline_note(v: Option<SensorValue>) -> &'static str {
+pub(super) fn inline_note(v: Option<SensorValue>) -> &'static str {
     match v {
         Some(SensorValue {
             upper_bound: true, ..
@@ -340,15 +410,15 @@ fn inline_note(v: Option<SensorValue>) -> &'static str {
 }
 
 /// The four values and the comments every configuration file carries.
-struct FileValues {
-    acc_n: Option<SensorValue>,
-    acc_w: Option<SensorValue>,
-    gyr_n: Option<SensorValue>,
-    gyr_w: Option<SensorValue>,
-    comments: Vec<String>,
+pub(super) struct FileValues {
+    pub(super) acc_n: Option<SensorValue>,
+    pub(super) acc_w: Option<SensorValue>,
+    pub(super) gyr_n: Option<SensorValue>,
+    pub(super) gyr_w: Option<SensorValue>,
+    pub(super) comments: Vec<String>,
 }
 
-fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
+pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
     let v = FileValues {
         acc_n: a.noise_density(Sensor::Acc),
         acc_w: a.random_walk(Sensor::Acc),
@@ -372,6 +442,13 @@ fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
                 failed.join(", ")
             ));
         }
+        let cut = a.truncated_axes(s);
+        if !cut.is_empty() {
+            comments.push(format!(
+                "TRUNCATED FIT on {}: the model describes the curve only up to there; a random walk it does not resolve is the whole curve's 95 % bound.",
+                cut.join(", ")
+            ));
+        }
         let approx = a.approximate_axes(s);
         if !approx.is_empty() {
             comments.push(format!(
@@ -382,6 +459,13 @@ fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
     }
     for (name, x) in names.iter().zip([v.acc_n, v.acc_w, v.gyr_n, v.gyr_w]) {
         comments.extend(note(name, x));
+    }
+    // what the record breaks of the analysis' assumptions (bag2mat::record_check)
+    for f in a.warnings() {
+        comments.push(format!(
+            "RECORD CHECK: {}; the values above carry it (the tool's warning says what to do).",
+            f.short()
+        ));
     }
     FileValues { comments, ..v }
 }

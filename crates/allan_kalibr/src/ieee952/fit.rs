@@ -66,26 +66,40 @@
 //!   (the usual case) every plausible corner widens the intervals
 //!   ([`FitResult::alternatives`]).
 //!
+//! And the vibration lines the PSD finds (IEEE 952's sinusoidal noise, [`LineShape`]): their
+//! shapes are known, their A² fitted; in the enumeration of active sets they are in every
+//! set (2⁶ sets whatever the lines), and they take any sign.
+//!
 //! Their covariance: the shaped terms' AVAR is given, point by point, to the power law of
-//! its local slope (`effective_coef`).
+//! its local slope (`effective_coef`); a line's to white noise (plus, for a resonance, the
+//! variance of a narrow-band estimate), and a ramp's — deterministic, but its estimate
+//! carries the noise's cross term — to random walk, so that an R read off the longest
+//! points is as uncertain as those points are (issue 18.5).
 
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
 use super::avar_cov::CovBasis;
 
-/// The model's coefficients: the five IEEE 952 terms, then the exponentially correlated
-/// (Gauss–Markov) bias of IEEE 952 Annex C.
-pub const TERM_COUNT: usize = 6;
+/// The model's coefficients: the five IEEE 952 terms, the exponentially correlated
+/// (Gauss–Markov) bias of IEEE 952 Annex C, then up to [`LINE_SLOTS`] vibration lines (IEEE
+/// 952's sinusoidal noise, see [`LineShape`]).
+pub const TERM_COUNT: usize = 6 + LINE_SLOTS;
+/// Lines the model can hold (the strongest the PSD finds).
+pub const LINE_SLOTS: usize = 3;
+/// Index of the first line coefficient A².
+pub const LINE0: usize = 6;
 /// The five IEEE 952 power-law terms (the first five coefficients).
 pub const IEEE_TERMS: usize = 5;
 /// Index of the Gauss–Markov coefficient σ².
 pub const GM: usize = 5;
 /// Term names in coefficient order.
-pub const TERM_NAMES: [&str; TERM_COUNT] = ["Q", "N", "B", "K", "R", "G"];
+pub const TERM_NAMES: [&str; TERM_COUNT] = ["Q", "N", "B", "K", "R", "G", "L1", "L2", "L3"];
 /// Power-law α of the AVAR of each term (R, a deterministic ramp, is given RW FM's; the
-/// Gauss–Markov bias, flat around its peak, flicker FM's).
-pub const TERM_ALPHA: [i32; TERM_COUNT] = [2, 0, -1, -2, -2, -1];
+/// Gauss–Markov bias, flat around its peak, flicker FM's; a line, white FM's: its bump and
+/// ripples come with the white noise's EDF, the wider interval for a nearly deterministic
+/// estimate).
+pub const TERM_ALPHA: [i32; TERM_COUNT] = [2, 0, -1, -2, -2, -1, 0, 0, 0];
 /// 2 ln2/π: the AVAR of bias instability B is this times B².
 pub const FLICKER_AVAR: f64 = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI;
 
@@ -176,22 +190,106 @@ const BAND_TABLE: (f64, f64) = (1e-2, 10.0);
 /// Cells of the table: linear interpolation in ln x errs by < 2e-6.
 const BAND_TABLE_CELLS: usize = 2048;
 
-/// The shape parameters of the non-power-law terms: the Gauss–Markov correlation time and
-/// the flicker floor's lower corner (see [`flicker_band`]).
+/// A vibration line of the model: its shape, known from the PSD ([`super::psd`]); its
+/// coefficient A² is fitted. The Allan variance per unit A² is the sampled sinusoid's
+/// (bandwidth 0) or the sampled resonance's ([`super::lines`]), at m = τ/τ₀.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineShape {
+    /// Frequency, Hz.
+    pub frequency: f64,
+    /// −3 dB bandwidth, Hz (0: a sinusoid).
+    pub bandwidth: f64,
+    /// Sample period, s.
+    pub tau0: f64,
+    /// A² as the PSD measured it (for the range's start rule; a resonance's coefficient).
+    pub psd_amp2: f64,
+    /// Record length, s (a resonance's estimate has about 2πB·T degrees of freedom).
+    pub record: f64,
+}
+
+impl LineShape {
+    /// Whether the line's coefficient is held at the PSD's instead of fitted. Not today:
+    /// the PSD's A² is a few percent off for a resonance (its peak is as noisy as any bin),
+    /// far more than the short-τ points' precision, while the Allan bump pins A² once the
+    /// points it dominates carry their own variance ([`LineShape::edf`]); kept as the one
+    /// switch should a record need it.
+    pub fn fixed(&self) -> bool {
+        false
+    }
+
+    /// Degrees of freedom of the line's own Allan variance estimate (∞ for a sinusoid,
+    /// whose estimate is deterministic up to the noise's cross term).
+    pub fn edf(&self) -> f64 {
+        if self.bandwidth > 0.0 {
+            (2.0 * std::f64::consts::PI * self.bandwidth * self.record).max(1.0)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Allan variance per unit A² at τ.
+    pub fn avar(&self, tau: f64) -> f64 {
+        let m = tau / self.tau0;
+        if self.bandwidth == 0.0 {
+            super::lines::sinusoid_avar(m, self.frequency * self.tau0)
+        } else {
+            let (a, b) = super::lines::resonance_poles(self.frequency, self.bandwidth, self.tau0);
+            0.5 * super::lines::resonance_avar(m.round().max(1.0) as usize, a, b)
+        }
+    }
+}
+
+/// The shape parameters of the non-power-law terms: the Gauss–Markov correlation time, the
+/// flicker floor's lower corner (see [`flicker_band`]) and the lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shapes {
     /// Correlation time of the Gauss–Markov bias, s (NaN: not in the model).
     pub gm_t: f64,
     /// Shortest correlation time of the flicker floor, s (0: a flat floor, IEEE 952's B).
     pub b_lo: f64,
+    /// The lines of coefficients [`LINE0`]… (None: that slot is empty).
+    pub lines: LineSlots,
 }
+
+/// The model's line slots ([`LINE_SLOTS`] of them, written out: rustc 1.9x mis-handles the
+/// constant in this field's type inside struct-update closures).
+pub type LineSlots = [Option<LineShape>; 3];
+const _: () = assert!(LINE_SLOTS == 3);
 
 impl Shapes {
     /// The IEEE 952 power laws alone.
     pub const FLAT: Shapes = Shapes {
         gm_t: f64::NAN,
         b_lo: 0.0,
+        lines: [None; 3],
     };
+
+    /// The power laws with the lines `lines`.
+    pub fn with_lines(lines: LineSlots) -> Shapes {
+        Shapes {
+            lines,
+            ..Shapes::FLAT
+        }
+    }
+
+    /// Whether coefficient j is a fitted term here (a line slot only when it holds a line
+    /// whose A² is fitted, [`LineShape::fixed`]).
+    pub fn has(&self, j: usize) -> bool {
+        j < LINE0 || self.lines[j - LINE0].is_some_and(|l| !l.fixed())
+    }
+
+    /// The coefficients of the fixed lines (0 elsewhere).
+    pub fn fixed_coef(&self) -> [f64; TERM_COUNT] {
+        let mut c = [0.0; TERM_COUNT];
+        for (k, l) in self.lines.iter().enumerate() {
+            if let Some(l) = l
+                && l.fixed()
+            {
+                c[LINE0 + k] = l.psd_amp2;
+            }
+        }
+        c
+    }
 }
 
 /// Basis function j at τ with the shapes `s`.
@@ -199,6 +297,7 @@ pub fn basis_at(j: usize, tau: f64, s: &Shapes) -> f64 {
     match j {
         GM => gm_basis(tau, s.gm_t),
         2 if s.b_lo > 0.0 => FLICKER_AVAR * flicker_band(tau / s.b_lo),
+        j if j >= LINE0 => s.lines[j - LINE0].map_or(0.0, |l| l.avar(tau)),
         _ => basis(j, tau),
     }
 }
@@ -232,6 +331,20 @@ fn effective_coef(c: &[f64; TERM_COUNT], s: &Shapes, tau: f64) -> [f64; TERM_COU
     if c[GM] != 0.0 && s.gm_t > 0.0 {
         let a = c[GM] * gm_basis(tau, s.gm_t);
         spread(&mut e, a, &|t| gm_basis(t, s.gm_t));
+    }
+    // a line's share of a point's variance: as white noise of the same Allan variance (its
+    // sinusoid's estimate varies less; the covariance errs on the wide side there)
+    for j in LINE0..TERM_COUNT {
+        if c[j] != 0.0 {
+            e[1] += c[j].max(0.0) * basis_at(j, tau, s) / basis(1, tau);
+            e[j] = 0.0;
+        }
+    }
+    // a ramp is deterministic, but its estimate at a τ carries the noise's cross term with
+    // it: as the random walk of the same Allan variance there, so that an R read off the
+    // longest points is as uncertain as those points are (issue 18.5)
+    if c[4] > 0.0 {
+        e[3] += c[4] * basis(4, tau) / basis(3, tau);
     }
     e
 }
@@ -310,6 +423,15 @@ pub struct FitData<'a> {
     pub basis: Option<&'a CovBasis>,
     /// Index of each point into the basis.
     pub basis_index: Vec<usize>,
+    /// The lines the model holds (from the PSD of the samples; none for a curve alone).
+    pub lines: LineSlots,
+}
+
+impl FitData<'_> {
+    /// The power laws and this curve's lines: the shapes every fit starts from.
+    pub fn base_shapes(&self) -> Shapes {
+        Shapes::with_lines(self.lines)
+    }
 }
 
 /// Indices of the points nearest (in log m) to each 2^(k/p), k = 0, 1, …, without repeats.
@@ -465,12 +587,32 @@ struct Problem<'d, 'a> {
 }
 
 impl<'d, 'a> Problem<'d, 'a> {
+    /// The points `sel` of `data` under `shapes`; the fixed lines' Allan variance is taken
+    /// off the data (their columns are zero: they are not solved for).
     fn new(data: &'d FitData<'a>, sel: &[usize], shapes: Shapes) -> Self {
+        let fixed = shapes.fixed_coef();
         let g = sel
             .iter()
-            .map(|&i| std::array::from_fn(|j| basis_at(j, data.points[i].tau, &shapes)))
+            .map(|&i| {
+                std::array::from_fn(|j| {
+                    if fixed[j] != 0.0 {
+                        0.0
+                    } else {
+                        basis_at(j, data.points[i].tau, &shapes)
+                    }
+                })
+            })
             .collect();
-        let a = sel.iter().map(|&i| data.points[i].avar).collect();
+        let a = sel
+            .iter()
+            .map(|&i| {
+                let tau = data.points[i].tau;
+                data.points[i].avar
+                    - (0..TERM_COUNT)
+                        .map(|j| fixed[j] * basis_at(j, tau, &shapes))
+                        .sum::<f64>()
+            })
+            .collect();
         Problem {
             data,
             sel: sel.to_vec(),
@@ -489,11 +631,50 @@ impl<'d, 'a> Problem<'d, 'a> {
 
     /// Statistical covariance at c (the 1/τ² component only where it is a positive Q).
     fn sigma(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
+        let v = self.sigma_terms(c)?;
+        Some(self.with_line_variance(c, v))
+    }
+
+    /// A resonance's own estimate varies like a narrow-band noise's: 2·(its AVAR)²/ν on the
+    /// diagonal, ν = [`LineShape::edf`] (its white-noise stand-in in the covariance has the
+    /// EDF of white noise, far more).
+    fn with_line_variance(&self, c: &[f64; TERM_COUNT], mut v: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let fixed = self.shapes.fixed_coef();
+        for (k, &i) in self.sel.iter().enumerate() {
+            let tau = self.data.points[i].tau;
+            for (s, l) in self.shapes.lines.iter().enumerate() {
+                if let Some(l) = l
+                    && l.bandwidth > 0.0
+                {
+                    let coef = if l.fixed() {
+                        fixed[LINE0 + s]
+                    } else {
+                        c[LINE0 + s]
+                    };
+                    let a = coef.max(0.0) * l.avar(tau);
+                    v[k][k] += 2.0 * a * a / l.edf();
+                }
+            }
+        }
+        v
+    }
+
+    /// The covariance of the power laws (and the lines' white-noise stand-ins) at c.
+    fn sigma_terms(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
         let b = self.data.basis?;
         let mut cp = *c;
         cp[0] = cp[0].max(0.0);
+        let fixed = self.shapes.fixed_coef();
+        for j in LINE0..TERM_COUNT {
+            if fixed[j] != 0.0 {
+                cp[j] = fixed[j];
+            }
+        }
         let idx: Vec<usize> = self.sel.iter().map(|&i| self.data.basis_index[i]).collect();
-        let shaped = (cp[2] != 0.0 && self.shapes.b_lo > 0.0) || cp[GM] != 0.0;
+        let shaped = (cp[2] != 0.0 && self.shapes.b_lo > 0.0)
+            || cp[GM] != 0.0
+            || cp[4] != 0.0
+            || (LINE0..TERM_COUNT).any(|j| cp[j] != 0.0);
         if !shaped {
             return Some(b.cov(&idx, &cp));
         }
@@ -576,7 +757,9 @@ fn gls(
     shapes: Shapes,
 ) -> Option<Solve> {
     let p = Problem::new(data, sel, shapes);
-    let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
+    let terms: Vec<usize> = (0..TERM_COUNT)
+        .filter(|&j| enabled[j] && shapes.has(j))
+        .collect();
     if terms.is_empty() || sel.len() < terms.len() + 1 {
         return None;
     }
@@ -691,7 +874,9 @@ fn fixed_ls(
     shapes: Shapes,
 ) -> Option<FixedLs> {
     let p = Problem::new(data, sel, shapes);
-    let terms: Vec<usize> = (0..TERM_COUNT).filter(|&j| enabled[j]).collect();
+    let terms: Vec<usize> = (0..TERM_COUNT)
+        .filter(|&j| enabled[j] && shapes.has(j))
+        .collect();
     if terms.is_empty() || sel.len() < terms.len() + 1 {
         return None;
     }
@@ -747,7 +932,13 @@ fn robust_scale(resid_w: &[f64]) -> f64 {
 }
 
 fn signed_terms(cfg: &FitConfig) -> [bool; TERM_COUNT] {
-    [cfg.band_limit, false, false, false, false, false]
+    let mut s = [false; TERM_COUNT];
+    s[0] = cfg.band_limit;
+    // the lines' shapes come from the PSD; their coefficients take any sign
+    for v in s.iter_mut().skip(LINE0) {
+        *v = true;
+    }
+    s
 }
 
 /// The IEEE 952 terms of `cfg` (the Gauss–Markov one off).
@@ -775,7 +966,22 @@ pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
     if !cfg.trim || n < MIN_FIT_POINTS + 1 {
         return 0;
     }
-    let dev: Vec<f64> = data.points.iter().map(|p| p.avar.sqrt()).collect();
+    // the shape rule on the curve without its lines (as the PSD measured them): a line's
+    // bump at short τ is the model's, not a band limit
+    let base = data.base_shapes();
+    let dev: Vec<f64> = data
+        .points
+        .iter()
+        .map(|p| {
+            let lines: f64 = data
+                .lines
+                .iter()
+                .flatten()
+                .map(|l| l.psd_amp2 * l.avar(p.tau))
+                .sum();
+            (p.avar - lines).max(LINE_CLEAN_FLOOR * p.avar).sqrt()
+        })
+        .collect();
     let fwd_slope =
         |i: usize| (dev[i + 1] / dev[i]).ln() / (data.points[i + 1].tau / data.points[i].tau).ln();
     let mut s = (0..n - 1)
@@ -795,13 +1001,13 @@ pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
         let rest: Vec<usize> = (s + 1..n).collect();
         let all: Vec<usize> = (s..n).collect();
         let terms = ieee_only(cfg.terms);
-        let Some(base) = gls(data, &rest, terms, signed, mode, cfg.max_iter, Shapes::FLAT) else {
+        let Some(fit0) = gls(data, &rest, terms, signed, mode, cfg.max_iter, base) else {
             break;
         };
         // both fits under the covariance of the fit without the point
         let (Some((_, chi_without, rw, _)), Some((_, chi_with, _, _))) = (
-            fixed_ls(data, &rest, terms, signed, &base.coef, delta, Shapes::FLAT),
-            fixed_ls(data, &all, terms, signed, &base.coef, delta, Shapes::FLAT),
+            fixed_ls(data, &rest, terms, signed, &fit0.coef, delta, base),
+            fixed_ls(data, &all, terms, signed, &fit0.coef, delta, base),
         ) else {
             break;
         };
@@ -821,6 +1027,9 @@ pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
 /// Log-log slope at or below which the curve is falling like white noise (−½) or faster:
 /// halfway between flat and −½.
 pub const RISE_SLOPE: f64 = -0.25;
+/// The start rule's curve without its lines keeps at least this share of the measured
+/// Allan variance (a PSD amplitude a few percent high must not make it vanish).
+const LINE_CLEAN_FLOOR: f64 = 0.05;
 /// Fewest points a fitted range keeps (five terms and two degrees of freedom).
 pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
 
@@ -871,13 +1080,17 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         Delta::Zero
     };
     let ieee = ieee_only(cfg.terms);
-    let full = gls(data, used, ieee, signed, est, cfg.max_iter, Shapes::FLAT);
+    let base = data.base_shapes();
+    let full = gls(data, used, ieee, signed, est, cfg.max_iter, base);
     let mut terms = ieee;
-    let mut shapes = Shapes::FLAT;
+    let mut shapes = base;
     if cfg.select {
         let mut t = [false; TERM_COUNT];
         t[1] = cfg.terms[1];
         t[3] = cfg.terms[3];
+        for j in LINE0..TERM_COUNT {
+            t[j] = cfg.terms[j] && base.has(j);
+        }
         if t.iter().any(|x| *x) {
             // each step tests the candidates under the covariance of the current model (the
             // null hypothesis), with the full model's discrepancy (see [`fixed_ls`])
@@ -957,7 +1170,7 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
             terms = t;
         }
     }
-    let mut s = if terms == ieee && shapes == Shapes::FLAT {
+    let mut s = if terms == ieee && shapes == base {
         full.clone()?
     } else {
         gls(data, used, terms, signed, est, cfg.max_iter, shapes)?
@@ -976,11 +1189,17 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     let mut cov = s.cov;
     let mut left_out_coef = [0.0; TERM_COUNT];
     for j in 0..TERM_COUNT {
-        if cfg.terms[j] && !terms[j] {
+        if cfg.terms[j] && !terms[j] && base.has(j) {
             left_out[j] = true;
             coef[j] = 0.0;
             cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
             left_out_coef[j] = full.as_ref().map_or(0.0, |f| f.coef[j].max(0.0));
+        }
+    }
+    // the fixed lines' coefficients are the PSD's
+    for (j, v) in shapes.fixed_coef().iter().enumerate() {
+        if *v != 0.0 {
+            coef[j] = *v;
         }
     }
     if coef[GM] == 0.0 {
@@ -1049,11 +1268,17 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     // each term's largest share of the model's Allan variance at a used point (the model
     // rather than the measured points: their scatter at long τ would make a term dominant,
     // or not, by chance)
+    // (a noise term's share of the noise: a resonance's tail adds white-like variance at
+    // long τ, and must not make the white noise "never dominant")
+    let mut noise_coef = coef;
+    for v in noise_coef.iter_mut().skip(LINE0) {
+        *v = 0.0;
+    }
     let max_share = std::array::from_fn(|j| {
         used.iter()
             .map(|&i| {
                 let tau = data.points[i].tau;
-                let total = predict(&coef, &shapes, tau);
+                let total = predict(if j < LINE0 { &noise_coef } else { &coef }, &shapes, tau);
                 if total > 0.0 {
                     (coef[j] * basis_at(j, tau, &shapes) / total).max(0.0)
                 } else {
@@ -1294,7 +1519,9 @@ fn whiten(
 
 /// Weighted least squares over the enabled terms with sign constraints (terms not in
 /// `signed` ≥ 0), by enumerating the sets of free terms; `feasible` rejects solutions (e.g.
-/// a model that is not positive at every point).
+/// a model that is not positive at every point). The line terms (from [`LINE0`] on) are in
+/// every set and take any sign: their shapes come from the PSD, so the enumeration is over
+/// the power laws only (2⁶ sets whatever the lines).
 fn nnls_subsets(
     g: &[[f64; TERM_COUNT]],
     a: &[f64],
@@ -1303,17 +1530,25 @@ fn nnls_subsets(
     signed: &[bool; TERM_COUNT],
     feasible: &dyn Fn(&[f64; TERM_COUNT]) -> bool,
 ) -> Option<[f64; TERM_COUNT]> {
-    let k = enabled.len();
+    let always: Vec<usize> = enabled.iter().copied().filter(|&j| j >= LINE0).collect();
+    let choose: Vec<usize> = enabled.iter().copied().filter(|&j| j < LINE0).collect();
+    let k = choose.len();
     let mut best: Option<(f64, [f64; TERM_COUNT])> = None;
-    for mask in 1u32..(1 << k) {
+    let first = if always.is_empty() { 1u32 } else { 0 };
+    for mask in first..(1 << k) {
         let set: Vec<usize> = (0..k)
             .filter(|b| mask & (1 << b) != 0)
-            .map(|b| enabled[b])
+            .map(|b| choose[b])
+            .chain(always.iter().copied())
             .collect();
         let Some(sol) = wls(g, a, w, &set) else {
             continue;
         };
-        if set.iter().zip(&sol).any(|(&j, v)| *v < 0.0 && !signed[j]) {
+        if set
+            .iter()
+            .zip(&sol)
+            .any(|(&j, v)| *v < 0.0 && !signed[j] && j < LINE0)
+        {
             continue;
         }
         let mut c = [0.0; TERM_COUNT];
@@ -1480,6 +1715,7 @@ mod tests {
             curve_index: (0..n).collect(),
             basis: cov_basis,
             basis_index: (0..n).collect(),
+            lines: [None; 3],
         }
     }
 
@@ -1652,11 +1888,11 @@ mod tests {
         let b = CovBasis::new(&ms, 16_000_000, tau0, Overlap::Overlapping);
         let mut d = data_for([0.0; 5], &ms, tau0, Some(&b));
         let shapes = Shapes {
-            gm_t: f64::NAN,
             b_lo: lo,
+            ..Shapes::FLAT
         };
         for p in d.points.iter_mut() {
-            p.avar = predict(&[0.0, n2, b2, k2, 0.0, 0.0], &shapes, p.tau);
+            p.avar = predict(&[0.0, n2, b2, k2, 0.0, 0.0, 0.0, 0.0, 0.0], &shapes, p.tau);
         }
         let used: Vec<usize> = (0..ms.len()).collect();
         let r = fit(&d, &used, &FitConfig::default()).unwrap();

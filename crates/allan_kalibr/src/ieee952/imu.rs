@@ -1,7 +1,7 @@
 //! The IEEE 952 analysis of a whole IMU, as both analysers run it next to their compat
 //! outputs: up to six axes (gyro x y z, accelerometer x y z) from samples or from another
-//! tool's curves, the record-length advice per axis, the stationarity checks, and the
-//! printed section. The files it writes are in [`super::files`].
+//! tool's curves, the record-length advice per axis, the record check's findings
+//! (`bag2mat::record_check`, named in the verdicts), and the printed section. The files it writes are in [`super::files`].
 //!
 //! One value per sensor goes into the configuration files: the largest of the three axes
 //! (the conservative choice, as allan_variance_ros writes), and never a number the data do
@@ -12,12 +12,11 @@ use std::fmt::Write as _;
 use rayon::prelude::*;
 
 use super::advisor::{self, Advice};
-use super::stationarity::{self, StartStats, Warmup};
 use super::{
     Analysis, AxisVerdict, Config, CovBasis, CurveData, Ieee952Error, Term, Verdict, analyse_curve,
     short,
 };
-use bag2mat::timing::Timing;
+use bag2mat::record_check::{Finding, Level};
 
 /// τ/T_lo from which a flicker floor with lower corner T_lo is within 2 % of 0.664·B in
 /// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
@@ -36,8 +35,6 @@ pub struct AxisResult {
     pub analysis: Analysis,
     /// Record-length advice (None without a sample count).
     pub advice: Option<Advice>,
-    /// A warm-up or drift at the start (samples only).
-    pub warmup: Option<Warmup>,
 }
 
 /// The analysis of an IMU.
@@ -47,8 +44,8 @@ pub struct ImuAnalysis {
     pub rate: f64,
     /// The axes, gyro first, x y z.
     pub axes: Vec<AxisResult>,
-    /// The time stamps' gaps and rate changes (samples with stamps only).
-    pub timing: Option<Timing>,
+    /// What the record check found (samples only): gaps, clocks, outliers, warm-up, …
+    pub checks: Vec<Finding>,
     /// Where the curves came from and what was inferred (for the printed section).
     pub notes: Vec<String>,
 }
@@ -106,20 +103,18 @@ pub fn analyse_curves(
                 axis: *axis,
                 advice: advisor::advise(&analysis),
                 analysis,
-                warmup: None,
             }
         })
         .collect();
     ImuAnalysis {
         rate,
         axes,
-        timing: None,
+        checks: Vec::new(),
         notes: Vec::new(),
     }
 }
 
-/// The part of [`analyse_imu`] that reads the samples: each axis' curve and warm-up
-/// statistics. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
+/// The part of [`analyse_imu`] that reads the samples: each axis' curve. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
 /// the sample columns on (the compat path turns them into prefix sums in place) while the
 /// fits run.
 #[derive(Debug, Clone)]
@@ -128,87 +123,47 @@ pub struct ImuCurves {
     pub rate: f64,
     /// Gyro x y z, then acc x y z.
     pub sensors: [(Sensor, [CurveData; 3]); 2],
-    /// Each axis' start statistics, same order.
-    pub starts: Vec<Option<StartStats>>,
 }
 
 impl ImuCurves {
-    /// Curves and start statistics of six rate series (gyro x y z in rad/s, then acc x y z
-    /// in m/s²) at `rate` Hz, the axes in parallel.
+    /// Curves of six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate`
+    /// Hz, the axes in parallel.
     pub fn from_samples(
         series: [&[f64]; 6],
         rate: f64,
         cfg: &Config,
     ) -> Result<ImuCurves, Ieee952Error> {
         let tau0 = 1.0 / rate;
-        // The warm-up statistics are taken in the same parallel pass, while the axis is in cache.
-        let (data, starts): (Vec<_>, Vec<Option<StartStats>>) = series
+        let data: Vec<CurveData> = series
             .par_iter()
-            .map(|y| {
-                CurveData::from_samples(y, tau0, cfg)
-                    .map(|c| (c, StartStats::from_samples(y, tau0)))
-            })
-            .collect::<Result<Vec<_>, _>>()?
-            .into_iter()
-            .unzip();
+            .map(|y| CurveData::from_samples(y, tau0, cfg))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut it = data.into_iter();
         let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
         Ok(ImuCurves {
             rate,
             sensors: [(Sensor::Gyro, take3()), (Sensor::Acc, take3())],
-            starts,
         })
     }
 
-    /// The fits, the advice and the warm-up checks; `timing` as in [`analyse_imu`].
-    pub fn finish(&self, timing: Option<Timing>, cfg: &Config) -> ImuAnalysis {
+    /// The fits and the advice; `checks` as in [`analyse_imu`].
+    pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
-        add_stationarity(&mut an, &self.starts, timing);
+        an.checks = checks;
         an
     }
 }
 
-/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz,
-/// with the warm-up check on each; `timing` (`bag2mat::timing::analyse` of the series' time
-/// stamps, which the caller has already run to cut the record) adds the gap and rate checks.
+/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz;
+/// `checks` are the record check's findings on them (`bag2mat::record_check`, which the
+/// caller has run to cut the record), named by the section and the files.
 pub fn analyse_imu(
     series: [&[f64]; 6],
     rate: f64,
-    timing: Option<Timing>,
+    checks: Vec<Finding>,
     cfg: &Config,
 ) -> Result<ImuAnalysis, Ieee952Error> {
-    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(timing, cfg))
-}
-
-/// Adds the warm-up checks (each axis' start statistics, gyro x y z then acc x y z, against
-/// its fitted model) and the time-stamp checks (`bag2mat::timing::analyse` of the analysed
-/// stamps: the run has it already, from deciding whether to cut the record).
-pub fn add_stationarity(
-    an: &mut ImuAnalysis,
-    starts: &[Option<StartStats>],
-    timing: Option<Timing>,
-) {
-    for ax in an.axes.iter_mut() {
-        let k = match ax.sensor {
-            Sensor::Gyro => ax.axis,
-            Sensor::Acc => 3 + ax.axis,
-        };
-        let Some(Some(st)) = starts.get(k) else {
-            continue;
-        };
-        let Some(f) = ax
-            .analysis
-            .fit
-            .as_ref()
-            .filter(|_| ax.analysis.verdict.fits())
-        else {
-            continue;
-        };
-        let f = f.clone();
-        let model = move |tau: f64| f.predict(tau).max(0.0);
-        ax.warmup = stationarity::warmup(st, &model);
-    }
-    an.timing = timing;
+    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(checks, cfg))
 }
 
 /// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
@@ -217,10 +172,10 @@ pub fn add_stationarity(
 pub fn analyse_section(
     series: [&[f64]; 6],
     rate: f64,
-    timing: Option<Timing>,
+    checks: Vec<Finding>,
     notes: &mut Vec<String>,
 ) -> Option<ImuAnalysis> {
-    section_curves(series, rate, notes).map(|c| c.finish(timing, &Config::default()))
+    section_curves(series, rate, notes).map(|c| c.finish(checks, &Config::default()))
 }
 
 /// The sample-reading part of [`analyse_section`] ([`ImuCurves::from_samples`] with the
@@ -257,10 +212,30 @@ impl ImuAnalysis {
     /// resolved axis value (or region reading, marked); when no axis has one, the largest
     /// 95 % upper bound, marked. `None` when the sensor is absent or nothing is known.
     pub fn sensor_value(&self, s: Sensor, term: fn(&super::Terms) -> &Term) -> Option<SensorValue> {
-        let terms: Vec<&Term> = self
+        self.sensor_value_within(s, term, |_| f64::INFINITY)
+    }
+
+    /// [`ImuAnalysis::sensor_value`] with every axis' value at most `bound` of its analysis
+    /// (the curve's own 95 % bound of the term, [`super::Analysis::bounds`]).
+    pub fn sensor_value_within(
+        &self,
+        s: Sensor,
+        term: fn(&super::Terms) -> &Term,
+        bound: fn(&super::Analysis) -> f64,
+    ) -> Option<SensorValue> {
+        let terms: Vec<Term> = self
             .sensor_axes(s)
-            .map(|a| term(&a.analysis.terms))
+            .map(|a| {
+                let mut t = *term(&a.analysis.terms);
+                let b = bound(&a.analysis);
+                if b.is_finite() {
+                    t.value = t.value.min(b);
+                    t.hi = t.hi.min(b);
+                }
+                t
+            })
             .collect();
+        let terms: Vec<&Term> = terms.iter().collect();
         if terms.is_empty() {
             return None;
         }
@@ -295,14 +270,30 @@ impl ImuAnalysis {
         })
     }
 
-    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
+    /// what the curve allows.
     pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.n)
+        self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
     }
 
-    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
+    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
+    /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
     pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value(s, |t| &t.k)
+        self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
+    }
+
+    /// The record check's warnings on one axis (a warm-up, a spike).
+    pub fn axis_checks(&self, sensor: Sensor, axis: usize) -> impl Iterator<Item = &Finding> {
+        self.checks.iter().filter(move |f| {
+            f.level >= Level::Warning
+                && f.axis
+                    .is_some_and(|x| x.sensor == sensor && x.index == axis)
+        })
+    }
+
+    /// The record check's warnings, for the files' caveats.
+    pub fn warnings(&self) -> impl Iterator<Item = &Finding> {
+        self.checks.iter().filter(|f| f.level >= Level::Warning)
     }
 
     /// Axes without a reliable fit, as `gyro y` labels.
@@ -310,6 +301,25 @@ impl ImuAnalysis {
         self.sensor_axes(s)
             .filter(|a| !a.analysis.verdict.fits())
             .map(|a| a.sensor.axis_label(a.axis))
+            .collect()
+    }
+
+    /// Axes of one sensor whose fitted range was cut at the long end, by label, with the
+    /// range's last τ.
+    pub fn truncated_axes(&self, s: Sensor) -> Vec<String> {
+        self.sensor_axes(s)
+            .filter_map(|a| match a.analysis.verdict {
+                AxisVerdict::Fits {
+                    long_cut: true,
+                    range,
+                    ..
+                } => Some(format!(
+                    "{} (τ ≤ {} s)",
+                    a.sensor.axis_label(a.axis),
+                    short(range.1)
+                )),
+                _ => None,
+            })
             .collect()
     }
 
@@ -351,9 +361,12 @@ fn term_text(t: &Term, unit: &str) -> String {
             }
         }
         Verdict::NeverDominant => format!(
-            "not resolved: the curve never shows it on its own ({:.2e} {unit}{})",
-            t.value,
-            iv(t)
+            "not resolved: the curve never shows it on its own (fit {:.2e} {unit}; 95 % upper bound {:.2e} {unit})",
+            t.value, t.hi
+        ),
+        Verdict::Contradicted => format!(
+            "not resolved: the whole record does not agree with the fit's {:.2e} {unit} (95 % upper bound from the curve {:.2e} {unit})",
+            t.value, t.hi
         ),
         Verdict::RegionReading => {
             format!("{:.4e} {unit}{} (IEEE 952 region reading)", t.value, iv(t))
@@ -396,6 +409,7 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     for n in &a.notes {
         let _ = writeln!(s, "   note: {n}");
     }
+    s.push_str(&lines_text(a));
     for ax in &a.axes {
         let an = &ax.analysis;
         let sensor = ax.sensor;
@@ -455,23 +469,31 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
                 Some(x) => format!("< {:.2e}", x.hi),
                 None => "-".into(),
             };
+            let psd_n = an
+                .psd
+                .as_ref()
+                .and_then(super::psd::white_density)
+                .map_or("-".into(), |v| format!("{v:.3e}"));
             let _ = writeln!(
                 s,
-                "{:<7} region readings (cross-check): N {}  B {}  K {}",
+                "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
                 "",
                 rd(r.n),
                 rd(r.b),
                 rd(r.k)
             );
         }
-        if let Some(w) = &ax.warmup {
-            let _ = writeln!(s, "{:<7} warm-up: {}", "", warmup_text(w, sensor.unit()));
+        for f in a.axis_checks(sensor, ax.axis) {
+            let _ = writeln!(
+                s,
+                "{:<7} caveat: {} (see the warning on stderr)",
+                "",
+                f.short()
+            );
         }
     }
     s.push_str(&advice_text(a));
-    if let Some(t) = &a.timing {
-        s.push_str(&timing_text(t));
-    }
+    s.push_str(&checks_text(a));
     for sensor in a.sensors() {
         let fmt = |v: Option<SensorValue>, unit: &str| match v {
             Some(v) => format!(
@@ -498,34 +520,88 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     s
 }
 
-/// What a warm-up found at the start of one axis says (the report's line and the warning).
-fn warmup_text(w: &Warmup, unit: &str) -> String {
-    format!(
-        "the first {} differ from the rest by {:.3e} {unit} ({:.0} σ of the noise): warm-up or drift; consider --skip-start {:.0}",
-        advisor::duration_text(w.duration),
-        w.size,
-        w.sigmas,
-        w.duration.ceil()
-    )
-}
+/// One line over a sensor's axes: (frequency, largest ratio, amplitude, axes, in the model
+/// on some axis, a resonance).
+type LineGroup = (f64, f64, f64, Vec<&'static str>, bool, bool);
 
-/// The findings of the analysis that are warnings (a warm-up or drift at the start of an
-/// axis), for the binaries to print on stderr as `warning:` lines; the report on stdout
-/// keeps them as findings. (The time stamps' gaps and rate changes are warned by the runs
-/// that found them, before the analysis.)
-pub fn warnings(a: &ImuAnalysis) -> Vec<String> {
-    a.axes
-        .iter()
-        .filter_map(|ax| {
-            ax.warmup.as_ref().map(|w| {
+/// Lines of one sensor's axes whose frequencies agree within this fraction are one line.
+pub const SAME_LINE_REL: f64 = 0.02;
+
+/// The vibration lines the PSDs show, per sensor: "a line at 0.52 Hz, 6× the floor, on acc x
+/// y z" (× the floor: the line's Allan bump over the white noise's deviation there, the
+/// largest of its axes), and whether the model holds it.
+pub fn lines_text(a: &ImuAnalysis) -> String {
+    let mut s = String::new();
+    for sensor in a.sensors() {
+        let mut groups: Vec<LineGroup> = Vec::new();
+        for ax in a.sensor_axes(sensor) {
+            let modelled: Vec<f64> = ax
+                .analysis
+                .terms
+                .lines
+                .iter()
+                .flatten()
+                .map(|l| l.frequency)
+                .collect();
+            for l in &ax.analysis.lines {
+                let in_model = modelled.contains(&l.frequency);
+                let axis = ["x", "y", "z"][ax.axis];
+                match groups
+                    .iter_mut()
+                    .find(|g| (g.0 / l.frequency - 1.0).abs() <= SAME_LINE_REL)
+                {
+                    Some(g) => {
+                        if !g.3.contains(&axis) {
+                            g.3.push(axis);
+                        }
+                        g.1 = g.1.max(l.allan_ratio());
+                        g.2 = g.2.max(l.amplitude);
+                        g.4 |= in_model;
+                        g.5 |= l.bandwidth > 0.0;
+                    }
+                    None => groups.push((
+                        l.frequency,
+                        l.allan_ratio(),
+                        l.amplitude,
+                        vec![axis],
+                        in_model,
+                        l.bandwidth > 0.0,
+                    )),
+                }
+            }
+        }
+        if groups.is_empty() {
+            continue;
+        }
+        groups.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let list: Vec<String> = groups
+            .iter()
+            .map(|(f, r, amp, axes, m, res)| {
                 format!(
-                    "{}: {}",
-                    ax.sensor.axis_label(ax.axis),
-                    warmup_text(w, ax.sensor.unit())
+                    "a {} at {} Hz, {:.1}× the floor (amplitude {:.2e} {}), on {} {}{}",
+                    if *res { "resonance" } else { "line" },
+                    short(*f),
+                    r,
+                    amp,
+                    sensor.unit(),
+                    sensor.short(),
+                    axes.join(" "),
+                    if *m {
+                        ""
+                    } else {
+                        " (too weak to move the Allan curve)"
+                    }
                 )
             })
-        })
-        .collect()
+            .collect();
+        let _ = writeln!(
+            s,
+            "{} PSD lines: {} — fitted as IEEE 952 sinusoidal terms, so the model describes the curve on both sides",
+            sensor.name(),
+            list.join("; ")
+        );
+    }
+    s
 }
 
 /// The record-length advice lines.
@@ -576,47 +652,16 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
     s
 }
 
-/// The time-stamp findings (`bag2mat::timing`): gaps the analysers kept (too small to cut
-/// the record at) and rate changes, listed at most [`MAX_LISTED`] each.
-pub fn timing_text(t: &Timing) -> String {
+/// The record check's findings that concern no single axis (clocks, gaps, motion), one
+/// line each; the warnings themselves are on stderr.
+pub fn checks_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
-    let Some(period) = t.median_period.filter(|p| *p > 0.0) else {
-        return s;
-    };
-    if !t.gaps.is_empty() {
-        let mut longest: Vec<_> = t.gaps.iter().collect();
-        longest.sort_by(|a, b| b.length.total_cmp(&a.length));
-        longest.truncate(MAX_LISTED);
-        let list: Vec<String> = longest
-            .iter()
-            .map(|g| format!("{} s after sample {}", short(g.length), g.after))
-            .collect();
-        let _ = writeln!(
-            s,
-            "time stamps: {} gap(s) (≈ {:.0} samples missing; longest: {}); the Allan estimators assume uniform sampling",
-            t.gaps.len(),
-            t.gap_time() / period,
-            list.join(", ")
-        );
-    }
-    if !t.rate_changes.is_empty() {
-        let list: Vec<String> = t
-            .rate_changes
-            .iter()
-            .take(MAX_LISTED)
-            .map(|i| format!("sample {i}"))
-            .collect();
-        let _ = writeln!(
-            s,
-            "time stamps: the sample rate changes ({} change(s) off the median {:.3} Hz by > {:.0} %, at {})",
-            t.rate_changes.len(),
-            1.0 / period,
-            100.0 * bag2mat::timing::RATE_CHANGE_REL,
-            list.join(", ")
-        );
+    for f in a
+        .checks
+        .iter()
+        .filter(|f| f.axis.is_none() && f.level >= Level::Warning)
+    {
+        let _ = writeln!(s, "record check: {} (see the warning on stderr)", f.short());
     }
     s
 }
-
-/// Gaps and rate changes listed at most (the counts are always given).
-pub const MAX_LISTED: usize = 5;

@@ -73,27 +73,36 @@ pub fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
 }
 
 /// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}` (the workspace's PNG+SVG
-/// writer); returns the two paths.
+/// writer) and, where the analysis has PSDs, the PSD chart beside it
+/// ([`super::psd_plot`]), the two rendered in parallel; returns the paths.
 pub fn write_chart(
     a: &ImuAnalysis,
     title: &str,
     truth: Option<&Truth>,
     dir: &Path,
     prefix: &str,
-) -> Result<[PathBuf; 2], bag2mat::Error> {
+) -> Result<Vec<PathBuf>, bag2mat::Error> {
     let rows = a.axes.len().div_ceil(3).max(1) as u32;
     let size = (PANEL.0 * 3, PANEL.1 * rows + 40);
     let psize = (
         (size.0 as f64 * PNG_SCALE) as u32,
         (size.1 as f64 * PNG_SCALE) as u32,
     );
-    bag2mat::shared::plot::write_png_svg(
-        &Chart { a, title, truth },
-        dir,
-        &format!("{prefix}{STEM}"),
-        size,
-        psize,
-    )
+    let (allan, psd) = rayon::join(
+        || {
+            bag2mat::shared::plot::write_png_svg(
+                &Chart { a, title, truth },
+                dir,
+                &format!("{prefix}{STEM}"),
+                size,
+                psize,
+            )
+        },
+        || super::psd_plot::write_psd_chart(a, title, dir, prefix),
+    );
+    let mut out = allan?.to_vec();
+    out.extend(psd?.into_iter().flatten());
+    Ok(out)
 }
 
 /// What the chart shows.

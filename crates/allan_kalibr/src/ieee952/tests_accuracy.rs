@@ -291,7 +291,7 @@ fn accuracy_methods() {
         (
             "N+K only",
             with(FitConfig {
-                terms: [false, true, false, true, false, false],
+                terms: [false, true, false, true, false, false, true, true, true],
                 ..FitConfig::default()
             }),
         ),

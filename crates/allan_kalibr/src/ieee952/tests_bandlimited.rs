@@ -183,6 +183,8 @@ fn mat_cases() -> Vec<Outcome> {
         timings: false,
         ieee952: true,
         skip_start: None,
+        input_options: Default::default(),
+        drop_outliers: false,
         curves: None,
     };
     crate::run::run(&config).expect("allan_kalibr run on the .mat");
@@ -221,6 +223,7 @@ fn mat_cases() -> Vec<Outcome> {
                 "NeverDominant" => Verdict::NeverDominant,
                 "RegionReading" => Verdict::RegionReading,
                 "RegionBound" => Verdict::RegionBound,
+                "Contradicted" => Verdict::Contradicted,
                 other => panic!("verdict {other}"),
             };
             let (n_true, k_true) = truth(&m, s, a, n);

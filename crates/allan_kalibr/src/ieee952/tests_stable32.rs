@@ -268,3 +268,82 @@ fn analyse_runs_on_clock_data() {
         a.terms.as_array().map(|t| t.verdict)
     );
 }
+
+/// Issue 17.3: the section's curve against allantools' `oadev` (the Python package the
+/// field checks itself against; pinned in `scripts/test.sh`, run from its virtual
+/// environment — missing, the test fails) at every cluster size of the section's grid, on
+/// both clock files. The two sum the same squares in another order.
+const ALLANTOOLS_REL_TOL: f64 = 1e-9;
+
+/// allantools' `oadev` of `data` (`"freq"` or `"phase"`, τ0 = 1 s) at the cluster sizes `ms`:
+/// (m, deviation, number of terms) as the package returns them.
+fn allantools_oadev(data: &[f64], data_type: &str, ms: &[usize]) -> Vec<(usize, f64, usize)> {
+    use std::io::Write as _;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = dir.path().join("data.txt");
+    let mut f = std::fs::File::create(&input).expect("data file");
+    for v in data {
+        writeln!(f, "{v:e}").expect("write");
+    }
+    drop(f);
+    let taus: Vec<String> = ms.iter().map(|m| m.to_string()).collect();
+    let script = format!(
+        "import sys, numpy, allantools\n\
+         d = numpy.loadtxt(sys.argv[1])\n\
+         t, dev, err, n = allantools.oadev(d, rate=1.0, data_type='{data_type}', taus=numpy.array([{}], dtype=float))\n\
+         for a, b, c in zip(t, dev, n): print('%d %.17g %d' % (round(a), b, c))\n",
+        taus.join(",")
+    );
+    let out = bag2mat::test_tools::run_ok(
+        std::process::Command::new(bag2mat::test_tools::venv_python())
+            .arg("-c")
+            .arg(script)
+            .arg(&input),
+    );
+    out.lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            (
+                f[0].parse().expect("tau"),
+                f[1].parse().expect("dev"),
+                f[2].parse().expect("n"),
+            )
+        })
+        .collect()
+}
+
+fn check_against_allantools(label: &str, rate: &[f64], data: &[f64], data_type: &str) {
+    let curve = super::CurveData::from_samples(rate, 1.0, &super::Config::default())
+        .unwrap_or_else(|e| panic!("{label}: {e}"));
+    let ms: Vec<usize> = curve.points.iter().map(|p| p.m).collect();
+    let theirs = allantools_oadev(data, data_type, &ms);
+    assert_eq!(
+        theirs.iter().map(|t| t.0).collect::<Vec<_>>(),
+        ms,
+        "{label}: allantools returned other cluster sizes"
+    );
+    let mut worst = 0.0f64;
+    for (p, &(m, dev, n)) in curve.points.iter().zip(&theirs) {
+        let ours = p.avar.sqrt();
+        let rel = (ours / dev - 1.0).abs();
+        assert_eq!(n, rate.len() + 1 - 2 * m, "{label} m={m}: term count");
+        assert!(
+            rel < ALLANTOOLS_REL_TOL,
+            "{label} m={m}: ours {ours:e}, allantools {dev:e}, tol {ALLANTOOLS_REL_TOL:e}"
+        );
+        worst = worst.max(rel);
+    }
+    println!(
+        "{label}: the curve equals allantools' oadev at all {} cluster sizes ({} above m = 256), max |rel diff| {worst:.1e}",
+        ms.len(),
+        ms.iter().filter(|&&m| m > 256).count()
+    );
+}
+
+#[test]
+fn issue17_3_the_curve_equals_allantools_oadev() {
+    let ocxo = ocxo_rate();
+    check_against_allantools("OCXO (frequency)", &ocxo, &ocxo, "freq");
+    let gps_phase = numbers("gps_1pps_phase_data.txt.gz");
+    check_against_allantools("GPS 1PPS (phase)", &gps_rate(), &gps_phase, "phase");
+}

@@ -9,7 +9,12 @@
 //!    b_{n+1} = b_n + K√Δt·e;
 //! 3. plus each AR(1) component (flicker components, then Gauss–Markov biases), started from
 //!    its stationary law: x_{n+1} = a·x_n + σ√(1 − a²)·e, a = e^(−Δt/T);
-//! 4. plus the ramp R·nΔt and the warm-up A·e^(−nΔt/T).
+//! 4. plus the ramp R·nΔt and the warm-up A·e^(−nΔt/T);
+//! 5. plus each line: a sinusoid A·sin(2πf₀nΔt + φ) with a uniform random phase φ, or a
+//!    resonance, the continuous 2nd-order system ẍ + 2ζω₀ẋ + ω₀²x = q·w sampled exactly (the
+//!    state (x, ẋ) advances by its transition matrix e^(AΔt) plus a normal innovation of
+//!    covariance P − ΦPΦᵀ, P the stationary covariance diag(σ², ω₀²σ²), started from P), so
+//!    that its autocovariance is the continuous one at the sample times.
 //!
 //! Then, in [`ImuNoise::apply`], the motion signal is added and the sum is quantised:
 //! the integrated angle/velocity with step q = √12·Q (the rate is the difference of the
@@ -47,6 +52,72 @@ enum WhiteChain {
     Biquad { sd: f64, d: usize, f: Biquad },
 }
 
+/// One line of an axis at the output rate (step 5 of the module docs).
+#[derive(Debug, Clone)]
+enum LineGen {
+    /// A·sin(ω·n + φ).
+    Sinusoid { amp: f64, omega: f64, phase: f64 },
+    /// The resonance's state (x, ẋ), transition Φ and innovation factor L (lower triangle).
+    Resonance {
+        state: [f64; 2],
+        phi: [[f64; 2]; 2],
+        l: [f64; 3],
+    },
+}
+
+impl LineGen {
+    fn new(line: &super::model::Line, dt: f64, rng: &mut Xoshiro256PlusPlus) -> LineGen {
+        let w0 = 2.0 * std::f64::consts::PI * line.frequency;
+        if line.bandwidth == 0.0 {
+            let u: f64 = rng.random();
+            return LineGen::Sinusoid {
+                amp: line.amplitude,
+                omega: w0 * dt,
+                phase: 2.0 * std::f64::consts::PI * u,
+            };
+        }
+        let zeta = line.bandwidth / (2.0 * line.frequency);
+        let (al, be) = (zeta * w0, w0 * (1.0 - zeta * zeta).sqrt());
+        let e = (-al * dt).exp();
+        let (sb, cb) = (be * dt).sin_cos();
+        let phi = [
+            [e * (cb + al / be * sb), e * sb / be],
+            [-e * w0 * w0 / be * sb, e * (cb - al / be * sb)],
+        ];
+        let var = 0.5 * line.amplitude * line.amplitude;
+        let p = [var, w0 * w0 * var];
+        // Q = P − ΦPΦᵀ (P diagonal), and its Cholesky factor
+        let q11 = p[0] - (phi[0][0] * phi[0][0] * p[0] + phi[0][1] * phi[0][1] * p[1]);
+        let q21 = -(phi[1][0] * phi[0][0] * p[0] + phi[1][1] * phi[0][1] * p[1]);
+        let q22 = p[1] - (phi[1][0] * phi[1][0] * p[0] + phi[1][1] * phi[1][1] * p[1]);
+        let l11 = q11.max(0.0).sqrt();
+        let l21 = if l11 > 0.0 { q21 / l11 } else { 0.0 };
+        let l22 = (q22 - l21 * l21).max(0.0).sqrt();
+        let state = [p[0].sqrt() * normal(rng), p[1].sqrt() * normal(rng)];
+        LineGen::Resonance {
+            state,
+            phi,
+            l: [l11, l21, l22],
+        }
+    }
+
+    /// The line's value at sample `n`, then a step.
+    #[inline]
+    fn next(&mut self, n: u64, rng: &mut Xoshiro256PlusPlus) -> f64 {
+        match self {
+            LineGen::Sinusoid { amp, omega, phase } => *amp * (*omega * n as f64 + *phase).sin(),
+            LineGen::Resonance { state, phi, l } => {
+                let x = state[0];
+                let (e1, e2) = (normal(rng), normal(rng));
+                let s0 = phi[0][0] * state[0] + phi[0][1] * state[1] + l[0] * e1;
+                let s1 = phi[1][0] * state[0] + phi[1][1] * state[1] + l[1] * e1 + l[2] * e2;
+                *state = [s0, s1];
+                x
+            }
+        }
+    }
+}
+
 /// One axis's noise before quantization.
 #[derive(Debug, Clone)]
 pub struct AxisGenerator {
@@ -59,6 +130,7 @@ pub struct AxisGenerator {
     n: u64,
     warm: f64,
     warm_factor: f64,
+    lines: Vec<LineGen>,
 }
 
 #[inline(always)]
@@ -105,6 +177,12 @@ impl AxisGenerator {
             Some(w) => (w.amplitude(), (-dt / w.tau()).exp()),
             None => (0.0, 0.0),
         };
+        // after every other draw of the set-up, so that a model without lines keeps its stream
+        let lines = a
+            .lines
+            .iter()
+            .map(|l| LineGen::new(l, dt, &mut rng))
+            .collect();
         AxisGenerator {
             rng,
             white,
@@ -115,6 +193,7 @@ impl AxisGenerator {
             n: 0,
             warm,
             warm_factor,
+            lines,
         }
     }
 
@@ -146,6 +225,9 @@ impl AxisGenerator {
             if self.warm != 0.0 {
                 y += self.warm;
                 self.warm *= self.warm_factor;
+            }
+            for l in self.lines.iter_mut() {
+                y += l.next(self.n, rng);
             }
             self.n += 1;
             *v = y;

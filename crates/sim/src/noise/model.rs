@@ -13,14 +13,17 @@
 //! | `quantization` | IEEE 952 Q, on the integrated angle/velocity | U·s | √3·Q/τ |
 //! | `resolution` | output LSB: values rounded to counts | U | white: AVAR r²/(12·m), m = τ·f |
 //! | `warmup` | exponential bias settling after power-on | U, s | deterministic |
+//! | `lines` | IEEE 952 sinusoidal noise A·sin(2πf₀t + φ), or with a bandwidth a lightly damped 2nd-order resonance driven by white noise (rms A/√2) | Hz, U | A²·sin⁴(πf₀τ)/(πf₀τ)² (a bump near τ ≈ 0.37/f₀, ripples beyond) |
 //!
 //! Where each term enters the chain (and so what the truth in [`super::truth`] computes):
 //! the white noise is generated at the internal rate, low-pass filtered and decimated; the
 //! bias terms (random walk, flicker, Gauss–Markov, ramp, warm-up) are generated at the output
 //! rate and added after the filter (their power lies decades below any DLPF corner, so the
 //! filter would change them by less than (f/f_c)⁴; leaving them out of it keeps their truth
-//! exact and the generator cheap); the sum plus the motion signal is then quantised: first the
-//! integrated angle/velocity (IEEE 952 Q), then the output value to its LSB.
+//! exact and the generator cheap); so are the lines, whose amplitude is the one the output
+//! carries (a vibration as the sensor's filter has already shaped it, what a PSD of the
+//! record shows); the sum plus the motion signal is then quantised: first the integrated
+//! angle/velocity (IEEE 952 Q), then the output value to its LSB.
 
 use std::fmt::Write as _;
 
@@ -96,6 +99,20 @@ impl Warmup {
     }
 }
 
+/// A vibration line (IEEE 952 sinusoidal noise) at the output: a sinusoid of amplitude A at
+/// f₀ with a random phase, or with a bandwidth, a lightly damped 2nd-order resonance driven
+/// by white noise (centre f₀, −3 dB width B, damping ζ = B/(2f₀), variance A²/2: the
+/// sinusoid of the same power).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    /// f₀, Hz (below half the output rate).
+    pub frequency: f64,
+    /// A, U.
+    pub amplitude: f64,
+    /// B, Hz (0: a sinusoid; below f₀).
+    pub bandwidth: f64,
+}
+
 /// Every term of one axis (module doc for units). Zero / `None` / empty = term off.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct AxisModel {
@@ -115,6 +132,8 @@ pub struct AxisModel {
     pub resolution: f64,
     /// Warm-up.
     pub warmup: Option<Warmup>,
+    /// Vibration lines.
+    pub lines: Vec<Line>,
 }
 
 impl AxisModel {
@@ -135,6 +154,7 @@ impl AxisModel {
             && self.quantization == 0.0
             && self.resolution == 0.0
             && self.warmup.is_none()
+            && self.lines.is_empty()
     }
 }
 
@@ -361,6 +381,28 @@ impl ImuModel {
                         ));
                     }
                 }
+                for l in &a.lines {
+                    if !(l.frequency.is_finite()
+                        && l.frequency > 0.0
+                        && l.frequency < 0.5 * output_rate
+                        && l.amplitude.is_finite()
+                        && l.amplitude >= 0.0
+                        && l.bandwidth.is_finite()
+                        && l.bandwidth >= 0.0
+                        && l.bandwidth < l.frequency)
+                    {
+                        return Err(at(
+                            "lines",
+                            format!(
+                                "a line needs 0 < frequency < {} Hz (half the output rate), amplitude >= 0 and 0 <= bandwidth < frequency (lightly damped), got frequency {} Hz, amplitude {}, bandwidth {} Hz",
+                                0.5 * output_rate,
+                                l.frequency,
+                                l.amplitude,
+                                l.bandwidth
+                            ),
+                        ));
+                    }
+                }
                 if let Some(w) = a.warmup {
                     let ok = w.amplitude().is_finite() && w.tau().is_finite() && w.tau() > 0.0;
                     if !ok {
@@ -443,6 +485,18 @@ impl ImuModel {
                         s.unit(),
                         w.tau()
                     );
+                }
+                for l in &a.lines {
+                    let _ = write!(
+                        o,
+                        ", line {} Hz amplitude {:.4e} {}",
+                        l.frequency,
+                        l.amplitude,
+                        s.unit()
+                    );
+                    if l.bandwidth > 0.0 {
+                        let _ = write!(o, " (resonance, bandwidth {} Hz)", l.bandwidth);
+                    }
                 }
                 let _ = writeln!(
                     o,

@@ -13,7 +13,7 @@
 //! against the documents named in [`Profile::source`] on 2026-11-30.
 
 use super::model::{
-    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, SensorModel, Warmup,
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, SensorModel, Warmup,
 };
 use super::{ContinuousNoise, Preset};
 
@@ -40,17 +40,21 @@ pub enum Profile {
     Adis16470,
     /// Safran Sensonor STIM300, tactical-grade MEMS IMU.
     Stim300,
+    /// The ADIS16470 on a running machine: vibration lines in the middle of the curve and at
+    /// short τ (IEEE 952 sinusoidal noise; assumed figures).
+    Vibration,
 }
 
 impl Profile {
     /// All profiles, in `sim sensors` order.
-    pub const ALL: [Profile; 6] = [
+    pub const ALL: [Profile; 7] = [
         Profile::Low,
         Profile::Medium,
         Profile::High,
         Profile::Bmi088,
         Profile::Adis16470,
         Profile::Stim300,
+        Profile::Vibration,
     ];
 
     /// The name on the command line.
@@ -62,6 +66,7 @@ impl Profile {
             Profile::Bmi088 => "bmi088",
             Profile::Adis16470 => "adis16470",
             Profile::Stim300 => "stim300",
+            Profile::Vibration => "vibration",
         }
     }
 
@@ -85,6 +90,9 @@ impl Profile {
             Profile::Stim300 => {
                 "Safran Sensonor STIM300 (tactical-grade MEMS IMU), noise figures of data sheet TS1524 rev. 9 (10 g accelerometers; rev. 31 quotes a quieter accelerometer); 2000 SPS internal, 66 Hz low-pass"
             }
+            Profile::Vibration => {
+                "the adis16470 profile on a running pump (assumed): accelerometer lines at 0.5 Hz and 1.7 Hz (a shoulder in the middle of the Allan curve, ripples after it), a 45 Hz gyroscope resonance 1 Hz wide (short tau); valid from a 90 Hz output rate"
+            }
         }
     }
 
@@ -97,6 +105,7 @@ impl Profile {
             Profile::Bmi088 => bmi088(),
             Profile::Adis16470 => adis16470(),
             Profile::Stim300 => stim300(),
+            Profile::Vibration => vibration(),
         }
     }
 }
@@ -316,6 +325,40 @@ fn stim300() -> ImuModel {
             axes: [acc.clone(), acc.clone(), acc],
         },
     }
+}
+
+/// The ADIS16470 with the lines of a machine it is bolted to (none of this is a datasheet
+/// figure): what a static record on a factory floor or a vehicle with its engine running
+/// shows — the case IEEE 952's sinusoidal term is for. Amplitudes are what the output carries.
+fn vibration() -> ImuModel {
+    let mut m = adis16470();
+    m.label = "vibration".into();
+    // Accelerometer: a pump at 0.5 Hz, its Allan bump (0.725·A at τ ≈ 0.74 s) about 6× the
+    // white noise's deviation there (N/√τ ≈ 7.2e-4 m/s²), and a line at 1.7 Hz about 2×.
+    for a in m.acc.axes.iter_mut() {
+        a.lines = vec![
+            Line {
+                frequency: 0.5,
+                amplitude: 6e-3,
+                bandwidth: 0.0,
+            },
+            Line {
+                frequency: 1.7,
+                amplitude: 3e-3,
+                bandwidth: 0.0,
+            },
+        ];
+    }
+    // Gyroscope: a structural resonance at 45 Hz, 1 Hz wide; at 200 Hz its Allan bump
+    // (τ ≈ 10 ms) is about 6× the white noise's deviation there.
+    for a in m.gyro.axes.iter_mut() {
+        a.lines = vec![Line {
+            frequency: 45.0,
+            amplitude: 8e-3,
+            bandwidth: 1.0,
+        }];
+    }
+    m
 }
 
 /// The `sim sensors` listing: every profile with its figures at `rate` Hz.

@@ -15,6 +15,8 @@
 //!   resolution: 1.065e-3        # output LSB [rad/s]
 //!   warmup: {amplitude: 2.6e-4, tau_s: 300}           # [rad/s], or
 //!   # warmup: {temperature_rise_k: 1, tau_s: 300, bias_per_k: 2.6e-4}
+//!   lines: [{frequency_hz: 0.5, amplitude: 2.0e-4}, {frequency_hz: 17, amplitude: 1.0e-3, bandwidth_hz: 0.5}]
+//!                               # vibration lines [Hz, rad/s]; bandwidth: a resonance; [] = off
 //!   axes:                       # optional per-axis overrides, same keys as above
 //!     z: {white_noise: 3.0e-4}
 //! accelerometer: { ... }        # the same keys, m/s^2-based units
@@ -28,7 +30,8 @@ use serde::Deserialize;
 use std::path::Path;
 
 use super::model::{
-    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, SensorModel, Warmup,
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, Sensor, SensorModel,
+    Warmup,
 };
 use super::profiles::Profile;
 use crate::error::{Result, SimError};
@@ -53,6 +56,18 @@ pub struct GmSpec {
     pub sigma: f64,
     /// T, s.
     pub tau_s: f64,
+}
+
+/// One entry of `lines:`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineSpec {
+    /// f₀, Hz.
+    pub frequency_hz: f64,
+    /// A.
+    pub amplitude: f64,
+    /// −3 dB bandwidth of a resonance, Hz (absent or 0: a sinusoid).
+    pub bandwidth_hz: Option<f64>,
 }
 
 /// `warmup:` — either `amplitude` or `temperature_rise_k` with `bias_per_k`.
@@ -101,6 +116,8 @@ macro_rules! term_struct {
             pub resolution: Option<f64>,
             /// Warm-up.
             pub warmup: Option<WarmupSpec>,
+            /// Vibration lines.
+            pub lines: Option<Vec<LineSpec>>,
             $($extra)*
         }
     };
@@ -214,6 +231,16 @@ fn apply_terms(a: &mut AxisModel, s: &AxisSpecRef<'_>) -> std::result::Result<()
     if let Some(v) = s.resolution {
         a.resolution = v;
     }
+    if let Some(l) = s.lines {
+        a.lines = l
+            .iter()
+            .map(|l| Line {
+                frequency: l.frequency_hz,
+                amplitude: l.amplitude,
+                bandwidth: l.bandwidth_hz.unwrap_or(0.0),
+            })
+            .collect();
+    }
     if let Some(w) = s.warmup {
         a.warmup = match (w.amplitude, w.temperature_rise_k, w.bias_per_k) {
             (Some(0.0), None, None) => None,
@@ -247,6 +274,7 @@ struct AxisSpecRef<'a> {
     quantization: Option<f64>,
     resolution: Option<f64>,
     warmup: Option<WarmupSpec>,
+    lines: Option<&'a Vec<LineSpec>>,
 }
 
 macro_rules! terms_ref {
@@ -260,6 +288,7 @@ macro_rules! terms_ref {
             quantization: $s.quantization,
             resolution: $s.resolution,
             warmup: $s.warmup,
+            lines: $s.lines.as_ref(),
         }
     };
 }
@@ -365,6 +394,7 @@ gyroscope:
     z: {white_noise: 0.5, warmup: {temperature_rise_k: 2, tau_s: 60, bias_per_k: 1.0e-4}}
 accelerometer:
   quantization: 1.0e-6
+  lines: [{frequency_hz: 0.5, amplitude: 2.0e-3}, {frequency_hz: 17, amplitude: 1.0e-3, bandwidth_hz: 0.5}]
 ";
         let s = parse(text).unwrap();
         let m = apply(&s, None, Path::new("t.yaml")).unwrap();
@@ -376,6 +406,22 @@ accelerometer:
         assert!(m.gyro.axes[0].warmup.is_none());
         assert!(m.acc.axes.iter().all(|a| a.quantization == 1e-6));
         assert_eq!(m.acc.axes[1].random_walk, 5e-4);
+        assert_eq!(
+            m.acc.axes[2].lines,
+            vec![
+                Line {
+                    frequency: 0.5,
+                    amplitude: 2e-3,
+                    bandwidth: 0.0
+                },
+                Line {
+                    frequency: 17.0,
+                    amplitude: 1e-3,
+                    bandwidth: 0.5
+                }
+            ]
+        );
+        assert!(m.gyro.axes[0].lines.is_empty());
     }
 
     #[test]

@@ -20,7 +20,11 @@
 //! | LSB r (white rate error) | variance r²/12 | r²/(12m) |
 //! | ramp R | R·nΔt | R²τ²/2 |
 //! | warm-up A, T | A·w^n, w = e^(−Δt/T), n < N | (A²/(2M m²))·((1−w^m)²/(1−w))²·(1−w^{2M})/(1−w²), M = N − 2m + 1 |
+//! | line: sinusoid A, f₀ (random phase) | A·sin(2πf₀nΔt + φ) | A²·sin⁴(πmν₀)/(m²·sin²(πν₀)), ν₀ = f₀Δt |
+//! | line: resonance A, f₀, B | R(k) = (A²/2)·e^(−a\|k\|)(cos bk + (a/b) sin b\|k\|) | the AR(1) form with a complex pole |
 //!
+//! The two line rows are `allan_kalibr::ieee952::lines` (the estimator's line terms use the
+//! same mathematics); the tests here check them against the spectral integral.
 //! The AR(1) bracket cancels catastrophically when mΔt ≪ T (both terms ≈ 2m/β, the result
 //! ≈ 2m³β/3): below x = mβ = [`AR1_SERIES_BELOW`] it is evaluated from its power series in
 //! β, whose coefficients are polynomials in m (derived symbolically; checked in the tests
@@ -401,13 +405,15 @@ pub struct TermAvar {
     pub rate_ramp: f64,
     /// Warm-up.
     pub warmup: f64,
+    /// Vibration lines (sinusoids and resonances).
+    pub lines: f64,
     /// Cross term of the two deterministic terms (ramp × warm-up): deterministic signals are
     /// not independent, so their Allan variances do not simply add. May be negative.
     pub deterministic_cross: f64,
 }
 
 /// Term names in [`TermAvar`] order (file columns).
-pub const TERM_NAMES: [&str; 8] = [
+pub const TERM_NAMES: [&str; 9] = [
     "white_noise",
     "quantization",
     "resolution",
@@ -416,11 +422,12 @@ pub const TERM_NAMES: [&str; 8] = [
     "random_walk",
     "rate_ramp",
     "warmup",
+    "lines",
 ];
 
 impl TermAvar {
     /// Values in [`TERM_NAMES`] order.
-    pub fn values(&self) -> [f64; 8] {
+    pub fn values(&self) -> [f64; 9] {
         [
             self.white,
             self.quantization,
@@ -430,6 +437,7 @@ impl TermAvar {
             self.random_walk,
             self.rate_ramp,
             self.warmup,
+            self.lines,
         ]
     }
 
@@ -457,6 +465,51 @@ pub struct AxisTruth {
     rw_step: f64,
     ramp: f64,
     warmup: Option<(f64, f64)>,
+    lines: Vec<LineTruth>,
+}
+
+/// One line of an axis, per output sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum LineTruth {
+    /// A², ν₀.
+    Sinusoid { a2: f64, nu0: f64 },
+    /// σ² and the poles (a, b) of `allan_kalibr::ieee952::lines::resonance_poles`.
+    Resonance { var: f64, a: f64, b: f64 },
+}
+
+impl LineTruth {
+    fn new(l: &super::model::Line, dt: f64) -> LineTruth {
+        use allan_kalibr::ieee952::lines::resonance_poles;
+        let a2 = l.amplitude * l.amplitude;
+        if l.bandwidth == 0.0 {
+            LineTruth::Sinusoid {
+                a2,
+                nu0: l.frequency * dt,
+            }
+        } else {
+            let (a, b) = resonance_poles(l.frequency, l.bandwidth, dt);
+            LineTruth::Resonance {
+                var: a2 / 2.0,
+                a,
+                b,
+            }
+        }
+    }
+
+    fn avar(&self, m: usize) -> f64 {
+        use allan_kalibr::ieee952::lines::{resonance_avar, sinusoid_avar};
+        match *self {
+            LineTruth::Sinusoid { a2, nu0 } => a2 * sinusoid_avar(m as f64, nu0),
+            LineTruth::Resonance { var, a, b } => var * resonance_avar(m, a, b),
+        }
+    }
+
+    fn variance(&self) -> f64 {
+        match *self {
+            LineTruth::Sinusoid { a2, .. } => a2 / 2.0,
+            LineTruth::Resonance { var, .. } => var,
+        }
+    }
 }
 
 impl AxisTruth {
@@ -482,6 +535,7 @@ impl AxisTruth {
             rw_step: super::random_walk_to_discrete(a.random_walk, dt),
             ramp: a.rate_ramp,
             warmup: a.warmup.map(|w| (w.amplitude(), dt / w.tau())),
+            lines: a.lines.iter().map(|l| LineTruth::new(l, dt)).collect(),
         }
     }
 
@@ -511,6 +565,7 @@ impl AxisTruth {
                 .warmup
                 .map(|(a, b)| warmup_avar(a, b, m, self.n))
                 .unwrap_or(0.0),
+            lines: self.lines.iter().map(|l| l.avar(m)).sum(),
             deterministic_cross: match self.warmup {
                 Some((a, b)) if self.ramp != 0.0 => {
                     ramp_warmup_cross(self.ramp * tau, a, b, m, self.n)
@@ -552,7 +607,8 @@ impl AxisTruth {
                 .chain(&self.gm)
                 .map(|v| v.0)
                 .sum::<f64>()
-            + self.rw_step * self.rw_step;
+            + self.rw_step * self.rw_step
+            + self.line_variance();
         Some(widrow_ratio(
             others.sqrt() * self.dt,
             super::quantization_step(self.quantization),
@@ -560,7 +616,8 @@ impl AxisTruth {
     }
 
     /// Per-sample variance of the random part of the output (white, LSB, quantization,
-    /// flicker, Gauss–Markov; the random walk and deterministic terms are not stationary).
+    /// flicker, Gauss–Markov, lines; the random walk and deterministic terms are not
+    /// stationary).
     pub fn stationary_variance(&self) -> f64 {
         self.white.variance()
             + self.lsb_var
@@ -571,6 +628,12 @@ impl AxisTruth {
                 .chain(&self.gm)
                 .map(|v| v.0)
                 .sum::<f64>()
+            + self.line_variance()
+    }
+
+    /// Variance of the lines together (each A²/2), U².
+    pub fn line_variance(&self) -> f64 {
+        self.lines.iter().map(|l| l.variance()).sum()
     }
 }
 
@@ -701,6 +764,78 @@ mod tests {
                 rel(spectral, exact) < ROUTES_REL_TOL,
                 "β {beta} m {m}: {spectral} vs {exact}"
             );
+        }
+    }
+
+    #[test]
+    fn lines_match_the_discrete_spectral_integral() {
+        // A resonance's sampled autocovariance R(k) = σ²e^(−a|k|)(cos bk + (a/b) sin b|k|)
+        // has the discrete PSD S_d(ν) = Σ_k R(k)e^(−2πiνk) (closed form below); the Allan
+        // integral of it against the closed form of `ieee952::lines` — the resonance through
+        // its PSD. The sinusoid is the zero-bandwidth limit, checked there.
+        use crate::noise::model::Line;
+        let dt = 0.01;
+        for (f0, bw) in [(0.7, 0.05), (17.0, 1.5), (44.0, 3.0)] {
+            let l = Line {
+                frequency: f0,
+                amplitude: 2e-3,
+                bandwidth: bw,
+            };
+            let a = AxisModel {
+                lines: vec![l],
+                ..Default::default()
+            };
+            let chain = crate::noise::model::Chain::DIRECT
+                .resolve(crate::noise::model::Sensor::Gyro, 1.0 / dt)
+                .unwrap();
+            let tr = AxisTruth::new(&a, &chain, dt, 1_000_000);
+            let (pa, pb) = allan_kalibr::ieee952::lines::resonance_poles(f0, bw, dt);
+            let var = 0.5 * l.amplitude * l.amplitude;
+            // S_d(ν) = Re(c) + Re[c·(u/(1 − u) + v/(1 − v))], u = z e^(−iθ), v = z e^(iθ)
+            let sd = |nu: f64| {
+                let th = 2.0 * PI * nu;
+                let (c_re, c_im) = (var, -var * pa / pb);
+                let term = |ang: f64| {
+                    // w = e^(−a + i ang); w/(1 − w)
+                    let r = (-pa).exp();
+                    let (wr, wi) = (r * ang.cos(), r * ang.sin());
+                    let (dr, di) = (1.0 - wr, -wi);
+                    let d = dr * dr + di * di;
+                    ((wr * dr + wi * di) / d, (wi * dr - wr * di) / d)
+                };
+                let (u, v) = (term(pb - th), term(pb + th));
+                let (sr, si) = (u.0 + v.0, u.1 + v.1);
+                c_re + (c_re * sr - c_im * si)
+            };
+            // the peak is a/(2π) wide in ν: panels graded around it, and fine enough for
+            // the kernel's oscillation (period 1/m)
+            let (nu0, w) = (pb / (2.0 * PI), pa / (2.0 * PI));
+            for m in [1usize, 3, 10, 57, 300] {
+                let mut cuts: Vec<f64> = (0..=16 * m.max(16))
+                    .map(|k| 0.5 * k as f64 / (16 * m.max(16)) as f64)
+                    .collect();
+                for j in -6..30 {
+                    let d = w * 1.5f64.powi(j);
+                    cuts.extend([nu0 - d, nu0 + d]);
+                }
+                cuts.retain(|c| (0.0..=0.5).contains(c));
+                cuts.sort_by(f64::total_cmp);
+                let kernel = |nu: f64| {
+                    let (a, b) = ((PI * m as f64 * nu).sin(), (PI * nu).sin());
+                    sd(nu) * a.powi(4) / (b * b)
+                };
+                let spectral: f64 = cuts
+                    .windows(2)
+                    .map(|c| crate::noise::quad::gauss_legendre(&kernel, c[0], c[1]))
+                    .sum::<f64>()
+                    * 4.0
+                    / (m * m) as f64;
+                let exact = tr.terms(m).lines;
+                assert!(
+                    rel(spectral, exact) < 1e-7,
+                    "f0 {f0} m {m}: spectral {spectral:e} vs closed {exact:e}"
+                );
+            }
         }
     }
 

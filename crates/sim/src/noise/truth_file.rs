@@ -178,6 +178,24 @@ fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
             let _ = writeln!(o, "{indent}warmup: {{amplitude: 0.0, tau_s: 1.0}}   # off");
         }
     }
+    let lines: Vec<String> = a
+        .lines
+        .iter()
+        .map(|l| {
+            format!(
+                "{{frequency_hz: {}, amplitude: {}, bandwidth_hz: {}}}",
+                g(l.frequency),
+                g(l.amplitude),
+                g(l.bandwidth)
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        o,
+        "{indent}lines: [{}]   # vibration lines at the output: amplitude [{}] of A*sin(2*pi*f*t + phase); bandwidth_hz > 0: a 2nd-order resonance of that -3 dB width, rms A/sqrt(2)",
+        lines.join(", "),
+        s.unit()
+    );
 }
 
 /// The yaml text.
@@ -217,7 +235,7 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
     for s in Sensor::BOTH {
         let _ = writeln!(
             o,
-            "  {}: {{white_noise: {}, random_walk: {}, bias_instability: {u}, gauss_markov_sigma: {u}, rate_ramp: {}, quantization: {}, resolution: {u}, warmup_amplitude: {u}, allan_deviation: {u}}}",
+            "  {}: {{white_noise: {}, random_walk: {}, bias_instability: {u}, gauss_markov_sigma: {u}, rate_ramp: {}, quantization: {}, resolution: {u}, warmup_amplitude: {u}, line_amplitude: {u}, allan_deviation: {u}}}",
             s.name(),
             s.term_unit("white_noise"),
             s.term_unit("random_walk"),
@@ -336,6 +354,18 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
                 g(super::quantization_step(a.quantization)),
                 s.term_unit("quantization")
             );
+            for l in &a.lines {
+                let (pa, pb) =
+                    allan_kalibr::ieee952::lines::resonance_poles(l.frequency, l.bandwidth, dt);
+                let _ = writeln!(
+                    o,
+                    "        line_{}hz: {{cycles_per_sample: {}, decay_per_sample: {}, radians_per_sample: {}}}   # nu0 = f*dt; a resonance's autocovariance (A^2/2)*exp(-a|k|)*(cos(b k) + (a/b) sin(b|k|))",
+                    g(l.frequency),
+                    g(l.frequency * dt),
+                    g(pa),
+                    g(pb)
+                );
+            }
             if let Some(wu) = a.warmup {
                 let _ = writeln!(
                     o,

@@ -1,0 +1,163 @@
+//! EuRoC/ASL datasets (also TUM-VI and many Kalibr-format datasets): `mav0/imuN/data.csv`
+//! with the header `#timestamp [ns],w_RS_S_x [rad s^-1],…,a_RS_S_z [m s^-2]`, given as the
+//! file, its `imuN` folder or the dataset root (every `imuN` found is a topic named after
+//! its folder, like several topics of a bag). The `sensor.yaml` beside a `data.csv` states
+//! the dataset's own noise figures: they are read and said next to ours, for the user to
+//! judge whether they hold.
+
+use std::path::{Path, PathBuf};
+
+use super::InputOptions;
+use crate::decoded::DecodedSource;
+use crate::error::Error;
+use crate::source::InputKind;
+
+/// The noise figures and rate a `sensor.yaml` states (continuous time, as Kalibr's).
+#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
+pub struct Stated {
+    /// `rate_hz`.
+    pub rate_hz: Option<f64>,
+    /// `gyroscope_noise_density`, rad/s/√Hz.
+    pub gyroscope_noise_density: Option<f64>,
+    /// `gyroscope_random_walk`, rad/s²/√Hz.
+    pub gyroscope_random_walk: Option<f64>,
+    /// `accelerometer_noise_density`, m/s²/√Hz.
+    pub accelerometer_noise_density: Option<f64>,
+    /// `accelerometer_random_walk`, m/s³/√Hz.
+    pub accelerometer_random_walk: Option<f64>,
+}
+
+impl Stated {
+    /// One line: every figure stated, with its unit.
+    pub fn describe(&self) -> String {
+        let mut v = Vec::new();
+        for (name, val, unit) in [
+            (
+                "gyroscope_noise_density",
+                self.gyroscope_noise_density,
+                "rad/s/sqrt(Hz)",
+            ),
+            (
+                "gyroscope_random_walk",
+                self.gyroscope_random_walk,
+                "rad/s^2/sqrt(Hz)",
+            ),
+            (
+                "accelerometer_noise_density",
+                self.accelerometer_noise_density,
+                "m/s^2/sqrt(Hz)",
+            ),
+            (
+                "accelerometer_random_walk",
+                self.accelerometer_random_walk,
+                "m/s^3/sqrt(Hz)",
+            ),
+            ("rate_hz", self.rate_hz, "Hz"),
+        ] {
+            if let Some(x) = val {
+                v.push(format!("{name} {x} {unit}"));
+            }
+        }
+        v.join(", ")
+    }
+}
+
+/// The `sensor.yaml` beside `data_csv`, if there is one that parses.
+pub fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, String>> {
+    let p = data_csv.parent()?.join("sensor.yaml");
+    let text = std::fs::read_to_string(&p).ok()?;
+    Some(serde_saphyr::from_str::<Stated>(&text).map_err(|e| format!("{}: {e}", p.display())))
+}
+
+/// The figures the `sensor.yaml` of topic `topic` of the input at `path` states (for the
+/// analysers, which print them next to theirs).
+pub fn stated_for(path: &Path, topic: &str) -> Option<Stated> {
+    let files = if path.is_dir() {
+        imu_files(path)
+    } else {
+        // only a data.csv in an EuRoC imuN folder has a sensor.yaml of its own
+        let dir = path.parent()?;
+        if path.file_name()? != "data.csv" || !is_imu_folder(dir) {
+            return None;
+        }
+        vec![(folder_topic(dir), path.to_path_buf())]
+    };
+    let (_, f) = files.into_iter().find(|(t, _)| t == topic)?;
+    sensor_yaml(&f)?.ok()
+}
+
+/// The topic of an `imuN` folder: its name.
+pub fn folder_topic(dir: &Path) -> String {
+    dir.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "imu0".into())
+}
+
+/// True when `dir` holds a `data.csv` with the EuRoC/ASL IMU header.
+pub fn is_imu_folder(dir: &Path) -> bool {
+    let f = dir.join("data.csv");
+    let Ok(file) = std::fs::File::open(&f) else {
+        return false;
+    };
+    let mut line = String::new();
+    use std::io::BufRead;
+    let mut r = std::io::BufReader::new(std::io::Read::take(file, 4096));
+    r.read_line(&mut line).is_ok() && line.contains("w_RS_S_x") && line.contains("a_RS_S_x")
+}
+
+/// Every IMU `data.csv` of an EuRoC/ASL layout at `path` (the `imuN` folder, the `mav0`
+/// folder or the dataset root), with its topic, sorted by topic.
+pub fn imu_files(path: &Path) -> Vec<(String, PathBuf)> {
+    if is_imu_folder(path) {
+        return vec![(folder_topic(path), path.join("data.csv"))];
+    }
+    for base in [path.to_path_buf(), path.join("mav0")] {
+        let Ok(rd) = std::fs::read_dir(&base) else {
+            continue;
+        };
+        let mut v: Vec<(String, PathBuf)> = rd
+            .filter_map(|e| e.ok())
+            .map(|e| e.path())
+            .filter(|p| p.is_dir() && is_imu_folder(p))
+            .map(|p| (folder_topic(&p), p.join("data.csv")))
+            .collect();
+        if !v.is_empty() {
+            v.sort();
+            return v;
+        }
+    }
+    Vec::new()
+}
+
+/// Opens the dataset at `path`.
+pub fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
+    open_files(imu_files(path), opts)
+}
+
+/// Opens the given `(topic, data.csv)` files as one source.
+pub fn open_files(
+    files: Vec<(String, PathBuf)>,
+    opts: &InputOptions,
+) -> Result<DecodedSource, Error> {
+    let mut streams = Vec::new();
+    let mut notes = Vec::new();
+    for (topic, f) in files {
+        let p = super::text::parse(&f, &topic, opts)?;
+        notes.extend(p.notes.into_iter().map(|n| format!("{topic}: {n}")));
+        match sensor_yaml(&f) {
+            Some(Ok(s)) if s != Stated::default() => notes.push(format!(
+                "{topic}: the dataset's sensor.yaml states {} (compare with the figures measured here)",
+                s.describe()
+            )),
+            Some(Err(e)) => notes.push(format!("{topic}: sensor.yaml does not parse: {e}")),
+            _ => {}
+        }
+        streams.extend(p.streams);
+    }
+    Ok(DecodedSource::new(
+        InputKind::EurocDir,
+        streams,
+        notes,
+        Vec::new(),
+    ))
+}

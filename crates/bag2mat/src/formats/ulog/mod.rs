@@ -1,0 +1,849 @@
+//! PX4 ULog (`.ulg`, the ULog file format of the PX4 documentation): the IMU topics the
+//! flight stack logs, each a topic like a bag's, named `name` when the log holds only its
+//! instance 0 and `name:k` (the ULog `multi_id`) otherwise:
+//!
+//! * `sensor_combined`: `gyro_rad`, `accelerometer_m_s2` (the gyro's `timestamp`).
+//! * `sensor_gyro`, `sensor_accel` (every instance; the raw per-IMU topics where the log
+//!   has them): `x y z` at `timestamp_sample`; the other sensor's columns are NaN.
+//! * `vehicle_imu`: `delta_angle`/`delta_angle_dt` and `delta_velocity`/`delta_velocity_dt`,
+//!   each delta divided by its own dt (µs); a message with a zero dt is skipped and counted.
+//!
+//! The record time is the message's `timestamp`, the stamp its `timestamp_sample` where the
+//! topic has one (µs since boot, as ns). Every other topic is listed with its message count
+//! and times (`bag2mat info`). Dropouts the logger recorded (`O` messages) are losses;
+//! bytes that do not parse are skipped to the next sync marker and reported.
+//!
+//! Opening hops once over the message headers (definitions, subscriptions, dropouts, counts)
+//! and cuts the data into message-aligned byte ranges; each range is then read and decoded
+//! on its own, in parallel, straight into the read path (nothing is held but the result).
+//!
+//! Our own parser (with [`crate::cursor`]): PX4's `px4-ulog` crate (0.6) and `yule_log`
+//! (0.4) stream the whole file through callbacks in one pass (no ranges to decode in
+//! parallel), and `px4-ulog`'s unpack helpers panic on short slices by design; the read path
+//! wants every message's record time, typed errors and the losses spelt out.
+
+pub mod write;
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::cursor::{Cursor, CursorError};
+use crate::decoded::Row;
+use crate::error::Error;
+use crate::source::{InputKind, Loss};
+
+/// The file's first 7 bytes (then a version byte and the start time, µs).
+pub const MAGIC: &[u8] = super::ULOG_MAGIC;
+/// The sync marker (`S` message body) a reader resynchronises on.
+pub const SYNC: [u8; 8] = [0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12];
+/// Bytes of the file header.
+pub const HEADER_LEN: usize = 16;
+
+/// One field of a format: its type, array length (1 for a scalar) and name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Field {
+    /// `float`, `uint64_t`, or another format's name.
+    pub ty: String,
+    /// Array length, 1 for a scalar.
+    pub len: usize,
+    /// Name.
+    pub name: String,
+}
+
+/// The bytes of a scalar type, or `None` for a nested format.
+pub fn scalar_size(ty: &str) -> Option<usize> {
+    Some(match ty {
+        "int8_t" | "uint8_t" | "bool" | "char" => 1,
+        "int16_t" | "uint16_t" => 2,
+        "int32_t" | "uint32_t" | "float" => 4,
+        "int64_t" | "uint64_t" | "double" => 8,
+        _ => return None,
+    })
+}
+
+/// Parses a format message's text `name:type field;…`.
+pub fn parse_format(text: &str) -> Option<(String, Vec<Field>)> {
+    let (name, rest) = text.split_once(':')?;
+    let mut fields = Vec::new();
+    for f in rest.split(';').filter(|f| !f.trim().is_empty()) {
+        let (ty, fname) = f.trim().rsplit_once(' ')?;
+        let (ty, len) = match ty.split_once('[') {
+            Some((t, n)) => (t, n.strip_suffix(']')?.parse().ok()?),
+            None => (ty, 1),
+        };
+        fields.push(Field {
+            ty: ty.to_string(),
+            len,
+            name: fname.to_string(),
+        });
+    }
+    Some((name.to_string(), fields))
+}
+
+/// A scalar's place in a message: byte offset and type.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Slot {
+    offset: usize,
+    ty: Scalar,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn of(ty: &str) -> Option<Scalar> {
+        Some(match ty {
+            "int8_t" => Scalar::I8,
+            "uint8_t" | "bool" | "char" => Scalar::U8,
+            "int16_t" => Scalar::I16,
+            "uint16_t" => Scalar::U16,
+            "int32_t" => Scalar::I32,
+            "uint32_t" => Scalar::U32,
+            "int64_t" => Scalar::I64,
+            "uint64_t" => Scalar::U64,
+            "float" => Scalar::F32,
+            "double" => Scalar::F64,
+            _ => return None,
+        })
+    }
+}
+
+impl Slot {
+    /// The value as f64, or `None` past the end of `data`.
+    fn get(&self, data: &[u8]) -> Option<f64> {
+        let mut c = Cursor::new(data.get(self.offset..)?);
+        let r: Result<f64, CursorError> = match self.ty {
+            Scalar::I8 => c.le::<i8>("").map(f64::from),
+            Scalar::U8 => c.le::<u8>("").map(f64::from),
+            Scalar::I16 => c.le::<i16>("").map(f64::from),
+            Scalar::U16 => c.le::<u16>("").map(f64::from),
+            Scalar::I32 => c.le::<i32>("").map(f64::from),
+            Scalar::U32 => c.le::<u32>("").map(f64::from),
+            Scalar::I64 => c.le::<i64>("").map(|v| v as f64),
+            Scalar::U64 => c.le::<u64>("").map(|v| v as f64),
+            Scalar::F32 => c.le::<f32>("").map(f64::from),
+            Scalar::F64 => c.le::<f64>(""),
+        };
+        r.ok()
+    }
+
+    fn get_u64(&self, data: &[u8]) -> Option<u64> {
+        let mut c = Cursor::new(data.get(self.offset..)?);
+        match self.ty {
+            Scalar::U64 => c.le::<u64>("").ok(),
+            Scalar::I64 => c.le::<i64>("").ok().and_then(|v| u64::try_from(v).ok()),
+            Scalar::U32 => c.le::<u32>("").ok().map(u64::from),
+            _ => None,
+        }
+    }
+}
+
+/// Formats by name, and the flattened scalar slots of each (`gyro_rad[1]`, `a.b`).
+struct Formats {
+    defs: HashMap<String, Vec<Field>>,
+}
+
+impl Formats {
+    /// Every scalar of a format with its flattened name.
+    fn slots(&self, name: &str) -> Option<HashMap<String, Slot>> {
+        let mut out = HashMap::new();
+        self.flatten(name, "", 0, &mut out, 0)?;
+        Some(out)
+    }
+
+    fn flatten(
+        &self,
+        name: &str,
+        prefix: &str,
+        base: usize,
+        out: &mut HashMap<String, Slot>,
+        depth: usize,
+    ) -> Option<usize> {
+        if depth > 16 {
+            return None;
+        }
+        let mut off = base;
+        for fld in self.defs.get(name)? {
+            for k in 0..fld.len {
+                let n = if fld.len > 1 {
+                    format!("{prefix}{}[{k}]", fld.name)
+                } else {
+                    format!("{prefix}{}", fld.name)
+                };
+                match Scalar::of(&fld.ty) {
+                    Some(ty) => {
+                        out.insert(n, Slot { offset: off, ty });
+                        off += scalar_size(&fld.ty)?;
+                    }
+                    None => {
+                        off = self.flatten(&fld.ty, &format!("{n}."), off, out, depth + 1)?;
+                    }
+                }
+            }
+        }
+        Some(off)
+    }
+}
+
+/// How the messages of one IMU topic become rows.
+#[derive(Debug, Clone)]
+enum Decoder {
+    Combined {
+        gyro: [Slot; 3],
+        acc: [Slot; 3],
+    },
+    Gyro {
+        sample: Option<Slot>,
+        v: [Slot; 3],
+    },
+    Accel {
+        sample: Option<Slot>,
+        v: [Slot; 3],
+    },
+    Deltas {
+        sample: Option<Slot>,
+        angle: [Slot; 3],
+        angle_dt: Slot,
+        vel: [Slot; 3],
+        vel_dt: Slot,
+    },
+}
+
+fn three(s: &HashMap<String, Slot>, base: &str) -> Option<[Slot; 3]> {
+    let a = |k: usize| s.get(&format!("{base}[{k}]")).copied();
+    Some([a(0)?, a(1)?, a(2)?])
+}
+
+fn xyz(s: &HashMap<String, Slot>) -> Option<[Slot; 3]> {
+    Some([*s.get("x")?, *s.get("y")?, *s.get("z")?])
+}
+
+impl Decoder {
+    fn for_topic(name: &str, s: &HashMap<String, Slot>) -> Option<Decoder> {
+        let sample = s.get("timestamp_sample").copied();
+        match name {
+            "sensor_combined" => Some(Decoder::Combined {
+                gyro: three(s, "gyro_rad")?,
+                acc: three(s, "accelerometer_m_s2")?,
+            }),
+            "sensor_gyro" => Some(Decoder::Gyro { sample, v: xyz(s)? }),
+            "sensor_accel" => Some(Decoder::Accel { sample, v: xyz(s)? }),
+            "vehicle_imu" => Some(Decoder::Deltas {
+                sample,
+                angle: three(s, "delta_angle")?,
+                angle_dt: *s.get("delta_angle_dt")?,
+                vel: three(s, "delta_velocity")?,
+                vel_dt: *s.get("delta_velocity_dt")?,
+            }),
+            _ => None,
+        }
+    }
+
+    fn msg_type(name: &str) -> String {
+        format!("px4/{name}")
+    }
+
+    /// The row of a data message (`data` starts with the timestamp), or why not.
+    fn row(&self, t_ns: u64, data: &[u8]) -> Result<Row, &'static str> {
+        let v3 = |s: &[Slot; 3]| -> Result<[f64; 3], &'static str> {
+            let mut v = [0.0; 3];
+            for k in 0..3 {
+                v[k] = s[k].get(data).ok_or("message shorter than its format")?;
+            }
+            Ok(v)
+        };
+        let stamp = |s: &Option<Slot>| -> u64 {
+            s.and_then(|s| s.get_u64(data))
+                .map_or(t_ns, |us| us.saturating_mul(1000))
+        };
+        let nan = [f64::NAN; 3];
+        Ok(match self {
+            Decoder::Combined { gyro, acc } => Row {
+                stamp: t_ns,
+                gyro: v3(gyro)?,
+                acc: v3(acc)?,
+            },
+            Decoder::Gyro { sample, v } => Row {
+                stamp: stamp(sample),
+                gyro: v3(v)?,
+                acc: nan,
+            },
+            Decoder::Accel { sample, v } => Row {
+                stamp: stamp(sample),
+                gyro: nan,
+                acc: v3(v)?,
+            },
+            Decoder::Deltas {
+                sample,
+                angle,
+                angle_dt,
+                vel,
+                vel_dt,
+            } => {
+                let da = angle_dt
+                    .get(data)
+                    .ok_or("message shorter than its format")?;
+                let dv = vel_dt.get(data).ok_or("message shorter than its format")?;
+                if !(da > 0.0 && dv > 0.0) {
+                    return Err("a delta with a zero dt");
+                }
+                let (a, v) = (v3(angle)?, v3(vel)?);
+                Row {
+                    stamp: stamp(sample),
+                    gyro: a.map(|x| x / (da * 1e-6)),
+                    acc: v.map(|x| x / (dv * 1e-6)),
+                }
+            }
+        })
+    }
+}
+
+/// How a channel's data messages are read: its decoder (an IMU topic) and where its
+/// `timestamp` is (the first field of every logged topic).
+#[derive(Debug, Clone)]
+struct Chan {
+    decoder: Option<Decoder>,
+    ts: Option<Slot>,
+}
+
+/// What the hop over the file found, beyond the channels.
+#[derive(Default)]
+struct Found {
+    dropouts: Vec<(u64, u16)>,
+    /// Bytes skipped to resynchronise: (offset, length).
+    skipped: Vec<(u64, u64)>,
+    /// Data messages for an id no `A` message announced.
+    orphans: u64,
+    /// The file ends inside a message at this offset.
+    truncated: Option<u64>,
+}
+
+/// Bytes per part: the unit of parallel decoding, at a message boundary.
+const PART_BYTES: u64 = 4 << 20;
+/// Bytes read at a time while hopping over the file.
+const WINDOW: usize = 8 << 20;
+
+/// A window on the file, moved forward as the parser asks for bytes.
+struct Window<'f> {
+    file: &'f std::fs::File,
+    len: u64,
+    buf: Vec<u8>,
+    start: u64,
+}
+
+impl Window<'_> {
+    /// Bytes `at..at + n` of the file, or `None` past its end.
+    fn get(&mut self, at: u64, n: usize) -> std::io::Result<Option<&[u8]>> {
+        use std::os::unix::fs::FileExt;
+        let end = at.saturating_add(n as u64);
+        if end > self.len {
+            return Ok(None);
+        }
+        if at < self.start || end > self.start + self.buf.len() as u64 {
+            let to = self.len.min(at + WINDOW.max(n) as u64);
+            self.buf.resize((to - at) as usize, 0);
+            self.file.read_exact_at(&mut self.buf, at)?;
+            self.start = at;
+        }
+        let i = (at - self.start) as usize;
+        Ok(Some(&self.buf[i..i + n]))
+    }
+}
+
+/// One step of the walk over the messages.
+enum Step {
+    /// A message: its offset, type and size (its body follows the 3 header bytes).
+    Msg(u64, u8, u16),
+    /// Bytes that are no message (resynchronised to the next sync marker) or cut by the
+    /// start of appended data: offset and length.
+    Skip(u64, u64),
+    /// The file ends inside a message at this offset.
+    Cut(u64),
+}
+
+/// The message types of the format.
+const TYPES: &[u8] = b"BFIMPQARDLCSO";
+
+/// The step at `at`: the hop and every part walk the messages the same way.
+fn step(win: &mut Window, at: u64, appended_at: Option<u64>) -> std::io::Result<Step> {
+    let Some(h) = win.get(at, 3)? else {
+        return Ok(Step::Cut(at));
+    };
+    let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
+    if !TYPES.contains(&ty) {
+        let n = WINDOW.min((win.len - at) as usize);
+        let rest = win.get(at, n)?.unwrap_or(&[]);
+        let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
+            Some(p) => p.saturating_sub(3),
+            None if at + (n as u64) < win.len => n - SYNC.len(),
+            None => n,
+        };
+        return Ok(Step::Skip(at, skip.max(1) as u64));
+    }
+    // a message cut by the start of appended data (the logger's DATA_APPENDED flag)
+    if let Some(ap) = appended_at
+        && at < ap
+        && at + 3 + size as u64 > ap
+        && ap <= win.len
+    {
+        return Ok(Step::Skip(at, ap - at));
+    }
+    if at + 3 + size as u64 > win.len {
+        return Ok(Step::Cut(at));
+    }
+    Ok(Step::Msg(at, ty, size))
+}
+
+/// An `A` message: multi_id, message id, format name.
+fn subscription(body: &[u8]) -> Option<(u8, u16, &str)> {
+    let mut m = Cursor::new(body);
+    let multi = m.le::<u8>("multi_id").ok()?;
+    let id = m.le::<u16>("msg_id").ok()?;
+    let n = m.remaining();
+    Some((multi, id, m.str(n, "message name").ok()?))
+}
+
+/// Subscriptions: message id → channel ([`NO_CHANNEL`] when none), a table for the hot loop.
+type Subs = Vec<u32>;
+/// A message id without a subscription.
+const NO_CHANNEL: u32 = u32::MAX;
+
+/// A part: its byte range and the subscriptions at its start.
+#[derive(Debug, Clone)]
+struct PartMap {
+    start: u64,
+    end: u64,
+    subs: Subs,
+}
+
+/// A PX4 ULog opened for reading: channels and parts from one hop over the file; each part
+/// is read and decoded on its own, in parallel.
+pub struct UlogReader {
+    file: std::fs::File,
+    len: u64,
+    contents: crate::source::Contents,
+    chans: Vec<Chan>,
+    by_key: HashMap<(String, u8), u32>,
+    parts: Vec<PartMap>,
+    appended_at: Option<u64>,
+}
+
+/// Opens a ULog file.
+pub fn open(path: &Path) -> Result<UlogReader, Error> {
+    let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let mut win = Window {
+        file: &file,
+        len,
+        buf: Vec::new(),
+        start: 0,
+    };
+    let header = win
+        .get(0, HEADER_LEN.min(len as usize))
+        .map_err(io)?
+        .unwrap_or(&[]);
+    let mut c = Cursor::new(header);
+    let magic = c
+        .take(MAGIC.len(), "ULog magic")
+        .map_err(|e| corrupt(path, e))?;
+    if magic != MAGIC {
+        return Err(corrupt(path, c.invalid("not a ULog file")));
+    }
+    let _version = c.le::<u8>("ULog version").map_err(|e| corrupt(path, e))?;
+    let _start_us = c
+        .le::<u64>("ULog start time")
+        .map_err(|e| corrupt(path, e))?;
+    let mut formats = Formats {
+        defs: HashMap::new(),
+    };
+    let mut channels: Vec<crate::source::Channel> = Vec::new();
+    let mut chans: Vec<Chan> = Vec::new();
+    let mut by_key: HashMap<(String, u8), u32> = HashMap::new();
+    let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
+    let mut found = Found::default();
+    let mut last_t: u64 = 0;
+    let mut appended_at: Option<u64> = None;
+    let mut parts: Vec<PartMap> = Vec::new();
+    let mut part_counts: Vec<Vec<u64>> = Vec::new();
+    let mut part_span: Vec<Option<(u64, u64)>> = Vec::new();
+    let mut at = HEADER_LEN as u64;
+    while at < len {
+        let (m_at, ty, size) = match step(&mut win, at, appended_at).map_err(io)? {
+            Step::Msg(a, t, n) => (a, t, n),
+            Step::Skip(a, n) => {
+                found.skipped.push((a, n));
+                at = a + n;
+                continue;
+            }
+            Step::Cut(a) => {
+                found.truncated = Some(a);
+                break;
+            }
+        };
+        at = m_at + 3 + size as u64;
+        // parts start at message boundaries in the data, each with the subscriptions then
+        if ty == b'D' && parts.last().is_none_or(|p| m_at - p.start >= PART_BYTES) {
+            if let Some(p) = parts.last_mut() {
+                p.end = m_at;
+            }
+            parts.push(PartMap {
+                start: m_at,
+                end: len,
+                subs: subs.clone(),
+            });
+            part_counts.push(Vec::new());
+            part_span.push(None);
+        }
+        let Some(body) = win.get(m_at + 3, size as usize).map_err(io)? else {
+            found.truncated = Some(m_at);
+            break;
+        };
+        let mut m = Cursor::at(body, m_at + 3);
+        match ty {
+            b'B' => {
+                // flag bits: compat[8], incompat[8], appended offsets[3]
+                if let (Ok(_), Ok(incompat)) =
+                    (m.take(8, "compat flags"), m.take(8, "incompat flags"))
+                    && incompat[0] & 1 != 0
+                    && let Ok(off) = m.le::<u64>("appended offset")
+                    && off > 0
+                {
+                    appended_at = Some(off);
+                }
+            }
+            b'F' => {
+                if let Some((name, fields)) =
+                    std::str::from_utf8(m.rest()).ok().and_then(parse_format)
+                {
+                    formats.defs.insert(name, fields);
+                }
+            }
+            b'A' => {
+                let Some((multi, id, name)) = subscription(body) else {
+                    found.skipped.push((m_at, size as u64 + 3));
+                    continue;
+                };
+                let key = (name.to_string(), multi);
+                let ch = match by_key.get(&key) {
+                    Some(&ch) => ch,
+                    None => {
+                        let slots = formats.slots(name);
+                        let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
+                        let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
+                        let ch = channels.len() as u32;
+                        channels.push(crate::source::Channel {
+                            id: ch,
+                            topic: format!("{name}:{multi}"),
+                            msg_type: Decoder::msg_type(name),
+                            encoding: if decoder.is_some() {
+                                crate::source::Encoding::Row
+                            } else {
+                                crate::source::Encoding::Other("ulog".into())
+                            },
+                            md5sum: None,
+                            count: Some(0),
+                        });
+                        chans.push(Chan { decoder, ts });
+                        by_key.insert(key, ch);
+                        ch
+                    }
+                };
+                subs[id as usize] = ch;
+            }
+            b'R' => {
+                if let Ok(id) = m.le::<u16>("msg_id") {
+                    subs[id as usize] = NO_CHANNEL;
+                }
+            }
+            b'D' => {
+                let Ok(id) = m.le::<u16>("msg_id") else {
+                    found.skipped.push((m_at, size as u64 + 3));
+                    continue;
+                };
+                let ch = subs[id as usize];
+                if ch == NO_CHANNEL {
+                    found.orphans += 1;
+                    continue;
+                }
+                let Some(t_us) = chans[ch as usize].ts.and_then(|s| s.get_u64(m.rest())) else {
+                    found.orphans += 1;
+                    continue;
+                };
+                let t = t_us.saturating_mul(1000);
+                last_t = last_t.max(t);
+                let k = parts.len() - 1;
+                let pc = &mut part_counts[k];
+                if pc.len() <= ch as usize {
+                    pc.resize(ch as usize + 1, 0);
+                }
+                pc[ch as usize] += 1;
+                let sp = &mut part_span[k];
+                *sp = Some(sp.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+                if let Some(c) = channels[ch as usize].count.as_mut() {
+                    *c += 1;
+                }
+            }
+            b'O' => {
+                if let Ok(ms) = m.le::<u16>("dropout duration") {
+                    found.dropouts.push((last_t, ms));
+                }
+            }
+            _ => {} // info, parameters, log text, sync
+        }
+    }
+    if let Some(p) = parts.last_mut() {
+        p.end = at.min(len);
+    }
+    if formats.defs.is_empty() && channels.is_empty() {
+        return Err(Error::Corrupt {
+            path: path.to_path_buf(),
+            offset: HEADER_LEN as u64,
+            what: "ULog: no format or subscription could be read".into(),
+        });
+    }
+    super::instance_topics(channels.iter_mut().map(|c| &mut c.topic));
+    let mut contents = crate::source::Contents {
+        losses: losses(&found),
+        ..Default::default()
+    };
+    if let Some(at) = found.truncated {
+        contents.notes.push(format!(
+            "the log ends inside a message at byte {at} (cut short): read to there"
+        ));
+    }
+    for (i, p) in parts.iter().enumerate() {
+        let counts: Vec<(u32, u64)> = part_counts[i]
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| **n > 0)
+            .map(|(c, n)| (c as u32, *n))
+            .collect();
+        // what the part delivers: one Row payload per message of an IMU channel
+        let rows: u64 = counts
+            .iter()
+            .filter(|(c, _)| chans[*c as usize].decoder.is_some())
+            .map(|(_, n)| *n)
+            .sum();
+        contents.parts.push(crate::source::Part {
+            label: format!("bytes {}..{}", p.start, p.end),
+            span: part_span[i],
+            counts: Some(counts),
+            bytes: rows * crate::decoded::ROW_LEN as u64,
+        });
+    }
+    contents.channels = channels;
+    Ok(UlogReader {
+        file,
+        len,
+        contents,
+        chans,
+        by_key,
+        parts,
+        appended_at,
+    })
+}
+
+fn corrupt(path: &Path, e: CursorError) -> Error {
+    let offset = match &e {
+        CursorError::Short { offset, .. } | CursorError::Invalid { offset, .. } => *offset,
+    };
+    Error::Corrupt {
+        path: path.to_path_buf(),
+        offset,
+        what: format!("ULog: {e}"),
+    }
+}
+
+/// What the hop found lost, as losses.
+fn losses(found: &Found) -> Vec<Loss> {
+    let mut losses = Vec::new();
+    if !found.dropouts.is_empty() {
+        let total: u64 = found.dropouts.iter().map(|d| d.1 as u64).sum();
+        let longest = found
+            .dropouts
+            .iter()
+            .max_by_key(|d| d.1)
+            .copied()
+            .unwrap_or((0, 0));
+        let first = found.dropouts[0].0;
+        let last = found
+            .dropouts
+            .last()
+            .map_or(0, |d| d.0.saturating_add(d.1 as u64 * 1_000_000));
+        losses.push(Loss {
+            what: format!(
+                "the logger recorded {} dropout{} totalling {total} ms (longest {} ms at {:.3} s): every topic lost its messages of that time",
+                found.dropouts.len(),
+                if found.dropouts.len() == 1 { "" } else { "s" },
+                longest.1,
+                longest.0 as f64 * 1e-9
+            ),
+            messages: None,
+            at_most: None,
+            span: Some((first, last)),
+            channel: None,
+        });
+    }
+    if !found.skipped.is_empty() {
+        let bytes: u64 = found.skipped.iter().map(|s| s.1).sum();
+        losses.push(Loss::new(format!(
+            "{bytes} bytes in {} stretch{} do not parse as ULog messages and were skipped to the next sync marker (first at byte {})",
+            found.skipped.len(),
+            if found.skipped.len() == 1 { "" } else { "es" },
+            found.skipped[0].0
+        )));
+    }
+    if found.orphans > 0 {
+        losses.push(Loss::new(format!(
+            "{} data messages belong to no subscription and were skipped",
+            found.orphans
+        )));
+    }
+    losses
+}
+
+impl crate::source::Source for UlogReader {
+    fn kind(&self) -> InputKind {
+        InputKind::Ulog
+    }
+    fn contents(&self) -> &crate::source::Contents {
+        &self.contents
+    }
+    fn read_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut crate::source::MessageSink<'_>,
+    ) -> crate::source::PartRead {
+        let mut r = crate::source::PartRead::default();
+        let Some(p) = self.parts.get(part) else {
+            r.error = Some(format!("no part {part}"));
+            return r;
+        };
+        // each thread's part buffer is reused from part to part
+        let buf = PART_BUF.with(|b| std::mem::take(&mut *b.borrow_mut()));
+        let mut win = Window {
+            file: &self.file,
+            len: p.end.min(self.len),
+            buf,
+            start: u64::MAX,
+        };
+        let mut subs = p.subs.clone();
+        let mut at = p.start;
+        while at < win.len {
+            let (m_at, ty, size) = match step(&mut win, at, self.appended_at) {
+                Ok(Step::Msg(a, t, n)) => (a, t, n),
+                Ok(Step::Skip(a, n)) => {
+                    at = a + n;
+                    continue;
+                }
+                Ok(Step::Cut(_)) => break,
+                Err(e) => {
+                    r.error = Some(format!("cannot read: {e}"));
+                    break;
+                }
+            };
+            at = m_at + 3 + size as u64;
+            let body = match win.get(m_at + 3, size as usize) {
+                Ok(Some(b)) => b,
+                _ => break,
+            };
+            match ty {
+                b'A' => {
+                    if let Some((multi, id, name)) = subscription(body)
+                        && let Some(&ch) = self.by_key.get(&(name.to_string(), multi))
+                    {
+                        subs[id as usize] = ch;
+                    }
+                }
+                b'R' if body.len() >= 2 => {
+                    subs[u16::from_le_bytes([body[0], body[1]]) as usize] = NO_CHANNEL;
+                }
+                b'D' if body.len() >= 2 => {
+                    let id = u16::from_le_bytes([body[0], body[1]]);
+                    let ch = subs[id as usize];
+                    if ch == NO_CHANNEL || !want(ch) {
+                        continue;
+                    }
+                    let data = &body[2..];
+                    let c = &self.chans[ch as usize];
+                    let Some(t_us) = c.ts.and_then(|s| s.get_u64(data)) else {
+                        continue;
+                    };
+                    let t = t_us.saturating_mul(1000);
+                    match &c.decoder {
+                        None => sink(ch, t, &[]),
+                        Some(d) => match d.row(t, data) {
+                            Ok(row) => sink(ch, t, &row.encode()),
+                            Err(why) => {
+                                r.skipped += 1;
+                                r.skip_reason.get_or_insert_with(|| {
+                                    format!(
+                                        "'{}': {why}",
+                                        self.contents.channels[ch as usize].topic
+                                    )
+                                });
+                                continue;
+                            }
+                        },
+                    }
+                    r.delivered += 1;
+                }
+                _ => {}
+            }
+        }
+        PART_BUF.with(|b| *b.borrow_mut() = win.buf);
+        r
+    }
+}
+
+thread_local! {
+    /// Each reading thread's part buffer.
+    static PART_BUF: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_parse_and_flatten() {
+        let (n, f) = parse_format(
+            "sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint8_t[2] _padding0;",
+        )
+        .unwrap();
+        assert_eq!(n, "sensor_combined");
+        assert_eq!(
+            f[1],
+            Field {
+                ty: "float".into(),
+                len: 3,
+                name: "gyro_rad".into()
+            }
+        );
+        let mut defs = HashMap::new();
+        defs.insert(n.clone(), f);
+        defs.insert(
+            "outer".into(),
+            parse_format("outer:uint64_t timestamp;sensor_combined[2] s;")
+                .unwrap()
+                .1,
+        );
+        let fm = Formats { defs };
+        let s = fm.slots("outer").unwrap();
+        assert_eq!(s["s[1].gyro_rad[2]"].offset, 8 + 22 + 8 + 8);
+        assert!(fm.slots("missing").is_none());
+    }
+}
