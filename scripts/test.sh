@@ -46,9 +46,12 @@ cargo test -p allan_kalibr --lib -- --ignored --exact \
   ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study \
   ieee952::tests_lines::lines_study
 
-# Issue 12's seeded corruption campaign (>= 300 variants per input format through the real
-# bag2mat binary, each under an address-space limit and a timeout); its last line gives the
-# counts per format, and any panic, hang, memory blow-up or silent loss fails the run.
+# Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
+# with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,
+# and files written by rosbags and Foxglove's writer — through the real bag2mat binary, each
+# under an address-space limit and a timeout; rows compared by value with the generator's);
+# its last line gives the counts per format, and any panic, hang, memory blow-up, silent or
+# under-counted loss, or Foxglove's reader recovering more than bag2mat fails the run.
 cargo build -q -p bag2mat --bin bag2mat --example fuzz_campaign
 "$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/debug/examples/fuzz_campaign"
 

@@ -194,10 +194,25 @@ fn parse_launch_int<T: std::str::FromStr>(
     .transpose()
 }
 
+impl Args {
+    /// [`allan_kalibr::cli::curve_flags_need_curves`], --rate included (it only sets the
+    /// rate of plain CSV curves here).
+    pub fn curve_flags_need_curves(&self) -> Result<(), String> {
+        allan_kalibr::cli::curve_flags_need_curves(
+            &self.curves,
+            &self.units,
+            self.duration,
+            self.samples,
+            &[("--rate", self.rate.is_some())],
+        )
+    }
+}
+
 impl TryFrom<Args> for Config {
     type Error = Error;
 
     fn try_from(a: Args) -> Result<Config, Error> {
+        a.curve_flags_need_curves().map_err(Error::Config)?;
         let lp = a.launch.as_deref().map(launch::read).transpose()?;
         let lp = lp.as_ref();
         let topics = if !a.topics.is_empty() {

@@ -10,7 +10,12 @@ use bag2mat::shared::{cli, output};
 
 const TOOL: &str = "allan_imu_utils";
 
+/// Out of memory is reported as an error, not an abort.
+#[global_allocator]
+static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new(TOOL);
+
 fn main() -> ExitCode {
+    bag2mat::shared::alloc::start_threads(TOOL);
     let t = std::time::Instant::now();
     let args = match Args::try_parse() {
         Ok(a) => a,
@@ -39,7 +44,9 @@ fn main() -> ExitCode {
             return cli::fail(TOOL, &e);
         }
         for note in &o.notes {
-            if !config.quiet || note.to_ascii_lowercase().starts_with("warning") {
+            if note.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{}", cli::warning_line(note));
+            } else if !config.quiet {
                 eprintln!("{note}");
             }
         }
@@ -63,11 +70,7 @@ fn main() -> ExitCode {
             text.push_str(&format!("===== topic {} =====\n", outcome.topic));
         }
         for note in &outcome.notes {
-            if note.to_ascii_lowercase().starts_with("warning") {
-                eprintln!("{note}");
-            } else {
-                eprintln!("warning: {note}");
-            }
+            eprintln!("{}", cli::warning_line(note));
         }
         // the record check's findings, always
         for f in &outcome.findings {

@@ -26,7 +26,10 @@ struct Curves<'a> {
     fit: [Vec<f64>; 3],
 }
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String> {
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let finite_pos = |v: &f64| v.is_finite() && *v > 0.0;
     let all: Vec<f64> = c
@@ -105,7 +108,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Re
         .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
+    bag2mat::shared::plot::present(root)
 }
 
 fn curves<'a>(an: &'a Analysis, name: &str, base: usize) -> Curves<'a> {

@@ -101,21 +101,19 @@ fn check_record(
 
 /// Drops the messages whose header stamp is within `seconds` of the first (a warm-up), as
 /// `rosbag play --start` would before imu_utils saw them; returns how many.
-fn skip_start(series: &mut bag2mat::ImuSeries, seconds: f64) -> Result<usize, Error> {
-    if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(Error::Config(format!(
-            "--skip-start must be a non-negative number of seconds, got {seconds}"
-        )));
-    }
+fn skip_start(
+    series: &mut bag2mat::ImuSeries,
+    seconds: f64,
+) -> Result<(usize, Option<String>), Error> {
     let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
-    let k = bag2mat::record_check::skip_index(&t, seconds);
+    let (k, warning) = bag2mat::record_check::checked_skip(&t, seconds).map_err(Error::Config)?;
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);
     for c in series.acc.iter_mut().chain(series.gyro.iter_mut()) {
         c.drain(..k);
     }
-    Ok(k)
+    Ok((k, warning))
 }
 
 /// What `--curves` produced.
@@ -180,7 +178,8 @@ fn run_series(
     let topic = series.topic.clone();
     let mut notes = series.notes.clone();
     if let Some(s) = config.skip_start {
-        let k = skip_start(&mut series, s)?;
+        let (k, warning) = skip_start(&mut series, s)?;
+        notes.extend(warning);
         notes.push(format!(
             "--skip-start {s}: dropped the first {k} messages ({} left)",
             series.len()
@@ -284,10 +283,7 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
-        path: config.out_dir.clone(),
-        cause: e,
-    })?;
+    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
     let mut files = report::write_curve_files(&analysis, &config.name, &config.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {
         let p = config.out_dir.join(mode.file_name(&config.name));
@@ -345,10 +341,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
-    std::fs::create_dir_all(&config.out_dir).map_err(|e| Error::Io {
-        path: config.out_dir.clone(),
-        cause: e,
-    })?;
+    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {
         let freq = 1.0 / raw.gyr_t[0];

@@ -30,7 +30,7 @@ fn run(cmd: &mut Command) -> Output {
 const SEED: u64 = 0xB0A7_5EED;
 
 /// A 200 Hz bag of `n` messages of white noise; `nan_at` puts a NaN into acc y there.
-fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
+pub fn write_bag(path: &Path, n: usize, nan_at: Option<usize>) {
     write_bag_dt(path, n, nan_at, 5_000_000);
 }
 

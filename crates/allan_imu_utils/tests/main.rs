@@ -10,6 +10,7 @@
 mod cli;
 mod common;
 mod curves;
+mod defects19;
 mod fit_reference;
 mod issue18;
 mod logs;

@@ -119,6 +119,31 @@ pub enum TimeArg {
     Header,
 }
 
+/// --units, --duration, --samples (and `more`) describe Allan curves: without --curves
+/// they would be ignored in silence. Both analysers check their flags with this.
+pub fn curve_flags_need_curves(
+    curves: &[PathBuf],
+    units: &[String],
+    duration: Option<f64>,
+    samples: Option<u64>,
+    more: &[(&str, bool)],
+) -> Result<(), String> {
+    let mut flags = vec![
+        ("--units", !units.is_empty()),
+        ("--duration", duration.is_some()),
+        ("--samples", samples.is_some()),
+    ];
+    flags.extend_from_slice(more);
+    bag2mat::shared::cli::only_with("--curves", !curves.is_empty(), &flags)
+}
+
+impl Args {
+    /// [`curve_flags_need_curves`] for these arguments.
+    pub fn curve_flags_need_curves(&self) -> Result<(), String> {
+        curve_flags_need_curves(&self.curves, &self.units, self.duration, self.samples, &[])
+    }
+}
+
 impl From<Args> for Config {
     fn from(a: Args) -> Config {
         let input = a

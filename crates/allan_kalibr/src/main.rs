@@ -11,9 +11,17 @@ use bag2mat::shared::{cli, output};
 
 const TOOL: &str = "allan_kalibr";
 
+/// Out of memory is reported as an error, not an abort.
+#[global_allocator]
+static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new(TOOL);
+
 fn main() -> ExitCode {
+    bag2mat::shared::alloc::start_threads(TOOL);
     let config: Config = match Args::try_parse() {
-        Ok(a) => a.into(),
+        Ok(a) => match a.curve_flags_need_curves() {
+            Ok(()) => a.into(),
+            Err(e) => return cli::usage(TOOL, &e),
+        },
         Err(e) if !e.use_stderr() => {
             let _ = e.print();
             return ExitCode::SUCCESS;
@@ -67,7 +75,9 @@ fn main() -> ExitCode {
         // The reader's warnings always, other notes (the estimated rate) only without
         // --quiet; then the record check's findings, always.
         for n in &out.notes {
-            if !config.quiet || n.to_ascii_lowercase().starts_with("warning") {
+            if n.to_ascii_lowercase().starts_with("warning") {
+                eprintln!("{}", cli::warning_line(n));
+            } else if !config.quiet {
                 eprintln!("{n}");
             }
         }

@@ -184,7 +184,8 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let mut notes: Vec<String> = data.notes.iter().map(|n| format!("warning: {n}")).collect();
     let data_topic = data.topic.clone();
     if let Some(skip) = config.skip_start {
-        let k = skip_start(&mut data, skip)?;
+        let (k, warning) = skip_start(&mut data, skip)?;
+        notes.extend(warning.map(|w| format!("warning: {w}")));
         notes.push(format!(
             "--skip-start {skip}: dropped the first {k} samples ({} left)",
             data.len()
@@ -309,7 +310,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
 
     let dir = &config.outdir;
-    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    bag2mat::shared::output::ensure_dir(dir)?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
     bag2mat::shared::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
@@ -371,25 +372,13 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     })
 }
 
-/// Drops the samples of the first `seconds` of the record; returns how many.
-fn skip_start(data: &mut ImuData, seconds: f64) -> Result<usize, Error> {
-    if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(Error::BadData {
-            what: format!("--skip-start must be a non-negative number of seconds, got {seconds}"),
-        });
-    }
-    let k = bag2mat::record_check::skip_index(&data.t, seconds);
-    if k + 3 > data.len() {
-        return Err(Error::BadData {
-            what: format!(
-                "--skip-start {seconds} leaves {} of {} samples",
-                data.len().saturating_sub(k),
-                data.len()
-            ),
-        });
-    }
+/// Drops the samples of the first `seconds` of the record; returns how many, and a
+/// warning when that is most of it.
+fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
+    let (k, warning) = bag2mat::record_check::checked_skip(&data.t, seconds)
+        .map_err(|what| Error::BadData { what })?;
     data.drop_first(k);
-    Ok(k)
+    Ok((k, warning))
 }
 
 /// Result of [`run_curves`].
@@ -423,7 +412,7 @@ pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput,
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let dir = &config.outdir;
-    std::fs::create_dir_all(dir).map_err(|e| bag2mat::Error::io(dir, e))?;
+    bag2mat::shared::output::ensure_dir(dir)?;
     let title = if config.title.is_empty() {
         config
             .input

@@ -350,8 +350,13 @@ fn non_finite_samples_are_a_clear_error() {
 
 /// A small .mat of white noise at 100 Hz (seeded LCG), `n` rows.
 fn noise_mat(path: &Path, n: usize) {
+    noise_mat_seeded(path, n, 0x5EED);
+}
+
+/// [`noise_mat`] from another seed of the LCG.
+pub fn noise_mat_seeded(path: &Path, n: usize, seed: u64) {
     let mut d = DataImu::with_capacity(n);
-    let mut s: u64 = 0x5EED;
+    let mut s: u64 = seed;
     let mut next = || {
         s = s
             .wrapping_mul(6364136223846793005)

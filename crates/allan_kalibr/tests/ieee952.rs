@@ -52,7 +52,7 @@ fn ok(o: &Output) -> String {
 
 /// White noise + random walk on each axis, optionally a warm-up on gyro x (amplitude, time
 /// constant) and a gap in the stamps (at, seconds).
-fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> DataImu {
+pub fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> DataImu {
     let n = (DURATION * RATE) as usize;
     let mut rng = StdRng::seed_from_u64(seed);
     let mut m = DataImu::with_capacity(n);

@@ -5,6 +5,7 @@
 mod cli;
 mod common;
 mod consumers;
+mod defects19;
 mod ieee952;
 mod issue18;
 mod logs;

@@ -333,7 +333,7 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
             && !single
             && !dir.as_os_str().is_empty()
         {
-            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+            crate::shared::output::ensure_dir(dir)?;
         }
         write(&out, &data, cfg.format)?;
         written.push((out, data.rows()));

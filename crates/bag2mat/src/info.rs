@@ -114,18 +114,21 @@ pub fn info_with(
     let mut losses: Vec<Loss> = src.losses().to_vec();
     let mut times: BTreeMap<u32, Vec<u64>> = BTreeMap::new();
     for (i, (m, r)) in per_part.into_iter().enumerate() {
+        losses.extend(r.lost);
         if let Some(e) = r.error.or(r.skip_reason) {
             losses.push(Loss {
                 what: format!("{}: {e}", parts[i].label),
                 messages: None,
                 span: parts[i].span,
                 channel: None,
+                ..Loss::default()
             });
         }
         for (c, v) in m {
             times.entry(c).or_default().extend(v);
         }
     }
+    losses.extend(src.losses_after_read());
     let mut by: BTreeMap<(String, String), TopicInfo> = BTreeMap::new();
     let mut topic_times: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
     for c in src.channels() {

@@ -92,7 +92,12 @@ pub enum TimeArg {
 
 const TOOL: &str = "bag2mat";
 
+/// Out of memory is reported as an error, not an abort.
+#[global_allocator]
+static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new(TOOL);
+
 fn main() -> ExitCode {
+    bag2mat::shared::alloc::start_threads(TOOL);
     let a = match Args::try_parse() {
         Ok(a) => a,
         Err(e) if !e.use_stderr() => {

@@ -790,6 +790,7 @@ pub fn read_from(
     pb.set_message("reading");
     let (columns, outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
     pb.finish_and_clear();
+    let after = src.losses_after_read();
 
     let n_sel = selected.len();
     let mut series = Vec::with_capacity(n_sel);
@@ -825,6 +826,19 @@ pub fn read_from(
             }
         }
         let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
+        // A loss on no particular channel is this topic's when the source has no other.
+        let only_topic = src.channels().iter().all(|c| mine_ch(&c.id));
+        // Messages lost on this topic (counted), of unknown topic (could be this one's), and
+        // whether some loss has no count at all.
+        let mut exact = 0u64;
+        let mut unknown_topic = 0u64;
+        let mut uncounted = false;
+        let mut count = |l: &Loss, mine: bool| match (l.messages, l.at_most) {
+            (Some(n), _) if mine || only_topic => exact = exact.saturating_add(n),
+            (Some(n), _) => unknown_topic = unknown_topic.saturating_add(n),
+            (None, Some(n)) => unknown_topic = unknown_topic.saturating_add(n),
+            (None, None) => uncounted = true,
+        };
         for (i, o) in outs.iter().enumerate() {
             let p = &parts[i];
             let mine: Option<u64> = p.counts.as_ref().map(|v| {
@@ -840,9 +854,13 @@ pub fn read_from(
                 match l.channel {
                     Some(c) if mine_ch(&c) => {
                         known += l.messages.unwrap_or(0);
+                        count(l, true);
                         r.losses.push(l.clone());
                     }
-                    None if mine != Some(0) => r.losses.push(l.clone()),
+                    None if mine != Some(0) => {
+                        count(l, false);
+                        r.losses.push(l.clone());
+                    }
                     _ => {}
                 }
             }
@@ -852,18 +870,18 @@ pub fn read_from(
                 _ => None,
             };
             let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
-            if let Some(reason) = reason {
+            let l = if let Some(reason) = reason {
                 if mine == Some(0) {
                     continue;
                 }
-                r.losses.push(Loss {
+                Loss {
                     what: format!("{}: {reason}", p.label),
                     messages: rest,
                     span: p.span,
-                    channel: None,
-                });
+                    ..Loss::default()
+                }
             } else if rest.is_some_and(|n| n > 0) {
-                r.losses.push(Loss {
+                Loss {
                     what: format!(
                         "{} holds {got} messages of '{}', its index says {}",
                         p.label,
@@ -872,30 +890,81 @@ pub fn read_from(
                     ),
                     messages: rest,
                     span: p.span,
-                    channel: None,
-                });
-            }
+                    ..Loss::default()
+                }
+            } else {
+                continue;
+            };
+            // Counted from this topic's own promise for the part.
+            count(&l, true);
+            r.losses.push(l);
+        }
+        let container: Vec<&Loss> = src
+            .losses()
+            .iter()
+            .chain(after.iter())
+            .filter(|l| l.channel.is_none_or(|c| mine_ch(&c)))
+            .collect();
+        for l in &container {
+            count(l, l.channel.is_some());
         }
         let mut notes: Vec<String> = src.notes().to_vec();
-        notes.extend(src.losses().iter().map(|l| l.to_string()));
+        for o in &outs {
+            notes.extend(o.read.notes.iter().cloned());
+        }
+        notes.extend(
+            src.losses()
+                .iter()
+                .chain(after.iter())
+                .map(|l| l.to_string()),
+        );
         notes.extend(s.note.iter().cloned());
         notes.extend(r.losses.iter().map(|l| l.to_string()));
         // Whatever the parts said, the container's own promise is checked as a whole.
-        let lost: u64 = r.losses.iter().filter_map(|l| l.messages).sum();
-        let missing = r
-            .promised
-            .map(|p| p.saturating_sub(r.delivered + r.undecodable))
-            .unwrap_or(lost);
+        let missing = match r.promised {
+            Some(p) => p.saturating_sub(r.delivered + r.undecodable).max(exact),
+            None => exact,
+        };
+        // Without a promise, losses of unknown topic may be this topic's: said as a bound.
+        // With a promise, what it finds missing beyond the counted losses may be those of
+        // unknown topic; the rest of them are said as a bound.
+        let (more, uncounted) = match r.promised {
+            Some(_) => (
+                unknown_topic.saturating_sub(missing.saturating_sub(exact)),
+                false,
+            ),
+            None => (unknown_topic, uncounted),
+        };
+        let see = if r.losses.is_empty() && container.is_empty() {
+            " (the container promises them; none of its parts could say where)"
+        } else {
+            " (see above)"
+        };
+        let tail = if uncounted {
+            ", and more that the damaged data does not count (see above)"
+        } else {
+            see
+        };
         if missing > 0 {
             notes.push(format!(
-                "{missing} of {} messages on '{}' were lost{}",
+                "{missing} of {} messages on '{}' were lost{}{tail}",
                 r.promised.unwrap_or(r.delivered + missing),
                 s.topic,
-                if r.losses.is_empty() && src.losses().is_empty() {
-                    " (the container promises them; none of its parts could say where)"
+                if more > 0 {
+                    format!(", and up to {more} more (messages of unknown topic were lost)")
                 } else {
-                    " (see above)"
+                    String::new()
                 }
+            ));
+        } else if more > 0 {
+            notes.push(format!(
+                "up to {more} messages on '{}' were lost (messages of unknown topic were lost){tail}",
+                s.topic
+            ));
+        } else if uncounted {
+            notes.push(format!(
+                "messages on '{}' may have been lost: the damaged data does not count them (see above)",
+                s.topic
             ));
         }
         if r.undecodable > 0 {
@@ -953,7 +1022,7 @@ pub fn read_from(
                 count,
             })
             .collect(),
-        losses: src.losses().to_vec(),
+        losses: src.losses().iter().chain(after.iter()).cloned().collect(),
     })
 }
 

@@ -140,12 +140,15 @@ pub struct Part {
 pub const MAX_EXPANSION: u64 = 64;
 
 /// Data that the container held or promised and that cannot be delivered.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Loss {
     /// What was lost and why.
     pub what: String,
     /// Messages lost, when known.
     pub messages: Option<u64>,
+    /// When the exact count is not known: the most `sensor_msgs/Imu` messages the lost
+    /// bytes can hold (the tools read Imu topics; other topics' messages may be more).
+    pub at_most: Option<u64>,
     /// Record-time span (ns) of the lost data, when known.
     pub span: Option<(u64, u64)>,
     /// The channel the lost messages belong to, when known.
@@ -157,9 +160,7 @@ impl Loss {
     pub fn new(what: impl Into<String>) -> Loss {
         Loss {
             what: what.into(),
-            messages: None,
-            span: None,
-            channel: None,
+            ..Loss::default()
         }
     }
 }
@@ -167,8 +168,10 @@ impl Loss {
 impl std::fmt::Display for Loss {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.what)?;
-        if let Some(n) = self.messages {
-            write!(f, "; {n} message{} lost", if n == 1 { "" } else { "s" })?;
+        match (self.messages, self.at_most) {
+            (Some(n), _) => write!(f, "; {n} message{} lost", if n == 1 { "" } else { "s" })?,
+            (None, Some(n)) => write!(f, "; up to {n} messages lost")?,
+            (None, None) => {}
         }
         if let Some((a, b)) = self.span {
             write!(
@@ -197,6 +200,9 @@ pub struct PartRead {
     /// Messages the part's own index promises that could not be delivered (damaged record
     /// headers, a resynchronised stretch), with their channel, count and time span.
     pub lost: Vec<Loss>,
+    /// What the read found and worked around without losing data (a row read in place of
+    /// one whose id is damaged, rows a damaged page holds twice read once, …).
+    pub notes: Vec<String>,
 }
 
 /// The callback of [`Source::read_part`]: `(channel id, record time in ns, payload)`.
@@ -232,6 +238,11 @@ pub trait Source: Sync {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut MessageSink<'_>,
     ) -> PartRead;
+    /// What only a complete read can tell was lost (the rows past the last one a damaged
+    /// table still holds, which its timestamp index lists): called once every part was read.
+    fn losses_after_read(&self) -> Vec<Loss> {
+        Vec::new()
+    }
 }
 
 /// What a source found on opening, the same for every format: each reader fills one.

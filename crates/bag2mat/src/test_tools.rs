@@ -115,9 +115,11 @@ pub const ROS2_MODES: [(&str, &[&str]); 7] = [
 /// [`crate::shared::output`]) left in `dir`: a test of an interrupted or failed run expects
 /// none.
 pub fn temp_files_in(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        // No directory (a failed run made none): nothing left in it.
+        return Vec::new();
+    };
+    rd.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| n.starts_with('.') && n.contains(".tmp"))
         .collect()
 }
@@ -141,6 +143,257 @@ pub fn string_message(text: &str) -> Vec<u8> {
     let mut d = (text.len() as u32).to_le_bytes().to_vec();
     d.extend_from_slice(text.as_bytes());
     d
+}
+
+/// One b-tree page of a SQLite file: what the page-level damage of the tests and the fuzz
+/// campaign aims at (index pages, row ids, cell counts, child pointers).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BtreePage {
+    /// The table or index it belongs to.
+    pub tree: String,
+    /// Page number (1-based).
+    pub number: u32,
+    /// File offset of its b-tree header (100 bytes into page 1).
+    pub header: usize,
+    /// 0x0D table leaf, 0x05 table interior, 0x0A index leaf, 0x02 index interior.
+    pub kind: u8,
+    /// Its cell count.
+    pub cells: u16,
+    /// File offsets of its cells, in cell-pointer order.
+    pub cell_offsets: Vec<usize>,
+}
+
+impl BtreePage {
+    /// True for a leaf page.
+    pub fn is_leaf(&self) -> bool {
+        self.kind == 0x0D || self.kind == 0x0A
+    }
+
+    /// File offset of its cell count (big-endian u16).
+    pub fn cell_count_at(&self) -> usize {
+        self.header + 3
+    }
+
+    /// File offsets of its child pointers (big-endian u32: one per cell, then the
+    /// right-most one in the header) when it is an interior page.
+    pub fn child_pointers(&self) -> Vec<usize> {
+        if self.is_leaf() {
+            return Vec::new();
+        }
+        let mut v = self.cell_offsets.clone();
+        v.push(self.header + 8);
+        v
+    }
+}
+
+/// A SQLite varint at `at`: its value and length.
+pub fn sqlite_varint(b: &[u8], at: usize) -> (u64, usize) {
+    let mut v = 0u64;
+    for k in 0..9 {
+        let c = b[at + k];
+        if k == 8 {
+            return ((v << 8) | c as u64, 9);
+        }
+        v = (v << 7) | (c & 0x7f) as u64;
+        if c < 0x80 {
+            return (v, k + 1);
+        }
+    }
+    (v, 9)
+}
+
+/// File offset and length of the row id of each cell of a table leaf page.
+pub fn rowid_fields(bytes: &[u8], page: &BtreePage) -> Vec<(usize, usize)> {
+    if page.kind != 0x0D {
+        return Vec::new();
+    }
+    page.cell_offsets
+        .iter()
+        .map(|&c| {
+            let (_, n) = sqlite_varint(bytes, c);
+            let (_, m) = sqlite_varint(bytes, c + n);
+            (c + n, m)
+        })
+        .collect()
+}
+
+/// Every b-tree page of every table and index of an undamaged SQLite file, root first.
+pub fn btree_pages(path: &Path) -> Vec<BtreePage> {
+    let bytes = std::fs::read(path).expect("read sqlite file");
+    let page_size = match u16::from_be_bytes([bytes[16], bytes[17]]) {
+        1 => 65536,
+        n => n as usize,
+    };
+    let conn =
+        rusqlite::Connection::open_with_flags(path, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY)
+            .expect("open sqlite file");
+    let roots: Vec<(String, u32)> = conn
+        .prepare("SELECT name, rootpage FROM sqlite_master WHERE rootpage > 0")
+        .and_then(|mut s| {
+            s.query_map([], |r| Ok((r.get(0)?, r.get(1)?)))?
+                .collect::<Result<_, _>>()
+        })
+        .expect("sqlite_master");
+    let mut out = Vec::new();
+    for (tree, root) in roots {
+        let mut todo = vec![root];
+        while let Some(p) = todo.pop() {
+            let start = (p as usize - 1) * page_size;
+            let header = start + if p == 1 { 100 } else { 0 };
+            let kind = bytes[header];
+            let cells = u16::from_be_bytes([bytes[header + 3], bytes[header + 4]]);
+            let ptrs = header + if kind == 0x0D || kind == 0x0A { 8 } else { 12 };
+            let cell_offsets: Vec<usize> = (0..cells as usize)
+                .map(|k| {
+                    start
+                        + u16::from_be_bytes([bytes[ptrs + 2 * k], bytes[ptrs + 2 * k + 1]])
+                            as usize
+                })
+                .collect();
+            let page = BtreePage {
+                tree: tree.clone(),
+                number: p,
+                header,
+                kind,
+                cells,
+                cell_offsets,
+            };
+            let mut children: Vec<u32> = page
+                .child_pointers()
+                .iter()
+                .map(|&o| u32::from_be_bytes(bytes[o..o + 4].try_into().expect("4 bytes")))
+                .collect();
+            children.reverse();
+            todo.extend(children);
+            out.push(page);
+        }
+    }
+    out
+}
+
+/// What a run's warnings say was lost on one topic: the per-topic summary line the read
+/// path ends with (`N of M messages on 'T' were lost`, `, and up to K more`, `up to K
+/// messages on 'T'`, or that the damaged data does not count them), and the messages it
+/// says do not decode.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Reported {
+    /// Messages said lost on the topic.
+    pub lost: u64,
+    /// Messages of unknown topic said lost besides (they may be the topic's).
+    pub more: u64,
+    /// A loss the warnings cannot count.
+    pub uncounted: bool,
+    /// Messages said not to decode as Imu (found, but lost as rows).
+    pub undecodable: u64,
+    /// A summary line was found.
+    pub said: bool,
+}
+
+/// Reads the per-topic loss summary of `topic` from a run's stderr.
+pub fn reported_losses(stderr: &str, topic: &str) -> Reported {
+    let mut r = Reported::default();
+    let on = format!(" messages on '{topic}' ");
+    for line in stderr.lines() {
+        let Some(l) = line.strip_prefix("warning: ") else {
+            continue;
+        };
+        if l.starts_with("messages on '") && l.contains(&format!("'{topic}' may have been lost")) {
+            r.said = true;
+            r.uncounted = true;
+            continue;
+        }
+        let Some(i) = l.find(&on) else { continue };
+        let head = &l[..i];
+        let rest = &l[i + on.len()..];
+        if rest.starts_with("do not decode")
+            && let Ok(n) = head.trim().parse::<u64>()
+        {
+            r.undecodable = r.undecodable.max(n);
+            r.said = true;
+            continue;
+        }
+        if !rest.starts_with("were lost") {
+            continue;
+        }
+        let num = |s: &str| s.trim().parse::<u64>().ok();
+        if let Some(n) = head.strip_prefix("up to ").and_then(num) {
+            r.more = r.more.max(n);
+        } else if let Some((n, _)) = head.split_once(" of ")
+            && let Some(n) = num(n)
+        {
+            r.lost = r.lost.max(n);
+            if let Some(k) = rest
+                .split_once(", and up to ")
+                .and_then(|(_, x)| x.split_whitespace().next())
+                .and_then(num)
+            {
+                r.more = r.more.max(k);
+            }
+        } else {
+            continue;
+        }
+        r.said = true;
+        r.uncounted |= rest.contains("does not count");
+    }
+    r
+}
+
+/// A top-level record of an MCAP file: where it starts, its opcode and its content.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct McapRecord {
+    /// File offset of its opcode.
+    pub pos: usize,
+    /// Opcode.
+    pub op: u8,
+    /// File offsets of its content.
+    pub content: std::ops::Range<usize>,
+}
+
+/// The top-level records of an undamaged MCAP file, in file order (up to the footer).
+pub fn mcap_records(b: &[u8]) -> Vec<McapRecord> {
+    let mut out = Vec::new();
+    let mut pos = 8;
+    while pos + 9 <= b.len() {
+        let op = b[pos];
+        let len = u64::from_le_bytes(b[pos + 1..pos + 9].try_into().expect("8 bytes")) as usize;
+        let Some(end) = (pos + 9).checked_add(len).filter(|&e| e <= b.len()) else {
+            break;
+        };
+        out.push(McapRecord {
+            pos,
+            op,
+            content: pos + 9..end,
+        });
+        if op == 0x02 {
+            break;
+        }
+        pos = end;
+    }
+    out
+}
+
+/// The records of an uncompressed chunk's content: (file offset, opcode, content range).
+pub fn mcap_chunk_records(
+    b: &[u8],
+    chunk: &McapRecord,
+) -> Vec<(usize, u8, std::ops::Range<usize>)> {
+    let c = chunk.content.start;
+    let slen = u32::from_le_bytes(b[c + 28..c + 32].try_into().expect("4 bytes")) as usize;
+    let mut pos = c + 32 + slen + 8;
+    let mut out = Vec::new();
+    while pos + 9 <= chunk.content.end {
+        let len = u64::from_le_bytes(b[pos + 1..pos + 9].try_into().expect("8 bytes")) as usize;
+        out.push((pos, b[pos], pos + 9..pos + 9 + len));
+        pos += 9 + len;
+    }
+    out
+}
+
+impl Reported {
+    /// Rows the warnings account for at most: lost, of unknown topic, undecodable.
+    pub fn total(&self) -> u64 {
+        self.lost + self.more + self.undecodable
+    }
 }
 
 /// Rewrites a `bag2mat -o x.csv` file (`t,ax,ay,az,wx,wy,wz`, t in s) as an EuRoC/ASL

@@ -4,6 +4,7 @@
 
 mod cli;
 mod defects;
+mod defects19;
 mod issue18;
 mod logs;
 mod real_tools;

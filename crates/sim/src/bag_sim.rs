@@ -233,11 +233,14 @@ pub fn validate(cfg: &BagConfig) -> Result<()> {
     // The last stamp, in integer ns: upstream's accumulated grid can place a sample at
     // t = duration itself (quirk_01), so one period is added; f64 would round the
     // comparison away near 2^32 s.
-    let last = (cfg.duration * 1e9).ceil() as u64 + (1e9 / cfg.rate).ceil() as u64;
-    if cfg
-        .start_ns
-        .checked_add(last)
-        .is_none_or(|e| e > MAX_ROS_NS)
+    // In f64 first: a duration past u64 ns would saturate the cast and pass.
+    let duration_ns = cfg.duration * 1e9;
+    let last = (duration_ns.ceil() as u64).saturating_add((1e9 / cfg.rate).ceil() as u64);
+    if duration_ns >= MAX_ROS_NS as f64
+        || cfg
+            .start_ns
+            .checked_add(last)
+            .is_none_or(|e| e > MAX_ROS_NS)
     {
         return Err(SimError::InvalidArgument(format!(
             "--start-time {} s + --duration {} s does not fit the 32-bit ROS time (its last stamp would pass 4294967295.999999999 s, year 2106)",
@@ -255,7 +258,7 @@ pub const BYTES_PER_MESSAGE: u64 = 440;
 /// About how many messages `sim bag` will write (closed form: the exact count of
 /// [`message_count`] walks the grid, which a huge job cannot afford before being refused).
 pub fn estimated_messages(cfg: &BagConfig) -> u64 {
-    (cfg.duration * cfg.rate).floor() as u64 + 1
+    ((cfg.duration * cfg.rate).floor() as u64).saturating_add(1)
 }
 
 /// About how many bytes `sim bag` will write.

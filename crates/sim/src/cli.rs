@@ -120,6 +120,14 @@ impl PresetArg {
     }
 }
 
+/// `--seed`: a whole number from 0 to 2^64 − 1, said so (not the parser's "unexpected
+/// argument" for a negative one).
+fn seed_value(s: &str) -> std::result::Result<u64, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a seed: a whole number from 0 to {}", u64::MAX))
+}
+
 /// Noise flags shared by the subcommands: a preset plus explicit overrides.
 #[derive(Debug, Clone, Args)]
 pub struct NoiseArgs {
@@ -139,7 +147,7 @@ pub struct NoiseArgs {
     #[arg(allow_negative_numbers = true, long, value_name = "S")]
     pub acc_bias_rw: Option<f64>,
     /// RNG seed (the same flags and seed give identical output).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_SEED)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_SEED, allow_negative_numbers = true, value_parser = seed_value)]
     pub seed: u64,
 }
 

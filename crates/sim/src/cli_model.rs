@@ -59,13 +59,13 @@ pub struct ModelArgs {
     #[arg(long, value_name = "FILE.yaml")]
     pub noise_spec: Option<PathBuf>,
     /// Internal sample rate of both sensors [Hz]; an integer multiple of --rate.
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
     pub internal_rate: Option<f64>,
     /// Gyro low-pass: 2nd-order Butterworth −3 dB frequency at the internal rate [Hz]; 0 = none.
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
     pub gyro_lpf: Option<f64>,
     /// Accelerometer low-pass −3 dB frequency [Hz]; 0 = none.
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
     pub acc_lpf: Option<f64>,
     /// Gyro bias instability B [rad/s] (flicker noise; Allan floor 0.664·B).
     #[arg(long, value_name = "B", allow_negative_numbers = true)]
@@ -108,7 +108,6 @@ pub struct ModelArgs {
         long,
         value_name = "A,T",
         value_delimiter = ',',
-        num_args = 2,
         allow_negative_numbers = true
     )]
     pub gyro_warmup: Option<Vec<f64>>,
@@ -117,7 +116,6 @@ pub struct ModelArgs {
         long,
         value_name = "A,T",
         value_delimiter = ',',
-        num_args = 2,
         allow_negative_numbers = true
     )]
     pub acc_warmup: Option<Vec<f64>>,

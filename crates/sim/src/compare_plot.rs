@@ -185,7 +185,7 @@ where
         .border_style(BLACK)
         .draw()
         .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))
+    bag2mat::shared::plot::present(&root)
 }
 
 /// What one comparison chart draws.

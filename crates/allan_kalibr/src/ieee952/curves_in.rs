@@ -70,13 +70,13 @@ impl std::fmt::Display for Format {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum CurvesError {
-    /// A file or directory could not be read.
-    #[error("{path}: {source}")]
+    /// A file or directory could not be read (the cause said plainly, as every tool says it).
+    #[error("{}: {}", .path.display(), bag2mat::shared::output::describe(.cause))]
     Io {
         /// The path.
         path: PathBuf,
         /// The cause.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// Not one of the formats.
     #[error("{path}: not a curve file this tool reads ({why}); accepted: {FORMATS}")]
@@ -157,9 +157,9 @@ pub struct Curves {
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CurvesError + '_ {
-    move |source| CurvesError::Io {
+    move |cause| CurvesError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     }
 }
 

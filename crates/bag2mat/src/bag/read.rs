@@ -341,10 +341,14 @@ impl BagReader {
         while pos < end {
             let Some((hb, data_pos, dlen)) = self.record_at(pos, end) else {
                 if end == self.len {
-                    self.contents.losses.push(Loss::new(format!(
-                        "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
-                        self.len - pos
-                    )));
+                    let at_most = self.tail_capacity(pos);
+                    self.contents.losses.push(Loss {
+                        at_most,
+                        ..Loss::new(format!(
+                            "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
+                            self.len - pos
+                        ))
+                    });
                 } else {
                     self.damaged_at(
                         pos,
@@ -549,6 +553,7 @@ impl BagReader {
                             messages: Some(info.counts.iter().map(|&(_, n)| n as u64).sum()),
                             span: Some((info.start_time.as_nanos(), info.end_time.as_nanos())),
                             channel: None,
+                            ..Loss::default()
                         }),
                     }
                 }
@@ -655,6 +660,30 @@ impl BagReader {
 
     /// The header bytes, data position and data length of the record at `pos`, if it is
     /// whole before `end` and its header is of a sane size.
+    /// The most Imu messages the incomplete record at `pos` (the end of a truncated bag)
+    /// can have held: a chunk its header's uncompressed size, bounded by what its stored
+    /// bytes decompress to; else what the bytes left hold.
+    fn tail_capacity(&self, pos: u64) -> Option<u64> {
+        let stored = self.len.saturating_sub(pos);
+        let mut b4 = [0u8; 4];
+        let size = self
+            .file
+            .read_exact_at(&mut b4, pos)
+            .ok()
+            .map(|_| u32::from_le_bytes(b4) as u64)
+            .filter(|&h| h <= MAX_RECORD_HEADER && pos + 4 + h <= self.len)
+            .and_then(|h| {
+                let mut hb = vec![0u8; h as usize];
+                self.file.read_exact_at(&mut hb, pos + 4).ok()?;
+                let hd = Header::parse(&hb).ok()?;
+                (hd.op().ok()? == Op::Chunk).then_some(())?;
+                hd.u32("size").ok().map(|s| s as u64)
+            });
+        let bound = stored.saturating_mul(source::MAX_EXPANSION);
+        // A header cut short says nothing of the records after it.
+        size.map(|s| s.min(bound) / crate::series::MIN_IMU_PAYLOAD)
+    }
+
     fn record_at(&self, pos: u64, end: u64) -> Option<RecordAt> {
         let mut b4 = [0u8; 4];
         self.file.read_exact_at(&mut b4, pos).ok()?;
@@ -804,6 +833,7 @@ impl BagReader {
                     messages: Some(n),
                     span: Some((a, b)),
                     channel: Some(conn),
+                    ..Loss::default()
                 });
             }
         }

@@ -147,6 +147,7 @@ pub fn open(path: &Path) -> Result<DecodedSource, Error> {
         losses.push(crate::source::Loss {
             what: format!("{n} rows have a time that is not a non-negative number of seconds (first: row {}, t = {t})", r + 1),
             messages: Some(n as u64),
+            at_most: None,
             span: None,
             channel: Some(0),
         });

@@ -500,6 +500,43 @@ pub fn skip_index(t: &[f64], seconds: f64) -> usize {
     t.partition_point(|&x| x < t0 + seconds)
 }
 
+/// The fewest samples a `--skip-start` may leave: below this no Allan deviation reaches past
+/// a few sample periods, and nothing can be fitted.
+pub const SKIP_MIN_SAMPLES_LEFT: usize = 1000;
+/// The smallest part of the record a `--skip-start` may leave (a skip that takes more is a
+/// mistaken number, not a warm-up).
+pub const SKIP_MIN_FRACTION_LEFT: f64 = 0.1;
+
+/// The `--skip-start` cut of `t` ([`skip_index`]), checked: an error when it leaves too
+/// little of the record to analyse ([`SKIP_MIN_SAMPLES_LEFT`], [`SKIP_MIN_FRACTION_LEFT`]);
+/// else the index and, when it drops more than half of the record, a warning to print.
+pub fn checked_skip(t: &[f64], seconds: f64) -> Result<(usize, Option<String>), String> {
+    if !(seconds >= 0.0 && seconds.is_finite()) {
+        return Err(format!(
+            "--skip-start must be a non-negative number of seconds, got {seconds}"
+        ));
+    }
+    let k = skip_index(t, seconds);
+    let left = t.len() - k;
+    let span = t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a);
+    if left < SKIP_MIN_SAMPLES_LEFT || (left as f64) < SKIP_MIN_FRACTION_LEFT * t.len() as f64 {
+        return Err(format!(
+            "--skip-start {seconds} leaves {left} of {} samples ({:.1} s of a {:.1} s record): too little for an Allan analysis (at least {SKIP_MIN_SAMPLES_LEFT} samples and {:.0} % of the record)",
+            t.len(),
+            (span - seconds).max(0.0),
+            span,
+            100.0 * SKIP_MIN_FRACTION_LEFT
+        ));
+    }
+    let warning = (2 * k > t.len()).then(|| {
+        format!(
+            "--skip-start {seconds} drops {k} of {} samples, more than half of the record",
+            t.len()
+        )
+    });
+    Ok((k, warning))
+}
+
 /// A relative disagreement between the rate given on the command line and the stamps'
 /// above which the corrected analysis uses the stamps'.
 pub const RATE_ARGUMENT_REL: f64 = 0.01;

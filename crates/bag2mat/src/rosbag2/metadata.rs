@@ -54,9 +54,15 @@ struct MetadataFile {
 impl BagInfo {
     /// Parses the text of a `metadata.yaml`.
     pub fn parse(text: &str) -> Result<BagInfo, String> {
+        // The parser's message: its first line (the excerpt after it is the file's text),
+        // without its own "error: ".
         serde_saphyr::from_str::<MetadataFile>(text)
             .map(|m| m.rosbag2_bagfile_information)
-            .map_err(|e| e.to_string())
+            .map_err(|e| {
+                let s = e.to_string();
+                let first = s.lines().next().unwrap_or("").trim();
+                first.strip_prefix("error: ").unwrap_or(first).to_string()
+            })
     }
 
     /// The compression format, empty when none.

@@ -10,6 +10,7 @@
 
 pub mod metadata;
 pub mod sqlite;
+mod table_walk;
 
 pub use sqlite::{Sqlite3Reader, Sqlite3Writer};
 
@@ -29,6 +30,10 @@ thread_local! {
     static PAYLOAD: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
+/// Fewer bytes than any stored message takes (a sqlite3 row's least): bounds the messages
+/// storage files can hold.
+const MIN_STORED_MESSAGE: u64 = 8;
+
 /// Largest decompressed message accepted in MESSAGE mode (a damaged frame cannot make the
 /// reader allocate more).
 const MAX_MESSAGE_BYTES: u64 = 1 << 30;
@@ -45,6 +50,8 @@ pub struct BagDir {
     files: Vec<FileSource>,
     /// Part in the bag → (file, part in the file).
     part_map: Vec<(usize, usize)>,
+    /// Each channel's count as its storage files state it (before metadata.yaml's).
+    file_counts: BTreeMap<u32, Option<u64>>,
     message_zstd: bool,
     contents: source::Contents,
     /// The parsed `metadata.yaml`, when there is one.
@@ -80,19 +87,27 @@ impl BagDir {
     pub fn open(dir: &Path) -> Result<BagDir, Error> {
         let meta_path = dir.join("metadata.yaml");
         let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
-        let info = BagInfo::parse(&text).map_err(|e| Error::Storage {
-            path: meta_path.clone(),
-            what: format!("not a rosbag2 metadata.yaml: {e}"),
-        })?;
         let mut notes = Vec::new();
         let mut losses = Vec::new();
+        // A damaged metadata.yaml costs its promises, not the storage files beside it.
+        let mut damaged = false;
+        let info = BagInfo::parse(&text).unwrap_or_else(|e| {
+            damaged = true;
+            notes.push(format!(
+                "{} is damaged ({e}); the storage files in the directory were read without it (it promises no counts)",
+                meta_path.display()
+            ));
+            BagInfo::default()
+        });
         let mut paths: Vec<PathBuf> = info
             .relative_file_paths
             .iter()
             .map(|r| dir.join(r))
             .collect();
-        if paths.is_empty() {
-            // Some tools leave the list empty; take the storage files in name order.
+        let listed = paths.len();
+        if !paths.iter().any(|p| p.exists()) {
+            // Some tools leave the list empty; take the storage files in name order (also
+            // when none of those listed is there).
             let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
                 .map_err(|e| Error::io(dir, e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
@@ -104,10 +119,23 @@ impl BagDir {
                 })
                 .collect();
             found.sort();
-            notes.push(format!(
-                "metadata.yaml lists no storage files; reading the {} found in the directory",
-                found.len()
-            ));
+            if listed == 0 && !damaged {
+                notes.push(format!(
+                    "metadata.yaml lists no storage files; reading the {} found in the directory",
+                    found.len()
+                ));
+            } else if listed > 0 && !found.is_empty() {
+                notes.push(format!(
+                    "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
+                    found.len()
+                ));
+            }
+            for p in &paths {
+                losses.push(Loss::new(format!(
+                    "{} is listed in metadata.yaml but missing",
+                    p.display()
+                )));
+            }
             paths = found;
         }
         let mut files = Vec::new();
@@ -118,6 +146,7 @@ impl BagDir {
                     messages: None,
                     span: None,
                     channel: None,
+                    ..Loss::default()
                 });
                 continue;
             }
@@ -140,13 +169,46 @@ impl BagDir {
                 ),
             });
         }
-        Ok(Self::assemble(
-            files,
-            Some(info),
-            message_zstd,
-            notes,
-            losses,
-        ))
+        // What the storage files can hold bounds the counts metadata.yaml states.
+        // (compressed data, MCAP chunks included, expands by at most MAX_EXPANSION).
+        let held: u64 = paths
+            .iter()
+            .filter_map(|p| {
+                let len = std::fs::metadata(p).ok()?.len();
+                let raw = source::detect(p).ok()? == InputKind::Sqlite3
+                    && info.compression_mode().is_empty();
+                Some(if raw {
+                    len
+                } else {
+                    len.saturating_mul(source::MAX_EXPANSION)
+                })
+            })
+            .fold(0u64, |a, b| a.saturating_add(b));
+        let mut d = Self::assemble(files, Some(info), message_zstd, notes, losses);
+        d.bound_promises(held);
+        Ok(d)
+    }
+
+    /// Drops a count of `metadata.yaml` that is more than `bytes` of storage can hold (a
+    /// damaged count), with a note; the storage's own count stands.
+    fn bound_promises(&mut self, bytes: u64) {
+        for c in self.contents.channels.iter_mut() {
+            let least = if crate::series::is_imu(c) {
+                crate::series::MIN_IMU_PAYLOAD
+            } else {
+                MIN_STORED_MESSAGE
+            };
+            let most = bytes / least;
+            if let Some(n) = c.count
+                && n > most
+            {
+                self.contents.notes.push(format!(
+                    "metadata.yaml promises {n} messages on '{}', more than its storage files can hold (at most {most}): the count is damaged and not used",
+                    crate::shared::cli::escape(&c.topic)
+                ));
+                c.count = self.file_counts.get(&c.id).copied().flatten();
+            }
+        }
     }
 
     /// Opens a bare FILE-mode compressed storage file (`.mcap.zstd`, `.db3.zstd`).
@@ -206,13 +268,18 @@ impl BagDir {
                 parts.push(p);
             }
             notes.extend(src.notes().iter().cloned());
-            losses.extend(src.losses().iter().cloned());
+            losses.extend(src.losses().iter().map(|l| Loss {
+                channel: l.channel.and_then(|c| ids.get(&c).copied()),
+                ..l.clone()
+            }));
             out_files.push(FileSource {
                 src,
                 ids,
                 _tmp: tmp,
             });
         }
+        let file_counts: BTreeMap<u32, Option<u64>> =
+            channels.iter().map(|c| (c.id, c.count)).collect();
         // metadata.yaml's counts are what the recorder promised for the whole bag.
         if let Some(info) = &info {
             for c in channels.iter_mut() {
@@ -225,6 +292,7 @@ impl BagDir {
         }
         BagDir {
             files: out_files,
+            file_counts,
             part_map,
             message_zstd,
             contents: source::Contents {
@@ -287,7 +355,24 @@ impl Source for BagDir {
         if r.skip_reason.is_none() {
             r.skip_reason = skip_reason;
         }
+        for l in r.lost.iter_mut() {
+            l.channel = l.channel.and_then(|c| f.ids.get(&c).copied());
+        }
         r
+    }
+    fn losses_after_read(&self) -> Vec<Loss> {
+        let multi = self.files.len() > 1;
+        let mut out = Vec::new();
+        for (fi, f) in self.files.iter().enumerate() {
+            for mut l in f.src.losses_after_read() {
+                l.channel = l.channel.and_then(|c| f.ids.get(&c).copied());
+                if multi {
+                    l.what = format!("file {}: {}", fi + 1, l.what);
+                }
+                out.push(l);
+            }
+        }
+        out
     }
 }
 

@@ -64,6 +64,31 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// A note said as the workspace's warning line: `warning: <what>`, whatever case the note
+/// starts with (the analysers keep upstream's own `WARNING: …` texts in their notes, for
+/// parity with the reference runs).
+pub fn warning_line(note: &str) -> String {
+    let what = ["WARNING: ", "Warning: ", "warning: "]
+        .iter()
+        .find_map(|p| note.strip_prefix(p))
+        .unwrap_or(note);
+    format!("warning: {what}")
+}
+
+/// Flags that only apply with another one: a usage error naming those given without it
+/// (clap's `requires` does not see an empty repeatable flag as absent here).
+pub fn only_with(needed: &str, present: bool, flags: &[(&str, bool)]) -> Result<(), String> {
+    let given: Vec<&str> = flags.iter().filter(|f| f.1).map(|f| f.0).collect();
+    if present || given.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "{} only appl{} with {needed}, which was not given",
+        given.join(", "),
+        if given.len() == 1 { "ies" } else { "y" }
+    ))
+}
+
 /// Text from a file (a topic name, a type) made safe to print: control characters are
 /// escaped, so a damaged or hostile name cannot move the cursor or clear the terminal.
 pub fn escape(s: &str) -> String {

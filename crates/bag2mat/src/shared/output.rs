@@ -9,7 +9,8 @@
 //! * A target that exists and is not a regular file (`/dev/null`, `/dev/stdout`, a FIFO) is
 //!   written through, never replaced; a directory is refused.
 //! * An input of the run ([`protect_input`]) is never an output (same device and inode).
-//! * [`Staging`]: a run that writes several files commits them together, all or none.
+//! * [`Staging`] ([`super::staging`]): a run that writes several files commits them
+//!   together, all or none, also across concurrent runs and a kill during the commit.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -24,12 +25,10 @@ use crate::error::Error;
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Inputs of this run, as (device, inode, path).
 static INPUTS: Mutex<Vec<(u64, u64, PathBuf)>> = Mutex::new(Vec::new());
-/// When a [`Staging`] is active: the `(temporary, target)` pairs waiting for its commit.
-static STAGED: Mutex<Option<Vec<(PathBuf, PathBuf)>>> = Mutex::new(None);
 /// Makes temporary names unique within the process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
@@ -42,14 +41,11 @@ fn install_signal_cleanup() {
         let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
             return;
         };
-        std::thread::spawn(move || {
+        // Without the thread (no memory left to start one) only the cleanup on signals is lost.
+        let _ = std::thread::Builder::new().spawn(move || {
             if let Some(sig) = signals.forever().next() {
                 for p in lock(&LIVE).drain(..) {
-                    if p.is_dir() {
-                        let _ = std::fs::remove_dir_all(&p);
-                    } else {
-                        let _ = std::fs::remove_file(&p);
-                    }
+                    remove(&p);
                 }
                 std::process::exit(128 + sig);
             }
@@ -57,12 +53,22 @@ fn install_signal_cleanup() {
     });
 }
 
-fn register(p: &Path) {
+/// Removes every live temporary path, after a failed allocation ([`super::alloc`]): the
+/// lock is only tried (the failing thread may hold it).
+pub(super) fn remove_live_paths() {
+    if let Ok(mut v) = LIVE.try_lock() {
+        for p in v.drain(..) {
+            remove(&p);
+        }
+    }
+}
+
+pub(super) fn register(p: &Path) {
     install_signal_cleanup();
     lock(&LIVE).push(p.to_path_buf());
 }
 
-fn unregister(p: &Path) {
+pub(super) fn unregister(p: &Path) {
     lock(&LIVE).retain(|x| x != p);
 }
 
@@ -98,32 +104,41 @@ pub fn describe(e: &std::io::Error) -> String {
         K::StorageFull => "no space left on the device".into(),
         K::ReadOnlyFilesystem => "the file system is read-only".into(),
         K::DirectoryNotEmpty => "a directory that is not empty is in the way".into(),
-        _ => {
-            let s = e.to_string();
-            match s.find(" (os error") {
-                Some(i) => s[..i].to_string(),
-                None => s,
-            }
-        }
+        _ => without_errno(&e.to_string()),
     }
 }
 
-/// The file a path names once its symlinks are followed (a dangling link names its target).
-fn resolve(target: &Path) -> PathBuf {
+/// An OS error's text without its "(os error N)".
+pub fn without_errno(s: &str) -> String {
+    match s.find(" (os error") {
+        Some(i) => s[..i].to_string(),
+        None => s.to_string(),
+    }
+}
+
+/// Symlinks followed at most (the kernel's limit, `MAXSYMLINKS`).
+const MAX_SYMLINKS: usize = 40;
+
+/// The file a path names once its symlinks are followed (a dangling link names its target);
+/// a loop of links (or a longer chain than the kernel follows) is refused.
+fn resolve(target: &Path) -> Result<PathBuf, Error> {
     let mut p = target.to_path_buf();
-    for _ in 0..40 {
+    for _ in 0..MAX_SYMLINKS {
         match std::fs::symlink_metadata(&p) {
             Ok(m) if m.file_type().is_symlink() => match std::fs::read_link(&p) {
                 Ok(to) if to.is_absolute() => p = to,
                 Ok(to) => {
                     p = p.parent().map(|d| d.join(&to)).unwrap_or(to);
                 }
-                Err(_) => return p,
+                Err(_) => return Ok(p),
             },
-            _ => return p,
+            _ => return Ok(p),
         }
     }
-    p
+    Err(Error::Output {
+        path: target.to_path_buf(),
+        what: "it is a loop of symbolic links (or a chain of more than 40)".into(),
+    })
 }
 
 /// Refuses an output that is an input of the run.
@@ -145,20 +160,59 @@ fn check_not_input(target: &Path, real: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-/// A temporary path beside its target that is renamed into place on commit (or staged, when
-/// a [`Staging`] is active), and removed otherwise.
+/// A fresh name `.<name>.<pid>.<n><suffix>` (unique in the process).
+pub(super) fn unique(name: &str, suffix: &str) -> String {
+    format!(
+        ".{name}.{}.{}{suffix}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// A temporary path for a file that is renamed into place on commit (or, while a
+/// [`Staging`] is active, written in its stage), and removed otherwise.
 pub struct TempPath {
     tmp: PathBuf,
     target: PathBuf,
     done: bool,
+    /// A file (staged with its directory), not a directory.
+    file: bool,
 }
 
 impl TempPath {
-    /// A fresh `.<name>.<pid>.<n><suffix>` beside `target` (after its symlinks), registered
-    /// for removal on SIGINT/SIGTERM. Nothing is created.
+    /// Where to write `target` (after its symlinks) until it is committed: a fresh
+    /// `.<name>.<pid>.<n><suffix>` beside it, or its place in the active [`Staging`]'s
+    /// stage; registered for removal on SIGINT/SIGTERM. Nothing is created but a stage.
     pub fn beside(target: &Path, suffix: &str) -> Result<TempPath, Error> {
-        let real = resolve(target);
+        let real = resolve(target)?;
         check_not_input(target, &real)?;
+        if real.is_dir() {
+            return Err(Error::Output {
+                path: target.to_path_buf(),
+                what: "it is a directory (name a file)".into(),
+            });
+        }
+        if let Some(tmp) = super::staging::file_path(&real)? {
+            return Ok(TempPath {
+                tmp,
+                target: real,
+                done: false,
+                file: true,
+            });
+        }
+        let mut t = Self::beside_path(target, &real, suffix)?;
+        t.file = true;
+        Ok(t)
+    }
+
+    /// A fresh temporary name beside `target` for a directory.
+    fn beside_dir(target: &Path) -> Result<TempPath, Error> {
+        let real = resolve(target)?;
+        check_not_input(target, &real)?;
+        Self::beside_path(target, &real, ".tmp")
+    }
+
+    fn beside_path(target: &Path, real: &Path, suffix: &str) -> Result<TempPath, Error> {
         if real.is_dir() {
             return Err(Error::Output {
                 path: target.to_path_buf(),
@@ -173,17 +227,13 @@ impl TempPath {
             path: target.to_path_buf(),
             what: "the path has no file name".into(),
         })?;
-        let tmp = dir.join(format!(
-            ".{}.{}.{}{suffix}",
-            name.to_string_lossy(),
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
+        let tmp = dir.join(unique(&name.to_string_lossy(), suffix));
         register(&tmp);
         Ok(TempPath {
             tmp,
-            target: real,
+            target: real.to_path_buf(),
             done: false,
+            file: false,
         })
     }
 
@@ -196,8 +246,7 @@ impl TempPath {
     /// failure the temporary path is removed and the error names the target.
     pub fn commit(mut self) -> Result<(), Error> {
         self.done = true;
-        if let Some(staged) = lock(&STAGED).as_mut() {
-            staged.push((self.tmp.clone(), self.target.clone()));
+        if super::staging::record(&self.tmp, &self.target, self.file) {
             return Ok(());
         }
         let r = std::fs::rename(&self.tmp, &self.target);
@@ -209,7 +258,7 @@ impl TempPath {
     }
 }
 
-fn remove(p: &Path) {
+pub(super) fn remove(p: &Path) {
     if p.is_dir() {
         let _ = std::fs::remove_dir_all(p);
     } else {
@@ -306,51 +355,16 @@ where
     f.commit()
 }
 
-/// Several outputs committed together: while a `Staging` is active, every commit of this
-/// module (files, plots, directories) only stages its temporary path; [`Staging::commit`]
-/// renames them all, and dropping it uncommitted removes them all. A run that fails half
-/// way therefore leaves none of its outputs, and never a mix of old and new ones.
-pub struct Staging {
-    done: bool,
-}
+pub use super::staging::Staging;
 
-impl Staging {
-    /// Starts staging (one at a time per process).
-    pub fn begin() -> Staging {
-        *lock(&STAGED) = Some(Vec::new());
-        Staging { done: false }
+/// Makes sure the output directory `dir` can take outputs: while a [`Staging`] is active
+/// nothing is created (its commit makes the directory, so a failed run leaves none);
+/// otherwise the directory and its parents are created.
+pub fn ensure_dir(dir: &Path) -> Result<(), Error> {
+    if super::staging::may_create(dir) {
+        return Ok(());
     }
-
-    /// Renames every staged output into place. If a rename fails, the outputs not yet
-    /// renamed are removed and the error names the first that failed.
-    pub fn commit(mut self) -> Result<(), Error> {
-        self.done = true;
-        let staged = lock(&STAGED).take().unwrap_or_default();
-        let mut err = None;
-        for (tmp, target) in staged {
-            if err.is_none()
-                && let Err(e) = std::fs::rename(&tmp, &target)
-            {
-                err = Some(Error::io(&target, e));
-            }
-            if err.is_some() {
-                remove(&tmp);
-            }
-            unregister(&tmp);
-        }
-        err.map_or(Ok(()), Err)
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        if !self.done {
-            for (tmp, _) in lock(&STAGED).take().unwrap_or_default() {
-                remove(&tmp);
-                unregister(&tmp);
-            }
-        }
-    }
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))
 }
 
 /// A directory being filled under a temporary name beside the target; [`AtomicDir::commit`]
@@ -371,7 +385,7 @@ impl AtomicDir {
                 what: "it already exists (remove it or choose another output)".into(),
             });
         }
-        let tmp = TempPath::beside(target, ".tmp")?;
+        let tmp = TempPath::beside_dir(target)?;
         std::fs::create_dir(tmp.path()).map_err(|e| Error::io(target, e))?;
         Ok(AtomicDir {
             tmp,

@@ -26,6 +26,39 @@ pub fn register_font() {
     });
 }
 
+/// The bitmap backend's error type (plotters does not name it).
+type BitmapError =
+    <plotters::prelude::BitMapBackend<'static> as plotters::prelude::DrawingBackend>::ErrorType;
+
+/// Finishes a drawing (`root.present()`: a bitmap backend encodes and writes its file here).
+/// A failed write is said as every tool says an I/O error (a full disk: "no space left on
+/// the device"), not as the backend's debug text.
+pub fn present<DB>(
+    root: &plotters::drawing::DrawingArea<DB, plotters::coord::Shift>,
+) -> Result<(), String>
+where
+    DB: plotters::prelude::DrawingBackend,
+    DB::ErrorType: 'static,
+{
+    use plotters::drawing::DrawingAreaErrorKind;
+    use plotters_backend::DrawingErrorKind;
+    root.present().map_err(|e| {
+        if let DrawingAreaErrorKind::BackendError(DrawingErrorKind::DrawingError(inner)) = &e
+            && let Some(b) = (inner as &dyn std::any::Any).downcast_ref::<BitmapError>()
+        {
+            match *b {
+                BitmapError::IOError(ref io) => return crate::shared::output::describe(io),
+                // The encoder's I/O error, as its text (the image crate keeps no source).
+                BitmapError::ImageError(ref ie) => {
+                    return crate::shared::output::without_errno(&ie.to_string());
+                }
+                _ => {}
+            }
+        }
+        e.to_string()
+    })
+}
+
 /// A chart drawn the same way on any plotters backend (the SVG and the PNG of one figure).
 pub trait Figure {
     /// Draws onto `root`. `scale` multiplies every size in pixels: 1 for the SVG (its user
@@ -56,7 +89,7 @@ pub fn write_png_svg(
     {
         let root = SVGBackend::with_string(&mut text, svg_size).into_drawing_area();
         fig.draw(&root, 1.0)
-            .and_then(|()| root.present().map_err(|e| e.to_string()))
+            .and_then(|()| present(&root))
             .map_err(|what| crate::Error::Plot {
                 path: svg.clone(),
                 what,
@@ -66,7 +99,7 @@ pub fn write_png_svg(
     let scale = png_size.0 as f64 / svg_size.0.max(1) as f64;
     png_atomic(&png, png_size, |root| {
         fig.draw(&root, scale)?;
-        root.present().map_err(|e| e.to_string())
+        present(&root)
     })?;
     Ok([png, svg])
 }

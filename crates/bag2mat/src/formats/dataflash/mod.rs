@@ -365,6 +365,7 @@ pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
         losses.push(Loss {
             what: format!("{short_batches} sensor batches (ISBH) hold fewer samples than their header promises"),
             messages: Some(short_samples),
+            at_most: None,
             span: None,
             channel: None,
         });

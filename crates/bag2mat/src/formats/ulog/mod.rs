@@ -691,6 +691,7 @@ fn losses(found: &Found) -> Vec<Loss> {
                 longest.0 as f64 * 1e-9
             ),
             messages: None,
+            at_most: None,
             span: Some((first, last)),
             channel: None,
         });
