@@ -719,7 +719,8 @@ mod tests {
 
     /// Issue 17 (the vibration profile's gyro N 1–3 % high, outside its interval): a
     /// resonance's width read against the running-median floor, which its wings and flat
-    /// low-frequency part lift, came out ≈ 8 % short. Fitted with a floor of its own it is
+    /// low-frequency part lift, came out short (by about 8 % in a hand estimate: N then +1–3 %
+    /// in the profile study). Fitted with a floor of its own it is
     /// within [`RESONANCE_BW_REL_TOL`], and its standard error is stated.
     #[test]
     fn issue_17_resonance_bandwidth_fitted_with_its_own_floor() {
