@@ -1029,4 +1029,110 @@ mod tests_issue18 {
             }
         }
     }
+
+    /// Issue 18.10 (second part): allan_variance_ros' `allan_variance.csv` of a noisy record
+    /// — its non-overlapping deviations on 0.1 s bin means, every period 0.1·p s — fitted
+    /// with the covariance and EDF of the overlapping estimator stopped at 3–13 s with χ²/dof
+    /// 8–25 and K never resolved (the format's other test uses a noiseless curve). Analysed
+    /// as what it is, every axis fits to the long end and resolves K.
+    ///
+    /// OPEN: this fails today (the Normal estimator's covariance does not yet describe these
+    /// curves: the first gyro axis fits only to 72 s at χ²/dof 9 with K "contradicted"), so
+    /// it is ignored until 18.10's second part is fixed; run it with `--ignored`.
+    #[test]
+    #[ignore = "issue 18.10 (second part) is open: fails today"]
+    fn issue18_10_allan_variance_ros_csv_of_a_noisy_record_fits_to_the_long_end() {
+        use super::super::tests_accuracy::simulate_axis;
+        let (rate, secs) = (100.0, 7200.0);
+        let (n_true, k_true) = (0.01, 1e-3); // K's +½ line crosses N's −½ line at 17 s
+        let bin = (rate * AVR_PERIOD_STEP).round() as usize;
+        let deg = 180.0 / std::f64::consts::PI;
+        // six axes: acc x y z (m/s²), gyro x y z (deg/s), each its own seed
+        let cols: Vec<Vec<f64>> = (0..6)
+            .map(|a| {
+                let y = simulate_axis(
+                    n_true,
+                    k_true,
+                    1.0 / rate,
+                    (secs * rate) as usize,
+                    0x1810 + a,
+                );
+                let scale = if a >= 3 { deg } else { 1.0 };
+                // prefix sums of the 0.1 s bin means
+                let mut ps = vec![0.0];
+                for b in y.chunks_exact(bin) {
+                    let m = b.iter().sum::<f64>() / bin as f64 * scale;
+                    ps.push(ps.last().unwrap() + m);
+                }
+                ps
+            })
+            .collect();
+        let bins = cols[0].len() - 1;
+        let mut body = String::new();
+        for p in 1..=9999usize {
+            let clusters = bins / p;
+            if clusters < 2 {
+                break;
+            }
+            body.push_str(&format!("{}", p as f64 * AVR_PERIOD_STEP));
+            for ps in &cols {
+                let mean = |j: usize| (ps[(j + 1) * p] - ps[j * p]) / p as f64;
+                let s: f64 = (0..clusters - 1)
+                    .map(|j| (mean(j + 1) - mean(j)).powi(2))
+                    .sum();
+                body.push_str(&format!(
+                    " {:e}",
+                    (s / (2.0 * (clusters - 1) as f64)).sqrt()
+                ));
+            }
+            body.push('\n');
+        }
+        let tmp = tempfile::tempdir().unwrap();
+        let f = tmp.path().join("allan_variance.csv");
+        std::fs::write(&f, body).unwrap();
+        let opts = Options {
+            duration: Some(secs),
+            ..Options::default()
+        };
+        let c = read(&[f], &opts).unwrap();
+        let cfg = super::super::Config::default();
+        let (mut k_covered, mut fails) = (0, Vec::new());
+        for s in &c.sensors {
+            let basis = s.axes[0].basis(cfg.fit.per_octave);
+            for (i, a) in s.axes.iter().enumerate() {
+                let an = super::super::analyse_curve(a, &cfg, basis.as_ref());
+                let k = an.terms.k;
+                let id = format!("{} {i}", s.sensor.name());
+                println!("{id}: {}; N {:.4e}, K {k:?}", an.verdict, an.terms.n.value);
+                let Some(fit) = an.fit.as_ref().filter(|_| an.verdict.fits()) else {
+                    fails.push(format!("{id}: no fit"));
+                    continue;
+                };
+                if fit.tau_range.1 < ROS_RANGE_END_S {
+                    fails.push(format!("{id}: fit ends at {} s", fit.tau_range.1));
+                }
+                if fit.chi2_per_dof > ROS_MAX_CHI2 {
+                    fails.push(format!("{id}: χ²/dof {:.2}", fit.chi2_per_dof));
+                }
+                if (an.terms.n.value / n_true - 1.0).abs() > 0.03 {
+                    fails.push(format!("{id}: N {:.4e}", an.terms.n.value));
+                }
+                if k.verdict != super::super::Verdict::Resolved {
+                    fails.push(format!("{id}: K {:?}", k.verdict));
+                }
+                if k.lo <= k_true && k_true <= k.hi {
+                    k_covered += 1;
+                }
+            }
+        }
+        assert!(fails.is_empty(), "{fails:#?}");
+        // 95 % intervals on six axes: five at least (one miss is within chance)
+        assert!(k_covered >= 5, "K covered on {k_covered}/6 axes");
+    }
+
+    /// The fit reaches this τ (the issue's fits stopped at 3–13 s; the record is 7200 s, the
+    /// last period with ≥ 2 clusters 999.9 s, where K dominates from 17 s).
+    const ROS_RANGE_END_S: f64 = 300.0;
+    /// χ²/dof at most (the issue's 8–25 were the wrong covariance's).
+    const ROS_MAX_CHI2: f64 = 3.0;
 }

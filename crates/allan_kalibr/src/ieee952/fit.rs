@@ -199,6 +199,9 @@ pub struct LineShape {
     pub frequency: f64,
     /// −3 dB bandwidth, Hz (0: a sinusoid).
     pub bandwidth: f64,
+    /// Standard error of the bandwidth as the PSD measured it, Hz (0 or NaN: none known);
+    /// the terms' intervals carry it ([`super::make_terms`]).
+    pub bandwidth_se: f64,
     /// Sample period, s.
     pub tau0: f64,
     /// A² as the PSD measured it (for the range's start rule; a resonance's coefficient).

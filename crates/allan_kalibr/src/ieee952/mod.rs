@@ -269,6 +269,7 @@ impl CurveData {
             let shape = fit::LineShape {
                 frequency: l.frequency,
                 bandwidth: l.bandwidth,
+                bandwidth_se: l.bandwidth_se,
                 tau0: self.tau0,
                 psd_amp2: l.amplitude * l.amplitude,
                 record: self.n.unwrap_or(0) as f64 * self.tau0,
@@ -1185,6 +1186,49 @@ fn data_bound(j: usize, f: &fit::FitResult, fd: &fit::FitData, curve: &[Point]) 
     region::upper_bound(used, |tau| fit::basis_at(j, tau, &f.shapes).sqrt())
 }
 
+/// The variance each coefficient takes from the resonances' bandwidths: the PSD measures a
+/// bandwidth with a standard error ([`psd::Line::bandwidth_se`]), and the fit takes the
+/// resonance's shape as known — its flat low-frequency part is white noise at long τ, and
+/// the share of the curve's white level the model gives it (rather than N) scales with the
+/// bandwidth (issue 17's vibration profile: a 45 Hz, 1 Hz wide gyro resonance holds a
+/// third of the long-τ white level). Each line's bandwidth moved by ±1 standard error, the
+/// range refitted: half the coefficients' change, squared, summed over the lines (a term
+/// the refit selects differently takes nothing from it).
+fn line_shape_variance(
+    f: &fit::FitResult,
+    fd: &fit::FitData,
+    cfg: &Config,
+) -> [f64; fit::TERM_COUNT] {
+    let mut var = [0.0; fit::TERM_COUNT];
+    if fd.basis.is_none() {
+        return var;
+    }
+    for s in 0..fit::LINE_SLOTS {
+        let Some(l) = fd.lines[s] else { continue };
+        if !(fit::is_positive(l.bandwidth) && fit::is_positive(l.bandwidth_se)) {
+            continue;
+        }
+        let refit = |bw: f64| {
+            let mut d = fd.clone();
+            if let Some(x) = d.lines[s].as_mut() {
+                x.bandwidth = bw;
+            }
+            fit::fit(&d, &f.used, &cfg.fit)
+        };
+        let se = l.bandwidth_se.min(0.5 * l.bandwidth);
+        let (Some(up), Some(dn)) = (refit(l.bandwidth + se), refit(l.bandwidth - se)) else {
+            continue;
+        };
+        for (j, v) in var.iter_mut().enumerate() {
+            if up.left_out[j] == f.left_out[j] && dn.left_out[j] == f.left_out[j] {
+                let d = 0.5 * (up.coef[j] - dn.coef[j]);
+                *v += d * d;
+            }
+        }
+    }
+    var
+}
+
 fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Config) -> Terms {
     let z = z_of(cfg.term_confidence);
     let have_stats = fd.basis.is_some();
@@ -1195,6 +1239,7 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
         .map(|p| p.adev)
         .fold(f64::INFINITY, f64::min);
     let floor_shown = |b: f64| (region::B_FLOOR_FACTOR * b / floor - 1.0).abs() <= B_FLOOR_TOL;
+    let shape_var = line_shape_variance(f, fd, cfg);
     let one = |j: usize| -> Term {
         if !cfg.fit.terms[j] {
             return Term::not_fitted();
@@ -1232,12 +1277,18 @@ fn make_terms(f: &fit::FitResult, fd: &fit::FitData, curve: &[Point], cfg: &Conf
             };
         }
         let value = c.sqrt();
-        let std_err = nan_if(se_c / (2.0 * value));
+        let std_err = nan_if((se_c * se_c + shape_var[j]).sqrt() / (2.0 * value));
         let (mut lo_c, mut hi_c) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
         // spanning the shapes of the flicker floor the data do not reject
         for alt in &f.alternatives {
             lo_c = lo_c.min((alt.coef[j] - z * alt.std_err[j]).max(0.0));
             hi_c = hi_c.max(alt.coef[j] + z * alt.std_err[j]);
+        }
+        // and the resonances' bandwidths the PSD measured, in quadrature
+        let spread = z * shape_var[j].sqrt();
+        if fit::is_positive(spread) {
+            lo_c = (c - (c - lo_c).hypot(spread)).max(0.0);
+            hi_c = c + (hi_c - c).hypot(spread);
         }
         let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE && (j != 2 || floor_shown(value));
         let verdict = if !have_stats {

@@ -52,17 +52,18 @@ impl Phase {
     /// from Knuth's two-sum).
     pub fn from_rate(y: &[f64], tau0: f64) -> Phase {
         let mean = neumaier_sum(y.iter().copied()) / y.len().max(1) as f64;
-        let mut x = Vec::with_capacity(y.len() + 1);
-        x.push(0.0);
+        // written into a zeroed vector (not pushed: the push's capacity check kept the two
+        // running sums in memory, the costliest part of the section's set-up after the sweep)
+        let mut x = vec![0.0; y.len() + 1];
         let (mut s, mut c) = (0.0f64, 0.0f64);
-        for &v in y {
+        for (o, &v) in x[1..].iter_mut().zip(y) {
             // Knuth's branch-free two-sum: u + err = s + t exactly
             let t = (v - mean) * tau0;
             let u = s + t;
             let bp = u - s;
             c += (s - (u - bp)) + (t - bp);
             s = u;
-            x.push(s + c);
+            *o = s + c;
         }
         Phase { x, tau0 }
     }

@@ -685,3 +685,53 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
         "ratio {ratio}"
     );
 }
+
+#[test]
+#[ignore = "timing of the section's stages on six 2.88 M-sample axes; --ignored --nocapture"]
+fn section_stage_timings() {
+    use super::imu::ImuCurves;
+    use super::{Phase, analyse_curve, noise_id, psd};
+    let ys: Vec<Vec<f64>> = (0..6)
+        .map(|a| simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED + a))
+        .collect();
+    let cfg = Config::default();
+    let ms = cfg.grid.cluster_sizes(ys[0].len());
+    let t = std::time::Instant::now();
+    let ph = Phase::from_rate(&ys[0], 0.005);
+    let pts = ph.avar_curve(&ms);
+    let t_avar = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let _ids: Vec<_> = pts.iter().map(|p| noise_id::identify(&ph, p.m)).collect();
+    let t_id = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let p = psd::welch(&ys[0], 200.0).unwrap();
+    let t_psd = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let _l = psd::find_lines(&p);
+    let t_lines = t.elapsed().as_secs_f64();
+    println!(
+        "one axis: {} m, phase+OADEV {t_avar:.3} s, noise ID {t_id:.3} s (serial), PSD {t_psd:.3} s, lines {t_lines:.3} s",
+        ms.len()
+    );
+    let t = std::time::Instant::now();
+    let series: [&[f64]; 6] = std::array::from_fn(|i| ys[i].as_slice());
+    let curves = ImuCurves::from_samples(series, 200.0, &cfg).unwrap();
+    let t_curves = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let basis = curves.sensors[0].1[0].basis(cfg.fit.per_octave);
+    let t_basis = t.elapsed().as_secs_f64();
+    let mut t_fits = Vec::new();
+    for (_, axes) in &curves.sensors {
+        for c in axes {
+            let t = std::time::Instant::now();
+            let _ = analyse_curve(c, &cfg, basis.as_ref());
+            t_fits.push(t.elapsed().as_secs_f64());
+        }
+    }
+    let t = std::time::Instant::now();
+    let _ = curves.finish(Vec::new(), &cfg);
+    let t_finish = t.elapsed().as_secs_f64();
+    println!(
+        "six axes: curves {t_curves:.3} s (parallel), one basis {t_basis:.3} s, analyse_curve per axis (serial) {t_fits:.3?} s, finish (parallel, bases included) {t_finish:.3} s"
+    );
+}

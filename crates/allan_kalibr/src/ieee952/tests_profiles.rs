@@ -268,6 +268,66 @@ pub(super) fn b_dominates_a_decade(at: &AxisTruth, b: f64, rate: f64, n: usize) 
     false
 }
 
+/// Issue 17: every number the yaml files take — each sensor's N and K
+/// ([`super::imu::ImuAnalysis::noise_density`], [`super::imu::ImuAnalysis::random_walk`]) —
+/// is within the data's own 95 % bound on an axis it can come from, computed here from the
+/// curve alone: min over τ of σ_hi95(τ)·√τ for N, σ_hi95(τ)·√(3/τ) for K. `axes` are one
+/// record's (sensor, axis, analysis); returns the breaches.
+pub(super) fn yaml_over_bounds(
+    label: &str,
+    axes: &[(bag2mat::Sensor, usize, &Analysis)],
+) -> Vec<String> {
+    use super::imu::{AxisResult, ImuAnalysis};
+    let imu = ImuAnalysis {
+        rate: f64::NAN,
+        axes: axes
+            .iter()
+            .map(|&(sensor, axis, a)| AxisResult {
+                sensor,
+                axis,
+                analysis: a.clone(),
+                advice: None,
+            })
+            .collect(),
+        checks: Vec::new(),
+        notes: Vec::new(),
+    };
+    let curve_bound = |a: &Analysis, per_unit: &dyn Fn(f64) -> f64| {
+        a.curve
+            .iter()
+            .filter(|p| p.hi95.is_finite())
+            .map(|p| p.hi95 / per_unit(p.tau))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut out = Vec::new();
+    for s in imu.sensors() {
+        let mine = || axes.iter().filter(move |x| x.0 == s).map(|x| x.2);
+        let n_bound = mine()
+            .map(|a| curve_bound(a, &|t| (1.0 / t).sqrt()))
+            .fold(0.0, f64::max);
+        let k_bound = mine()
+            .map(|a| curve_bound(a, &|t| (t / 3.0).sqrt()))
+            .fold(0.0, f64::max);
+        for (what, v, b) in [
+            ("N", imu.noise_density(s), n_bound),
+            ("K", imu.random_walk(s), k_bound),
+        ] {
+            if let Some(v) = v
+                && v.value > b * (1.0 + YAML_BOUND_REL_TOL)
+            {
+                out.push(format!(
+                    "{label} {s:?}: yaml {what} {:.3e} above the curve's bound {b:.3e}",
+                    v.value
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// The yaml value may equal the bound (it is clamped to it): rounding only.
+const YAML_BOUND_REL_TOL: f64 = 1e-9;
+
 /// The scores of a set of cases (issue 10's Phase B acceptance).
 #[derive(Debug, Default)]
 pub(super) struct Scores {
@@ -446,6 +506,31 @@ fn profiles_study() {
         "K covered by its 95 % interval (or bounded at or above the truth): {k_ok}/{} axes",
         cases.len()
     );
+    // issue 17: no yaml value above the data's own bound, on every record of the study
+    let over: Vec<String> = cases
+        .chunks(6)
+        .flat_map(|rec| {
+            let axes: Vec<(bag2mat::Sensor, usize, &Analysis)> = rec
+                .iter()
+                .map(|c| {
+                    let s = if c.label.starts_with("gyro") {
+                        bag2mat::Sensor::Gyro
+                    } else {
+                        bag2mat::Sensor::Acc
+                    };
+                    let axis = "xyz".find(c.label.chars().last().unwrap_or('x'));
+                    (s, axis.unwrap_or(0), &c.analysis)
+                })
+                .collect();
+            yaml_over_bounds(&format!("{} s{}", rec[0].profile, rec[0].seed), &axes)
+        })
+        .collect();
+    println!(
+        "yaml values above the data's bound: {} of {} records",
+        over.len(),
+        cases.len() / 6
+    );
+    assert!(over.is_empty(), "{over:?}");
     println!(
         "study: {} axes in {:.1} s",
         cases.len(),
