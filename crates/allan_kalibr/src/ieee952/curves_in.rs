@@ -1034,13 +1034,9 @@ mod tests_issue18 {
     /// — its non-overlapping deviations on 0.1 s bin means, every period 0.1·p s — fitted
     /// with the covariance and EDF of the overlapping estimator stopped at 3–13 s with χ²/dof
     /// 8–25 and K never resolved (the format's other test uses a noiseless curve). Analysed
-    /// as what it is, every axis fits to the long end and resolves K.
-    ///
-    /// OPEN: this fails today (the Normal estimator's covariance does not yet describe these
-    /// curves: the first gyro axis fits only to 72 s at χ²/dof 9 with K "contradicted"), so
-    /// it is ignored until 18.10's second part is fixed; run it with `--ignored`.
+    /// as what it is, every axis fits to the long end and resolves K (after the fix: all six
+    /// fit the whole curve, K resolved and covered on 6/6).
     #[test]
-    #[ignore = "issue 18.10 (second part) is open: fails today"]
     fn issue18_10_allan_variance_ros_csv_of_a_noisy_record_fits_to_the_long_end() {
         use super::super::tests_accuracy::simulate_axis;
         let (rate, secs) = (100.0, 7200.0);
