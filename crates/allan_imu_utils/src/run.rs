@@ -179,14 +179,7 @@ fn run_series(
     // a one-sensor topic (PX4 sensor_gyro, …): zeros stand in for the absent sensor in the
     // record check, its samples in the Allan step; nothing of it is printed nor written
     let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
-    if let Some(s) = absent {
-        notes.push(format!(
-            "warning: the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
-            s.name(),
-            s.other().name(),
-            s.name()
-        ));
-    }
+    notes.extend(absent.map(bag2mat::series::absent_warning));
     if let Some(s) = config.skip_start {
         let k = skip_start(&mut series, s)?;
         notes.push(format!(

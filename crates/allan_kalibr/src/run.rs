@@ -213,14 +213,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let mut findings = check.findings.clone();
     let absent = data.absent;
     bag2mat::record_check::drop_absent(&mut findings, absent);
-    if let Some(s) = absent {
-        notes.push(format!(
-            "warning: the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
-            s.name(),
-            s.other().name(),
-            s.name()
-        ));
-    }
+    notes.extend(absent.map(bag2mat::series::absent_warning));
     let whole = check.keep.is_all();
     let data = data.select(&check.keep);
     if data.len() < 3 {

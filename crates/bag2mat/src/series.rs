@@ -179,6 +179,16 @@ impl ImuSeries {
     }
 }
 
+/// The analysers' warning for a topic without `absent` (a one-sensor topic).
+pub fn absent_warning(absent: crate::Sensor) -> String {
+    format!(
+        "warning: the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
+        absent.name(),
+        absent.other().name(),
+        absent.name()
+    )
+}
+
 /// What [`ImuSeries::stand_in_absent`] puts in an absent sensor's columns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StandIn {

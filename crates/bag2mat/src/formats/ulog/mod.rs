@@ -331,16 +331,17 @@ impl Decoder {
         let n = self.rows_in(data);
         let dt = dt.get(data).ok_or(short)?;
         let scale = scale.get(data).ok_or(short)?;
-        if n > 1 && !(dt > 0.0) {
+        if n > 1 && (dt.is_nan() || dt <= 0.0) {
             return Err("a FIFO message with a zero dt");
         }
         let newest = sample
             .and_then(|s| s.get_u64(data))
             .map_or(t_ns, |us| us.saturating_mul(1000));
-        for k in 0..n {
+        let slots = v[0].iter().zip(&v[1]).zip(&v[2]).take(n);
+        for (k, ((sx, sy), sz)) in slots.enumerate() {
             let mut x = [0.0; 3];
-            for (a, x) in x.iter_mut().enumerate() {
-                *x = v[a][k].get(data).ok_or(short)? * scale;
+            for (x, s) in x.iter_mut().zip([sx, sy, sz]) {
+                *x = s.get(data).ok_or(short)? * scale;
             }
             let off = fifo_offset_ns(n, k, dt);
             let nan = [f64::NAN; 3];
