@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of the workspace. Installs, when missing, the real tools the tests check our
 # files with: Debian's python3-rosbag (rosbag info/check, python API), GNU Octave, scipy,
-# numpy, OpenCV's python bindings (cv2.FileStorage) and PyYAML; and, in a virtual environment
+# numpy, OpenCV's python bindings (cv2.FileStorage), PyYAML, and g++ with cereal (Basalt's JSON
+# library, libcereal-dev); and, in a virtual environment
 # at target/py-venv, the independent ROS 2 implementations (rosbags, Foxglove's mcap and
 # mcap-ros2-support), pyulog, pymavlink and pandas, pinned. Tests never skip for a missing tool: they fail.
 set -euo pipefail
@@ -11,6 +12,8 @@ need=()
 command -v rosbag >/dev/null 2>&1 || need+=(python3-rosbag)
 command -v octave >/dev/null 2>&1 || need+=(octave)
 /usr/bin/python3 -c "import ensurepip, venv" >/dev/null 2>&1 || need+=(python3-venv)
+command -v g++ >/dev/null 2>&1 || need+=(g++)
+[ -f /usr/include/cereal/archives/json.hpp ] || need+=(libcereal-dev)
 for mod in scipy:python3-scipy numpy:python3-numpy cv2:python3-opencv yaml:python3-yaml sensor_msgs:python3-sensor-msgs; do
   /usr/bin/python3 -c "import ${mod%%:*}" >/dev/null 2>&1 || need+=("${mod##*:}")
 done

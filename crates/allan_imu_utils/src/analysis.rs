@@ -122,6 +122,22 @@ pub struct Analysis {
     pub gyro_mean: [f64; 3],
     /// The six fits, same order as `axes`.
     pub fits: Vec<AxisFit>,
+    /// A sensor the topic does not carry (PX4 `sensor_gyro`, …): its three axes above were
+    /// computed on a stand-in (the present sensor's samples) and are never printed nor
+    /// written.
+    pub absent: Option<bag2mat::Sensor>,
+}
+
+impl Analysis {
+    /// True when axis `i` (gyr x y z, acc x y z) belongs to a sensor the topic carries.
+    pub fn present(&self, i: usize) -> bool {
+        let s = if i < 3 {
+            bag2mat::Sensor::Gyro
+        } else {
+            bag2mat::Sensor::Acc
+        };
+        self.absent != Some(s)
+    }
 }
 
 impl Analysis {
@@ -155,6 +171,7 @@ impl Analysis {
             axes,
             gyro_mean: [f64::NAN; 3],
             fits,
+            absent: None,
         }
     }
 }
@@ -220,5 +237,6 @@ pub fn analyse(c: &Collected<'_>, max_cluster: usize) -> Result<Analysis, Error>
         axes,
         gyro_mean,
         fits,
+        absent: None,
     })
 }

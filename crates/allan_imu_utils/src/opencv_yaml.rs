@@ -168,8 +168,17 @@ pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode) -> String {
             ]
         }
     };
+    if let Some(s) = an.absent {
+        let _ = writeln!(
+            out,
+            "# The topic carries no {}: its block is left out.",
+            s.name()
+        );
+    }
     for b in &blocks {
-        push_block(&mut out, b);
+        if b.sensor == "Gyr" && an.present(0) || b.sensor == "Acc" && an.present(3) {
+            push_block(&mut out, b);
+        }
     }
     out
 }

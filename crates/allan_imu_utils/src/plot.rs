@@ -150,6 +150,7 @@ pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>
     let jobs = [("allan_gyr", 0), ("allan_acc", 3)];
     let files: Vec<[PathBuf; 2]> = jobs
         .par_iter()
+        .filter(|(_, base)| an.present(*base))
         .map(|&(stem, base)| {
             bag2mat::shared::plot::write_png_svg(&curves(an, name, base), dir, stem, SIZE, SIZE)
         })

@@ -45,25 +45,37 @@ fn calc_block(out: &mut String, a: &crate::analysis::AxisAllan) {
 }
 
 /// The whole stdout of an upstream run, from the `num of Cluster` lines on.
+///
+/// A sensor the topic does not carry ([`Analysis::absent`]) gets one line saying so instead
+/// of its lines.
 pub fn stdout_text(an: &Analysis) -> String {
     let mut out = String::new();
-    for name in AXIS_NAMES {
-        let _ = writeln!(out, "{name}  num of Cluster {}", an.max_cluster);
+    for (i, name) in AXIS_NAMES.iter().enumerate() {
+        if an.present(i) {
+            let _ = writeln!(out, "{name}  num of Cluster {}", an.max_cluster);
+        }
     }
     out.push_str("wait for imu data.\n");
-    for i in 0..3 {
-        calc_block(&mut out, &an.axes[i]);
+    if let Some(s) = an.absent {
+        let _ = writeln!(out, "{}: absent from this topic (not analysed)", s.name());
     }
-    for i in 0..3 {
-        gyro_fit_block(&mut out, an, i, true);
+    if an.present(0) {
+        for i in 0..3 {
+            calc_block(&mut out, &an.axes[i]);
+        }
+        for i in 0..3 {
+            gyro_fit_block(&mut out, an, i, true);
+        }
     }
     out.push_str("==============================================\n");
     out.push_str("==============================================\n");
-    for i in 3..6 {
-        calc_block(&mut out, &an.axes[i]);
-    }
-    for i in 3..6 {
-        acc_fit_block(&mut out, an, i);
+    if an.present(3) {
+        for i in 3..6 {
+            calc_block(&mut out, &an.axes[i]);
+        }
+        for i in 3..6 {
+            acc_fit_block(&mut out, an, i);
+        }
     }
     out
 }
@@ -138,11 +150,14 @@ pub fn curve_text(values: &[f64]) -> String {
     s
 }
 
-/// The 16 curve files (file name, content) in upstream's write order: sim_gyr, gyr,
+/// The 16 curve files (8 of the sensor a one-sensor topic carries) (file name, content) in upstream's write order: sim_gyr, gyr,
 /// sim_acc, acc.
 pub fn curve_files(an: &Analysis, name: &str) -> Vec<(String, String)> {
     let mut files = Vec::with_capacity(16);
     for (sensor, base) in [("gyr", 0usize), ("acc", 3usize)] {
+        if !an.present(base) {
+            continue;
+        }
         let taus = &an.axes[base].taus;
         // sim: fitted deviation of each axis at the x-axis taus (all of them).
         files.push((format!("data_{name}_sim_{sensor}_t.txt"), curve_text(taus)));
@@ -232,6 +247,7 @@ mod tests {
             axes,
             gyro_mean: [1.0, 2.0, 3.0],
             fits,
+            absent: None,
         }
     }
 

@@ -149,9 +149,6 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
         },
         &config.input_options,
     )?;
-    for s in &read.series {
-        s.require_both_sensors()?;
-    }
     let read_time = t0.elapsed();
     let several = read.series.len() > 1 || config.all_imu;
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
@@ -177,6 +174,10 @@ fn run_series(
     let mut timings = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
     let mut notes = series.notes.clone();
+    // a one-sensor topic (PX4 sensor_gyro, …): zeros stand in for the absent sensor in the
+    // record check, its samples in the Allan step; nothing of it is printed nor written
+    let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
+    notes.extend(absent.map(bag2mat::series::absent_warning));
     if let Some(s) = config.skip_start {
         let (k, warning) = skip_start(&mut series, s)?;
         notes.extend(warning);
@@ -199,17 +200,24 @@ fn run_series(
     let (n, stop) = (collected.len(), collected.stop);
     drop(collected);
     let t1 = Instant::now();
-    let check = check_record(&series, n, config);
+    let mut check = check_record(&series, n, config);
+    bag2mat::record_check::drop_absent(&mut check.findings, absent);
     timings.push(("record_check", t1.elapsed()));
-    let series = if check.keep.is_all() && n == series.len() {
+    let mut series = if check.keep.is_all() && n == series.len() {
         series
     } else {
         check.keep.select_series(&series, n)
     };
+    match absent {
+        Some(bag2mat::Sensor::Acc) => series.acc = series.gyro.clone(),
+        Some(bag2mat::Sensor::Gyro) => series.gyro = series.acc.clone(),
+        None => {}
+    }
     let collected = collect::Collected::first(&series, series.len(), config.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     let problems: Vec<_> = (0..collect::FIELDS.len())
         .into_par_iter()
+        .filter(|&k| absent != Some(if k < 3 { Sensor::Gyro } else { Sensor::Acc }))
         .map(|k| {
             let col = if k < 3 {
                 collected.gyro_rad_s(k)
@@ -248,6 +256,7 @@ fn run_series(
         let curves: Vec<CurveData> = axes
             .par_iter()
             .enumerate()
+            .filter(|(i, _)| absent != Some(if *i < 3 { Sensor::Gyro } else { Sensor::Acc }))
             .map(|(i, a)| {
                 let y = if i < 3 {
                     collected.gyro_rad_s(i)
@@ -258,8 +267,16 @@ fn run_series(
             })
             .collect();
         let mut it = curves.into_iter();
-        let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
-        let sensors = [(Sensor::Gyro, take3()), (Sensor::Acc, take3())];
+        let sensors: Vec<(Sensor, [CurveData; 3])> = [Sensor::Gyro, Sensor::Acc]
+            .into_iter()
+            .filter(|s| Some(*s) != absent)
+            .map(|s| {
+                (
+                    s,
+                    std::array::from_fn(|_| it.next().expect("three per sensor")),
+                )
+            })
+            .collect();
         let mut an = imu::analyse_curves(
             &sensors,
             section_rate,
@@ -280,6 +297,7 @@ fn run_series(
         axes,
         gyro_mean,
         fits,
+        absent,
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();

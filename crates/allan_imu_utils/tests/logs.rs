@@ -55,3 +55,100 @@ fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
         "OpenVINS file"
     );
 }
+
+/// Issue 20: a one-sensor topic (PX4 `sensor_gyro:0`, `sensor_accel:1`) of a ULog pyulog's
+/// writer laid out is analysed from the command line: the sensor present gets exactly the
+/// files and yaml block the same samples get in a layout with both sensors (a EuRoC pairing
+/// of the two topics); the absent sensor's files, block and lines are left out.
+#[test]
+fn defect_20_1_one_sensor_ulog_topics_are_analysed_and_the_absent_sensor_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bag2mat::test_tools::pyulog_imu_log(dir.path(), 600.0, 100.0);
+    let run = |input: &std::path::Path, topic: &str, out: &std::path::Path| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_allan_imu_utils"))
+            .arg(input)
+            .args(["--topic", topic, "--max-time-min", "9", "--data-save-path"])
+            .arg(out)
+            .output()
+            .unwrap();
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        );
+        assert!(o.status.success(), "{topic}: {stdout}{stderr}");
+        (stdout, stderr)
+    };
+    // the yaml from the line of `block` (`Gyr:`/`Acc:`) to the next top-level key
+    let block = |d: &std::path::Path, f: &str, block: &str| -> String {
+        let text = std::fs::read_to_string(d.join(f)).unwrap();
+        let mut out = String::new();
+        let mut inside = false;
+        for l in text.lines() {
+            if !l.starts_with(' ') {
+                inside = l.starts_with(block);
+            }
+            if inside {
+                out.push_str(l);
+                out.push('\n');
+            }
+        }
+        out
+    };
+    for (gyro, acc, topic, present, absent) in [
+        (
+            "sensor_gyro:0",
+            "sensor_accel:0",
+            "sensor_gyro:0",
+            ("gyr", "Gyr"),
+            ("acc", "Acc"),
+        ),
+        (
+            "sensor_gyro:1",
+            "sensor_accel:1",
+            "sensor_accel:1",
+            ("acc", "Acc"),
+            ("gyr", "Gyr"),
+        ),
+    ] {
+        let tag = topic.replace(':', "_");
+        let (one, both) = (
+            dir.path().join(format!("one_{tag}")),
+            dir.path().join(format!("both_{tag}")),
+        );
+        let (stdout, stderr) = run(&log, topic, &one);
+        let root = bag2mat::test_tools::euroc_pairing(&log, gyro, acc, &dir.path().join(&tag));
+        let _ = run(&root, "imu0", &both);
+        let absent_name = if absent.0 == "gyr" {
+            "gyroscope"
+        } else {
+            "accelerometer"
+        };
+        assert!(
+            stdout.contains(&format!("{absent_name}: absent from this topic")),
+            "{stdout}"
+        );
+        assert!(
+            stderr.contains(&format!("the topic carries no {absent_name}")),
+            "{stderr}"
+        );
+        for f in ["imu_imu_param.yaml", "imu_imu_param_continuous.yaml"] {
+            let b = block(&one, f, present.1);
+            assert!(b.len() > 20, "{f}: {b}");
+            assert_eq!(b, block(&both, f, present.1), "{topic} {f}");
+            assert_eq!(block(&one, f, absent.1), "", "{topic} {f}");
+        }
+        for axis in ["t", "x", "y", "z"] {
+            for sim in ["", "sim_"] {
+                let f = format!("data_imu_{sim}{}_{axis}.txt", present.0);
+                let text = std::fs::read_to_string(one.join(&f)).unwrap();
+                assert_eq!(text, std::fs::read_to_string(both.join(&f)).unwrap(), "{f}");
+                assert!(
+                    !one.join(format!("data_imu_{sim}{}_{axis}.txt", absent.0))
+                        .exists()
+                );
+            }
+        }
+        assert!(!one.join(format!("allan_{}.png", absent.0)).exists());
+        assert!(one.join(format!("allan_{}.png", present.0)).exists());
+    }
+}

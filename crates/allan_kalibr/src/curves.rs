@@ -28,12 +28,43 @@ pub fn write_csv(
     acc_avg: &[f64],
     gyro_avg: &[f64],
 ) -> std::io::Result<()> {
-    writeln!(w, "{HEADER}")?;
+    write_csv_of(w, tau1, sig2, acc_avg, gyro_avg, None)
+}
+
+/// [`write_csv`] for a topic that may lack a sensor: that sensor's three columns and its
+/// average are left out (the others keep their names, so readers by name still work).
+pub fn write_csv_of(
+    w: &mut dyn Write,
+    tau1: &[f64],
+    sig2: &[Vec<f64>; 6],
+    acc_avg: &[f64],
+    gyro_avg: &[f64],
+    absent: Option<bag2mat::Sensor>,
+) -> std::io::Result<()> {
+    use bag2mat::Sensor;
+    let names: Vec<&str> = HEADER.split(',').collect();
+    // column k of the header (after tau1): ax ay az wx wy wz acc_avg gyro_avg
+    let sensor_of = |k: usize| match k {
+        0..=2 | 6 => Sensor::Acc,
+        _ => Sensor::Gyro,
+    };
+    let cols: Vec<usize> = (0..8).filter(|&k| Some(sensor_of(k)) != absent).collect();
+    let mut head = String::from(names[0]);
+    for &k in &cols {
+        head.push(',');
+        head.push_str(names[k + 1]);
+    }
+    writeln!(w, "{head}")?;
     for i in 0..tau1.len() {
         let mut row = csv_float(tau1[i]);
-        for c in sig2.iter().map(|c| c[i]).chain([acc_avg[i], gyro_avg[i]]) {
+        for &k in &cols {
+            let v = match k {
+                0..=5 => sig2[k][i],
+                6 => acc_avg[i],
+                _ => gyro_avg[i],
+            };
             row.push(',');
-            row.push_str(&csv_float(c));
+            row.push_str(&csv_float(v));
         }
         writeln!(w, "{row}")?;
     }

@@ -28,6 +28,10 @@ pub struct ImuData {
     pub notes: Vec<String>,
     /// The stamps in nanoseconds and what the record check needs besides the samples.
     pub clock: Clock,
+    /// A sensor the topic does not carry (PX4 `sensor_gyro`, a gyro-only DataFlash
+    /// instance): its columns hold zeros as a stand-in (`bag2mat::series::StandIn::Zeros`),
+    /// never analysed nor written.
+    pub absent: Option<bag2mat::Sensor>,
 }
 
 /// The clock side of [`ImuData`], for `bag2mat::record_check`: the time column in exact
@@ -61,6 +65,7 @@ impl ImuData {
     /// Builds the columns from a bag2mat series with the chosen time column (bagconvert's
     /// record time by default), through bag2mat's one series-to-matrix conversion.
     pub fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
+        let absent = s.stand_in_absent(bag2mat::series::StandIn::Zeros);
         let topic = s.topic.clone();
         let notes = s.notes.clone();
         let (used, other) = match time {
@@ -81,6 +86,7 @@ impl ImuData {
             topic: Some(topic),
             notes,
             clock,
+            absent,
         }
     }
 
@@ -102,6 +108,7 @@ impl ImuData {
                 storage_order: None,
                 promised: c.promised,
             },
+            absent: self.absent,
         }
     }
 
@@ -189,15 +196,11 @@ pub fn load_all(
         return Ok(vec![load_mat(path)?]);
     }
     match bag2mat::series::read_imu_topics_with(path, sel, &bag2mat::ReadOptions { quiet }, opts) {
-        Ok(r) => {
-            for s in &r.series {
-                s.require_both_sensors()?;
-            }
-            Ok(r.series
-                .into_iter()
-                .map(|s| ImuData::from_series(s, time))
-                .collect())
-        }
+        Ok(r) => Ok(r
+            .series
+            .into_iter()
+            .map(|s| ImuData::from_series(s, time))
+            .collect()),
         Err(bag2mat::Error::NotABag { .. }) => Err(Error::UnknownInput {
             path: path.to_path_buf(),
         }),
@@ -219,6 +222,7 @@ fn load_mat(path: &Path) -> Result<ImuData, Error> {
         topic: None,
         notes: Vec::new(),
         clock,
+        absent: None,
     })
 }
 

@@ -65,21 +65,37 @@ pub fn final_lines(accel: &ChartFit, gyro: &ChartFit) -> [String; 4] {
 
 /// The whole printed text of SCRIPT_process_results.m (interpreter warnings excluded).
 pub fn full_text(accel: &ChartFit, gyro: &ChartFit) -> String {
-    let mut out = String::new();
-    out.push_str("=> opening the mat file.\n=> plotting accelerometer.\n");
-    for l in chart_lines(accel) {
-        out.push_str(&l);
-        out.push('\n');
-    }
-    out.push_str("=> plotting gyroscope.\n");
-    for l in chart_lines(gyro) {
-        out.push_str(&l);
-        out.push('\n');
+    full_text_of(accel, gyro, None)
+}
+
+/// [`full_text`] for a topic that may lack a sensor: the absent sensor's chart and final
+/// lines are replaced by one line saying it is absent (no figures for it).
+pub fn full_text_of(accel: &ChartFit, gyro: &ChartFit, absent: Option<bag2mat::Sensor>) -> String {
+    use bag2mat::Sensor;
+    let absent_line =
+        |s: Sensor| format!("=> {}: absent from this topic (not analysed)\n", s.name());
+    let mut out = String::from("=> opening the mat file.\n");
+    for (sensor, fit, what) in [
+        (Sensor::Acc, accel, "accelerometer"),
+        (Sensor::Gyro, gyro, "gyroscope"),
+    ] {
+        if absent == Some(sensor) {
+            out.push_str(&absent_line(sensor));
+            continue;
+        }
+        out.push_str(&format!("=> plotting {what}.\n"));
+        for l in chart_lines(fit) {
+            out.push_str(&l);
+            out.push('\n');
+        }
     }
     out.push_str("=> final results\n");
-    for l in final_lines(accel, gyro) {
-        out.push_str(&l);
-        out.push('\n');
+    for (k, l) in final_lines(accel, gyro).into_iter().enumerate() {
+        let sensor = if k < 2 { Sensor::Acc } else { Sensor::Gyro };
+        if absent != Some(sensor) {
+            out.push_str(&l);
+            out.push('\n');
+        }
     }
     out
 }

@@ -70,6 +70,9 @@ pub struct Analysis {
     pub accel: ChartFit,
     /// gen_chart on the gyroscope curves.
     pub gyro: ChartFit,
+    /// A sensor the topic does not carry: its curves and fit above were computed on a
+    /// stand-in (the present sensor's samples) and are never printed nor written.
+    pub absent: Option<bag2mat::Sensor>,
 }
 
 /// Computes grid, curves and both fits for `axes` (each N samples) at `rate` Hz. The
@@ -94,6 +97,7 @@ pub fn analyse(
         sig2,
         accel,
         gyro,
+        absent: None,
     })
 }
 
@@ -208,6 +212,9 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     );
     let checks_s = checks_start.elapsed().as_secs_f64();
     let mut findings = check.findings.clone();
+    let absent = data.absent;
+    bag2mat::record_check::drop_absent(&mut findings, absent);
+    notes.extend(absent.map(bag2mat::series::absent_warning));
     let whole = check.keep.is_all();
     let data = data.select(&check.keep);
     if data.len() < 3 {
@@ -219,7 +226,10 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     } else {
         std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a]))
     };
-    for (name, scan) in input::AXIS_NAMES.iter().zip(&scans) {
+    for (a, (name, scan)) in input::AXIS_NAMES.iter().zip(&scans).enumerate() {
+        if Some(data_imu_sensor(a)) == absent {
+            continue;
+        }
         match scan.problem(name) {
             Some((true, what)) => return Err(Error::BadData { what }),
             Some((false, what)) => notes.push(format!("warning: {what}")),
@@ -258,12 +268,24 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             &a[1][..],
             &a[2][..],
         ];
-        crate::ieee952::imu::section_curves(series, rate.section, &mut notes)
+        crate::ieee952::imu::section_curves_of(series, absent, rate.section, &mut notes)
     } else {
         None
     };
     let curves_s = start.elapsed().as_secs_f64();
-    let ImuData { axes, .. } = data;
+    let ImuData { mut axes, .. } = data;
+    // the compat path runs on six columns: the absent sensor's get the present one's
+    // samples as a stand-in, whose results are dropped below
+    if let Some(s) = absent {
+        let (to, from) = if s == bag2mat::Sensor::Acc {
+            (0, 3)
+        } else {
+            (3, 0)
+        };
+        for k in 0..3 {
+            axes[to + k] = axes[from + k].clone();
+        }
+    }
     let ((ieee, fits_s), analysis) = rayon::join(
         || {
             let start = Instant::now();
@@ -277,12 +299,13 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             analyse(axes, rate.used, config.estimator, config.quiet).map(|a| (a, start.elapsed()))
         },
     );
-    let (analysis, analyse_t) = analysis?;
+    let (mut analysis, analyse_t) = analysis?;
+    analysis.absent = absent;
     let analyse_s = analyse_t.as_secs_f64();
     // the section's share of the wall time: its curves, and its fits less what they overlapped
     let ieee_s = curves_s + (fits_s - analyse_s).max(0.0);
     let start = Instant::now();
-    let text = report::full_text(&analysis.accel, &analysis.gyro);
+    let text = report::full_text_of(&analysis.accel, &analysis.gyro, absent);
 
     // Render the text outputs before touching the output directory.
     let source = config
@@ -297,15 +320,17 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         gyroscope_random_walk: analysis.gyro.bias,
         rostopic: topic.clone(),
         update_rate: rate.used,
+        absent,
     }
     .render(&source);
     let mut csv = Vec::new();
-    curves::write_csv(
+    curves::write_csv_of(
         &mut csv,
         &analysis.grid.tau1,
         &analysis.sig2,
         &analysis.accel.sigavg,
         &analysis.gyro.sigavg,
+        absent,
     )
     .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
 
@@ -465,7 +490,20 @@ pub fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<PathBuf>
         fit: &a.gyro,
     };
     let mut out = Vec::new();
-    out.extend(plot::write_chart(&accel, dir, "allan_accel")?);
-    out.extend(plot::write_chart(&gyro, dir, "allan_gyro")?);
+    if a.absent != Some(bag2mat::Sensor::Acc) {
+        out.extend(plot::write_chart(&accel, dir, "allan_accel")?);
+    }
+    if a.absent != Some(bag2mat::Sensor::Gyro) {
+        out.extend(plot::write_chart(&gyro, dir, "allan_gyro")?);
+    }
     Ok(out)
+}
+
+/// The sensor of column `a` of the six `data_imu` sample columns (ax ay az wx wy wz).
+fn data_imu_sensor(a: usize) -> bag2mat::Sensor {
+    if a < 3 {
+        bag2mat::Sensor::Acc
+    } else {
+        bag2mat::Sensor::Gyro
+    }
 }

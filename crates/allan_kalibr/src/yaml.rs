@@ -22,6 +22,8 @@ pub struct ImuYaml {
     pub rostopic: String,
     /// Hz.
     pub update_rate: f64,
+    /// A sensor the topic does not carry: its keys are left out, and a comment says so.
+    pub absent: Option<bag2mat::Sensor>,
 }
 
 /// A float as YAML 1.1 reads it back bit-for-bit: shortest round-trip digits, a `.` always
@@ -78,8 +80,29 @@ impl ImuYaml {
         for c in comments {
             let _ = writeln!(o, "# {c}");
         }
-        let w = |o: &mut String, key: &str, v: String, c: &str| o.push_str(&key_line(key, &v, c));
-        o.push_str("#Accelerometers\n");
+        let absent = self.absent;
+        let w = |o: &mut String, key: &str, v: String, c: &str| {
+            let sensor = if key.starts_with("acc") {
+                Some(bag2mat::Sensor::Acc)
+            } else if key.starts_with("gyro") {
+                Some(bag2mat::Sensor::Gyro)
+            } else {
+                None
+            };
+            if sensor.is_none() || sensor != absent {
+                o.push_str(&key_line(key, &v, c));
+            }
+        };
+        if let Some(s) = absent {
+            let _ = writeln!(
+                o,
+                "# The topic carries no {}: its keys are left out (Kalibr needs all four; take them from another source).",
+                s.name()
+            );
+        }
+        if absent != Some(bag2mat::Sensor::Acc) {
+            o.push_str("#Accelerometers\n");
+        }
         w(
             &mut o,
             "accelerometer_noise_density",
@@ -92,7 +115,9 @@ impl ImuYaml {
             yaml_float(self.accelerometer_random_walk),
             "Bias random walk                  [m/s^3/sqrt(Hz)]",
         );
-        o.push_str("#Gyroscopes\n");
+        if absent != Some(bag2mat::Sensor::Gyro) {
+            o.push_str("#Gyroscopes\n");
+        }
         w(
             &mut o,
             "gyroscope_noise_density",
@@ -162,6 +187,7 @@ mod tests {
             gyroscope_random_walk: 1e-4,
             rostopic: "/imu/data".into(),
             update_rate: 100.0,
+            absent: None,
         };
         let text = y.render("x.bag");
         for key in [

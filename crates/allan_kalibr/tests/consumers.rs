@@ -1,7 +1,8 @@
 //! The IEEE 952 configuration files read by the parsers their consumers use: Kalibr loads
 //! `imu.yaml` with PyYAML; VINS-Mono/VINS-Fusion and ORB-SLAM3 read their settings with
 //! OpenCV's `cv2.FileStorage`, and so does OpenVINS for its `kalibr_imu_chain.yaml`; Basalt's
-//! noise fields are JSON (Python's `json`). Run on p4 (60 min at 100 Hz), whose terms are all resolved
+//! noise fields are JSON (Python's `json`), merged into a calibration and loaded with cereal
+//! (Basalt's JSON library) as Basalt loads its calibration. Run on p4 (60 min at 100 Hz), whose terms are all resolved
 //! except where the record is too short; the values read back must be the ones in
 //! `ieee952_terms.csv` (largest axis), exactly.
 
@@ -175,4 +176,54 @@ fn pyyaml_and_opencv_read_the_ieee952_files() {
         })
         .count();
     assert_eq!(v[14].parse::<usize>().unwrap(), unresolved, "{b}");
+
+    // Basalt's loader: the fragment merged into a calibration (its members replacing the
+    // calibration's, the `_` members added) is read by cereal's JSON archive the way Basalt
+    // reads basalt::Calibration, with the same values; the fragment alone is not a
+    // calibration (cereal misses `T_imu_cam`), as its `_convention` says.
+    let merged = out.join("calib_merged.json");
+    python(&format!(
+        "import json; frag = json.load(open('{}'), parse_constant=lambda c: exec('raise ValueError(c)'))['value0']; \
+         calib = {{'value0': {{'T_imu_cam': [], 'intrinsics': [], 'resolution': [], 'calib_accel_bias': [0.0] * 9, 'calib_gyro_bias': [0.0] * 12, 'imu_update_rate': 200.0, 'accel_noise_std': [1.0] * 3, 'gyro_noise_std': [1.0] * 3, 'accel_bias_std': [1.0] * 3, 'gyro_bias_std': [1.0] * 3, 'cam_time_offset_ns': 0, 'vignette': []}}}}; \
+         assert set(k for k in frag if not k.startswith('_')) <= set(calib['value0']), frag.keys(); \
+         calib['value0'].update(frag); json.dump(calib, open('{}', 'w'), indent=2)",
+        out.join("basalt_imu_noise_ieee952.json").display(),
+        merged.display()
+    ));
+    let loader = cereal_loader(out);
+    let o = Command::new(&loader).arg(&merged).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let got: Vec<f64> = String::from_utf8_lossy(&o.stdout)
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(got[0], 100.0);
+    assert_eq!(&got[1..], &want[..], "cereal's values");
+    let o = Command::new(&loader)
+        .arg(out.join("basalt_imu_noise_ieee952.json"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("T_imu_cam"));
+}
+
+/// Builds `tests/cereal/basalt_imu_load.cpp` (Basalt's way of loading its calibration JSON
+/// with cereal, Debian's libcereal-dev) into `dir`.
+fn cereal_loader(dir: &std::path::Path) -> std::path::PathBuf {
+    let exe = dir.join("basalt_imu_load");
+    let src =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cereal/basalt_imu_load.cpp");
+    let o = Command::new("g++")
+        .args(["-std=c++17", "-O0", "-o"])
+        .arg(&exe)
+        .arg(&src)
+        .output()
+        .expect("run g++ (scripts/test.sh installs g++ and libcereal-dev)");
+    assert!(
+        o.status.success(),
+        "g++ {}: {}",
+        src.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    exe
 }

@@ -1,5 +1,6 @@
 //! Writes the synthetic logs the cross-checks and `scripts/bench.sh` read:
 //! `write_logs ulog OUT SECONDS RATE` (PX4 IMU topics, bag2mat::formats::ulog::write),
+//! `write_logs ulog-fifo OUT SECONDS RATE` (PX4's raw FIFO topics, 6 samples a message),
 //! `write_logs dataflash OUT SECONDS RATE` (IMU and ISBH/ISBD, formats::dataflash::write),
 //! `write_logs euroc DIR SECONDS RATE` (DIR/mav0/imu0/data.csv, EuRoC/ASL header).
 
@@ -9,7 +10,7 @@ fn main() -> anyhow::Result<()> {
     let a: Vec<String> = std::env::args().collect();
     anyhow::ensure!(
         a.len() == 5,
-        "usage: write_logs ulog|dataflash|euroc OUT SECONDS RATE"
+        "usage: write_logs ulog|ulog-fifo|dataflash|euroc OUT SECONDS RATE"
     );
     let (out, seconds, rate) = (std::path::Path::new(&a[2]), a[3].parse()?, a[4].parse()?);
     match a[1].as_str() {
@@ -24,6 +25,15 @@ fn main() -> anyhow::Result<()> {
             bag2mat::formats::ulog::write::imu_log(
                 BufWriter::new(std::fs::File::create(out)?),
                 &spec,
+            )?;
+        }
+        "ulog-fifo" => {
+            bag2mat::formats::ulog::write::fifo_log(
+                BufWriter::new(std::fs::File::create(out)?),
+                seconds,
+                rate,
+                6,
+                20,
             )?;
         }
         "dataflash" => {

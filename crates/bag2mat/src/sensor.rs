@@ -72,6 +72,13 @@ impl Sensor {
             Sensor::Acc => "m/s^3",
         }
     }
+    /// The other sensor of an IMU.
+    pub fn other(self) -> Sensor {
+        match self {
+            Sensor::Gyro => Sensor::Acc,
+            Sensor::Acc => Sensor::Gyro,
+        }
+    }
     /// `gyroscope` / `accelerometer`.
     pub fn name(self) -> &'static str {
         match self {

@@ -138,6 +138,26 @@ impl ImuSeries {
         }
     }
 
+    /// For the analysers on a one-sensor topic: fills the absent sensor's NaN columns with
+    /// `stand_in` and returns which sensor that is (`None`: both present, nothing changed).
+    /// The stand-in only lets the six-axis machinery run (the record check reads zeros as
+    /// a sensor that says nothing; the Allan step may mirror the present sensor); every
+    /// output for the absent sensor is then omitted or marked absent by the caller.
+    pub fn stand_in_absent(&mut self, stand_in: StandIn) -> Option<crate::Sensor> {
+        let absent = self.absent_sensor()?;
+        let (to, from) = match absent {
+            crate::Sensor::Acc => (&mut self.acc, &self.gyro),
+            crate::Sensor::Gyro => (&mut self.gyro, &self.acc),
+        };
+        for (t, f) in to.iter_mut().zip(from) {
+            match stand_in {
+                StandIn::Zeros => t.iter_mut().for_each(|v| *v = 0.0),
+                StandIn::Mirror => t.clone_from(f),
+            }
+        }
+        Some(absent)
+    }
+
     /// Fails with [`Error::OneSensor`] when the topic lacks a sensor (for the analysers,
     /// which fit both).
     pub fn require_both_sensors(&self) -> Result<(), Error> {
@@ -157,6 +177,26 @@ impl ImuSeries {
             TimeColumn::Header => &self.stamp,
         }
     }
+}
+
+/// The analysers' warning for a topic without `absent` (a one-sensor topic).
+pub fn absent_warning(absent: crate::Sensor) -> String {
+    format!(
+        "warning: the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
+        absent.name(),
+        absent.other().name(),
+        absent.name()
+    )
+}
+
+/// What [`ImuSeries::stand_in_absent`] puts in an absent sensor's columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StandIn {
+    /// Zeros: a sensor that says nothing (the record check finds nothing on it).
+    Zeros,
+    /// The present sensor's columns (the computations run on real-looking data; their
+    /// results for the absent sensor are discarded).
+    Mirror,
 }
 
 /// Everything one pass over an input delivered.

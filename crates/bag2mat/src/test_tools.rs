@@ -520,3 +520,66 @@ pub fn warnings<'a>(stderr: &'a str, kind: &str) -> Vec<&'a str> {
         .filter(|l| l.starts_with(&format!("warning: {kind}")))
         .collect()
 }
+
+/// A PX4 ULog of `seconds` at `rate` Hz (two `sensor_gyro`/`sensor_accel` instances,
+/// `sensor_combined`, `vehicle_imu`; [`crate::formats::ulog::write::imu_log`]) as pyulog's
+/// own writer lays it out (`ULog.write_ulog`, an independent writer): `dir/pyulog.ulg`.
+pub fn pyulog_imu_log(dir: &Path, seconds: f64, rate: f64) -> PathBuf {
+    let ours = dir.join("ours.ulg");
+    let spec = crate::formats::ulog::write::ImuLogSpec {
+        seconds,
+        rate,
+        instances: 2,
+        dropout_ms: None,
+        seed: 20,
+    };
+    let f = std::io::BufWriter::new(std::fs::File::create(&ours).expect("create ours.ulg"));
+    crate::formats::ulog::write::imu_log(f, &spec).expect("write ours.ulg");
+    let theirs = dir.join("pyulog.ulg");
+    run_ok(
+        Command::new(venv_python())
+            .arg(workspace().join("crates/bag2mat/tests/py/read_logs.py"))
+            .args(["ulog-rewrite"])
+            .arg(&ours)
+            .arg(&theirs),
+    );
+    theirs
+}
+
+/// An EuRoC/ASL `data.csv` (under `dir/paired/mav0/imu0`) holding the gyro of topic `gyro`
+/// and the accelerometer of topic `acc` of `log`, paired row by row on the gyro topic's
+/// sample stamps (the topics must have as many rows): the same samples as the one-sensor
+/// topics, in a layout that has both. Returns the dataset root.
+pub fn euroc_pairing(log: &Path, gyro: &str, acc: &str, dir: &Path) -> PathBuf {
+    use std::fmt::Write as _;
+    let read = |t: &str| {
+        crate::series::read_imu_topics_with(
+            log,
+            &crate::TopicSelector::one(t),
+            &crate::ReadOptions { quiet: true },
+            &Default::default(),
+        )
+        .expect("read the log")
+        .series
+        .remove(0)
+    };
+    let (g, a) = (read(gyro), read(acc));
+    assert_eq!(g.len(), a.len(), "{gyro} and {acc} differ in length");
+    let mut s = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    let t = crate::timing::ns_of_times(&g.record_time);
+    for (i, t) in t.iter().enumerate() {
+        let (w, f) = (g.gyro_at(i), a.acc_at(i));
+        let _ = writeln!(
+            s,
+            "{t},{},{},{},{},{},{}",
+            w[0], w[1], w[2], f[0], f[1], f[2]
+        );
+    }
+    let root = dir.join("paired");
+    let imu0 = root.join("mav0/imu0");
+    std::fs::create_dir_all(&imu0).expect("create the dataset");
+    std::fs::write(imu0.join("data.csv"), s).expect("write data.csv");
+    root
+}

@@ -129,6 +129,51 @@ fn ulog_topics_match_pyulog_bit_for_bit_also_on_pyulogs_own_rewrite() {
     }
 }
 
+/// Issue 20: PX4's raw FIFO topics (`sensor_gyro_fifo`, `sensor_accel_fifo`: up to 32
+/// int16 samples a message with `dt` and `scale`) are read sample by sample, equal to
+/// pyulog's decode of the same messages expanded at `dt` (the newest at
+/// `timestamp_sample`), on our writer's log and on pyulog's rewrite of it; `bag2mat info`
+/// lists them with the samples' rate.
+#[test]
+fn defect_20_2_ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() {
+    let dir = tempfile::tempdir().unwrap();
+    let ours = dir.path().join("fifo.ulg");
+    let f = std::io::BufWriter::new(std::fs::File::create(&ours).unwrap());
+    bag2mat::formats::ulog::write::fifo_log(f, 20.0, 800.0, 6, 3).unwrap();
+    let rewritten = dir.path().join("rewritten.ulg");
+    let _ = independent(&[
+        "ulog-rewrite",
+        ours.to_str().unwrap(),
+        rewritten.to_str().unwrap(),
+    ]);
+    for f in [&ours, &rewritten] {
+        let (theirs, other) = independent(&["ulog", f.to_str().unwrap()]);
+        let names: Vec<&str> = theirs.iter().map(|t| t.topic.as_str()).collect();
+        assert_eq!(
+            names,
+            ["sensor_accel_fifo", "sensor_gyro_fifo"],
+            "{other:?}"
+        );
+        let series = assert_same_rows(f, &theirs);
+        for s in &series {
+            // every sample of the 20 s at 800 Hz, none lost, evenly spaced
+            assert_eq!(s.len(), 16_000, "{}", s.topic);
+            let tm = bag2mat::timing::analyse(&bag2mat::timing::ns_of_times(&s.stamp));
+            assert!(tm.gaps.is_empty(), "{}: {tm:?}", s.topic);
+            let rate = tm.nominal_rate().unwrap();
+            assert!((rate - 800.0).abs() < 0.01, "{}: {rate}", s.topic);
+        }
+    }
+    let out = bag2mat::info::info(&ours, true).unwrap().text(&ours);
+    for topic in ["sensor_gyro_fifo", "sensor_accel_fifo"] {
+        let line = out
+            .lines()
+            .find(|l| l.contains(topic))
+            .unwrap_or_else(|| panic!("{out}"));
+        assert!(line.contains("16000") && line.contains("800.0"), "{line}");
+    }
+}
+
 #[test]
 fn ulog_topics_are_chosen_like_bag_topics_and_convert() {
     let dir = tempfile::tempdir().unwrap();

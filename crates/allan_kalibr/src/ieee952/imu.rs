@@ -121,8 +121,8 @@ pub fn analyse_curves(
 pub struct ImuCurves {
     /// Sample rate, Hz.
     pub rate: f64,
-    /// Gyro x y z, then acc x y z.
-    pub sensors: [(Sensor, [CurveData; 3]); 2],
+    /// Gyro x y z, then acc x y z (a sensor the topic does not carry left out).
+    pub sensors: Vec<(Sensor, [CurveData; 3])>,
 }
 
 impl ImuCurves {
@@ -133,17 +133,44 @@ impl ImuCurves {
         rate: f64,
         cfg: &Config,
     ) -> Result<ImuCurves, Ieee952Error> {
+        Self::from_samples_of(series, None, rate, cfg)
+    }
+
+    /// [`ImuCurves::from_samples`] without the `absent` sensor's three series (a
+    /// one-sensor topic: they are a stand-in, not read).
+    pub fn from_samples_of(
+        series: [&[f64]; 6],
+        absent: Option<Sensor>,
+        rate: f64,
+        cfg: &Config,
+    ) -> Result<ImuCurves, Ieee952Error> {
         let tau0 = 1.0 / rate;
-        let data: Vec<CurveData> = series
+        let present: Vec<Sensor> = [Sensor::Gyro, Sensor::Acc]
+            .into_iter()
+            .filter(|s| Some(*s) != absent)
+            .collect();
+        let wanted: Vec<&[f64]> = present
+            .iter()
+            .flat_map(|s| {
+                let base = if *s == Sensor::Gyro { 0 } else { 3 };
+                series[base..base + 3].iter().copied()
+            })
+            .collect();
+        let data: Vec<CurveData> = wanted
             .par_iter()
             .map(|y| CurveData::from_samples(y, tau0, cfg))
             .collect::<Result<Vec<_>, _>>()?;
         let mut it = data.into_iter();
-        let mut take3 = || -> [CurveData; 3] { std::array::from_fn(|_| it.next().expect("six")) };
-        Ok(ImuCurves {
-            rate,
-            sensors: [(Sensor::Gyro, take3()), (Sensor::Acc, take3())],
-        })
+        let sensors = present
+            .into_iter()
+            .map(|s| {
+                (
+                    s,
+                    std::array::from_fn(|_| it.next().expect("three per sensor")),
+                )
+            })
+            .collect();
+        Ok(ImuCurves { rate, sensors })
     }
 
     /// The fits and the advice; `checks` as in [`analyse_imu`].
@@ -185,7 +212,17 @@ pub fn section_curves(
     rate: f64,
     notes: &mut Vec<String>,
 ) -> Option<ImuCurves> {
-    match ImuCurves::from_samples(series, rate, &Config::default()) {
+    section_curves_of(series, None, rate, notes)
+}
+
+/// [`section_curves`] without the `absent` sensor (a one-sensor topic).
+pub fn section_curves_of(
+    series: [&[f64]; 6],
+    absent: Option<Sensor>,
+    rate: f64,
+    notes: &mut Vec<String>,
+) -> Option<ImuCurves> {
+    match ImuCurves::from_samples_of(series, absent, rate, &Config::default()) {
         Ok(c) => Some(c),
         Err(e) => {
             notes.push(format!("IEEE 952 analysis skipped: {e}"));

@@ -14,7 +14,12 @@
 //!   member (and which values are 95 % upper bounds in `"_not_resolved"`): Basalt loads its
 //!   calibration with cereal, whose JSON archive looks members up by name, so such extra
 //!   members are ignored. The file is a fragment: its `value0` members are merged into the
-//!   `value0` object of the user's full calibration (cameras, `T_imu_cam`, …).
+//!   `value0` object of the user's full calibration (cameras, `T_imu_cam`, …). Checked in
+//!   the tests (`tests/consumers.rs`) with cereal itself: merged into a calibration, cereal's
+//!   JSON archive reads it as Basalt reads `basalt::Calibration` (its twelve members by name,
+//!   each fixed-size vector a JSON array of exactly its length, as basalt-headers'
+//!   `eigen_io.h` requires), with our values; the fragment alone fails on `T_imu_cam`. Keys
+//!   with no value (a sensor not analysed) are left out, so the merge keeps the user's.
 
 use std::fmt::Write as _;
 

@@ -5,7 +5,8 @@
 //!   the EuRoC/ASL `data.csv` header; [`euroc`]: an EuRoC/ASL dataset folder (`mav0/imuN`,
 //!   `imuN` or the folder holding `data.csv`), with its `sensor.yaml` figures.
 //! * [`npy`]: NumPy `.npy` in bag2mat's own N×7 layout (`bag2mat -o x.npy`).
-//! * [`ulog`]: PX4 ULog (`sensor_combined`, `sensor_gyro`/`sensor_accel` instances,
+//! * [`ulog`]: PX4 ULog (`sensor_combined`, `sensor_gyro`/`sensor_accel` instances, the
+//!   raw `sensor_gyro_fifo`/`sensor_accel_fifo` samples,
 //!   `vehicle_imu` deltas), dropouts as losses.
 //! * [`dataflash`]: ArduPilot DataFlash `.bin` (`IMU` per instance, `ISBH`/`ISBD` batches).
 //!

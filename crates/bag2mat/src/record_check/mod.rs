@@ -494,6 +494,14 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
     }
 }
 
+/// Drops the findings on the axes of a sensor the topic does not carry (its columns were a
+/// stand-in, `crate::series::StandIn`).
+pub fn drop_absent(findings: &mut Vec<Finding>, absent: Option<Sensor>) {
+    if let Some(s) = absent {
+        findings.retain(|f| f.axis.is_none_or(|a| a.sensor != s));
+    }
+}
+
 /// Index of the first sample at or after `t[0] + seconds` (the `--skip-start` cut).
 pub fn skip_index(t: &[f64], seconds: f64) -> usize {
     let Some(&t0) = t.first() else { return 0 };

@@ -41,6 +41,17 @@ def ulog(path):
             for i in range(n):
                 v = [float(f[a][i]) for a in "xyz"]
                 rows.append([t[i], ts[i]] + (v + [NAN] * 3 if d.name == "sensor_gyro" else [NAN] * 3 + v))
+        elif d.name in ("sensor_gyro_fifo", "sensor_accel_fifo"):
+            # samples k of N, dt µs apart, the newest at timestamp_sample; x[k] * scale
+            for i in range(n):
+                N = int(f["samples"][i])
+                dt = float(f["dt"][i])
+                sc = float(f["scale"][i])
+                for k in range(N):
+                    off = math.floor((N - 1 - k) * dt * 1000.0 + 0.5)
+                    v = [float(int(f[f"{a}[{k}]"][i])) * sc for a in "xyz"]
+                    rows.append([t[i] - off, ts[i] - off]
+                                + (v + [NAN] * 3 if d.name == "sensor_gyro_fifo" else [NAN] * 3 + v))
         elif d.name == "vehicle_imu":
             for i in range(n):
                 da = float(f["delta_angle_dt"][i])

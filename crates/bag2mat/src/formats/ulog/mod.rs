@@ -5,6 +5,13 @@
 //! * `sensor_combined`: `gyro_rad`, `accelerometer_m_s2` (the gyro's `timestamp`).
 //! * `sensor_gyro`, `sensor_accel` (every instance; the raw per-IMU topics where the log
 //!   has them): `x y z` at `timestamp_sample`; the other sensor's columns are NaN.
+//! * `sensor_gyro_fifo`, `sensor_accel_fifo` (every instance; the raw high-rate samples
+//!   PX4 logs with `SDLOG_PROFILE` high-rate/debug): each message packs `samples` (≤ 32)
+//!   int16 `x[] y[] z[]` at `dt` µs apart, in physical units after × `scale`; the newest
+//!   sample is at `timestamp_sample` (PX4's drivers stamp the FIFO read, and
+//!   `PX4Gyroscope::updateFIFO` integrates up to sample N−1 at that stamp), so sample k of N
+//!   is at `timestamp_sample − (N−1−k)·dt`, and its record time is the message's `timestamp`
+//!   less the same offset. Values are `x[k] · scale` in f64 (exact: 16 × 24 bits).
 //! * `vehicle_imu`: `delta_angle`/`delta_angle_dt` and `delta_velocity`/`delta_velocity_dt`,
 //!   each delta divided by its own dt (µs); a message with a zero dt is skipped and counted.
 //!
@@ -218,6 +225,28 @@ enum Decoder {
         vel: [Slot; 3],
         vel_dt: Slot,
     },
+    Fifo {
+        acc: bool,
+        sample: Option<Slot>,
+        dt: Slot,
+        scale: Slot,
+        samples: Slot,
+        /// `x[k]`, `y[k]`, `z[k]` for k below the arrays' length (32 in PX4).
+        v: [Vec<Slot>; 3],
+    },
+}
+
+/// The slots `base[0]`, `base[1]`, … of an array field.
+fn array(s: &HashMap<String, Slot>, base: &str) -> Vec<Slot> {
+    (0..)
+        .map_while(|k| s.get(&format!("{base}[{k}]")).copied())
+        .collect()
+}
+
+/// The offset, ns, of sample `k` of `n` before the newest one, `dt_us` apart (rounded half
+/// up, the same arithmetic as the pyulog cross-check's).
+pub fn fifo_offset_ns(n: usize, k: usize, dt_us: f64) -> u64 {
+    (((n - 1 - k) as f64) * dt_us * 1000.0 + 0.5).floor() as u64
 }
 
 fn three(s: &HashMap<String, Slot>, base: &str) -> Option<[Slot; 3]> {
@@ -239,6 +268,20 @@ impl Decoder {
             }),
             "sensor_gyro" => Some(Decoder::Gyro { sample, v: xyz(s)? }),
             "sensor_accel" => Some(Decoder::Accel { sample, v: xyz(s)? }),
+            "sensor_gyro_fifo" | "sensor_accel_fifo" => {
+                let v = [array(s, "x"), array(s, "y"), array(s, "z")];
+                if v[0].is_empty() || v.iter().any(|a| a.len() != v[0].len()) {
+                    return None;
+                }
+                Some(Decoder::Fifo {
+                    acc: name == "sensor_accel_fifo",
+                    sample,
+                    dt: *s.get("dt")?,
+                    scale: *s.get("scale")?,
+                    samples: *s.get("samples")?,
+                    v,
+                })
+            }
             "vehicle_imu" => Some(Decoder::Deltas {
                 sample,
                 angle: three(s, "delta_angle")?,
@@ -254,7 +297,68 @@ impl Decoder {
         format!("px4/{name}")
     }
 
-    /// The row of a data message (`data` starts with the timestamp), or why not.
+    /// Rows a data message holds: 1, or a FIFO message's valid samples.
+    fn rows_in(&self, data: &[u8]) -> usize {
+        match self {
+            Decoder::Fifo { samples, v, .. } => samples
+                .get(data)
+                .map_or(0, |n| (n.max(0.0) as usize).min(v[0].len())),
+            _ => 1,
+        }
+    }
+
+    /// Every row of a data message logged at `t_ns` (`data` starts with the timestamp),
+    /// each with its record time, or why not.
+    fn rows(
+        &self,
+        t_ns: u64,
+        data: &[u8],
+        out: &mut dyn FnMut(u64, Row),
+    ) -> Result<(), &'static str> {
+        let Decoder::Fifo {
+            acc,
+            sample,
+            dt,
+            scale,
+            v,
+            ..
+        } = self
+        else {
+            out(t_ns, self.row(t_ns, data)?);
+            return Ok(());
+        };
+        let short = "message shorter than its format";
+        let n = self.rows_in(data);
+        let dt = dt.get(data).ok_or(short)?;
+        let scale = scale.get(data).ok_or(short)?;
+        if n > 1 && (dt.is_nan() || dt <= 0.0) {
+            return Err("a FIFO message with a zero dt");
+        }
+        let newest = sample
+            .and_then(|s| s.get_u64(data))
+            .map_or(t_ns, |us| us.saturating_mul(1000));
+        let slots = v[0].iter().zip(&v[1]).zip(&v[2]).take(n);
+        for (k, ((sx, sy), sz)) in slots.enumerate() {
+            let mut x = [0.0; 3];
+            for (x, s) in x.iter_mut().zip([sx, sy, sz]) {
+                *x = s.get(data).ok_or(short)? * scale;
+            }
+            let off = fifo_offset_ns(n, k, dt);
+            let nan = [f64::NAN; 3];
+            let (gyro, acc) = if *acc { (nan, x) } else { (x, nan) };
+            out(
+                t_ns.saturating_sub(off),
+                Row {
+                    stamp: newest.saturating_sub(off),
+                    gyro,
+                    acc,
+                },
+            );
+        }
+        Ok(())
+    }
+
+    /// The row of a one-sample data message (`data` starts with the timestamp), or why not.
     fn row(&self, t_ns: u64, data: &[u8]) -> Result<Row, &'static str> {
         let v3 = |s: &[Slot; 3]| -> Result<[f64; 3], &'static str> {
             let mut v = [0.0; 3];
@@ -284,6 +388,7 @@ impl Decoder {
                 gyro: nan,
                 acc: v3(v)?,
             },
+            Decoder::Fifo { .. } => return Err("a FIFO message holds several rows"),
             Decoder::Deltas {
                 sample,
                 angle,
@@ -583,16 +688,28 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
                 };
                 let t = t_us.saturating_mul(1000);
                 last_t = last_t.max(t);
+                // a FIFO message is several rows, the oldest (n−1)·dt before its time
+                let (rows, first) = match &chans[ch as usize].decoder {
+                    Some(d @ Decoder::Fifo { dt, .. }) => {
+                        let n = d.rows_in(m.rest());
+                        let dt = dt.get(m.rest()).unwrap_or(0.0).max(0.0);
+                        (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
+                    }
+                    _ => (1, t),
+                };
+                if rows == 0 {
+                    continue;
+                }
                 let k = parts.len() - 1;
                 let pc = &mut part_counts[k];
                 if pc.len() <= ch as usize {
                     pc.resize(ch as usize + 1, 0);
                 }
-                pc[ch as usize] += 1;
+                pc[ch as usize] += rows;
                 let sp = &mut part_span[k];
-                *sp = Some(sp.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+                *sp = Some(sp.map_or((first, t), |(a, b)| (a.min(first), b.max(t))));
                 if let Some(c) = channels[ch as usize].count.as_mut() {
-                    *c += 1;
+                    *c += rows;
                 }
             }
             b'O' => {
@@ -785,10 +902,13 @@ impl crate::source::Source for UlogReader {
                     let t = t_us.saturating_mul(1000);
                     match &c.decoder {
                         None => sink(ch, t, &[]),
-                        Some(d) => match d.row(t, data) {
-                            Ok(row) => sink(ch, t, &row.encode()),
+                        Some(d) => match d.rows(t, data, &mut |rt, row| {
+                            sink(ch, rt, &row.encode());
+                            r.delivered += 1;
+                        }) {
+                            Ok(()) => continue,
                             Err(why) => {
-                                r.skipped += 1;
+                                r.skipped += d.rows_in(data).max(1) as u64;
                                 r.skip_reason.get_or_insert_with(|| {
                                     format!(
                                         "'{}': {why}",

@@ -83,6 +83,82 @@ pub const SENSOR_GYRO: &str = "sensor_gyro:uint64_t timestamp;uint64_t timestamp
 pub const SENSOR_ACCEL: &str = "sensor_accel:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float x;float y;float z;float temperature;uint32_t error_count;uint8_t[3] clip_counter;uint8_t samples;";
 /// PX4's `vehicle_imu`.
 pub const VEHICLE_IMU: &str = "vehicle_imu:uint64_t timestamp;uint64_t timestamp_sample;uint32_t accel_device_id;uint32_t gyro_device_id;float[3] delta_angle;float[3] delta_velocity;uint16_t delta_angle_dt;uint16_t delta_velocity_dt;uint8_t delta_angle_clipping;uint8_t delta_velocity_clipping;uint8_t accel_calibration_count;uint8_t gyro_calibration_count;";
+/// PX4's `sensor_gyro_fifo` (fields in the logger's size order, padded to 8 bytes; the
+/// logger writes messages without the trailing padding).
+pub const SENSOR_GYRO_FIFO: &str = "sensor_gyro_fifo:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float dt;float scale;int16_t[32] x;int16_t[32] y;int16_t[32] z;uint8_t samples;uint8_t rotation;uint8_t[2] _padding0;";
+/// PX4's `sensor_accel_fifo`.
+pub const SENSOR_ACCEL_FIFO: &str = "sensor_accel_fifo:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float dt;float scale;int16_t[32] x;int16_t[32] y;int16_t[32] z;uint8_t samples;uint8_t rotation;uint8_t[2] _padding0;";
+
+/// Writes a log of PX4's raw FIFO topics: `sensor_gyro_fifo` and `sensor_accel_fifo`
+/// (instance 0 each) at `rate` Hz for `seconds`, `per_msg` samples a message (every third
+/// message one fewer, as a FIFO read that came early), int16 noise around a level with
+/// PX4's scales (2000 °/s and 16 g full range), and `vehicle_status` once a second.
+pub fn fifo_log<W: Write>(w: W, seconds: f64, rate: f64, per_msg: u8, seed: u64) -> io::Result<W> {
+    let mut u = Writer::new(w, 0)?;
+    u.info("char[5] sys_name", b"PX4_t")?;
+    for f in [SENSOR_GYRO_FIFO, SENSOR_ACCEL_FIFO, VEHICLE_STATUS] {
+        u.format(f)?;
+    }
+    u.add(0, 0, "sensor_gyro_fifo")?;
+    u.add(0, 1, "sensor_accel_fifo")?;
+    u.add(0, 2, "vehicle_status")?;
+    let mut state = seed;
+    let mut noise = || crate::formats::synthetic_noise(&mut state);
+    let dt_us = 1e6 / rate;
+    let total = (seconds * rate) as u64;
+    let scales = [
+        (2000.0f64.to_radians() / 32767.0) as f32,
+        (16.0 * 9.80665 / 32767.0) as f32,
+    ];
+    let (mut done, mut msg, mut next_status) = (0u64, 0u64, 0u64);
+    let t0 = 10_000_000f64;
+    let mut b = Vec::with_capacity(240);
+    while done < total {
+        let n = if msg % 3 == 2 {
+            per_msg.saturating_sub(1)
+        } else {
+            per_msg
+        };
+        let n = (n.clamp(1, 32) as u64).min(total - done) as u8;
+        // the newest sample's time
+        let newest = (t0 + (done + n as u64 - 1) as f64 * dt_us).round() as u64;
+        for (id, scale) in [(0u16, scales[0]), (1u16, scales[1])] {
+            let mut xyz = [[0i16; 32]; 3];
+            for k in 0..n as usize {
+                for (a, col) in xyz.iter_mut().enumerate() {
+                    let level = if id == 1 && a == 2 { -2005.0 } else { 0.0 };
+                    col[k] = (level + 40.0 * noise()).round() as i16;
+                }
+            }
+            b.clear();
+            b.extend_from_slice(&(newest + 200).to_le_bytes());
+            b.extend_from_slice(&newest.to_le_bytes());
+            b.extend_from_slice(&(0x0024_0000u32 + id as u32).to_le_bytes());
+            b.extend_from_slice(&(dt_us as f32).to_le_bytes());
+            b.extend_from_slice(&scale.to_le_bytes());
+            for col in &xyz {
+                for v in col {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            // samples, rotation; PX4's logger leaves the trailing padding out (pyulog
+            // takes a longer message for a corrupt one)
+            b.extend_from_slice(&[n, 0]);
+            u.data(id, &b)?;
+        }
+        if newest >= next_status {
+            b.clear();
+            b.extend_from_slice(&newest.to_le_bytes());
+            b.extend_from_slice(&[1, 2]);
+            u.data(2, &b)?;
+            next_status = newest + 1_000_000;
+        }
+        done += n as u64;
+        msg += 1;
+    }
+    u.finish()
+}
+
 /// A topic the tools do not read as Imu.
 pub const VEHICLE_STATUS: &str = "vehicle_status:uint64_t timestamp;uint8_t arming_state;uint8_t nav_state;uint8_t[6] _padding0;";
 
