@@ -194,25 +194,14 @@ where
     }
     let (x0, x1) = (x0 / 1.2, x1 * 1.2);
     let (y0, y1) = (y0 / 3.0, y1 * 3.0);
-    let mut ctx = ChartBuilder::on(area)
-        .caption(
-            format!("{label} — {} segments of {}", p.segments, p.segment),
-            ("sans-serif", px(15.0)),
-        )
-        .margin(px(8.0))
-        .x_label_area_size(px(34.0))
-        .y_label_area_size(px(62.0))
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-    ctx.configure_mesh()
-        .x_desc("f [Hz]")
-        .y_desc(format!("PSD [({})²/Hz]", ax.sensor.unit()))
-        .label_style(("sans-serif", px(11.0)))
-        .axis_desc_style(("sans-serif", px(12.0)))
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .light_line_style(RGBColor(238, 238, 238))
-        .bold_line_style(RGBColor(210, 210, 210))
-        .draw()?;
+    let mut ctx = super::plot::log_log_panel(
+        area,
+        format!("{label} — {} segments of {}", p.segments, p.segment),
+        (x0, x1),
+        (y0, y1),
+        ("f [Hz]", &format!("PSD [({})²/Hz]", ax.sensor.unit())),
+        scale,
+    )?;
     let data = RGBColor(0, 90, 170);
     ctx.draw_series(LineSeries::new(
         bins.iter()
@@ -269,13 +258,7 @@ where
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red));
         }
     }
-    ctx.configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .label_font(("sans-serif", px(10.0)))
-        .draw()?;
-    Ok(())
+    super::plot::draw_legend(&mut ctx, scale)
 }
 
 #[cfg(test)]
