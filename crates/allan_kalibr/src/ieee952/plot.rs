@@ -135,22 +135,40 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let px = |v: f64| (v * scale).round() as u32;
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let (top, body) = root.split_vertically(px(40.0));
-    top.draw(&Text::new(
-        format!("{title} — IEEE 952 (95 % band; shaded: τ not described by the model)"),
-        (px(12.0) as i32, px(10.0) as i32),
-        ("sans-serif", px(18.0)),
-    ))
-    .map_err(|e| e.to_string())?;
-    let rows = a.axes.len().div_ceil(3).max(1);
-    let panels = body.split_evenly((rows, 3));
+    let panels = titled_panels(
+        root,
+        &format!("{title} — IEEE 952 (95 % band; shaded: τ not described by the model)"),
+        a.axes.len(),
+        scale,
+    )?;
     for (i, ax) in a.axes.iter().enumerate() {
         let t = truth.and_then(|t| t.get(i)).map(|v| v.as_slice());
         panel(ax, t, &panels[i], scale).map_err(|e| e.to_string())?;
     }
     Ok(())
+}
+
+/// A chart's white page with `title` across the top and the panels of `axes` axes below it,
+/// three to a row.
+pub(super) fn titled_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    axes: usize,
+    scale: f64,
+) -> Result<Vec<DrawingArea<DB, Shift>>, String>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (top, body) = root.split_vertically(px(40.0));
+    top.draw(&Text::new(
+        title.to_string(),
+        (px(12.0) as i32, px(10.0) as i32),
+        ("sans-serif", px(18.0)),
+    ))
+    .map_err(|e| e.to_string())?;
+    Ok(body.split_evenly((axes.div_ceil(3).max(1), 3)))
 }
 
 fn panel<DB: DrawingBackend>(

@@ -65,20 +65,15 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let px = |v: f64| (v * scale).round() as u32;
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let (top, body) = root.split_vertically(px(40.0));
-        top.draw(&Text::new(
-            format!(
+        let panels = super::plot::titled_panels(
+            root,
+            &format!(
                 "{} — Welch PSD, one-sided (white noise N: level 2N²); lines found marked",
                 self.title
             ),
-            (px(12.0) as i32, px(10.0) as i32),
-            ("sans-serif", px(18.0)),
-        ))
-        .map_err(|e| e.to_string())?;
-        let rows = self.a.axes.len().div_ceil(3).max(1);
-        let panels = body.split_evenly((rows, 3));
+            self.a.axes.len(),
+            scale,
+        )?;
         for (i, ax) in self.a.axes.iter().enumerate() {
             panel(ax, &panels[i], scale).map_err(|e| e.to_string())?;
         }
