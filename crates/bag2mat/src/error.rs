@@ -97,6 +97,12 @@ pub enum Error {
         /// Every topic in the bag.
         available: Vec<TopicSummary>,
     },
+    /// No topic named and several carry `sensor_msgs/Imu`: which one is the user's to say.
+    #[error("{}", several_imu_topics(.available))]
+    SeveralImuTopics {
+        /// Every topic in the bag.
+        available: Vec<TopicSummary>,
+    },
     /// The topic exists but does not carry `sensor_msgs/Imu` (with the right md5 for ROS 1).
     #[error(
         "topic '{}' carries {} [{}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
@@ -184,6 +190,12 @@ fn nothing_read(topic: &str, why: &[String]) -> String {
 
 fn no_imu_topic(available: &[TopicSummary]) -> String {
     let mut s = "no topic carries sensor_msgs/Imu".to_string();
+    list_topics(&mut s, available);
+    s
+}
+
+fn several_imu_topics(available: &[TopicSummary]) -> String {
+    let mut s = "no topic named and several carry sensor_msgs/Imu: name one (TOPIC, --topic) or pass --all-imu-topics".to_string();
     list_topics(&mut s, available);
     s
 }

@@ -24,7 +24,8 @@ struct Args {
     command: Option<Command>,
     /// The input: a ROS 1 bag, a ROS 2 bag directory, an .mcap or a .db3.
     bag: Option<PathBuf>,
-    /// The Imu topic (`imu` and `/imu` are tried in that order if the exact name is missing).
+    /// The Imu topic (`imu` and `/imu` are tried in that order if the exact name is missing)
+    /// [default: the input's only sensor_msgs/Imu topic].
     topic: Option<String>,
     /// Another Imu topic (repeatable); each topic gets its own output folder.
     #[arg(long = "topic", value_name = "TOPIC")]
@@ -130,15 +131,6 @@ fn main() -> ExitCode {
             };
             let mut topics: Vec<String> = a.topic.into_iter().collect();
             topics.extend(a.topics);
-            if topics.is_empty() && !a.all_imu_topics {
-                return cli::usage(
-                    TOOL,
-                    &format!(
-                        "name a topic (TOPIC, --topic) or pass --all-imu-topics; `bag2mat info {}` lists them",
-                        bag.display()
-                    ),
-                );
-            }
             let given = a.format.map(|f| match f {
                 FormatArg::Mat => Format::Mat,
                 FormatArg::Csv => Format::Csv,

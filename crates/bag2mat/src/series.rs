@@ -24,7 +24,8 @@ pub struct ReadOptions {
     pub quiet: bool,
 }
 
-/// Which topics to read.
+/// Which topics to read. None named and not `all_imu` (the default): the input's only
+/// `sensor_msgs/Imu` topic, an error naming them when there are several.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct TopicSelector {
     /// Topics by name (each tried in the other slash form when missing).
@@ -419,6 +420,31 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             crate::shared::cli::escape(&other)
         );
         push(&mut out, other, cs, Some(note), true)?;
+    }
+    if sel.topics.is_empty() && !sel.all_imu {
+        let mut topics: Vec<&str> = chans
+            .iter()
+            .filter(|c| is_imu(c))
+            .map(|c| c.topic.as_str())
+            .collect();
+        topics.sort();
+        topics.dedup();
+        return match topics[..] {
+            [] => Err(Error::NoImuTopic {
+                available: topic_summaries(src),
+            }),
+            [t] => {
+                let note = format!(
+                    "no topic named: reading '{}', the only sensor_msgs/Imu topic",
+                    crate::shared::cli::escape(t)
+                );
+                push(&mut out, t.to_string(), on(t), Some(note), true)?;
+                Ok(out)
+            }
+            _ => Err(Error::SeveralImuTopics {
+                available: topic_summaries(src),
+            }),
+        };
     }
     if sel.all_imu {
         let mut topics: Vec<&str> = chans

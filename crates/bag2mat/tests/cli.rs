@@ -4,7 +4,7 @@ use std::process::Command;
 
 use bag2mat::Compression;
 
-use crate::util::{case_bag, run, write_synthetic};
+use crate::util::{case_bag, run, synthetic, write_synthetic};
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))
@@ -133,4 +133,44 @@ fn a_failing_standard_output_is_an_error_not_a_panic() {
         );
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn the_only_imu_topic_is_the_default_and_several_must_be_named() {
+    // a newcomer's first run: `bag2mat BAG -o x.mat` on a bag with one Imu topic (and a
+    // status topic) reads that topic and says so; with two, which is the user's to say
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("one.bag");
+    write_synthetic(&bag, "/imu0", 300, Compression::None, true);
+    let mat = dir.path().join("one.mat");
+    let (ok, _, err) = run(bag2mat().arg(&bag).arg("-o").arg(&mat));
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("no topic named: reading '/imu0', the only sensor_msgs/Imu topic"),
+        "{err}"
+    );
+    assert_eq!(bag2mat::mat::read_data_imu(&mat).unwrap().rows(), 300);
+    let two = dir.path().join("two.bag");
+    {
+        let mut w = bag2mat::bag::BagWriter::create(&two, Compression::None).unwrap();
+        let a = w.add_imu_connection("/imu0");
+        let b = w.add_imu_connection("/imu1");
+        for i in 0..10 {
+            let (t, m) = synthetic(i);
+            w.write_imu(a, t, &m).unwrap();
+            w.write_imu(b, t, &m).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let out = dir.path().join("two.mat");
+    let (ok, _, err) = run(bag2mat().arg(&two).arg("-o").arg(&out));
+    assert!(!ok);
+    assert!(
+        err.contains("several carry sensor_msgs/Imu")
+            && err.contains("--all-imu-topics")
+            && err.contains("/imu0")
+            && err.contains("/imu1"),
+        "{err}"
+    );
+    assert!(!out.exists());
 }

@@ -600,6 +600,8 @@ fn defect_14_one_error_convention() {
     let missing = dir.path().join("missing.bag");
     for args in [
         vec![missing.display().to_string(), "imu".into()],
+        // no topic: the input's only Imu topic, so reading it is what fails
+        vec![missing.display().to_string()],
         vec!["info".into(), missing.display().to_string()],
     ] {
         let (code, err) = status(bag2mat().args(&args));
@@ -619,7 +621,7 @@ fn defect_14_one_error_convention() {
     for args in [
         vec![],
         vec!["--no-such-flag".to_string()],
-        vec!["x.bag".into()],
+        vec!["x.bag".into(), "--format".into(), "xls".into()],
     ] {
         let (code, err) = status(bag2mat().args(&args));
         assert_eq!(code, Some(2), "{args:?}: {err}");
