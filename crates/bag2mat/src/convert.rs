@@ -270,9 +270,21 @@ pub fn output_paths(cfg: &Config, topics: &[&str]) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet. Returns each
-/// output path with its number of rows.
+/// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet, its outputs
+/// all or none ([`crate::shared::output::Staging`], one at a time per process: the binary's
+/// way). Returns each output path with its number of rows.
 pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
+    convert(cfg, true)
+}
+
+/// [`run`] without the process-wide staging, each output still written atomically: for a
+/// caller that runs beside other conversions or analyses in one process (tests), whose
+/// outputs another's staging would otherwise take in.
+pub fn run_unstaged(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
+    convert(cfg, false)
+}
+
+fn convert(cfg: &Config, staged: bool) -> Result<Vec<(PathBuf, usize)>, Error> {
     let log = |s: &str| {
         if !cfg.quiet {
             eprintln!("{s}");
@@ -306,7 +318,7 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
         });
     }
     // Several topics: all files or none.
-    let staging = crate::shared::output::Staging::begin();
+    let staging = staged.then(crate::shared::output::Staging::begin);
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let outs = output_paths(cfg, &names);
@@ -338,7 +350,9 @@ pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
         write(&out, &data, cfg.format)?;
         written.push((out, data.rows()));
     }
-    staging.commit()?;
+    if let Some(s) = staging {
+        s.commit()?;
+    }
     log("Done processing IMU data");
     Ok(written)
 }

@@ -440,7 +440,8 @@ pub fn euroc_dataset_from_bag(
         quiet: true,
         input: Default::default(),
     };
-    crate::convert::run(&cfg).expect("bag2mat -o x.csv");
+    // unstaged: tests run beside each other in one process
+    crate::convert::run_unstaged(&cfg).expect("bag2mat -o x.csv");
     let root = dir.join("dataset");
     euroc_from_bag2mat_csv(&csv, &root);
     root
