@@ -323,6 +323,18 @@ fn other_slash_form(topic: &str) -> String {
     }
 }
 
+/// The distinct topics of `chans` that carry `sensor_msgs/Imu`, sorted.
+fn imu_topics(chans: &[Channel]) -> Vec<&str> {
+    let mut topics: Vec<&str> = chans
+        .iter()
+        .filter(|c| is_imu(c))
+        .map(|c| c.topic.as_str())
+        .collect();
+    topics.sort();
+    topics.dedup();
+    topics
+}
+
 fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error> {
     let chans = src.channels();
     if chans.is_empty() {
@@ -422,14 +434,7 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         push(&mut out, other, cs, Some(note), true)?;
     }
     if sel.topics.is_empty() && !sel.all_imu {
-        let mut topics: Vec<&str> = chans
-            .iter()
-            .filter(|c| is_imu(c))
-            .map(|c| c.topic.as_str())
-            .collect();
-        topics.sort();
-        topics.dedup();
-        return match topics[..] {
+        return match imu_topics(chans)[..] {
             [] => Err(Error::NoImuTopic {
                 available: topic_summaries(src),
             }),
@@ -447,15 +452,8 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         };
     }
     if sel.all_imu {
-        let mut topics: Vec<&str> = chans
-            .iter()
-            .filter(|c| is_imu(c))
-            .map(|c| c.topic.as_str())
-            .collect();
-        topics.sort();
-        topics.dedup();
         let before = out.len();
-        for t in topics {
+        for t in imu_topics(chans) {
             // A topic that mixes Imu with another type gives its Imu connection (with a note).
             push(&mut out, t.to_string(), on(t), None, false)?;
         }
