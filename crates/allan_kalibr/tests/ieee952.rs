@@ -8,8 +8,8 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use allan_kalibr::ieee952::files::{
-    COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE,
-    TERMS_FILE,
+    COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_SENSOR,
+    COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE, TERMS_FILE,
 };
 use bag2mat::mat::{DataImu, write_data_imu};
 use rand::SeedableRng;
@@ -90,6 +90,10 @@ pub(crate) struct Row {
     pub(crate) lo: f64,
     pub(crate) hi: f64,
     pub(crate) verdict: String,
+    /// The axis' fit code (`fits`, `fits_range`, …), its fitted range's long end and χ²/dof.
+    pub(crate) fit: String,
+    pub(crate) fit_tau_hi: f64,
+    pub(crate) chi2_per_dof: f64,
 }
 
 pub(crate) fn terms(dir: &Path) -> Vec<Row> {
@@ -106,6 +110,7 @@ pub(crate) fn terms(dir: &Path) -> Vec<Row> {
         col(COL_CI95_HI),
         col(COL_VERDICT),
     );
+    let (cf, cfh, cx) = (col(COL_FIT), col(COL_FIT_TAU_HI), col(COL_CHI2_DOF));
     lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
@@ -118,6 +123,9 @@ pub(crate) fn terms(dir: &Path) -> Vec<Row> {
                 lo: num(cl),
                 hi: num(ch),
                 verdict: f[cd].into(),
+                fit: f[cf].into(),
+                fit_tau_hi: num(cfh),
+                chi2_per_dof: num(cx),
             }
         })
         .collect()

@@ -319,32 +319,6 @@ fn issue18_8_one_spike_is_reported_with_its_time_and_dropped_on_request() {
     );
 }
 
-/// Per axis of a terms file (gyro x y z, acc x y z): the fit code, the fitted range's long
-/// end and χ²/dof (from the N rows).
-fn fit_columns(dir: &Path) -> Vec<(String, f64, f64)> {
-    let text = std::fs::read_to_string(dir.join("ieee952_terms.csv")).unwrap();
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
-    let (ct, cf, chi, cx) = (
-        col("term"),
-        col("fit"),
-        col("fit_tau_hi"),
-        col("chi2_per_dof"),
-    );
-    lines
-        .map(|l| l.split(',').collect::<Vec<_>>())
-        .filter(|f| f[ct] == "N")
-        .map(|f| {
-            (
-                f[cf].to_string(),
-                f[chi].parse().unwrap(),
-                f[cx].parse().unwrap(),
-            )
-        })
-        .collect()
-}
-
 /// Issue 18.10: a fit of a clean record's curve is as good as its statistics; χ²/dof this
 /// far above 1 is a model or covariance that does not describe the points (before the fix:
 /// 8–37 on allan_variance_ros' curve of white noise and random walk).
@@ -383,10 +357,15 @@ fn issue18_10_allan_variance_ros_curves_fit_like_the_samples() {
     assert!(o.status.success(), "{}", s(&o.stderr));
     // before: fits cut at 3–18 s ("the curve bends where the model has no term") with
     // χ²/dof 8–37 on every axis
-    for (i, (code, hi, chi2)) in fit_columns(&from_csv).into_iter().enumerate() {
-        assert!(code.starts_with("fits"), "axis {i}: {code}");
-        assert!(hi >= seconds / 20.0, "axis {i}: fitted to {hi} s only");
-        assert!(chi2 <= MAX_CLEAN_CHI2, "axis {i}: χ²/dof {chi2}");
+    for r in terms(&from_csv).iter().filter(|r| r.term == "N") {
+        let (i, code, hi, chi2) = (&r.axis, &r.fit, r.fit_tau_hi, r.chi2_per_dof);
+        assert!(code.starts_with("fits"), "{} {i}: {code}", r.sensor);
+        assert!(
+            hi >= seconds / 20.0,
+            "{} {i}: fitted to {hi} s only",
+            r.sensor
+        );
+        assert!(chi2 <= MAX_CLEAN_CHI2, "{} {i}: χ²/dof {chi2}", r.sensor);
     }
     let r = n_ratios(&from_csv, &truth);
     assert!(

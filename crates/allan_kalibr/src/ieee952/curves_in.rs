@@ -360,20 +360,17 @@ fn point_list(ms: &[usize], tau0: f64, adev: &[f64]) -> Vec<CurvePoint> {
         .collect()
 }
 
-/// Which rows of a dense non-overlapping curve (allan_variance_ros: every 0.1 s) have an m
-/// on the section's log grid ([`super::tau_grid::GridSpec`]'s points per octave). The fit
-/// uses that grid anyway ([`CurveData::fit_ms`]); the range check visits every point of the
-/// curve, and on a dense curve its thousands of points would be thousands of chances for a
-/// chance miss.
+/// Which rows of a dense non-overlapping curve (allan_variance_ros: every 0.1 s) are the
+/// points of the section's log grid (the fit grid's own choice, [`super::fit::thin_to_grid`],
+/// at [`super::tau_grid::GridSpec`]'s points per octave). The fit uses that grid anyway
+/// ([`CurveData::fit_ms`]); the range check visits every point of the curve, and on a dense
+/// curve its thousands of points would be thousands of chances for a chance miss.
 fn on_log_grid(ms: &[usize]) -> Vec<bool> {
-    let top = ms.iter().copied().max().unwrap_or(0);
-    let spec = super::tau_grid::GridSpec::default();
-    // the grid up to the largest m present (cluster_sizes(n) stops at n / min_clusters)
-    let grid: std::collections::BTreeSet<usize> = spec
-        .cluster_sizes(top.saturating_mul(spec.min_clusters.max(3)))
-        .into_iter()
-        .collect();
-    ms.iter().map(|m| grid.contains(m)).collect()
+    let mut keep = vec![false; ms.len()];
+    for i in super::fit::thin_to_grid(ms, super::tau_grid::GridSpec::default().per_octave) {
+        keep[i] = true;
+    }
+    keep
 }
 
 /// The items of `v` whose `keep` is true.
