@@ -5,76 +5,40 @@ use std::path::PathBuf;
 
 use clap::Parser;
 
+use allan_kalibr::front::{Common, CommonArgs, Input};
+
 use crate::error::Error;
 use crate::launch::{self, LaunchParams, LaunchValue};
 
-/// Default topic, name, limit and cluster count (imu_utils' shipped launch files).
-pub const DEFAULT_TOPIC: &str = "imu";
 /// Default IMU name.
 pub const DEFAULT_NAME: &str = "imu";
 /// Default `max_time_min` of the shipped launch files.
 pub const DEFAULT_MAX_TIME_MIN: u32 = 120;
 /// Default `max_cluster` of the shipped launch files.
 pub const DEFAULT_MAX_CLUSTER: usize = 100;
+/// The tool's name: its default output folder is `<input stem>_allan_imu_utils/`.
+pub const TOOL: &str = "allan_imu_utils";
 
 /// imu_utils' Allan variance and noise fit, read straight from a bag — ROS 1, a ROS 2 bag
-/// directory, an .mcap or a .db3 (no roscore, no replay). Prints upstream's report and writes
-/// `<name>_imu_param.yaml`, a continuous-time `<name>_imu_param_continuous.yaml`, the 16
+/// directory, an .mcap or a .db3 (no roscore, no replay) — or an IMU log. Prints upstream's
+/// report and writes `<name>_imu_param.yaml` (upstream's file, discrete-time as imu_utils
+/// writes it), a continuous-time `<name>_imu_param_continuous.yaml`, the 16
 /// `data_<name>_*.txt` curves and plots. Then the IEEE 952 section (unless --compat-only):
 /// terms with 95 % intervals, the fitted range and fit quality per axis, recording-length
-/// advice, warm-up and gap checks, and its files prefixed `<name>_`. With --curves it works on
-/// Allan curves another tool wrote.
+/// advice, record checks, and its files prefixed `<name>_` — `<name>_kalibr_imu_ieee952.yaml`
+/// is the file to give Kalibr. With --curves it works on Allan curves another tool wrote.
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version, allow_negative_numbers = true)]
 pub struct Args {
-    /// The bag: ROS 1 (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, .mcap or .db3;
-    /// or an IMU log (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
-    #[arg(required_unless_present = "curves")]
-    pub bag: Option<PathBuf>,
-    /// Analyse existing Allan curves instead of a bag: an imu_utils data directory (then
-    /// imu_utils' own fit is re-run and its yaml files written), allan_variance_ros'
-    /// allan_variance.csv, an allan_curves.csv, an ieee952_curves.csv, or a plain CSV
-    /// `tau,x,y,z` (one sensor; give --units). A plain CSV per sensor may be given twice.
-    #[arg(long, value_name = "PATH", conflicts_with = "bag")]
-    pub curves: Vec<PathBuf>,
-    /// Unit of each plain CSV of --curves, in order: rad/s, deg/s, deg/h, imu_utils, m/s^2,
-    /// g, mg (the values are Allan deviations).
-    #[arg(long, value_name = "UNIT")]
-    pub units: Vec<String>,
-    /// Length of the record behind --curves, in seconds (for the confidence intervals).
-    #[arg(long, value_name = "SECONDS", conflicts_with = "samples", value_parser = bag2mat::shared::cli::positive_f64)]
-    pub duration: Option<f64>,
-    /// Number of samples behind --curves (for the confidence intervals).
-    #[arg(long, value_name = "N")]
-    pub samples: Option<u64>,
-    /// IMU rate of plain --curves CSVs whose τ do not start at one sample, or of a text log
-    /// without a time column, Hz.
-    #[arg(long, value_name = "HZ")]
-    pub rate: Option<f64>,
-    /// Drop the first SECONDS of header time (a warm-up) before the stop rule and analysis.
-    #[arg(long, value_name = "SECONDS", value_parser = bag2mat::shared::cli::positive_f64)]
-    pub skip_start: Option<f64>,
-    /// Drop the samples the record check finds to be spikes (a sample far off its
-    /// neighbours, reported with its time) before the analysis.
-    #[arg(long)]
-    pub drop_outliers: bool,
-    /// sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic then
-    /// gets its own folder under the output directory [default: imu]
-    #[arg(long = "topic", value_name = "TOPIC")]
-    pub topics: Vec<String>,
-    /// Every topic of the bag that carries sensor_msgs/Imu, each into its own folder
-    #[arg(long)]
-    pub all_imu_topics: bool,
+    #[command(flatten)]
+    pub common: CommonArgs,
     /// The time the Allan variance and the stop rule use: header.stamp (imu_utils) or the
     /// record (receive) time
-    #[arg(long, value_enum, default_value_t = TimeArg::Header)]
-    pub time: TimeArg,
+    #[arg(long, value_enum, default_value_t = bag2mat::TimeColumn::Header)]
+    pub time: bag2mat::TimeColumn,
     /// IMU name used in output file names and the yaml [default: imu]
     #[arg(long)]
     pub name: Option<String>,
-    /// Output directory (created if missing) [default: .]
-    #[arg(long)]
-    pub data_save_path: Option<PathBuf>,
     /// Stop after this many minutes of header time; the message crossing it is kept [default: 120]
     #[arg(long, value_parser = positive_int::<u32>)]
     pub max_time_min: Option<u32>,
@@ -84,76 +48,39 @@ pub struct Args {
     /// Take the settings from an imu_utils roslaunch file; explicit flags override it
     #[arg(long, value_name = "FILE.launch")]
     pub launch: Option<PathBuf>,
-    /// Only errors and warnings on stderr: no progress bar (the report still goes to stdout)
-    #[arg(long, short)]
-    pub quiet: bool,
     /// Do not draw allan_gyr/allan_acc plots
     #[arg(long)]
     pub no_plots: bool,
-    /// Print the time of each phase on stderr (for benchmarks)
-    #[arg(long)]
-    pub timings: bool,
-    /// Only what imu_utils produces: skip the IEEE 952 section and its files
-    #[arg(long)]
-    pub compat_only: bool,
-    #[command(flatten)]
-    pub input_args: bag2mat::formats::InputArgs,
-}
-
-/// The time column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum TimeArg {
-    /// header.stamp: what imu_utils' node reads.
-    Header,
-    /// Record (receive) time.
-    Record,
-}
-
-/// `--curves`: the inputs and what the user said about them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CurvesInput {
-    /// A directory or files.
-    pub paths: Vec<PathBuf>,
-    /// Record length, sample count, rate, units, name.
-    pub options: allan_kalibr::ieee952::curves_in::Options,
 }
 
 /// What a run uses.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
-    /// Input bag (empty with --curves).
-    pub bag: PathBuf,
-    /// Curves to analyse instead of a bag.
-    pub curves: Option<CurvesInput>,
-    /// Seconds dropped at the start.
-    pub skip_start: Option<f64>,
-    /// Drop the spikes the record check finds.
-    pub drop_outliers: bool,
-    /// Topics (one unless several were asked for).
-    pub topics: Vec<String>,
-    /// Also every other Imu topic of the bag.
-    pub all_imu: bool,
-    /// The time column.
-    pub time: bag2mat::TimeColumn,
+    /// What both analysers share: input, topics, time column, output folder, …
+    pub common: Common,
     /// IMU name.
     pub name: String,
-    /// Output directory.
-    pub out_dir: PathBuf,
     /// Stop rule, minutes.
     pub max_time_min: u32,
     /// Cluster count M.
     pub max_cluster: usize,
-    /// No progress bar.
-    pub quiet: bool,
     /// Draw plots.
     pub plots: bool,
-    /// Report phase times.
-    pub timings: bool,
-    /// Also run the IEEE 952 analysis (allan_kalibr::ieee952) beside the compat outputs.
-    pub ieee952: bool,
-    /// What the user said about a log whose content does not say it all (a text log's
-    /// columns and units).
-    pub input_options: bag2mat::formats::InputOptions,
+}
+
+impl Config {
+    /// Settings for `input` with every other choice at imu_utils' defaults.
+    pub fn new(input: Input, out_dir: impl Into<PathBuf>) -> Config {
+        let mut common = Common::new(input, out_dir);
+        common.time = bag2mat::TimeColumn::Header;
+        Config {
+            common,
+            name: DEFAULT_NAME.into(),
+            max_time_min: DEFAULT_MAX_TIME_MIN,
+            max_cluster: DEFAULT_MAX_CLUSTER,
+            plots: true,
+        }
+    }
 }
 
 /// A positive whole number: "must be positive" for 0 and negatives (clap would otherwise
@@ -194,44 +121,42 @@ fn parse_launch_int<T: std::str::FromStr>(
     .transpose()
 }
 
-impl Args {
-    /// [`allan_kalibr::cli::curve_flags_need_curves`], --rate included (it only sets the
-    /// rate of plain CSV curves here).
-    pub fn curve_flags_need_curves(&self) -> Result<(), String> {
-        allan_kalibr::cli::curve_flags_need_curves(
-            &self.curves,
-            &self.units,
-            self.duration,
-            self.samples,
-            &[("--rate", self.rate.is_some())],
-        )
-    }
-}
-
 impl TryFrom<Args> for Config {
     type Error = Error;
 
     fn try_from(a: Args) -> Result<Config, Error> {
-        a.curve_flags_need_curves().map_err(Error::Config)?;
+        // --rate sets the rate of plain CSV curves, or of a text log without a time column:
+        // for any other input it would do nothing (imu_utils uses the stamps)
+        a.common
+            .curve_flags_need_curves(&[])
+            .map_err(Error::Config)?;
+        let text_rate =
+            allan_kalibr::front::rate_for_text(a.common.input.as_deref(), a.common.rate);
+        if let (Some(input), Some(rate), None) = (&a.common.input, a.common.rate, text_rate) {
+            let kind = bag2mat::source::detect(input)
+                .map(|k| k.describe())
+                .unwrap_or("input");
+            return Err(Error::Config(format!(
+                "--rate {rate} does nothing for a {kind} (imu_utils' analysis uses its time stamps): it only applies to a text log without a time column, or with --curves"
+            )));
+        }
         let lp = a.launch.as_deref().map(launch::read).transpose()?;
         let lp = lp.as_ref();
-        let topics = if !a.topics.is_empty() {
-            a.topics
-        } else if a.all_imu_topics {
-            Vec::new()
-        } else {
-            vec![from_launch(lp, "imu_topic")?.unwrap_or_else(|| DEFAULT_TOPIC.into())]
-        };
+        let mut common = a.common;
+        if common.topics.is_empty()
+            && !common.all_imu_topics
+            && let Some(t) = from_launch(lp, "imu_topic")?
+        {
+            common.topics = vec![t];
+        }
         let name_given = a.name.is_some();
         let name = match a.name {
             Some(n) => n,
             None => from_launch(lp, "imu_name")?.unwrap_or_else(|| DEFAULT_NAME.into()),
         };
-        let out_dir = match a.data_save_path {
-            Some(p) => p,
-            None => from_launch(lp, "data_save_path")?
-                .map(PathBuf::from)
-                .unwrap_or_else(|| PathBuf::from(".")),
+        let launch_dir = match common.out_dir {
+            Some(_) => None,
+            None => from_launch(lp, "data_save_path")?.map(PathBuf::from),
         };
         let max_time_min = match a.max_time_min {
             Some(v) => v,
@@ -248,7 +173,7 @@ impl TryFrom<Args> for Config {
                 "max_cluster must be at least 2 (got {max_cluster})"
             )));
         }
-        if topics.iter().any(|t| t.trim().is_empty()) {
+        if common.topics.iter().any(|t| t.trim().is_empty()) {
             return Err(Error::Config("the topic is empty".into()));
         }
         if name.is_empty() || name.contains('/') {
@@ -256,40 +181,14 @@ impl TryFrom<Args> for Config {
                 "the IMU name '{name}' must be non-empty and contain no '/'"
             )));
         }
-        let curves = (!a.curves.is_empty()).then(|| CurvesInput {
-            paths: a.curves.clone(),
-            options: allan_kalibr::ieee952::curves_in::Options {
-                duration: a.duration,
-                samples: a.samples,
-                rate: a.rate,
-                units: a.units.clone(),
-                // an imu_utils directory may hold several IMUs: --name picks one
-                name: name_given.then(|| name.clone()),
-            },
-        });
+        // an imu_utils directory may hold several IMUs: --name picks one
+        let curves_name = name_given.then(|| name.clone());
         Ok(Config {
-            bag: a.bag.unwrap_or_default(),
-            curves,
-            skip_start: a.skip_start,
-            drop_outliers: a.drop_outliers,
-            topics,
-            all_imu: a.all_imu_topics,
-            time: match a.time {
-                TimeArg::Header => bag2mat::TimeColumn::Header,
-                TimeArg::Record => bag2mat::TimeColumn::Record,
-            },
+            common: common.resolve(TOOL, a.time, curves_name, launch_dir, text_rate),
             name,
-            out_dir,
             max_time_min,
             max_cluster,
-            quiet: a.quiet,
             plots: !a.no_plots,
-            timings: a.timings,
-            ieee952: !a.compat_only,
-            // a text log without a time column is sampled at --rate
-            input_options: a
-                .input_args
-                .options(if a.curves.is_empty() { a.rate } else { None }),
         })
     }
 }
@@ -309,14 +208,14 @@ mod tests {
         let c = Config::try_from(args(&[])).unwrap();
         assert_eq!(
             (
-                c.topics[0].as_str(),
+                c.common.topics.preferred.as_deref(),
                 c.name.as_str(),
                 c.max_time_min,
                 c.max_cluster
             ),
-            ("imu", "imu", 120, 100)
+            (Some("imu"), "imu", 120, 100)
         );
-        assert_eq!(c.out_dir, PathBuf::from("."));
+        assert_eq!(c.common.out_dir, PathBuf::from("x_allan_imu_utils"));
     }
 
     #[test]
@@ -350,12 +249,12 @@ mod tests {
             "100",
         ]))
         .unwrap();
-        assert_eq!(c.topics, vec!["/imu/data".to_string()]);
-        assert_eq!(c.time, bag2mat::TimeColumn::Header);
+        assert_eq!(c.common.topics.topics, vec!["/imu/data".to_string()]);
+        assert_eq!(c.common.time, bag2mat::TimeColumn::Header);
         assert_eq!(c.name, "xsens");
         assert_eq!(c.max_time_min, 200);
         assert_eq!(c.max_cluster, 100);
-        assert_eq!(c.out_dir, PathBuf::from("/tmp/o"));
+        assert_eq!(c.common.out_dir, PathBuf::from("/tmp/o"));
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use bag2mat::shared::note::Note;
 use rayon::prelude::*;
 
 use allan_kalibr::ieee952::imu::{self, ImuAnalysis, Sensor};
@@ -29,7 +30,7 @@ pub struct Outcome {
     /// What the record check found (stderr, always).
     pub findings: Vec<bag2mat::record_check::Finding>,
     /// Things to say on stderr (end of bag, topic fallback, …).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Files written.
     pub files: Vec<PathBuf>,
     /// The analysis itself.
@@ -80,13 +81,13 @@ fn check_record(
     n: usize,
     config: &Config,
 ) -> bag2mat::record_check::Check {
-    let (used, other) = match config.time {
+    let (used, other) = match config.common.time {
         bag2mat::TimeColumn::Header => (&series.stamp, &series.record_time),
         bag2mat::TimeColumn::Record => (&series.record_time, &series.stamp),
     };
     let t = bag2mat::timing::ns_of_times(&used[..n]);
     let o = bag2mat::timing::ns_of_times(&other[..n]);
-    let mut rec = bag2mat::record_check::Record::of_series(series, config.time, &t, &o);
+    let mut rec = bag2mat::record_check::Record::of_series(series, config.common.time, &t, &o);
     rec.storage_order = rec.storage_order.map(|s| &s[..n]);
     for v in rec.values.iter_mut() {
         *v = &v[..n];
@@ -94,7 +95,7 @@ fn check_record(
     bag2mat::record_check::check(
         &rec,
         &bag2mat::record_check::Options {
-            drop_outliers: config.drop_outliers,
+            drop_outliers: config.common.drop_outliers,
         },
     )
 }
@@ -124,7 +125,7 @@ pub struct CurvesOutcome {
     /// The IEEE 952 section.
     pub ieee952_text: String,
     /// Things to say on stderr.
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Files written.
     pub files: Vec<PathBuf>,
     /// imu_utils' analysis of an imu_utils data directory.
@@ -133,24 +134,50 @@ pub struct CurvesOutcome {
     pub ieee952: ImuAnalysis,
 }
 
+/// The whole job as the binary says it: [`run`] or [`run_curves`], each result an
+/// [`allan_kalibr::front::Section`].
+pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::front::Section>, Error> {
+    if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
+        let o = run_curves(config)?;
+        return Ok(vec![allan_kalibr::front::Section {
+            notes: o.notes,
+            text: o.stdout + &o.ieee952_text,
+            written: o.files,
+            ..Default::default()
+        }]);
+    }
+    Ok(run(config)?
+        .into_iter()
+        .map(|o| allan_kalibr::front::Section {
+            topic: Some(o.topic),
+            notes: o.notes,
+            findings: o.findings,
+            text: o.stdout + o.ieee952_text.as_deref().unwrap_or(""),
+            written: o.files,
+            timings: o
+                .timings
+                .iter()
+                .map(|(phase, d)| format!("timing {phase} {:.3} s", d.as_secs_f64()))
+                .collect(),
+        })
+        .collect())
+}
+
 /// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
 /// selected topic is read in one pass and analysed on its own. With one topic the outputs go
 /// into `out_dir`; with several, into `out_dir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
     let read = bag2mat::series::read_imu_topics_with(
-        &config.bag,
-        &bag2mat::TopicSelector {
-            topics: config.topics.clone(),
-            all_imu: config.all_imu,
-        },
+        config.common.samples_path(),
+        &config.common.topics,
         &bag2mat::ReadOptions {
-            quiet: config.quiet,
+            quiet: config.common.quiet,
         },
-        &config.input_options,
+        &config.common.input_options,
     )?;
     let read_time = t0.elapsed();
-    let several = read.series.len() > 1 || config.all_imu;
+    let several = read.series.len() > 1 || config.common.topics.all_imu;
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let folders = bag2mat::series::topic_folder_names(&names);
@@ -158,7 +185,7 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     for (series, folder) in read.series.into_iter().zip(folders) {
         let mut c = config.clone();
         if several {
-            c.out_dir = config.out_dir.join(folder);
+            c.common.out_dir = config.common.out_dir.join(folder);
         }
         outs.push(run_series(&c, series, read_time)?);
     }
@@ -173,25 +200,29 @@ fn run_series(
 ) -> Result<Outcome, Error> {
     let mut timings = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
-    let mut notes = series.notes.clone();
+    let mut notes = bag2mat::shared::note::warnings(&series.notes);
     // a one-sensor topic (PX4 sensor_gyro, …): zeros stand in for the absent sensor in the
     // record check, its samples in the Allan step; nothing of it is printed nor written
     let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
     notes.extend(absent.map(bag2mat::series::absent_warning));
-    if let Some(s) = config.skip_start {
+    if let Some(s) = config.common.skip_start {
         let (k, warning) = skip_start(&mut series, s)?;
-        notes.extend(warning);
-        notes.push(format!(
+        notes.extend(warning.map(Note::warning));
+        notes.push(Note::info(format!(
             "--skip-start {s}: dropped the first {k} messages ({} left)",
             series.len()
-        ));
+        )));
     }
-    let collected = collect::collect(&series, config.max_time_min, config.time);
+    let collected = collect::collect(&series, config.max_time_min, config.common.time);
     if collected.stop == Stop::EndOfBag {
-        notes.push(format!(
-            "WARNING: bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
+        // imu_utils' own words on stderr (the reference runs' stderr.txt)
+        notes.push(Note::upstream_warning(
+            "WARNING: ",
+            format!(
+            "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
             collected.len(),
             config.max_time_min
+        ),
         ));
     }
     // The record check (bag2mat::record_check) on the collected messages: duplicates, a
@@ -213,7 +244,7 @@ fn run_series(
         Some(bag2mat::Sensor::Gyro) => series.gyro = series.acc.clone(),
         None => {}
     }
-    let collected = collect::Collected::first(&series, series.len(), config.time, stop);
+    let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     let problems: Vec<_> = (0..collect::FIELDS.len())
         .into_par_iter()
@@ -230,12 +261,13 @@ fn run_series(
     for problem in problems {
         match problem {
             Some((true, what)) => return Err(Error::Config(what)),
-            Some((false, what)) => notes.push(format!("warning: {what}")),
+            Some((false, what)) => notes.push(Note::warning(what)),
             None => {}
         }
     }
     let t1 = Instant::now();
-    let (axes, gyro_mean) = analysis::allan_step(&collected, config.max_cluster, config.ieee952)?;
+    let (axes, gyro_mean) =
+        analysis::allan_step(&collected, config.max_cluster, config.common.ieee952)?;
     timings.push(("allan", t1.elapsed()));
     // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at the stamps'
     // nominal rate (lost samples do not change it; imu_utils' mean period does), with the
@@ -245,13 +277,13 @@ fn run_series(
         .rate
         .map(allan_kalibr::input::snap_rate)
         .unwrap_or(axes[0].freq);
-    if let (true, Some(r)) = (config.ieee952, check.refusal()) {
-        notes.push(format!(
+    if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
+        notes.push(Note::warning(format!(
             "IEEE 952 section not computed: the record breaks its assumptions ({})",
             r.short()
-        ));
+        )));
     }
-    let ieee = if config.ieee952 && check.refusal().is_none() {
+    let ieee = if config.common.ieee952 && check.refusal().is_none() {
         // with the PSD and the lines of the samples (in SI units)
         let curves: Vec<CurveData> = axes
             .par_iter()
@@ -301,22 +333,27 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
-    let mut files = report::write_curve_files(&analysis, &config.name, &config.out_dir)?;
+    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
+    let mut files = report::write_curve_files(&analysis, &config.name, &config.common.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {
-        let p = config.out_dir.join(mode.file_name(&config.name));
+        let p = config.common.out_dir.join(mode.file_name(&config.name));
         report::write_text(&p, &opencv_yaml::yaml_text(&analysis, &config.name, mode))?;
         files.push(p);
     }
     if config.plots {
-        files.extend(plot::write_plots(&analysis, &config.name, &config.out_dir)?);
+        files.extend(plot::write_plots(
+            &analysis,
+            &config.name,
+            &config.common.out_dir,
+        )?);
     }
     if let Some(an) = &ieee {
         files.extend(write_ieee952(an, config, &topic)?);
     }
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee.as_ref().map(|a| {
-        imu::summary_text(a) + &allan_kalibr::ieee952::stated::beside_ours(a, &config.bag, &topic)
+        imu::summary_text(a)
+            + &allan_kalibr::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
     });
     Ok(Outcome {
         topic,
@@ -334,14 +371,14 @@ fn run_series(
 /// The section's files (prefixed `<name>_`) and chart.
 fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = files::write_outputs(an, &config.out_dir, &prefix, rostopic)?;
+    let mut out = files::write_outputs(an, &config.common.out_dir, &prefix, rostopic)?;
     if config.plots {
-        let truth = allan_kalibr::ieee952::plot::find_truth(&config.bag, an);
+        let truth = allan_kalibr::ieee952::plot::find_truth(config.common.samples_path(), an);
         out.extend(allan_kalibr::ieee952::plot::write_chart(
             an,
             &config.name,
             truth.as_ref(),
-            &config.out_dir,
+            &config.common.out_dir,
             &prefix,
         )?);
     }
@@ -352,14 +389,14 @@ fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Ve
 /// directory (its `*_n` needs the rate, taken as 1/first τ as the files imply), and the
 /// IEEE 952 section on any format.
 pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
-    let Some(input) = config.curves.as_ref() else {
+    let allan_kalibr::Input::Curves(input) = &config.common.input else {
         return Err(Error::Config("no --curves given".into()));
     };
     let c = curves_in::read(&input.paths, &input.options)?;
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
-    bag2mat::shared::output::ensure_dir(&config.out_dir)?;
+    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {
         let freq = 1.0 / raw.gyr_t[0];
@@ -374,16 +411,16 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
         let an = Analysis::from_curves(raw, fits, freq);
         stdout.push_str(&report::fit_text(&an));
         for mode in [YamlMode::Compat, YamlMode::Continuous] {
-            let p = config.out_dir.join(mode.file_name(&config.name));
+            let p = config.common.out_dir.join(mode.file_name(&config.name));
             report::write_text(&p, &opencv_yaml::yaml_text(&an, &config.name, mode))?;
             files.push(p);
         }
         analysis = Some(an);
     } else {
-        notes.push(format!(
+        notes.push(Note::info(format!(
             "{}: imu_utils' own fit runs on imu_utils data directories only; IEEE 952 section only",
             c.format
-        ));
+        )));
     }
     let sensors: Vec<_> = c
         .sensors
@@ -393,7 +430,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut an = imu::analyse_curves(&sensors, c.rate, &allan_kalibr::ieee952::Config::default());
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
-    let rostopic = config.topics.first().map_or("imu", |s| s.as_str());
+    let rostopic = config.common.named_topic();
     files.extend(write_ieee952(&an, config, rostopic)?);
     Ok(CurvesOutcome {
         stdout,

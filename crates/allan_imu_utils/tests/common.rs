@@ -124,43 +124,19 @@ pub fn rel_err(actual: f64, expected: f64) -> f64 {
 /// allan_imu_utils' settings for `topic` of `bag` into `out` (IMU name `x`, header time,
 /// quiet, no plots), as the command line would give them.
 pub fn imu_utils_config(bag: &Path, topic: &str, out: &Path) -> allan_imu_utils::cli::Config {
-    allan_imu_utils::cli::Config {
-        bag: bag.to_path_buf(),
-        topics: vec![topic.into()],
-        all_imu: false,
-        time: bag2mat::TimeColumn::Header,
-        name: "x".into(),
-        out_dir: out.to_path_buf(),
-        max_time_min: 120,
-        max_cluster: 100,
-        quiet: true,
-        plots: false,
-        timings: false,
-        ieee952: true,
-        curves: None,
-        skip_start: None,
-        drop_outliers: false,
-        input_options: Default::default(),
-    }
+    let mut c =
+        allan_imu_utils::cli::Config::new(allan_kalibr::Input::Samples(bag.to_path_buf()), out);
+    c.common.topics = bag2mat::TopicSelector::one(topic);
+    c.name = "x".into();
+    c.plots = false;
+    c
 }
 
 /// allan_kalibr's settings for `topic` of `bag` into `out` (record time, rate from the
 /// stamps, quiet), as the command line would give them.
 pub fn kalibr_config(bag: &Path, topic: &str, out: &Path) -> allan_kalibr::Config {
-    allan_kalibr::Config {
-        input: bag.to_path_buf(),
-        topics: bag2mat::TopicSelector::one(topic),
-        time: bag2mat::TimeColumn::Record,
-        update_rate: None,
-        title: "t".into(),
-        estimator: allan_kalibr::estimator::Estimator::PrefixSum,
-        outdir: out.to_path_buf(),
-        quiet: true,
-        timings: false,
-        ieee952: true,
-        skip_start: None,
-        drop_outliers: false,
-        curves: None,
-        input_options: Default::default(),
-    }
+    let mut c = allan_kalibr::Config::new(allan_kalibr::Input::Samples(bag.to_path_buf()), out);
+    c.common.topics = bag2mat::TopicSelector::one(topic);
+    c.title = "t".into();
+    c
 }

@@ -27,26 +27,14 @@ const PRINTED_10G_REL_TOL: f64 = 1e-9;
 const FITTED_PRINT_REL_TOL: f64 = 1e-3;
 
 fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
-    let config = Config {
-        bag: case.bag(),
-        topics: vec![case.topic.into()],
-        all_imu: false,
-        time: bag2mat::TimeColumn::Header,
-        name: case.name.into(),
-        out_dir: out.to_path_buf(),
-        max_time_min: case.max_time_min,
-        max_cluster: 100,
-        quiet: true,
-        plots: false,
-        timings: false,
-        // Parity of the compat outputs; the IEEE 952 section is checked in allan_kalibr
-        // and in cli.rs.
-        ieee952: false,
-        curves: None,
-        skip_start: None,
-        input_options: Default::default(),
-        drop_outliers: false,
-    };
+    let mut config = Config::new(allan_kalibr::Input::Samples(case.bag()), out);
+    config.common.topics = bag2mat::TopicSelector::one(case.topic);
+    config.name = case.name.into();
+    config.max_time_min = case.max_time_min;
+    config.plots = false;
+    // Parity of the compat outputs; the IEEE 952 section is checked in allan_kalibr and in
+    // cli.rs.
+    config.common.ieee952 = false;
     run(&config)
         .unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
         .remove(0)

@@ -11,10 +11,8 @@ use bag2mat::test_tools::{ROS2_MODES, rosbags_convert};
 use crate::common::{CASES, imu_utils_config, kalibr_config};
 
 fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
-    let c = Config {
-        ieee952: false,
-        ..imu_utils_config(bag, topic, out)
-    };
+    let mut c: Config = imu_utils_config(bag, topic, out);
+    c.common.ieee952 = false;
     let o = allan_imu_utils::run::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);
@@ -23,10 +21,8 @@ fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
 }
 
 fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
-    let c = allan_kalibr::Config {
-        ieee952: false,
-        ..kalibr_config(bag, topic, out)
-    };
+    let mut c = kalibr_config(bag, topic, out);
+    c.common.ieee952 = false;
     let o = allan_kalibr::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);

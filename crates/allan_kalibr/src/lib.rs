@@ -53,6 +53,7 @@ pub mod curves;
 pub mod error;
 pub mod estimator;
 pub mod fit;
+pub mod front;
 pub mod ieee952;
 pub mod input;
 pub mod plot;
@@ -63,6 +64,5 @@ pub mod yaml;
 
 pub use error::Error;
 pub use estimator::Estimator;
-pub use run::{
-    Analysis, Config, CurvesInput, CurvesOutput, RunOutput, analyse, run, run_curves, run_on,
-};
+pub use front::{Common, CurvesInput, Input};
+pub use run::{Analysis, Config, CurvesOutput, RunOutput, analyse, run, run_curves, run_on};

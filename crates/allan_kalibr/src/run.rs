@@ -15,48 +15,29 @@ use crate::plot::{self, Chart};
 use crate::report;
 use crate::tau_grid::TauGrid;
 use crate::yaml::ImuYaml;
+use bag2mat::shared::note::Note;
 
 /// What the program runs with (resolved from the command line in `cli`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
-    /// `.bag` or `.mat`.
-    pub input: PathBuf,
-    /// Bag topics (bag2mat's topic rules); each topic of several gets its own folder.
-    pub topics: bag2mat::TopicSelector,
-    /// The time column used to estimate the rate: the record time, as bagconvert.
-    pub time: bag2mat::TimeColumn,
-    /// Hz; None = estimate from the timestamps.
-    pub update_rate: Option<f64>,
+    /// What both analysers share: input, topics, time column, `--rate` (here also the τ
+    /// grid's update_rate; `None`: estimated from the time stamps), output folder, …
+    pub common: crate::front::Common,
     /// Chart title prefix (upstream's hard-coded `titlestr`).
     pub title: String,
     /// Fast prefix sums or the bit-exact recursion.
     pub estimator: Estimator,
-    /// Output directory (created if missing).
-    pub outdir: PathBuf,
-    /// No progress bars.
-    pub quiet: bool,
-    /// Print phase timings on stderr (for the benchmark).
-    pub timings: bool,
-    /// Also run the IEEE 952 analysis (section and files beside the compat outputs).
-    pub ieee952: bool,
-    /// Seconds dropped at the start of the record (a warm-up), before everything.
-    pub skip_start: Option<f64>,
-    /// Drop the samples the record check finds to be spikes, before everything else.
-    pub drop_outliers: bool,
-    /// Analyse other tools' Allan curves instead of samples (`--curves`).
-    pub curves: Option<CurvesInput>,
-    /// What the user said about a log whose content does not say it all (a text log's
-    /// columns and units).
-    pub input_options: bag2mat::formats::InputOptions,
 }
 
-/// `--curves`: the files and what the user said about them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CurvesInput {
-    /// A directory (imu_utils) or files.
-    pub paths: Vec<PathBuf>,
-    /// Record length, sample count, rate, units.
-    pub options: crate::ieee952::curves_in::Options,
+impl Config {
+    /// Settings for `input` with every other choice at its default.
+    pub fn new(input: crate::front::Input, out_dir: impl Into<PathBuf>) -> Config {
+        Config {
+            common: crate::front::Common::new(input, out_dir),
+            title: String::new(),
+            estimator: Estimator::PrefixSum,
+        }
+    }
 }
 
 /// The numbers of one run.
@@ -117,7 +98,7 @@ pub struct RunOutput {
     /// What the record check found (stderr, always).
     pub findings: Vec<bag2mat::record_check::Finding>,
     /// Notes and warnings (stderr), in order.
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Files written.
     pub written: Vec<PathBuf>,
     /// Wall time of each phase.
@@ -150,19 +131,44 @@ impl std::fmt::Display for Timings {
     }
 }
 
+/// The whole job as the binary says it: [`run`] or [`run_curves`], each result a
+/// [`crate::front::Section`] (the topic, notes, findings, text, files and timings).
+pub fn sections(config: &Config) -> Result<Vec<crate::front::Section>, Error> {
+    if let crate::front::Input::Curves(curves) = &config.common.input {
+        let out = run_curves(config, curves)?;
+        return Ok(vec![crate::front::Section {
+            notes: out.notes,
+            text: out.text,
+            written: out.written,
+            ..Default::default()
+        }]);
+    }
+    Ok(run(config)?
+        .into_iter()
+        .map(|out| crate::front::Section {
+            topic: out.topic,
+            notes: out.notes,
+            findings: out.findings,
+            text: out.text + out.ieee952_text.as_deref().unwrap_or(""),
+            written: out.written,
+            timings: vec![out.timings.to_string()],
+        })
+        .collect())
+}
+
 /// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
 /// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     let start = Instant::now();
     let datas = input::load_all(
-        &config.input,
-        &config.topics,
-        config.time,
-        config.quiet,
-        &config.input_options,
+        config.common.samples_path(),
+        &config.common.topics,
+        config.common.time,
+        config.common.quiet,
+        &config.common.input_options,
     )?;
     let load = start.elapsed().as_secs_f64();
-    let several = datas.len() > 1 || config.topics.all_imu;
+    let several = datas.len() > 1 || config.common.topics.all_imu;
     let names: Vec<String> = datas
         .iter()
         .map(|d| d.topic.clone().unwrap_or_default())
@@ -173,7 +179,7 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     for (data, folder) in datas.into_iter().zip(folders) {
         let mut c = config.clone();
         if several {
-            c.outdir = config.outdir.join(folder);
+            c.common.out_dir = config.common.out_dir.join(folder);
         }
         let mut out = run_on(&c, data)?;
         out.timings.load = load;
@@ -185,15 +191,15 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
 /// [`run`] on samples already in memory.
 pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
-    let mut notes: Vec<String> = data.notes.iter().map(|n| format!("warning: {n}")).collect();
+    let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
-    if let Some(skip) = config.skip_start {
+    if let Some(skip) = config.common.skip_start {
         let (k, warning) = skip_start(&mut data, skip)?;
-        notes.extend(warning.map(|w| format!("warning: {w}")));
-        notes.push(format!(
+        notes.extend(warning.map(Note::warning));
+        notes.push(Note::info(format!(
             "--skip-start {skip}: dropped the first {k} samples ({} left)",
             data.len()
-        ));
+        )));
     }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
@@ -207,7 +213,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let check = bag2mat::record_check::check(
         &data.record(),
         &bag2mat::record_check::Options {
-            drop_outliers: config.drop_outliers,
+            drop_outliers: config.common.drop_outliers,
         },
     );
     let checks_s = checks_start.elapsed().as_secs_f64();
@@ -232,33 +238,29 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         }
         match scan.problem(name) {
             Some((true, what)) => return Err(Error::BadData { what }),
-            Some((false, what)) => notes.push(format!("warning: {what}")),
+            Some((false, what)) => notes.push(Note::warning(what)),
             None => {}
         }
     }
-    let rate = input::choose_rate(config.update_rate, check.rate, data.len())?;
-    notes.extend(rate.message.clone());
+    let rate = input::choose_rate(config.common.rate, check.rate, data.len())?;
+    notes.extend(rate.message.clone().map(Note::info));
     findings.extend(rate.finding.clone());
-    let topic = data.topic.clone().unwrap_or_else(|| {
-        config
-            .topics
-            .topics
-            .first()
-            .cloned()
-            .unwrap_or_else(|| "imu".into())
-    });
+    let topic = data
+        .topic
+        .clone()
+        .unwrap_or_else(|| config.common.named_topic().to_string());
     // The IEEE 952 analysis reads the raw columns, so its curves are made before the compat
     // path turns them into prefix sums; its fits then run beside the compat path. Data too
     // short for it only cost the section, with a note.
     let start = Instant::now();
     let refusal = check.refusal().cloned();
-    if let (true, Some(r)) = (config.ieee952, &refusal) {
-        notes.push(format!(
+    if let (true, Some(r)) = (config.common.ieee952, &refusal) {
+        notes.push(Note::warning(format!(
             "IEEE 952 section not computed: the record breaks its assumptions ({})",
             r.short()
-        ));
+        )));
     }
-    let curves = if config.ieee952 && refusal.is_none() {
+    let curves = if config.common.ieee952 && refusal.is_none() {
         let a = &data.axes;
         let series = [
             &a[3][..],
@@ -296,7 +298,8 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         },
         || {
             let start = Instant::now();
-            analyse(axes, rate.used, config.estimator, config.quiet).map(|a| (a, start.elapsed()))
+            analyse(axes, rate.used, config.estimator, config.common.quiet)
+                .map(|a| (a, start.elapsed()))
         },
     );
     let (mut analysis, analyse_t) = analysis?;
@@ -309,7 +312,8 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
 
     // Render the text outputs before touching the output directory.
     let source = config
-        .input
+        .common
+        .samples_path()
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
@@ -334,7 +338,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     )
     .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
 
-    let dir = &config.outdir;
+    let dir = &config.common.out_dir;
     bag2mat::shared::output::ensure_dir(dir)?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
@@ -346,7 +350,9 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
     let title = if config.title.is_empty() {
         config
+            .common
             .input
+            .first()
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default()
@@ -361,7 +367,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
                 return Ok(Vec::new());
             };
             let mut w = crate::ieee952::files::write_outputs(an, dir, "", &topic)?;
-            let truth = crate::ieee952::plot::find_truth(&config.input, an);
+            let truth = crate::ieee952::plot::find_truth(config.common.samples_path(), an);
             w.extend(crate::ieee952::plot::write_chart(
                 an,
                 &title,
@@ -388,7 +394,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         text,
         ieee952_text: ieee.as_ref().map(|a| {
             crate::ieee952::imu::summary_text(a)
-                + &crate::ieee952::stated::beside_ours(a, &config.input, &topic)
+                + &crate::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
         }),
         findings,
         notes,
@@ -412,7 +418,7 @@ pub struct CurvesOutput {
     /// The IEEE 952 section.
     pub text: String,
     /// Notes (how the sample count was found, …).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Files written.
     pub written: Vec<PathBuf>,
     /// The analysis.
@@ -421,10 +427,13 @@ pub struct CurvesOutput {
 
 /// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat
 /// outputs), with the same files and chart as from a bag.
-pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput, Error> {
+pub fn run_curves(
+    config: &Config,
+    curves: &crate::front::CurvesInput,
+) -> Result<CurvesOutput, Error> {
     let mut opts = curves.options.clone();
     if opts.rate.is_none() {
-        opts.rate = config.update_rate;
+        opts.rate = config.common.rate;
     }
     let c = crate::ieee952::curves_in::read(&curves.paths, &opts)?;
     let sensors: Vec<_> = c
@@ -436,18 +445,20 @@ pub fn run_curves(config: &Config, curves: &CurvesInput) -> Result<CurvesOutput,
         crate::ieee952::imu::analyse_curves(&sensors, c.rate, &crate::ieee952::Config::default());
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
-    let dir = &config.outdir;
+    let dir = &config.common.out_dir;
     bag2mat::shared::output::ensure_dir(dir)?;
     let title = if config.title.is_empty() {
         config
+            .common
             .input
+            .first()
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default()
     } else {
         config.title.clone()
     };
-    let rostopic = config.topics.topics.first().map_or("imu", |s| s.as_str());
+    let rostopic = config.common.named_topic();
     let mut written = crate::ieee952::files::write_outputs(&an, dir, "", rostopic)?;
     written.extend(crate::ieee952::plot::write_chart(
         &an, &title, None, dir, "",

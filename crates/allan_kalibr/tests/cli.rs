@@ -186,7 +186,8 @@ fn mat_input_matches_bag_input() {
         ]);
     }
     write_data_imu(&mat, &m).unwrap();
-    // Default OUTDIR: beside the input.
+    // Default output folder: <stem>_allan_kalibr/ beside the input (issue 21: never the data
+    // folder itself).
     let o = run(&[
         mat.to_str().unwrap(),
         "--update-rate",
@@ -203,8 +204,13 @@ fn mat_input_matches_bag_input() {
         .collect();
     assert_eq!(chart, process_lines(case));
     assert!(s(&o.stdout).ends_with(&case.kalibr("final.txt")));
+    let default_out = mat.with_file_name(format!(
+        "{}_allan_kalibr",
+        mat.file_stem().unwrap().to_string_lossy()
+    ));
     for f in OUTPUTS {
-        assert!(tmp.path().join(f).exists(), "{f} not beside the input");
+        assert!(default_out.join(f).exists(), "{f} not in {default_out:?}");
+        assert!(!tmp.path().join(f).exists(), "{f} written into the data folder");
     }
     let warn = run(&[
         mat.to_str().unwrap(),
@@ -494,6 +500,8 @@ fn defect_07_the_input_is_never_overwritten() {
         "imu",
         "-q",
         "--compat-only",
+        "-o",
+        dir.path().to_str().unwrap(),
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");

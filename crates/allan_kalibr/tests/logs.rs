@@ -55,7 +55,9 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        let run = allan_kalibr::run::run(&args.into()).unwrap().remove(0);
+        let run = allan_kalibr::run::run(&args.try_into().unwrap())
+            .unwrap()
+            .remove(0);
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (
             read("ieee952_terms.csv"),

@@ -10,6 +10,7 @@ fn main() -> anyhow::Result<()> {
     let sel = bag2mat::TopicSelector {
         topics: vec![],
         all_imu: true,
+        preferred: None,
     };
     let r = bag2mat::read_imu_topics(
         std::path::Path::new(&path),

@@ -384,6 +384,7 @@ mod tests {
             topics: TopicSelector {
                 topics: vec!["/imu0".into(), "/imu1".into()],
                 all_imu: false,
+                preferred: None,
             },
             output: None,
             format: Format::Mat,

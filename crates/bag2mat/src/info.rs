@@ -185,6 +185,7 @@ fn check_imu_topics(src: &dyn source::Source, by: &mut BTreeMap<(String, String)
     let sel = crate::TopicSelector {
         topics: Vec::new(),
         all_imu: true,
+        preferred: None,
     };
     // a topic that cannot be read as Imu keeps its plain summary (the read says why)
     let Ok(read) = crate::series::read_from(src, &sel, &crate::ReadOptions { quiet: true }) else {

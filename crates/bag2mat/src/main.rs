@@ -22,7 +22,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 struct Args {
     #[command(subcommand)]
     command: Option<Command>,
-    /// The input: a ROS 1 bag, a ROS 2 bag directory, an .mcap or a .db3.
+    /// The input: a ROS 1 bag, a ROS 2 bag directory, an .mcap or a .db3, or an IMU log
+    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
     bag: Option<PathBuf>,
     /// The Imu topic (`imu` and `/imu` are tried in that order if the exact name is missing)
     /// [default: the input's only sensor_msgs/Imu topic].
@@ -41,8 +42,8 @@ struct Args {
     #[arg(long, value_enum)]
     format: Option<FormatArg>,
     /// The time in column t: the record (receive) time, as bagconvert, or header.stamp.
-    #[arg(long, value_enum, default_value_t = TimeArg::Record)]
-    time: TimeArg,
+    #[arg(long, value_enum, default_value_t = TimeColumn::Record)]
+    time: TimeColumn,
     /// Only errors and warnings: no progress bar, no log lines.
     #[arg(short, long)]
     quiet: bool,
@@ -80,15 +81,6 @@ enum FormatArg {
     Csv,
     /// NumPy .npy, float64, shape (N, 7).
     Npy,
-}
-
-/// The time column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TimeArg {
-    /// Record (receive) time: bagconvert's rule.
-    Record,
-    /// header.stamp.
-    Header,
 }
 
 const TOOL: &str = "bag2mat";
@@ -145,13 +137,11 @@ fn main() -> ExitCode {
                 topics: TopicSelector {
                     topics,
                     all_imu: a.all_imu_topics,
+                    preferred: None,
                 },
                 output: a.output,
                 format,
-                time: match a.time {
-                    TimeArg::Record => TimeColumn::Record,
-                    TimeArg::Header => TimeColumn::Header,
-                },
+                time: a.time,
                 quiet: a.quiet,
                 input: a.input.options(a.rate),
             };

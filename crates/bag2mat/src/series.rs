@@ -24,14 +24,18 @@ pub struct ReadOptions {
     pub quiet: bool,
 }
 
-/// Which topics to read. None named and not `all_imu` (the default): the input's only
-/// `sensor_msgs/Imu` topic, an error naming them when there are several.
+/// Which topics to read. None named and not `all_imu` (the default): `preferred` when the
+/// input has it, else the input's only `sensor_msgs/Imu` topic, an error naming them when
+/// there are several.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct TopicSelector {
     /// Topics by name (each tried in the other slash form when missing).
     pub topics: Vec<String>,
     /// Every topic that carries `sensor_msgs/Imu`, besides the named ones.
     pub all_imu: bool,
+    /// The topic read when none is named and the input has it (in either slash form): the
+    /// analysers' upstream default `imu`. `None` (bag2mat): only the only-topic rule.
+    pub preferred: Option<String>,
 }
 
 impl TopicSelector {
@@ -39,13 +43,13 @@ impl TopicSelector {
     pub fn one(topic: &str) -> TopicSelector {
         TopicSelector {
             topics: vec![topic.to_string()],
-            all_imu: false,
+            ..TopicSelector::default()
         }
     }
 }
 
-/// Which time goes into the time column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Which time goes into the time column (also the tools' `--time` values).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum TimeColumn {
     /// The container's record (receive, log) time: bagconvert's rule.
     #[default]
@@ -181,13 +185,13 @@ impl ImuSeries {
 }
 
 /// The analysers' warning for a topic without `absent` (a one-sensor topic).
-pub fn absent_warning(absent: crate::Sensor) -> String {
-    format!(
-        "warning: the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
+pub fn absent_warning(absent: crate::Sensor) -> crate::shared::note::Note {
+    crate::shared::note::Note::warning(format!(
+        "the topic carries no {} (a one-sensor topic): only the {} is analysed; the {} outputs are left out",
         absent.name(),
         absent.other().name(),
         absent.name()
-    )
+    ))
 }
 
 /// What [`ImuSeries::stand_in_absent`] puts in an absent sensor's columns.
@@ -434,13 +438,24 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         push(&mut out, other, cs, Some(note), true)?;
     }
     if sel.topics.is_empty() && !sel.all_imu {
+        if let Some(p) = &sel.preferred {
+            let other = other_slash_form(p);
+            if let Some(t) = [p, &other].into_iter().find(|t| !on(t).is_empty()) {
+                push(&mut out, t.clone(), on(t), None, true)?;
+                return Ok(out);
+            }
+        }
         return match imu_topics(chans)[..] {
             [] => Err(Error::NoImuTopic {
                 available: topic_summaries(src),
             }),
             [t] => {
+                let missing = match &sel.preferred {
+                    Some(p) => format!(" and no '{}'", crate::shared::cli::escape(p)),
+                    None => String::new(),
+                };
                 let note = format!(
-                    "no topic named: reading '{}', the only sensor_msgs/Imu topic",
+                    "no topic named{missing}: reading '{}', the only sensor_msgs/Imu topic",
                     crate::shared::cli::escape(t)
                 );
                 push(&mut out, t.to_string(), on(t), Some(note), true)?;

@@ -55,6 +55,7 @@ fn assert_same_rows(path: &Path, theirs: &[Theirs]) -> Vec<ImuSeries> {
     let sel = TopicSelector {
         topics: vec![],
         all_imu: true,
+        preferred: None,
     };
     let ours = read_imu_topics(path, &sel, &ReadOptions { quiet: true }).unwrap();
     let names: Vec<&str> = ours.series.iter().map(|s| s.topic.as_str()).collect();
@@ -518,6 +519,7 @@ fn a_damaged_ulog_says_what_it_lost_and_keeps_the_rest() {
         &TopicSelector {
             topics: vec![],
             all_imu: true,
+            preferred: None,
         },
         &ReadOptions { quiet: true },
     )
@@ -567,6 +569,7 @@ fn damaged_logs_of_every_format_never_panic() {
     let sel = TopicSelector {
         topics: vec![],
         all_imu: true,
+        preferred: None,
     };
     for (name, src) in [
         ("a.ulg", d.join("a.ulg")),

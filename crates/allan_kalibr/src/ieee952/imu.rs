@@ -200,7 +200,7 @@ pub fn analyse_section(
     series: [&[f64]; 6],
     rate: f64,
     checks: Vec<Finding>,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<bag2mat::shared::note::Note>,
 ) -> Option<ImuAnalysis> {
     section_curves(series, rate, notes).map(|c| c.finish(checks, &Config::default()))
 }
@@ -210,7 +210,7 @@ pub fn analyse_section(
 pub fn section_curves(
     series: [&[f64]; 6],
     rate: f64,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<bag2mat::shared::note::Note>,
 ) -> Option<ImuCurves> {
     section_curves_of(series, None, rate, notes)
 }
@@ -220,12 +220,14 @@ pub fn section_curves_of(
     series: [&[f64]; 6],
     absent: Option<Sensor>,
     rate: f64,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<bag2mat::shared::note::Note>,
 ) -> Option<ImuCurves> {
     match ImuCurves::from_samples_of(series, absent, rate, &Config::default()) {
         Ok(c) => Some(c),
         Err(e) => {
-            notes.push(format!("IEEE 952 analysis skipped: {e}"));
+            notes.push(bag2mat::shared::note::Note::warning(format!(
+                "IEEE 952 analysis skipped: {e}"
+            )));
             None
         }
     }

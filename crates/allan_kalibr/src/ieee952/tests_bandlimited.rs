@@ -171,22 +171,9 @@ fn mat_cases() -> Vec<Outcome> {
     bag2mat::mat::write_data_imu(&mat, &data).expect("write .mat");
     drop(data);
     let out = dir.path().join("out");
-    let config = crate::run::Config {
-        input: mat,
-        topics: bag2mat::TopicSelector::one("/imu0"),
-        time: bag2mat::TimeColumn::default(),
-        update_rate: None,
-        title: "bmi088-like".into(),
-        estimator: crate::estimator::Estimator::default(),
-        outdir: out.clone(),
-        quiet: true,
-        timings: false,
-        ieee952: true,
-        skip_start: None,
-        input_options: Default::default(),
-        drop_outliers: false,
-        curves: None,
-    };
+    let mut config = crate::run::Config::new(crate::front::Input::Samples(mat), out.clone());
+    config.common.topics = bag2mat::TopicSelector::one("/imu0");
+    config.title = "bmi088-like".into();
     crate::run::run(&config).expect("allan_kalibr run on the .mat");
     let csv = std::fs::read_to_string(out.join(super::files::TERMS_FILE)).expect("terms file");
     let mut lines = csv.lines().filter(|l| !l.starts_with('#'));

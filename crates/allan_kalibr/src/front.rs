@@ -1,0 +1,483 @@
+//! The analysers' one front end: the arguments both `allan_kalibr` and `allan_imu_utils`
+//! take ([`CommonArgs`], flattened into each tool's clap struct), their resolution into
+//! [`Common`] settings, and the one [`finish`] that runs a job inside an all-or-none output
+//! stage and says its results, notes, findings and timings the same way for both tools.
+//!
+//! One spelling for both tools: `-o/--out-dir` (kalibr_allan's `--outdir` and imu_utils'
+//! `data_save_path` as aliases), `--rate` (`--update-rate` as alias). A flag that would do
+//! nothing for the input is an error, never ignored. Results go to a folder of their own
+//! (`<input stem>_<tool>/` beside the input) unless `-o` says otherwise: never the data folder.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use bag2mat::record_check::Finding;
+use bag2mat::shared::note::Note;
+use bag2mat::shared::{cli, output};
+
+/// The slowest sample rate accepted, Hz: below it a τ grid of seconds-to-hours is meaningless
+/// and the printed numbers run to hundreds of digits.
+pub const MIN_RATE_HZ: f64 = 1e-3;
+/// The fastest sample rate accepted, Hz (IMUs sample at 1 Hz to a few tens of kHz).
+pub const MAX_RATE_HZ: f64 = 1e7;
+
+/// The topic read when none is named and the input has it: both upstream tools' default.
+pub const DEFAULT_TOPIC: &str = "imu";
+
+/// The arguments both analysers take, in one place.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct CommonArgs {
+    /// The input: a ROS 1 bag (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, an
+    /// .mcap or .db3, a bagconvert .mat (data_imu, N x 7: t ax ay az wx wy wz), or an IMU log
+    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
+    #[arg(required_unless_present = "curves", value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// Analyse existing Allan curves instead (IEEE 952 section only): an imu_utils data
+    /// directory, allan_variance_ros' allan_variance.csv, an allan_curves.csv, an
+    /// ieee952_curves.csv, or a plain CSV `tau,x,y,z` (one sensor; give --units). A plain CSV
+    /// per sensor may be given twice.
+    #[arg(long, value_name = "PATH", conflicts_with = "input")]
+    pub curves: Vec<PathBuf>,
+    /// Unit of each plain CSV of --curves, in order: rad/s, deg/s, deg/h, imu_utils, m/s^2,
+    /// g, mg (the values are Allan deviations).
+    #[arg(long, value_name = "UNIT")]
+    pub units: Vec<String>,
+    /// Length of the record behind --curves, in seconds (for the confidence intervals).
+    #[arg(long, value_name = "SECONDS", conflicts_with = "samples", value_parser = cli::positive_f64)]
+    pub duration: Option<f64>,
+    /// Number of samples behind --curves (for the confidence intervals).
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u64>,
+    /// The sample rate, Hz: of a text log without a time column, or of plain --curves CSVs
+    /// whose τ do not start at one sample (allan_kalibr: also the τ grid's update_rate;
+    /// default: estimated from the time stamps).
+    #[arg(long, value_name = "HZ", visible_alias = "update-rate", value_parser = rate_hz)]
+    pub rate: Option<f64>,
+    /// Drop the first SECONDS of the record (a warm-up) before any analysis.
+    #[arg(long, value_name = "SECONDS", value_parser = cli::positive_f64)]
+    pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes (a sample far off its
+    /// neighbours, reported with its time) before any analysis.
+    #[arg(long)]
+    pub drop_outliers: bool,
+    /// The sensor_msgs/Imu topic (`imu` and `/imu` are the same); repeatable, each topic
+    /// then gets its own folder under the output directory [default: `imu` when the input
+    /// has it, else the input's only Imu topic].
+    #[arg(long = "topic", value_name = "TOPIC")]
+    pub topics: Vec<String>,
+    /// Every topic of the input that carries sensor_msgs/Imu, each into its own folder.
+    #[arg(long)]
+    pub all_imu_topics: bool,
+    /// Output directory, created if missing [default: <input stem>_<tool>/ beside the input].
+    #[arg(
+        short = 'o',
+        long = "out-dir",
+        value_name = "DIR",
+        visible_aliases = ["outdir", "data-save-path"]
+    )]
+    pub out_dir: Option<PathBuf>,
+    /// Only errors and warnings on stderr: no progress bars, no "wrote" lines (the results
+    /// still go to stdout).
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Print the wall time of each phase on stderr (for benchmarks).
+    #[arg(long)]
+    pub timings: bool,
+    /// Only what the upstream tool produces: skip the IEEE 952 section and its files.
+    #[arg(long)]
+    pub compat_only: bool,
+    #[command(flatten)]
+    pub input_args: bag2mat::formats::InputArgs,
+}
+
+/// `--rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
+fn rate_hz(s: &str) -> Result<f64, String> {
+    let v = cli::positive_f64(s)?;
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
+        return Err(format!(
+            "{s} Hz is outside {MIN_RATE_HZ} .. {MAX_RATE_HZ:e} Hz"
+        ));
+    }
+    Ok(v)
+}
+
+/// What a run reads: samples, or Allan curves another tool wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Input {
+    /// A bag, a `.mat` or an IMU log.
+    Samples(PathBuf),
+    /// `--curves`.
+    Curves(CurvesInput),
+}
+
+impl Input {
+    /// The paths the run reads (never an output).
+    pub fn paths(&self) -> Vec<&Path> {
+        match self {
+            Input::Samples(p) => vec![p.as_path()],
+            Input::Curves(c) => c.paths.iter().map(|p| p.as_path()).collect(),
+        }
+    }
+
+    /// The first path: what the default output folder is named after.
+    pub fn first(&self) -> &Path {
+        self.paths().first().copied().unwrap_or(Path::new("."))
+    }
+}
+
+/// `--curves`: the files and what the user said about them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvesInput {
+    /// A directory (imu_utils) or files.
+    pub paths: Vec<PathBuf>,
+    /// Record length, sample count, rate, units, name.
+    pub options: crate::ieee952::curves_in::Options,
+}
+
+/// The settings both analysers share, resolved from [`CommonArgs`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Common {
+    /// Samples or curves.
+    pub input: Input,
+    /// Topics (bag2mat's topic rules, `imu` preferred); each of several gets its own folder.
+    pub topics: bag2mat::TopicSelector,
+    /// The time column.
+    pub time: bag2mat::TimeColumn,
+    /// `--rate`, Hz.
+    pub rate: Option<f64>,
+    /// Output directory (created if missing).
+    pub out_dir: PathBuf,
+    /// Seconds dropped at the start of the record (a warm-up), before everything.
+    pub skip_start: Option<f64>,
+    /// Drop the samples the record check finds to be spikes, before everything else.
+    pub drop_outliers: bool,
+    /// No progress bars, no information notes.
+    pub quiet: bool,
+    /// Print phase timings on stderr.
+    pub timings: bool,
+    /// Also run the IEEE 952 analysis (section and files beside the compat outputs).
+    pub ieee952: bool,
+    /// What the user said about a log whose content does not say it all (a text log's
+    /// columns, units and, without a time column, its rate).
+    pub input_options: bag2mat::formats::InputOptions,
+}
+
+impl Common {
+    /// Settings for `input` with every other choice at its default (library callers, tests).
+    pub fn new(input: Input, out_dir: impl Into<PathBuf>) -> Common {
+        Common {
+            input,
+            topics: default_topics(),
+            time: bag2mat::TimeColumn::Record,
+            rate: None,
+            out_dir: out_dir.into(),
+            skip_start: None,
+            drop_outliers: false,
+            quiet: true,
+            timings: false,
+            ieee952: true,
+            input_options: Default::default(),
+        }
+    }
+
+    /// The topic a `.mat` or curves input stands for (imu.yaml's `rostopic`): the first
+    /// named, else the default.
+    pub fn named_topic(&self) -> &str {
+        self.topics
+            .topics
+            .first()
+            .or(self.topics.preferred.as_ref())
+            .map_or(DEFAULT_TOPIC, |s| s.as_str())
+    }
+
+    /// The samples' path (empty with `--curves`).
+    pub fn samples_path(&self) -> &Path {
+        match &self.input {
+            Input::Samples(p) => p,
+            Input::Curves(_) => Path::new(""),
+        }
+    }
+}
+
+/// No topic named: `imu` when the input has it, else its only Imu topic.
+pub fn default_topics() -> bag2mat::TopicSelector {
+    bag2mat::TopicSelector {
+        preferred: Some(DEFAULT_TOPIC.to_string()),
+        ..Default::default()
+    }
+}
+
+/// The default output folder of `tool` for `input`: `<stem>_<tool>` beside it (a bag
+/// directory's or curves directory's name stands for the stem), never the data folder.
+pub fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
+    let input = if input.file_name().is_some_and(|n| n == "metadata.yaml") {
+        input.parent().unwrap_or(Path::new("."))
+    } else {
+        input
+    };
+    // a directory by its own name ("." included), a file by its stem
+    let (parent, stem) = if input.is_dir() {
+        let canon = std::fs::canonicalize(input).unwrap_or_else(|_| input.to_path_buf());
+        let parent = canon.parent().map(Path::to_path_buf).unwrap_or_default();
+        (parent, canon.file_name().map(|s| s.to_os_string()))
+    } else {
+        let parent = input.parent().map(Path::to_path_buf).unwrap_or_default();
+        (parent, input.file_stem().map(|s| s.to_os_string()))
+    };
+    let stem = stem
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "input".to_string());
+    parent.join(format!("{stem}_{tool}"))
+}
+
+impl CommonArgs {
+    /// --units, --duration, --samples (and `more`) describe Allan curves: without --curves
+    /// they would be ignored in silence.
+    pub fn curve_flags_need_curves(&self, more: &[(&str, bool)]) -> Result<(), String> {
+        let mut flags = vec![
+            ("--units", !self.units.is_empty()),
+            ("--duration", self.duration.is_some()),
+            ("--samples", self.samples.is_some()),
+        ];
+        flags.extend_from_slice(more);
+        cli::only_with("--curves", !self.curves.is_empty(), &flags)
+    }
+
+    /// The settings, for `tool` (the default output folder's suffix), with `time` and the
+    /// curves' IMU `name` (imu_utils' `--name`). `out_dir` given by a tool's own source (a
+    /// launch file) stands in for a missing `-o`. `timeless_rate` is the rate a text log
+    /// without a time column is sampled at.
+    pub fn resolve(
+        self,
+        tool: &str,
+        time: bag2mat::TimeColumn,
+        name: Option<String>,
+        out_dir: Option<PathBuf>,
+        timeless_rate: Option<f64>,
+    ) -> Common {
+        let input = match self.input {
+            Some(p) => Input::Samples(p),
+            None => Input::Curves(CurvesInput {
+                paths: self.curves.clone(),
+                options: crate::ieee952::curves_in::Options {
+                    duration: self.duration,
+                    samples: self.samples,
+                    rate: self.rate,
+                    units: self.units.clone(),
+                    name,
+                },
+            }),
+        };
+        let out_dir = self
+            .out_dir
+            .or(out_dir)
+            .unwrap_or_else(|| default_out_dir(input.first(), tool));
+        let topics = if self.topics.is_empty() && !self.all_imu_topics {
+            default_topics()
+        } else {
+            bag2mat::TopicSelector {
+                topics: self.topics,
+                all_imu: self.all_imu_topics,
+                preferred: None,
+            }
+        };
+        Common {
+            input,
+            topics,
+            time,
+            rate: self.rate,
+            out_dir,
+            skip_start: self.skip_start,
+            drop_outliers: self.drop_outliers,
+            quiet: self.quiet,
+            timings: self.timings,
+            ieee952: !self.compat_only,
+            input_options: self.input_args.options(timeless_rate),
+        }
+    }
+}
+
+/// The rate a text log without a time column is sampled at: `--rate` when the input is a
+/// text log (for every other input the rate is the stamps'; the reader refuses a rate it
+/// cannot use, so a flag that does nothing is an error).
+pub fn rate_for_text(input: Option<&Path>, rate: Option<f64>) -> Option<f64> {
+    let text = input.is_some_and(|p| {
+        matches!(
+            bag2mat::source::detect(p),
+            Ok(bag2mat::source::InputKind::Text)
+        )
+    });
+    rate.filter(|_| text)
+}
+
+/// What a run says about one topic (or about the curves it read).
+#[derive(Debug, Default)]
+pub struct Section {
+    /// The topic, when the run read several (a header line before its text).
+    pub topic: Option<String>,
+    /// Notes and warnings, in order.
+    pub notes: Vec<Note>,
+    /// What the record check found (always said).
+    pub findings: Vec<Finding>,
+    /// The results (stdout).
+    pub text: String,
+    /// Files written (a "wrote" line each, without --quiet).
+    pub written: Vec<PathBuf>,
+    /// Phase timings, one line each (with --timings).
+    pub timings: Vec<String>,
+}
+
+/// Parses the tool's arguments into its settings: `--help`/`--version` print and exit 0,
+/// a command line that cannot be run is a usage error (exit 2).
+pub fn parse<A: clap::Parser, C>(
+    tool: &str,
+    resolve: impl FnOnce(A) -> Result<C, String>,
+) -> Result<C, ExitCode> {
+    let args = match A::try_parse() {
+        Ok(a) => a,
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return Err(ExitCode::SUCCESS);
+        }
+        Err(e) => return Err(cli::usage(tool, &e.render().to_string())),
+    };
+    resolve(args).map_err(|e| cli::usage(tool, &e))
+}
+
+/// Runs `job` with every output staged (all of them or none are put in place), then says
+/// what it found: per section its notes (warnings always, information without --quiet),
+/// the record check's findings, the results on stdout, the files written and the timings.
+/// The exit code: 0, or 1 with the error said once.
+pub fn finish<E: std::fmt::Display>(
+    tool: &str,
+    common: &Common,
+    job: impl FnOnce() -> Result<Vec<Section>, E>,
+) -> ExitCode {
+    for p in common.input.paths() {
+        output::protect_input(p);
+    }
+    let started = std::time::Instant::now();
+    let staging = output::Staging::begin();
+    let sections = match job() {
+        Ok(s) => s,
+        Err(e) => return cli::fail(tool, &e),
+    };
+    if let Err(e) = staging.commit() {
+        return cli::fail(tool, &e);
+    }
+    let several = sections.iter().filter(|s| s.topic.is_some()).count() > 1;
+    let mut printing = true;
+    for s in &sections {
+        for n in &s.notes {
+            if n.is_warning() || !common.quiet {
+                eprintln!("{}", n.line());
+            }
+        }
+        let topic = s.topic.as_deref().filter(|_| several);
+        for f in &s.findings {
+            eprintln!("{}", f.line(topic));
+        }
+        if printing {
+            let mut text = String::new();
+            if let Some(t) = topic {
+                text.push_str(&format!("===== topic {t} =====\n"));
+            }
+            text.push_str(&s.text);
+            match cli::print(&text) {
+                Ok(more) => printing = more,
+                Err(e) => return cli::fail(tool, &e),
+            }
+        }
+        if !common.quiet {
+            for line in wrote_lines(&s.written) {
+                eprintln!("{line}");
+            }
+        }
+        if common.timings {
+            for t in &s.timings {
+                eprintln!("{t}");
+            }
+        }
+    }
+    if common.timings {
+        eprintln!("timing total {:.3} s", started.elapsed().as_secs_f64());
+    }
+    ExitCode::SUCCESS
+}
+
+/// "wrote N files to DIR/: a, b, …", one line per folder, in the order written.
+fn wrote_lines(written: &[PathBuf]) -> Vec<String> {
+    let mut folders: Vec<(&Path, Vec<String>)> = Vec::new();
+    for p in written {
+        let dir = p.parent().unwrap_or(Path::new(""));
+        let name = p.file_name().map_or_else(
+            || p.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        match folders.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, names)) => names.push(name),
+            None => folders.push((dir, vec![name])),
+        }
+    }
+    folders
+        .into_iter()
+        .map(|(dir, names)| {
+            let dir = if dir.as_os_str().is_empty() {
+                ".".to_string()
+            } else {
+                dir.display().to_string()
+            };
+            let files = if names.len() == 1 { "file" } else { "files" };
+            format!(
+                "wrote {} {files} to {dir}/: {}",
+                names.len(),
+                names.join(", ")
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_output_folder_is_beside_the_input_never_in_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let bag = dir.path().join("rec.bag");
+        std::fs::write(&bag, b"x").unwrap();
+        assert_eq!(
+            default_out_dir(&bag, "allan_kalibr"),
+            dir.path().join("rec_allan_kalibr")
+        );
+        let ros2 = dir.path().join("run1");
+        std::fs::create_dir(&ros2).unwrap();
+        std::fs::write(ros2.join("metadata.yaml"), b"x").unwrap();
+        let canon = std::fs::canonicalize(dir.path()).unwrap();
+        assert_eq!(
+            default_out_dir(&ros2, "allan_imu_utils"),
+            canon.join("run1_allan_imu_utils")
+        );
+        assert_eq!(
+            default_out_dir(&ros2.join("metadata.yaml"), "allan_imu_utils"),
+            canon.join("run1_allan_imu_utils")
+        );
+        assert_eq!(
+            default_out_dir(Path::new("x.mat"), "allan_kalibr"),
+            PathBuf::from("x_allan_kalibr")
+        );
+    }
+
+    #[test]
+    fn the_files_written_are_said_once_per_folder() {
+        let w = ["o/a.yaml", "o/b.csv", "o/s/c.png"].map(PathBuf::from);
+        assert_eq!(
+            wrote_lines(&w),
+            [
+                "wrote 2 files to o/: a.yaml, b.csv",
+                "wrote 1 file to o/s/: c.png"
+            ]
+        );
+    }
+}
