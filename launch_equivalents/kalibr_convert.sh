@@ -1,3 +1,4 @@
 #!/bin/sh
 # ROS: rosrun bagconvert bagconvert BAG TOPIC (writes BAG's stem .mat beside it). Usage: kalibr_convert.sh BAG [TOPIC]
-exec bag2mat "$1" "${2:-imu}"
+. "$(dirname "$0")/lib.sh"
+if [ $# -gt 1 ]; then tool bag2mat "$1" "$2"; else tool bag2mat "$1"; fi

@@ -64,3 +64,17 @@ target_dir=$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c '
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 BIN_DIR="$target_dir/debug" scripts/compare.sh --duration 1800 --rate 100 --out "$out" --check
+
+# The launch_equivalents scripts as a user runs them once scripts/install.sh has put the
+# binaries on PATH (here: the ones cargo test built), each output where the script says.
+le="$out/launch_equivalents"
+mkdir -p "$le"
+PATH="$target_dir/debug:$PATH" launch_equivalents/simulate.sh "$le/imu.bag" --duration 120 --rate 100 --seed 3 --quiet
+PATH="$target_dir/debug:$PATH" launch_equivalents/kalibr_convert.sh "$le/imu.bag" > /dev/null 2>&1
+PATH="$target_dir/debug:$PATH" launch_equivalents/kalibr_analyse.sh "$le/imu.mat" -q > /dev/null
+PATH="$target_dir/debug:$PATH" launch_equivalents/imu_utils.sh "$le/imu.bag" "$le/iu" -q > /dev/null 2>&1
+PATH="$target_dir/debug:$PATH" launch_equivalents/ros2_info.sh "$le/imu.bag" > /dev/null
+for f in imu.mat imu_allan_kalibr/imu.yaml imu_allan_kalibr/kalibr_imu_ieee952.yaml iu/imu_imu_param.yaml; do
+  [ -f "$le/$f" ] || { echo "launch_equivalents: $le/$f was not written" >&2; exit 1; }
+done
+echo "launch_equivalents: simulate, convert, analyse (both tools) and info ran" >&2

@@ -12,6 +12,7 @@ mod common;
 mod curves;
 mod defects19;
 mod fit_reference;
+mod front;
 mod issue18;
 mod logs;
 mod reference;

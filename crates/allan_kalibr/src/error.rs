@@ -19,7 +19,7 @@ pub enum Error {
         n: usize,
     },
     /// The timestamps cannot give a rate (no --update-rate and no positive time span).
-    #[error("cannot estimate the update rate from the timestamps ({what}); pass --update-rate HZ")]
+    #[error("cannot estimate the update rate from the timestamps ({what}); pass --rate HZ")]
     NoRate {
         /// Why.
         what: String,

@@ -403,7 +403,7 @@ pub fn choose_rate(
             })?;
             let used = snap_rate(m);
             let message = Some(format!(
-                "update rate: {used} Hz (estimated from the timestamps: {m:.4} Hz; pass --update-rate to override)"
+                "update rate: {used} Hz (estimated from the timestamps: {m:.4} Hz; pass --rate to override)"
             ));
             Ok(RateChoice {
                 used,

@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod consumers;
 mod defects19;
+mod front;
 mod ieee952;
 mod issue18;
 mod logs;

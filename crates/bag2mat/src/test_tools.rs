@@ -584,3 +584,26 @@ pub fn euroc_pairing(log: &Path, gyro: &str, acc: &str, dir: &Path) -> PathBuf {
     std::fs::write(imu0.join("data.csv"), s).expect("write data.csv");
     root
 }
+
+/// The Imu samples of `topic` in `src` written again as a ROS 1 bag at `dst`, under each of
+/// `topics` (the same messages on every one): a bag whose only Imu topic is not `imu`, or
+/// one with several.
+pub fn retopic(src: &Path, topic: &str, dst: &Path, topics: &[&str]) {
+    let s = crate::read_imu_series(src, topic, &crate::ReadOptions { quiet: true })
+        .expect("read the source bag");
+    let mut w = crate::bag::BagWriter::create(dst, crate::Compression::None).expect("create");
+    let conns: Vec<_> = topics.iter().map(|t| w.add_imu_connection(t)).collect();
+    for i in 0..s.len() {
+        let m = crate::imu_msg::Imu {
+            seq: s.seq[i],
+            stamp: s.stamp[i],
+            angular_velocity: s.gyro_at(i),
+            linear_acceleration: s.acc_at(i),
+            ..Default::default()
+        };
+        for &c in &conns {
+            w.write_imu(c, s.record_time[i], &m).expect("write");
+        }
+    }
+    w.finish().expect("finish the bag");
+}

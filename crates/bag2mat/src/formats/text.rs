@@ -579,7 +579,7 @@ fn layout(path: &Path, head: &[u8], file_len: u64, opts: &InputOptions) -> Resul
         return Err(bad(
             path,
             format!(
-                "no time column among {} (t, time, timestamp, …): name it with --columns, or give the sample rate (bag2mat --rate, allan_kalibr --update-rate, allan_imu_utils --rate)",
+                "no time column among {} (t, time, timestamp, …): name it with --columns, or give the sample rate (--rate, in every tool)",
                 names.join(", ")
             ),
         ));
