@@ -352,14 +352,28 @@ pub struct RateChoice {
     pub finding: Option<bag2mat::record_check::Finding>,
 }
 
-/// A rate from the stamps within [`RATE_SNAP_REL`] of an integer is that integer.
+/// A measured rate within this fraction of a rate with at most [`RATE_ROUND_DECIMALS`]
+/// decimals is that rate: 1 ppm, far inside a MEMS clock's own tolerance (10–50 ppm), so the
+/// yaml files say `62.5`, not the float noise of a mean period (`62.49998612009537`).
+pub const RATE_ROUND_REL: f64 = 1e-6;
+/// Decimals of the round rates [`snap_rate`] snaps to within [`RATE_ROUND_REL`].
+pub const RATE_ROUND_DECIMALS: i32 = 3;
+
+/// A rate from the stamps within [`RATE_SNAP_REL`] of an integer is that integer; else one
+/// within [`RATE_ROUND_REL`] of a rate with few decimals is that rate.
 pub fn snap_rate(m: f64) -> f64 {
     let r = m.round();
     if r >= 1.0 && ((m - r) / r).abs() <= RATE_SNAP_REL {
-        r
-    } else {
-        m
+        return r;
     }
+    for d in 1..=RATE_ROUND_DECIMALS {
+        let scale = 10f64.powi(d);
+        let r = (m * scale).round() / scale;
+        if r > 0.0 && ((m - r) / r).abs() <= RATE_ROUND_REL {
+            return r;
+        }
+    }
+    m
 }
 
 /// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span (the
@@ -419,6 +433,15 @@ pub fn choose_rate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn issue21_a_measured_rate_is_said_without_float_noise() {
+        assert_eq!(snap_rate(62.49998612009537), 62.5);
+        assert_eq!(snap_rate(199.3), 199.0);
+        assert_eq!(snap_rate(33.333333), 33.333333);
+        assert_eq!(snap_rate(12.3456), 12.3456);
+        assert_eq!(snap_rate(0.0125000004), 0.0125000004);
+    }
 
     fn times(n: usize, rate: f64) -> Vec<f64> {
         (0..n).map(|i| 1.6e9 + i as f64 / rate).collect()

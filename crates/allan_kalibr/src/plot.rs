@@ -165,7 +165,10 @@ where
         crate::report::matlab_fixed(fit.tau_at1, 2)
     );
     let bias_label = if fit.bias.is_nan() {
-        "+½ fit: σ_b = NaN (no finite point 50 past the minimum)".to_owned()
+        // kalibr_allan's +½ window starts 50 grid points past the curve's minimum: on a
+        // curve that still falls at its end the window is empty (upstream's NaN)
+        "+½ fit: none (the curve has no +½ slope before its end; kalibr_allan prints NaN)"
+            .to_owned()
     } else {
         format!(
             "+½ fit: σ_b = {} {} (τ = {} s)",

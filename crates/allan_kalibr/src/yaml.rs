@@ -71,6 +71,8 @@ impl ImuYaml {
             "Kalibr discretises them with update_rate. Values from static data are",
             "optimistic: users commonly inflate them (x10 or more) before use.",
             ".nan means the fit window was empty (Allan minimum too close to the end).",
+            "For Kalibr, prefer kalibr_imu_ieee952.yaml beside this file (the IEEE 952 fit,",
+            "every value within what the data support); this one reproduces kalibr_allan.",
         ])
     }
 

@@ -159,23 +159,25 @@ where
             });
         }
     }
+    // The IEEE 952 points first, as open circles, and kalibr_allan's curve over them: a
+    // filled dot hid the line it sits on.
     for (i, c) in curves.iter().enumerate() {
         let col = COLORS[i % COLORS.len()];
         chart
+            .draw_series(c.ieee.iter().map(|&p| Circle::new(p, 4, col.stroke_width(1))))
+            .map_err(|x| e(&x))?
+            .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
+        chart
             .draw_series(LineSeries::new(
                 c.kalibr.iter().copied(),
-                col.mix(0.35).stroke_width(1),
+                col.mix(0.8).stroke_width(2),
             ))
             .map_err(|x| e(&x))?
             .label(format!("{}: kalibr_allan (non-overlapping, avg)", c.preset))
             .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], col.mix(0.35).stroke_width(3))
+                PathElement::new(vec![(x, y), (x + 20, y)], col.mix(0.8).stroke_width(3))
             });
-        chart
-            .draw_series(c.ieee.iter().map(|&p| Circle::new(p, 4, col.filled())))
-            .map_err(|x| e(&x))?
-            .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
-            .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.filled()));
     }
     chart
         .configure_series_labels()

@@ -495,6 +495,7 @@ pub fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
         "(largest of the three axes). These are CONTINUOUS-TIME values; Kalibr discretises",
         "them with update_rate. Values from static data are optimistic: users commonly",
         "inflate them (x10 or more) before use.",
+        "This is the file to give Kalibr (imu.yaml beside it reproduces kalibr_allan's).",
     ] {
         let _ = writeln!(o, "# {c}");
     }

@@ -556,6 +556,11 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
             fmt(a.random_walk(sensor), sensor.k_unit()),
         );
     }
+    if !a.sensors().is_empty() {
+        s.push_str(
+            "for Kalibr: the kalibr_imu_ieee952.yaml written with these values (the upstream-compatible yaml reproduces the upstream tool)\n",
+        );
+    }
     s
 }
 

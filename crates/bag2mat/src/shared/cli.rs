@@ -64,17 +64,6 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// A note said as the workspace's warning line: `warning: <what>`, whatever case the note
-/// starts with (the analysers keep upstream's own `WARNING: …` texts in their notes, for
-/// parity with the reference runs).
-pub fn warning_line(note: &str) -> String {
-    let what = ["WARNING: ", "Warning: ", "warning: "]
-        .iter()
-        .find_map(|p| note.strip_prefix(p))
-        .unwrap_or(note);
-    format!("warning: {what}")
-}
-
 /// Flags that only apply with another one: a usage error naming those given without it
 /// (clap's `requires` does not see an empty repeatable flag as absent here).
 pub fn only_with(needed: &str, present: bool, flags: &[(&str, bool)]) -> Result<(), String> {
