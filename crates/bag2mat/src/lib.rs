@@ -34,6 +34,7 @@
 
 pub mod bag;
 pub mod cdr;
+pub mod cli;
 pub mod convert;
 pub mod cursor;
 pub mod decoded;
