@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 /// The workspace's testdata directory.
 pub fn testdata() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testdata")
+    bag2mat::test_tools::testdata()
 }
 
 /// One reference case and the arguments upstream ran with (testdata/README.md, spec §8).

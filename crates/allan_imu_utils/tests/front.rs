@@ -53,6 +53,9 @@ fn issue21_results_go_to_a_folder_of_their_own_and_rate_with_a_bag_is_an_error()
     let o = run(dir.path(), &["rec.bag", "--rate", "100", "-o", "x"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("--rate 100 does nothing for a ROS 1 bag"), "{err}");
+    assert!(
+        err.contains("--rate 100 does nothing for a ROS 1 bag"),
+        "{err}"
+    );
     assert!(!dir.path().join("x").exists());
 }

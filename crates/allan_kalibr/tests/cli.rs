@@ -210,7 +210,10 @@ fn mat_input_matches_bag_input() {
     ));
     for f in OUTPUTS {
         assert!(default_out.join(f).exists(), "{f} not in {default_out:?}");
-        assert!(!tmp.path().join(f).exists(), "{f} written into the data folder");
+        assert!(
+            !tmp.path().join(f).exists(),
+            "{f} written into the data folder"
+        );
     }
     let warn = run(&[
         mat.to_str().unwrap(),

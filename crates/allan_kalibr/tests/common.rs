@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 /// `testdata/` at the workspace top.
 pub fn testdata() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testdata")
+    bag2mat::test_tools::testdata()
 }
 
 /// A public reference case: directory name, bag topic, update_rate given to the scripts.

@@ -58,11 +58,16 @@ fn issue21_results_go_to_a_folder_of_their_own_and_the_only_imu_topic_is_read() 
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert_eq!(names.len(), 2, "the data folder holds {names:?}");
-    assert!(data.join("rec_allan_kalibr/imu.yaml").is_file(), "{names:?}");
+    assert!(
+        data.join("rec_allan_kalibr/imu.yaml").is_file(),
+        "{names:?}"
+    );
     let yaml = std::fs::read_to_string(data.join("rec_allan_kalibr/imu.yaml")).unwrap();
     assert!(
-        yaml.lines()
-            .any(|l| l.split_whitespace().take(2).eq(["rostopic:", "/camera/imu"])),
+        yaml.lines().any(|l| l
+            .split_whitespace()
+            .take(2)
+            .eq(["rostopic:", "/camera/imu"])),
         "{yaml}"
     );
 

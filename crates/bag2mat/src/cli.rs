@@ -17,7 +17,7 @@ use crate::{TimeColumn, TopicSelector};
 /// PX4 ULog, ArduPilot DataFlash .bin, NumPy .npy), recognised from their content.
 /// `bag2mat info BAG` lists what an input holds.
 #[derive(Parser, Debug)]
-#[command(version, about, args_conflicts_with_subcommands = true)]
+#[command(name = "bag2mat", version, args_conflicts_with_subcommands = true)]
 pub struct Args {
     #[allow(missing_docs)] // a subcommand's help is its own
     #[command(subcommand)]
@@ -85,7 +85,6 @@ pub enum FormatArg {
     /// NumPy .npy, float64, shape (N, 7).
     Npy,
 }
-
 
 /// What the command line asked for, done: `Ok(Some(text))` is `bag2mat info`'s report for
 /// stdout; a conversion says what it wrote itself. A command line that cannot be run is

@@ -11,6 +11,30 @@ pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// The repository's `testdata/` folder (the reference outputs and real curves).
+pub fn testdata() -> PathBuf {
+    workspace().join("testdata")
+}
+
+/// A binary of the workspace (`sim`, `allan_kalibr`, …) as `cargo test --workspace` built it
+/// beside the running test (in cargo's target directory, wherever that is); panics with
+/// what to run when it is missing.
+pub fn workspace_binary(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    // <target>/<profile>/deps/<test> → <target>/<profile>/<name>
+    let p = exe
+        .parent()
+        .and_then(Path::parent)
+        .map(|d| d.join(name))
+        .expect("the test binary is in <target>/<profile>/deps");
+    assert!(
+        p.exists(),
+        "{} not built: run cargo test --workspace",
+        p.display()
+    );
+    p
+}
+
 /// The virtual environment `scripts/test.sh` installs.
 pub fn venv() -> PathBuf {
     workspace().join("target/py-venv")

@@ -118,12 +118,7 @@ fn bare_storage_files_read_like_their_directory() {
 fn two_imu_topics_and_another_in_one_pass() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sim = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/debug/sim");
-    let sim_bin = if sim.exists() {
-        sim
-    } else {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/release/sim")
-    };
+    let sim_bin = bag2mat::test_tools::workspace_binary("sim");
     let mut sources = Vec::new();
     for (topic, seed) in [("/imu0", "1"), ("/imu1", "2")] {
         let p = d.join(format!("{}.bag", &topic[1..]));
@@ -250,12 +245,7 @@ else:
 #[test]
 fn our_mcap_and_sqlite3_read_back_exactly_in_rosbags_and_mcap() {
     let dir = tempfile::tempdir().unwrap();
-    let sim = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/debug/sim");
-    assert!(
-        sim.exists(),
-        "{} not built: run cargo test --workspace",
-        sim.display()
-    );
+    let sim = bag2mat::test_tools::workspace_binary("sim");
     let common = [
         "--duration",
         "3",

@@ -8,7 +8,7 @@ use bag2mat::{Compression, RosTime};
 
 /// The workspace's `testdata/` folder.
 pub fn testdata() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata")
+    bag2mat::test_tools::testdata()
 }
 
 /// The reference cases with their Imu topic.

@@ -164,7 +164,11 @@ where
     for (i, c) in curves.iter().enumerate() {
         let col = COLORS[i % COLORS.len()];
         chart
-            .draw_series(c.ieee.iter().map(|&p| Circle::new(p, 4, col.stroke_width(1))))
+            .draw_series(
+                c.ieee
+                    .iter()
+                    .map(|&p| Circle::new(p, 4, col.stroke_width(1))),
+            )
             .map_err(|x| e(&x))?
             .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
