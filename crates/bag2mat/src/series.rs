@@ -684,6 +684,16 @@ impl Target<'_> {
         }
     }
 
+    /// [`Target::put`] for a decoded row (its seq stays 0: the column is left untouched).
+    fn put_row(&mut self, t: u64, r: &crate::decoded::Row) {
+        if self.filled < self.slot.cap() {
+            self.slot.set_row(self.filled, t, r);
+            self.filled += 1;
+        } else {
+            self.overflow.push_row(t, r);
+        }
+    }
+
     fn rows(&self) -> usize {
         self.filled + self.overflow.len()
     }
@@ -743,7 +753,7 @@ fn decode_part(
     let by_rows = if all_rows {
         src.read_part_rows(i, &want, &mut |c, t, row| {
             if let Some(Some((k, _))) = lookup.get(c as usize) {
-                targets[*k].put(t, &ImuSample::from(row));
+                targets[*k].put_row(t, row);
             }
         })
     } else {

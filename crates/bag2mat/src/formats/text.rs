@@ -1141,9 +1141,9 @@ fn parse_range<'a>(text: &[u8], lay: &Layout, quoted: bool, slot: RowsMut<'a>) -
     out
 }
 
-/// Rows a range of text can hold: one per line.
+/// Rows a range of text can hold: one per line, as [`parse_range`] counts them.
 fn room(text: &[u8]) -> usize {
-    text.iter().filter(|&&c| c == b'\n').count() + 1
+    memchr::memchr_iter(b'\n', text).count() + usize::from(text.last().is_some_and(|&c| c != b'\n'))
 }
 
 /// What a range gave, once its rows are in the columns.
