@@ -127,30 +127,33 @@ impl Scalar {
 }
 
 impl Slot {
-    /// The value as f64, or `None` past the end of `data`.
+    /// The `N` bytes of the value, or `None` past the end of `data`.
+    fn bytes<const N: usize>(&self, data: &[u8]) -> Option<[u8; N]> {
+        data.get(self.offset..)?.first_chunk::<N>().copied()
+    }
+
+    /// The value as f64, or `None` past the end of `data`. (Read for every field of every
+    /// sample: plain little-endian loads, no cursor.)
     fn get(&self, data: &[u8]) -> Option<f64> {
-        let mut c = Cursor::new(data.get(self.offset..)?);
-        let r: Result<f64, CursorError> = match self.ty {
-            Scalar::I8 => c.le::<i8>("").map(f64::from),
-            Scalar::U8 => c.le::<u8>("").map(f64::from),
-            Scalar::I16 => c.le::<i16>("").map(f64::from),
-            Scalar::U16 => c.le::<u16>("").map(f64::from),
-            Scalar::I32 => c.le::<i32>("").map(f64::from),
-            Scalar::U32 => c.le::<u32>("").map(f64::from),
-            Scalar::I64 => c.le::<i64>("").map(|v| v as f64),
-            Scalar::U64 => c.le::<u64>("").map(|v| v as f64),
-            Scalar::F32 => c.le::<f32>("").map(f64::from),
-            Scalar::F64 => c.le::<f64>(""),
-        };
-        r.ok()
+        Some(match self.ty {
+            Scalar::I8 => i8::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U8 => u8::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I16 => i16::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U16 => u16::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I32 => i32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U32 => u32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I64 => i64::from_le_bytes(self.bytes(data)?) as f64,
+            Scalar::U64 => u64::from_le_bytes(self.bytes(data)?) as f64,
+            Scalar::F32 => f32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::F64 => f64::from_le_bytes(self.bytes(data)?),
+        })
     }
 
     fn get_u64(&self, data: &[u8]) -> Option<u64> {
-        let mut c = Cursor::new(data.get(self.offset..)?);
         match self.ty {
-            Scalar::U64 => c.le::<u64>("").ok(),
-            Scalar::I64 => c.le::<i64>("").ok().and_then(|v| u64::try_from(v).ok()),
-            Scalar::U32 => c.le::<u32>("").ok().map(u64::from),
+            Scalar::U64 => Some(u64::from_le_bytes(self.bytes(data)?)),
+            Scalar::I64 => u64::try_from(i64::from_le_bytes(self.bytes(data)?)).ok(),
+            Scalar::U32 => Some(u32::from_le_bytes(self.bytes(data)?).into()),
             _ => None,
         }
     }
@@ -470,13 +473,24 @@ enum Step {
 /// The message types of the format.
 const TYPES: &[u8] = b"BFIMPQARDLCSO";
 
+/// True for a message type of the format (a table: asked of every message).
+const IS_TYPE: [bool; 256] = {
+    let mut t = [false; 256];
+    let mut i = 0;
+    while i < TYPES.len() {
+        t[TYPES[i] as usize] = true;
+        i += 1;
+    }
+    t
+};
+
 /// The step at `at`: the hop and every part walk the messages the same way.
 fn step(win: &Window, at: u64, appended_at: Option<u64>) -> Step {
     let Some(h) = win.get(at, 3) else {
         return Step::Cut(at);
     };
     let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
-    if !TYPES.contains(&ty) {
+    if !IS_TYPE[ty as usize] {
         let n = WINDOW.min((win.len - at) as usize);
         let rest = win.get(at, n).unwrap_or(&[]);
         let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
