@@ -23,13 +23,11 @@ impl Mapped {
         if len == 0 {
             return Ok(Mapped { map: None });
         }
-        // SAFETY: the mapping is read only and private to this reader; the file changing
-        // under it is the documented risk of the module (no undefined behaviour in our
-        // code: the bytes are only read, as plain bytes).
+        // SAFETY: the mapping is read only and only read as plain bytes. Rust assumes the
+        // slice does not change while borrowed: a file rewritten or cut under the reader
+        // breaks that, the risk the module doc states and every mapping reader takes.
         let map =
             unsafe { memmap2::MmapOptions::new().map(file) }.map_err(|e| Error::io(path, e))?;
-        // the readers go through the file once, front to back
-        let _ = map.advise(memmap2::Advice::Sequential);
         Ok(Mapped { map: Some(map) })
     }
 

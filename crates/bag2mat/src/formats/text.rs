@@ -811,6 +811,13 @@ fn num(s: &[u8]) -> Option<f64> {
 struct Chunk<'a> {
     /// The range's rows: its slot of the columns, filled from the start.
     slot: RowsMut<'a>,
+    got: Summary,
+}
+
+/// What a range gave besides its rows.
+#[derive(Default)]
+struct Summary {
+    /// Rows in the slot.
     filled: usize,
     /// Lines in the range (so later ranges know their line numbers).
     lines: u64,
@@ -905,18 +912,18 @@ fn row_of<'f>(
 impl Chunk<'_> {
     fn take(&mut self, line: u64, r: Result<Row, String>) {
         match r {
-            Ok(row) if self.filled < self.slot.cap() => {
-                self.slot.set_row(self.filled, row.stamp, &row);
-                self.filled += 1;
-                self.order.next(line, row.stamp);
+            Ok(row) if self.got.filled < self.slot.cap() => {
+                self.slot.set_row(self.got.filled, row.stamp, &row);
+                self.got.filled += 1;
+                self.got.order.next(line, row.stamp);
             }
             Ok(_) => self.take(
                 line,
                 Err("more rows than lines in a range (a reader defect)".into()),
             ),
             Err(why) => {
-                self.bad += 1;
-                self.first_bad.get_or_insert((line, why));
+                self.got.bad += 1;
+                self.got.first_bad.get_or_insert((line, why));
             }
         }
     }
@@ -952,8 +959,8 @@ fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) -> u64 {
             Ok(true) => {}
             Err(e) => {
                 let line = line_of(rdr.position().byte());
-                out.bad += 1;
-                out.first_bad.get_or_insert((line, e.to_string()));
+                out.got.bad += 1;
+                out.got.first_bad.get_or_insert((line, e.to_string()));
                 continue;
             }
         }
@@ -1115,7 +1122,7 @@ fn parse_range<'a>(text: &[u8], lay: &Layout, quoted: bool, slot: RowsMut<'a>) -
         ..Chunk::default()
     };
     if quoted {
-        out.lines = parse_csv(text, lay, 1, &mut out);
+        out.got.lines = parse_csv(text, lay, 1, &mut out);
         return out;
     }
     let cols = columns(lay);
@@ -1133,40 +1140,17 @@ fn parse_range<'a>(text: &[u8], lay: &Layout, quoted: bool, slot: RowsMut<'a>) -
             .iter()
             .position(|&c| c == b'\n')
             .map_or(rest.len(), |p| p + 1);
-        out.quoted |= rest[..end].contains(&b'"');
+        out.got.quoted |= rest[..end].contains(&b'"');
         parse_csv(&rest[..end], lay, line, &mut out);
         pos += end;
     }
-    out.lines = line;
+    out.got.lines = line;
     out
 }
 
 /// Rows a range of text can hold: one per line, as [`parse_range`] counts them.
 fn room(text: &[u8]) -> usize {
     memchr::memchr_iter(b'\n', text).count() + usize::from(text.last().is_some_and(|&c| c != b'\n'))
-}
-
-/// What a range gave, once its rows are in the columns.
-struct Summary {
-    filled: usize,
-    lines: u64,
-    bad: u64,
-    first_bad: Option<(u64, String)>,
-    quoted: bool,
-    order: Order,
-}
-
-impl From<Chunk<'_>> for Summary {
-    fn from(c: Chunk<'_>) -> Summary {
-        Summary {
-            filled: c.filled,
-            lines: c.lines,
-            bad: c.bad,
-            first_bad: c.first_bad,
-            quoted: c.quoted,
-            order: c.order,
-        }
-    }
 }
 
 /// The lines of the body that start in `a..b` (file offsets): the range of `bytes` they
@@ -1225,7 +1209,7 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
         let got: Vec<Summary> = ranges
             .par_iter()
             .zip(rows.split(&room))
-            .map(|(r, slot)| Summary::from(parse_range(r, &lay, quoted, slot)))
+            .map(|(r, slot)| parse_range(r, &lay, quoted, slot).got)
             .collect();
         // the rows of each range follow those of the ranges before it
         let mut n = 0;
@@ -1487,16 +1471,22 @@ mod tests {
                 slot: slow_rows.split(&[n]).remove(0),
                 ..Chunk::default()
             };
-            slow.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
-            assert!(fast.filled > 0 && fast.filled == slow.filled, "{text:?}");
-            let (fo, so) = (fast.order, slow.order);
+            slow.got.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
+            assert!(
+                fast.got.filled > 0 && fast.got.filled == slow.got.filled,
+                "{text:?}"
+            );
+            let (fo, so) = (fast.got.order, slow.got.order);
             assert_eq!(
                 (fo.first, fo.last, fo.back, fo.dup),
                 (so.first, so.last, so.back, so.dup)
             );
-            assert_eq!((fast.bad, fast.lines), (slow.bad, slow.lines));
-            assert_eq!(fast.first_bad, slow.first_bad);
-            let filled = fast.filled;
+            assert_eq!(
+                (fast.got.bad, fast.got.lines),
+                (slow.got.bad, slow.got.lines)
+            );
+            assert_eq!(fast.got.first_bad, slow.got.first_bad);
+            let filled = fast.got.filled;
             drop((fast, slow));
             for i in 0..filled {
                 let (a, b) = (fast_rows.row(i), slow_rows.row(i));
