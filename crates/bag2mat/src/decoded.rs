@@ -403,5 +403,73 @@ mod tests {
         assert!(s.gyro[1][9].is_nan() && s.gyro[2][9] == 0.5);
         assert!(s.notes.is_empty(), "{:?}", s.notes);
         assert!(Row::decode(&[0u8; 8]).is_err());
+        // the payload path gives the same rows as the row path
+        let mut by_payload = Vec::new();
+        src.read_part(0, &|_| true, &mut |_, t, p| {
+            by_payload.push((t, Row::decode(p).map(|x| x.acc[0])))
+        });
+        assert_eq!(by_payload.len(), PART_ROWS);
+        assert_eq!(by_payload[4].0, 1_020);
+        assert_eq!(by_payload[4].1.as_ref().ok(), Some(&4.0));
+    }
+
+    /// A read that owns the source takes a whole topic's rows as they are (no copy) and
+    /// gives the series a read of its parts gives, losses accounted the same; the pieces of
+    /// a parallel parse are read part by part.
+    #[test]
+    fn an_owned_read_takes_a_whole_topic_and_reads_pieces() {
+        let stream = |from: u64, n: u64| {
+            let mut s = Stream::imu("imu", "text/imu");
+            for i in from..from + n {
+                let v = i as f64;
+                s.push(
+                    10 * i,
+                    &Row {
+                        stamp: 10 * i + 1,
+                        acc: [v, 2.0 * v, 3.0],
+                        gyro: [-v, f64::NAN, 0.25],
+                    },
+                );
+            }
+            s
+        };
+        let n = PART_ROWS as u64 * 2 + 3;
+        let opts = ReadOptions { quiet: true };
+        let sel = TopicSelector::one("imu");
+        let whole = || DecodedSource::new(InputKind::Text, vec![stream(0, n)], vec![], vec![]);
+        let by_parts = read_from(&whole(), &sel, &opts).unwrap();
+        let src = whole();
+        assert!(src.take_rows(0).is_some_and(|r| r.len() == n as usize));
+        // taken: its parts say so instead of delivering nothing in silence
+        let after = read_from(&src, &sel, &opts);
+        assert!(
+            matches!(&after, Err(Error::NothingRead { why, .. }) if why.iter().any(|w| w.contains(TAKEN))),
+            "{:?}",
+            after.map(|r| r.series.len())
+        );
+        let pieces = || {
+            DecodedSource::new(
+                InputKind::Text,
+                vec![stream(0, n / 2), stream(n / 2, n - n / 2)],
+                vec![],
+                vec![],
+            )
+        };
+        assert!(pieces().take_rows(0).is_none());
+        for owned in [
+            crate::series::read_owned(Box::new(whole()), &sel, &opts).unwrap(),
+            crate::series::read_owned(Box::new(pieces()), &sel, &opts).unwrap(),
+        ] {
+            let (a, b) = (&owned.series[0], &by_parts.series[0]);
+            assert_eq!(a.len(), n as usize);
+            assert_eq!(
+                (&a.record_time, &a.stamp, &a.acc),
+                (&b.record_time, &b.stamp, &b.acc)
+            );
+            assert_eq!(a.gyro[0], b.gyro[0]);
+            assert!(a.gyro[1].iter().all(|v| v.is_nan()));
+            assert_eq!((&a.report, &a.notes), (&b.report, &b.notes));
+            assert_eq!(a.report.delivered, n);
+        }
     }
 }
