@@ -1,6 +1,7 @@
 //! Logs whose readers decode the samples themselves (text, NumPy, PX4 ULog, ArduPilot
 //! DataFlash): their rows reach the one read path ([`crate::series`]) as payloads of one
-//! fixed layout, [`Row`], on channels of encoding [`Encoding::Row`], so the topic rules,
+//! fixed layout, [`Row`], on channels of encoding [`Encoding::Row`] (handed over as they are
+//! through [`source::Source::read_part_rows`], or as payload bytes), so the topic rules,
 //! sorting, progress and loss accounting stay written once.
 //!
 //! Such a reader parses its file when it opens (the formats have no index to plan by) into
@@ -11,6 +12,7 @@
 use crate::RosTime;
 use crate::error::Error;
 use crate::imu_msg::ImuSample;
+use crate::series::Rows;
 use crate::source::{self, Channel, Contents, Encoding, InputKind, Loss, MessageSink, Part};
 
 /// Bytes of one [`Row`] payload: the sample time (u64 ns), then acc x y z and gyro x y z
@@ -45,31 +47,38 @@ impl Row {
 
     /// The sample of a payload.
     pub fn decode(b: &[u8]) -> Result<ImuSample, Error> {
-        if b.len() != ROW_LEN {
+        let Some(b) = b.first_chunk::<ROW_LEN>().filter(|_| b.len() == ROW_LEN) else {
             return Err(Error::BadMessage {
                 what: format!("a decoded row is {ROW_LEN} bytes, this one {}", b.len()),
             });
-        }
-        let mut c = crate::cursor::Cursor::new(b);
-        let bad = |e: crate::cursor::CursorError| Error::BadMessage {
-            what: e.to_string(),
         };
-        let stamp = c.le::<u64>("row stamp").map_err(bad)?;
+        let (stamp, values) = b.split_first_chunk::<8>().unwrap_or((&[0; 8], &[]));
         let mut v = [0f64; 6];
-        for x in &mut v {
-            *x = c.le::<f64>("row value").map_err(bad)?;
+        for (x, c) in v.iter_mut().zip(values.chunks_exact(8)) {
+            *x = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
         }
-        Ok(ImuSample {
-            seq: 0,
-            stamp: RosTime::from_nanos(stamp),
+        Ok(ImuSample::from(&Row {
+            stamp: u64::from_le_bytes(*stamp),
             acc: [v[0], v[1], v[2]],
             gyro: [v[3], v[4], v[5]],
-        })
+        }))
+    }
+}
+
+impl From<&Row> for ImuSample {
+    fn from(r: &Row) -> ImuSample {
+        ImuSample {
+            seq: 0,
+            stamp: RosTime::from_nanos(r.stamp),
+            acc: r.acc,
+            gyro: r.gyro,
+        }
     }
 }
 
 /// One topic's messages (or a piece of them): their log (record) times and, for an Imu
-/// topic, their rows.
+/// topic, their rows, kept as the columns the read path delivers ([`crate::series`]), so a
+/// reader that decoded a whole topic hands them over without a copy.
 #[derive(Debug, Clone, Default)]
 pub struct Stream {
     /// Topic name.
@@ -78,10 +87,11 @@ pub struct Stream {
     pub msg_type: String,
     /// True when its messages are rows (an Imu topic); false for times only.
     pub imu: bool,
-    /// Record (log) time of each message, ns.
-    pub record: Vec<u64>,
-    /// [`ROW_LEN`] bytes per message (empty unless `imu`).
-    pub rows: Vec<u8>,
+    /// Record (log) time of each message of a times-only topic, ns (an Imu topic's are in
+    /// its rows).
+    times: Vec<u64>,
+    /// An Imu topic's rows: record time, stamp, acc, gyro (seq 0).
+    pub(crate) rows: Rows,
 }
 
 impl Stream {
@@ -91,8 +101,7 @@ impl Stream {
             topic: topic.into(),
             msg_type: msg_type.into(),
             imu: true,
-            record: Vec::new(),
-            rows: Vec::new(),
+            ..Stream::default()
         }
     }
 
@@ -104,33 +113,59 @@ impl Stream {
         }
     }
 
+    /// An Imu topic whose rows a reader wrote into columns itself.
+    pub(crate) fn of_rows(topic: &str, msg_type: &str, rows: Rows) -> Stream {
+        Stream {
+            rows,
+            ..Stream::imu(topic, msg_type)
+        }
+    }
+
     /// Appends a row logged at `record` ns.
     pub fn push(&mut self, record: u64, row: &Row) {
-        self.record.push(record);
-        self.rows.extend_from_slice(&row.encode());
+        self.rows.push_row(record, row);
     }
 
     /// Room for `n` more messages.
     pub fn reserve(&mut self, n: usize) {
-        self.record.reserve(n);
         if self.imu {
-            self.rows.reserve(n * ROW_LEN);
+            self.rows.reserve(n);
+        } else {
+            self.times.reserve(n);
         }
     }
 
     /// Appends a message of a times-only topic.
     pub fn push_time(&mut self, record: u64) {
-        self.record.push(record);
+        self.times.push(record);
     }
 
     /// Messages.
     pub fn len(&self) -> usize {
-        self.record.len()
+        if self.imu {
+            self.rows.len()
+        } else {
+            self.times.len()
+        }
     }
 
     /// True when empty.
     pub fn is_empty(&self) -> bool {
-        self.record.is_empty()
+        self.len() == 0
+    }
+
+    /// Record time of message `i`, ns.
+    pub fn record(&self, i: usize) -> u64 {
+        if self.imu {
+            self.rows.record_time[i].as_nanos()
+        } else {
+            self.times[i]
+        }
+    }
+
+    /// Row `i` of an Imu topic.
+    pub fn row(&self, i: usize) -> Row {
+        self.rows.row(i)
     }
 }
 
@@ -138,7 +173,10 @@ impl Stream {
 pub struct DecodedSource {
     kind: InputKind,
     contents: Contents,
+    /// The streams' names, types and times-only messages (their rows are in `rows`).
     streams: Vec<Stream>,
+    /// Each stream's rows; [`source::Source::take_rows`] moves them out.
+    rows: Vec<std::sync::RwLock<Rows>>,
     /// Part → (stream, channel, first message, end).
     map: Vec<(usize, u32, usize, usize)>,
 }
@@ -149,7 +187,7 @@ impl DecodedSource {
     /// without joining them); channel ids count the channels in order.
     pub fn new(
         kind: InputKind,
-        streams: Vec<Stream>,
+        mut streams: Vec<Stream>,
         notes: Vec<String>,
         losses: Vec<Loss>,
     ) -> DecodedSource {
@@ -189,7 +227,9 @@ impl DecodedSource {
             let mut a = 0;
             while a < s.len() {
                 let b = (a + PART_ROWS).min(s.len());
-                let t = &s.record[a..b];
+                let (lo, hi) = (a..b)
+                    .map(|i| s.record(i))
+                    .fold((u64::MAX, 0), |(lo, hi), t| (lo.min(t), hi.max(t)));
                 contents.parts.push(Part {
                     label: format!(
                         "messages {}..{} of '{}'",
@@ -197,7 +237,7 @@ impl DecodedSource {
                         before + b as u64,
                         s.topic
                     ),
-                    span: t.iter().min().zip(t.iter().max()).map(|(x, y)| (*x, *y)),
+                    span: Some((lo, hi)),
                     counts: Some(vec![(id, (b - a) as u64)]),
                     bytes: ((b - a) * if s.imu { ROW_LEN } else { 0 }) as u64,
                 });
@@ -205,10 +245,15 @@ impl DecodedSource {
                 a = b;
             }
         }
+        let rows = streams
+            .iter_mut()
+            .map(|s| std::sync::RwLock::new(std::mem::take(&mut s.rows)))
+            .collect();
         DecodedSource {
             kind,
             contents,
             streams,
+            rows,
             map,
         }
     }
@@ -222,6 +267,9 @@ fn kind_encoding(kind: InputKind) -> &'static str {
         _ => "text",
     }
 }
+
+/// What a part of rows handed over by [`source::Source::take_rows`] says when read.
+const TAKEN: &str = "the rows were handed over to a read already";
 
 impl source::Source for DecodedSource {
     fn kind(&self) -> InputKind {
@@ -245,16 +293,54 @@ impl source::Source for DecodedSource {
             return r;
         }
         let s = &self.streams[k];
+        if !s.imu {
+            for &t in &s.times[a..b] {
+                sink(id, t, &[]);
+            }
+            r.delivered = (b - a) as u64;
+            return r;
+        }
+        let rows = self.rows[k].read().unwrap_or_else(|e| e.into_inner());
+        if rows.len() < b {
+            r.error = Some(TAKEN.into());
+            return r;
+        }
         for i in a..b {
-            let payload = if s.imu {
-                &s.rows[i * ROW_LEN..(i + 1) * ROW_LEN]
-            } else {
-                &[][..]
-            };
-            sink(id, s.record[i], payload);
+            sink(id, rows.record_time[i].as_nanos(), &rows.row(i).encode());
         }
         r.delivered = (b - a) as u64;
         r
+    }
+    fn read_part_rows(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut source::RowSink<'_>,
+    ) -> Option<source::PartRead> {
+        let &(k, id, a, b) = self.map.get(part)?;
+        let mut r = source::PartRead::default();
+        if !self.streams[k].imu || !want(id) {
+            return Some(r);
+        }
+        let rows = self.rows[k].read().unwrap_or_else(|e| e.into_inner());
+        if rows.len() < b {
+            r.error = Some(TAKEN.into());
+            return Some(r);
+        }
+        for i in a..b {
+            sink(id, rows.record_time[i].as_nanos(), &rows.row(i));
+        }
+        r.delivered = (b - a) as u64;
+        Some(r)
+    }
+    fn take_rows(&self, channel: u32) -> Option<Rows> {
+        let mut of_channel = self.map.iter().filter(|m| m.1 == channel).map(|m| m.0);
+        let k = of_channel.next()?;
+        if of_channel.any(|j| j != k) || !self.streams[k].imu {
+            return None; // pieces: read part by part
+        }
+        let mut rows = self.rows[k].write().unwrap_or_else(|e| e.into_inner());
+        Some(std::mem::take(&mut *rows))
     }
 }
 
@@ -282,12 +368,14 @@ mod tests {
         let mut o = Stream::other("status", "text/other");
         o.push_time(3);
         // a reader that parsed in parallel hands its pieces over: one channel
-        let mut s2 = s.clone();
-        s2.record.drain(n / 2..);
-        s2.rows.drain(n / 2 * ROW_LEN..);
-        let mut s3 = s.clone();
-        s3.record.drain(..n / 2);
-        s3.rows.drain(..n / 2 * ROW_LEN);
+        let (mut s2, mut s3) = (
+            Stream::imu("imu", "text/imu"),
+            Stream::imu("imu", "text/imu"),
+        );
+        for i in 0..n {
+            let piece = if i < n / 2 { &mut s2 } else { &mut s3 };
+            piece.push(s.record(i), &s.row(i));
+        }
         let src = DecodedSource::new(InputKind::Text, vec![s, o], vec![], vec![]);
         assert_eq!(src.contents().parts.len(), 3);
         let pieces = DecodedSource::new(InputKind::Text, vec![s2, s3], vec![], vec![]);
@@ -315,5 +403,73 @@ mod tests {
         assert!(s.gyro[1][9].is_nan() && s.gyro[2][9] == 0.5);
         assert!(s.notes.is_empty(), "{:?}", s.notes);
         assert!(Row::decode(&[0u8; 8]).is_err());
+        // the payload path gives the same rows as the row path
+        let mut by_payload = Vec::new();
+        src.read_part(0, &|_| true, &mut |_, t, p| {
+            by_payload.push((t, Row::decode(p).map(|x| x.acc[0])))
+        });
+        assert_eq!(by_payload.len(), PART_ROWS);
+        assert_eq!(by_payload[4].0, 1_020);
+        assert_eq!(by_payload[4].1.as_ref().ok(), Some(&4.0));
+    }
+
+    /// A read that owns the source takes a whole topic's rows as they are (no copy) and
+    /// gives the series a read of its parts gives, losses accounted the same; the pieces of
+    /// a parallel parse are read part by part.
+    #[test]
+    fn an_owned_read_takes_a_whole_topic_and_reads_pieces() {
+        let stream = |from: u64, n: u64| {
+            let mut s = Stream::imu("imu", "text/imu");
+            for i in from..from + n {
+                let v = i as f64;
+                s.push(
+                    10 * i,
+                    &Row {
+                        stamp: 10 * i + 1,
+                        acc: [v, 2.0 * v, 3.0],
+                        gyro: [-v, f64::NAN, 0.25],
+                    },
+                );
+            }
+            s
+        };
+        let n = PART_ROWS as u64 * 2 + 3;
+        let opts = ReadOptions { quiet: true };
+        let sel = TopicSelector::one("imu");
+        let whole = || DecodedSource::new(InputKind::Text, vec![stream(0, n)], vec![], vec![]);
+        let by_parts = read_from(&whole(), &sel, &opts).unwrap();
+        let src = whole();
+        assert!(src.take_rows(0).is_some_and(|r| r.len() == n as usize));
+        // taken: its parts say so instead of delivering nothing in silence
+        let after = read_from(&src, &sel, &opts);
+        assert!(
+            matches!(&after, Err(Error::NothingRead { why, .. }) if why.iter().any(|w| w.contains(TAKEN))),
+            "{:?}",
+            after.map(|r| r.series.len())
+        );
+        let pieces = || {
+            DecodedSource::new(
+                InputKind::Text,
+                vec![stream(0, n / 2), stream(n / 2, n - n / 2)],
+                vec![],
+                vec![],
+            )
+        };
+        assert!(pieces().take_rows(0).is_none());
+        for owned in [
+            crate::series::read_owned(Box::new(whole()), &sel, &opts).unwrap(),
+            crate::series::read_owned(Box::new(pieces()), &sel, &opts).unwrap(),
+        ] {
+            let (a, b) = (&owned.series[0], &by_parts.series[0]);
+            assert_eq!(a.len(), n as usize);
+            assert_eq!(
+                (&a.record_time, &a.stamp, &a.acc),
+                (&b.record_time, &b.stamp, &b.acc)
+            );
+            assert_eq!(a.gyro[0], b.gyro[0]);
+            assert!(a.gyro[1].iter().all(|v| v.is_nan()));
+            assert_eq!((&a.report, &a.notes), (&b.report, &b.notes));
+            assert_eq!(a.report.delivered, n);
+        }
     }
 }

@@ -42,6 +42,7 @@ mod error;
 pub mod formats;
 pub mod imu_msg;
 pub mod info;
+pub mod mapped;
 pub mod mat;
 pub mod mcap;
 pub mod record_check;

@@ -491,18 +491,20 @@ pub const MIN_IMU_PAYLOAD: u64 = 16 + 37 * 8;
 /// rows are buffered, then appended in order, so memory stays near the size of the result.
 const WINDOW_PARTS_PER_THREAD: usize = 4;
 
-/// The columns of one topic's rows.
+/// The columns of one topic's rows, as [`ImuSeries`] holds them (what a log reader that
+/// decoded a topic on opening hands over whole: [`Source::take_rows`]).
 #[derive(Debug, Clone, Default)]
-struct Rows {
-    record_time: Vec<RosTime>,
-    stamp: Vec<RosTime>,
-    seq: Vec<u32>,
-    acc: [Vec<f64>; 3],
-    gyro: [Vec<f64>; 3],
+pub struct Rows {
+    pub(crate) record_time: Vec<RosTime>,
+    pub(crate) stamp: Vec<RosTime>,
+    pub(crate) seq: Vec<u32>,
+    pub(crate) acc: [Vec<f64>; 3],
+    pub(crate) gyro: [Vec<f64>; 3],
 }
 
 impl Rows {
-    fn zeroed(n: usize) -> Rows {
+    /// `n` rows of zeros (allocated zeroed: pages are touched only where written).
+    pub(crate) fn zeroed(n: usize) -> Rows {
         Rows {
             record_time: vec![RosTime::default(); n],
             stamp: vec![RosTime::default(); n],
@@ -512,8 +514,56 @@ impl Rows {
         }
     }
 
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.record_time.len()
+    }
+
+    /// Room for `n` more rows.
+    pub(crate) fn reserve(&mut self, n: usize) {
+        self.record_time.reserve(n);
+        self.stamp.reserve(n);
+        self.seq.reserve(n);
+        for c in 0..3 {
+            self.acc[c].reserve(n);
+            self.gyro[c].reserve(n);
+        }
+    }
+
+    /// Appends a decoded row logged at `t` ns.
+    pub(crate) fn push_row(&mut self, t: u64, r: &crate::decoded::Row) {
+        self.push(t, &ImuSample::from(r));
+    }
+
+    /// Row `i` as a decoded row.
+    pub(crate) fn row(&self, i: usize) -> crate::decoded::Row {
+        crate::decoded::Row {
+            stamp: self.stamp[i].as_nanos(),
+            acc: std::array::from_fn(|c| self.acc[c][i]),
+            gyro: std::array::from_fn(|c| self.gyro[c][i]),
+        }
+    }
+
+    /// Keeps the first `n` rows.
+    pub(crate) fn truncate(&mut self, n: usize) {
+        self.record_time.truncate(n);
+        self.stamp.truncate(n);
+        self.seq.truncate(n);
+        for c in 0..3 {
+            self.acc[c].truncate(n);
+            self.gyro[c].truncate(n);
+        }
+    }
+
+    /// Moves rows `from..from + n` to `to` (`to <= from`).
+    pub(crate) fn move_down(&mut self, from: usize, n: usize, to: usize) {
+        let r = from..from + n;
+        self.record_time.copy_within(r.clone(), to);
+        self.stamp.copy_within(r.clone(), to);
+        self.seq.copy_within(r.clone(), to);
+        for c in 0..3 {
+            self.acc[c].copy_within(r.clone(), to);
+            self.gyro[c].copy_within(r.clone(), to);
+        }
     }
 
     fn push(&mut self, t: u64, s: &ImuSample) {
@@ -548,7 +598,7 @@ impl Rows {
     }
 
     /// One mutable slot per part, of the given lengths.
-    fn split(&mut self, sizes: &[usize]) -> Vec<RowsMut<'_>> {
+    pub(crate) fn split(&mut self, sizes: &[usize]) -> Vec<RowsMut<'_>> {
         let mut rt = split_rows(&mut self.record_time, sizes).into_iter();
         let mut st = split_rows(&mut self.stamp, sizes).into_iter();
         let mut sq = split_rows(&mut self.seq, sizes).into_iter();
@@ -597,7 +647,7 @@ impl Rows {
 
 /// One part's rows of every column of one topic.
 #[derive(Default)]
-struct RowsMut<'a> {
+pub(crate) struct RowsMut<'a> {
     record_time: &'a mut [RosTime],
     stamp: &'a mut [RosTime],
     seq: &'a mut [u32],
@@ -606,8 +656,18 @@ struct RowsMut<'a> {
 }
 
 impl RowsMut<'_> {
-    fn cap(&self) -> usize {
+    pub(crate) fn cap(&self) -> usize {
         self.record_time.len()
+    }
+
+    /// Sets row `i` to a decoded row logged at `t` ns (its seq stays 0).
+    pub(crate) fn set_row(&mut self, i: usize, t: u64, r: &crate::decoded::Row) {
+        self.record_time[i] = RosTime::from_nanos(t);
+        self.stamp[i] = RosTime::from_nanos(r.stamp);
+        for c in 0..3 {
+            self.acc[c][i] = r.acc[c];
+            self.gyro[c][i] = r.gyro[c];
+        }
     }
 
     fn set(&mut self, i: usize, t: u64, s: &ImuSample) {
@@ -636,6 +696,16 @@ impl Target<'_> {
             self.filled += 1;
         } else {
             self.overflow.push(t, s);
+        }
+    }
+
+    /// [`Target::put`] for a decoded row (its seq stays 0: the column is left untouched).
+    fn put_row(&mut self, t: u64, r: &crate::decoded::Row) {
+        if self.filled < self.slot.cap() {
+            self.slot.set_row(self.filled, t, r);
+            self.filled += 1;
+        } else {
+            self.overflow.push_row(t, r);
         }
     }
 
@@ -674,8 +744,7 @@ pub fn read_imu_topics_with(
     opts: &ReadOptions,
     input: &crate::formats::InputOptions,
 ) -> Result<ImuRead, Error> {
-    let src = source::open_with(path, input)?;
-    read_from(src.as_ref(), sel, opts)
+    read_owned(source::open_with(path, input)?, sel, opts)
 }
 
 /// How part `i` routes a selected channel's messages: channel id → (topic, codec).
@@ -694,17 +763,31 @@ fn decode_part(
     let mut bad = vec![0u64; n_sel];
     let mut first_bad: Vec<Option<String>> = vec![None; n_sel];
     let want = |c: u32| lookup.get(c as usize).is_some_and(|x| x.is_some());
-    let read = src.read_part(i, &want, &mut |c, t, data| {
-        if let Some(Some((k, codec))) = lookup.get(c as usize) {
-            match decode(*codec, data) {
-                Ok(s) => targets[*k].put(t, &s),
-                Err(e) => {
-                    bad[*k] += 1;
-                    first_bad[*k].get_or_insert_with(|| e.to_string());
+    // rows a log reader decoded go straight into the columns, without a payload
+    let all_rows = lookup.iter().flatten().all(|(_, c)| *c == Codec::Row);
+    let by_rows = if all_rows {
+        src.read_part_rows(i, &want, &mut |c, t, row| {
+            if let Some(Some((k, _))) = lookup.get(c as usize) {
+                targets[*k].put_row(t, row);
+            }
+        })
+    } else {
+        None
+    };
+    let read = match by_rows {
+        Some(read) => read,
+        None => src.read_part(i, &want, &mut |c, t, data| {
+            if let Some(Some((k, codec))) = lookup.get(c as usize) {
+                match decode(*codec, data) {
+                    Ok(s) => targets[*k].put(t, &s),
+                    Err(e) => {
+                        bad[*k] += 1;
+                        first_bad[*k].get_or_insert_with(|| e.to_string());
+                    }
                 }
             }
-        }
-    });
+        }),
+    };
     pb.inc(if per_part_unit { 1 } else { read.delivered });
     PartOut {
         rows: targets.iter().map(|t| t.rows() as u64).collect(),
@@ -745,8 +828,10 @@ fn decode_all(
                 selected
                     .iter()
                     .map(|s| {
+                        // channels the parts deliver (not those taken whole)
                         let n: u64 = counts
                             .iter()
+                            .filter(|(c, _)| lookup.get(*c as usize).is_some_and(|x| x.is_some()))
                             .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
                             .map(|(_, n)| *n)
                             .fold(0u64, |a, b| a.saturating_add(b));
@@ -841,6 +926,25 @@ pub fn read_from(
     sel: &TopicSelector,
     opts: &ReadOptions,
 ) -> Result<ImuRead, Error> {
+    read_source(src, sel, opts, false)
+}
+
+/// [`read_from`] on a source read once and dropped: a topic its reader decoded whole on
+/// opening moves into the series ([`Source::take_rows`]) instead of being copied.
+pub fn read_owned(
+    src: Box<dyn Source>,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+) -> Result<ImuRead, Error> {
+    read_source(src.as_ref(), sel, opts, true)
+}
+
+fn read_source(
+    src: &dyn Source,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+    take: bool,
+) -> Result<ImuRead, Error> {
     let selected = select(src, sel)?;
     // Channel id → (selected topic, codec); a dense table for the usual small ids.
     let max_id = src.channels().iter().map(|c| c.id).max().unwrap_or(0) as usize;
@@ -867,7 +971,40 @@ pub fn read_from(
         if per_part_unit { "parts" } else { "msgs" },
     );
     pb.set_message("reading");
-    let (columns, outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
+    // A topic of one channel of rows its reader decoded whole is taken as it is; the parts
+    // then deliver only the other topics.
+    let taken: Vec<Option<Rows>> = selected
+        .iter()
+        .map(|s| match s.channels[..] {
+            [(id, Codec::Row)] if take => src.take_rows(id),
+            _ => None,
+        })
+        .collect();
+    for (s, t) in selected.iter().zip(&taken) {
+        if t.is_some() {
+            s.channels
+                .iter()
+                .for_each(|(id, _)| lookup[*id as usize] = None);
+            pb.inc(t.as_ref().map_or(0, |r| r.len() as u64));
+        }
+    }
+    let (mut columns, mut outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
+    for (k, (s, t)) in selected.iter().zip(taken).enumerate() {
+        let Some(rows) = t else { continue };
+        // what each part holds of the topic, as if its parts had delivered them
+        for (o, p) in outs.iter_mut().zip(parts) {
+            let n: u64 = p
+                .counts
+                .iter()
+                .flatten()
+                .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                .map(|(_, n)| *n)
+                .sum();
+            o.rows[k] = n;
+            o.read.delivered += n;
+        }
+        columns[k] = rows;
+    }
     pb.finish_and_clear();
     let after = src.losses_after_read();
 

@@ -208,6 +208,9 @@ pub struct PartRead {
 /// The callback of [`Source::read_part`]: `(channel id, record time in ns, payload)`.
 pub type MessageSink<'a> = dyn FnMut(u32, u64, &[u8]) + 'a;
 
+/// The callback of [`Source::read_part_rows`]: `(channel id, record time in ns, row)`.
+pub type RowSink<'a> = dyn FnMut(u32, u64, &crate::decoded::Row) + 'a;
+
 /// A container opened for reading.
 pub trait Source: Sync {
     /// What it is.
@@ -238,6 +241,25 @@ pub trait Source: Sync {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut MessageSink<'_>,
     ) -> PartRead;
+    /// [`Source::read_part`] for a reader that decodes its Imu channels' rows itself
+    /// ([`Encoding::Row`]): the rows go to `sink` as they are, without a payload to encode
+    /// and decode again; the channels of other encodings are not delivered. `None`: the
+    /// reader has no such path (the bag formats).
+    fn read_part_rows(
+        &self,
+        _part: usize,
+        _want: &(dyn Fn(u32) -> bool + Sync),
+        _sink: &mut RowSink<'_>,
+    ) -> Option<PartRead> {
+        None
+    }
+    /// The whole of an Imu channel's rows, moved out of a reader that decoded them on
+    /// opening, for a read that owns the source and reads it once
+    /// ([`crate::series::read_owned`]): no part of the channel delivers rows afterwards.
+    /// `None`: the reader keeps no such columns (read the parts).
+    fn take_rows(&self, _channel: u32) -> Option<crate::series::Rows> {
+        None
+    }
     /// What only a complete read can tell was lost (the rows past the last one a damaged
     /// table still holds, which its timestamp index lists): called once every part was read.
     fn losses_after_read(&self) -> Vec<Loss> {

@@ -123,8 +123,7 @@ pub fn open(path: &Path) -> Result<DecodedSource, Error> {
         }
     };
     let mut s = Stream::imu("imu", "bag2mat/data_imu");
-    s.record.reserve(h.rows);
-    s.rows.reserve(h.rows * crate::decoded::ROW_LEN);
+    s.reserve(h.rows);
     let mut bad_t: Option<(usize, f64)> = None;
     for r in 0..h.rows {
         let t = at(r, 0);

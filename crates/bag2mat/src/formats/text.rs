@@ -20,8 +20,10 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 use super::InputOptions;
-use crate::decoded::{DecodedSource, ROW_LEN, Row, Stream};
+use crate::RosTime;
+use crate::decoded::{DecodedSource, Row, Stream};
 use crate::error::Error;
+use crate::series::{Rows, RowsMut};
 use crate::source::InputKind;
 
 /// Bytes looked at to decide whether a file is text, and to find its header.
@@ -803,21 +805,61 @@ fn num(s: &[u8]) -> Option<f64> {
     fast_float2::parse(trim(s)).ok()
 }
 
-/// What one byte range of the body gave.
+/// What one byte range of the body gave; its rows are written into its slot of the
+/// topic's columns.
 #[derive(Default)]
-struct Chunk {
-    /// The rows, as a piece of the topic's stream.
-    rows: Stream,
+struct Chunk<'a> {
+    /// The range's rows: its slot of the columns, filled from the start.
+    slot: RowsMut<'a>,
+    got: Summary,
+}
+
+/// What a range gave besides its rows.
+#[derive(Default)]
+struct Summary {
+    /// Rows in the slot.
+    filled: usize,
     /// Lines in the range (so later ranges know their line numbers).
     lines: u64,
     bad: u64,
     /// Line (in the range, 1-based) and reason of the first malformed line.
     first_bad: Option<(u64, String)>,
-    /// Line of each row in the range (for the stamp checks' messages).
-    row_lines: Vec<u32>,
     /// A line the csv crate read held a quote: a quoted field may hold a line break, so the
     /// file is read by the csv crate whole.
     quoted: bool,
+    /// The order of the range's stamps.
+    order: Order,
+}
+
+/// How the stamps of a range follow each other: counts and first lines (in the range) of
+/// those that go backwards or repeat, and the range's first and last stamps (with the
+/// first one's line), for the check across ranges.
+#[derive(Debug, Clone, Copy, Default)]
+struct Order {
+    first: Option<(u64, u64)>,
+    last: Option<u64>,
+    back: u64,
+    first_back: Option<u64>,
+    dup: u64,
+    first_dup: Option<u64>,
+}
+
+impl Order {
+    fn next(&mut self, line: u64, t: u64) {
+        match self.last {
+            None => self.first = Some((t, line)),
+            Some(p) if t < p => {
+                self.back += 1;
+                self.first_back.get_or_insert(line);
+            }
+            Some(p) if t == p => {
+                self.dup += 1;
+                self.first_dup.get_or_insert(line);
+            }
+            Some(_) => {}
+        }
+        self.last = Some(t);
+    }
 }
 
 /// The row of a record's fields (`get(i)`: field `i`), or why not. Without a time column
@@ -867,16 +909,21 @@ fn row_of<'f>(
     })
 }
 
-impl Chunk {
+impl Chunk<'_> {
     fn take(&mut self, line: u64, r: Result<Row, String>) {
         match r {
-            Ok(row) => {
-                self.rows.push(row.stamp, &row);
-                self.row_lines.push(line as u32);
+            Ok(row) if self.got.filled < self.slot.cap() => {
+                self.slot.set_row(self.got.filled, row.stamp, &row);
+                self.got.filled += 1;
+                self.got.order.next(line, row.stamp);
             }
+            Ok(_) => self.take(
+                line,
+                Err("more rows than lines in a range (a reader defect)".into()),
+            ),
             Err(why) => {
-                self.bad += 1;
-                self.first_bad.get_or_insert((line, why));
+                self.got.bad += 1;
+                self.got.first_bad.get_or_insert((line, why));
             }
         }
     }
@@ -912,8 +959,8 @@ fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) -> u64 {
             Ok(true) => {}
             Err(e) => {
                 let line = line_of(rdr.position().byte());
-                out.bad += 1;
-                out.first_bad.get_or_insert((line, e.to_string()));
+                out.got.bad += 1;
+                out.got.first_bad.get_or_insert((line, e.to_string()));
                 continue;
             }
         }
@@ -990,12 +1037,23 @@ fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
         }
         match col {
             Col::Time => {
-                let e = i + b[i..]
-                    .iter()
-                    .position(|&c| !(c.is_ascii_digit() || c == b'.'))
-                    .unwrap_or(b.len() - i);
-                row.stamp = parse_time_ns(&b[i..e], lay.time_unit)?;
-                i = e;
+                // an integer of up to 19 digits (EuRoC's ns) in one pass, else every form
+                let st = i;
+                let mut v = 0u64;
+                while i < b.len() && b[i].is_ascii_digit() && i - st < 19 {
+                    v = v * 10 + (b[i] - b'0') as u64;
+                    i += 1;
+                }
+                if i < b.len() && (b[i] == b'.' || b[i].is_ascii_digit()) || i == st {
+                    i = st
+                        + b[st..]
+                            .iter()
+                            .position(|&c| !(c.is_ascii_digit() || c == b'.'))
+                            .unwrap_or(b.len() - st);
+                    row.stamp = parse_time_ns(&b[st..i], lay.time_unit)?;
+                } else {
+                    row.stamp = v.checked_mul(lay.time_unit.nanos())?;
+                }
             }
             Col::Gyro(a) | Col::Acc(a) => {
                 let (v, n) = fast_float2::parse_partial::<f64, _>(&b[i..]).ok()?;
@@ -1057,13 +1115,14 @@ fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
     (took > 0).then_some((row, took))
 }
 
-fn parse_range(text: &[u8], lay: &Layout, quoted: bool, piece: Stream) -> Chunk {
+/// Parses the lines of `text` into `slot` (room for every line of it).
+fn parse_range<'a>(text: &[u8], lay: &Layout, quoted: bool, slot: RowsMut<'a>) -> Chunk<'a> {
     let mut out = Chunk {
-        rows: piece,
+        slot,
         ..Chunk::default()
     };
     if quoted {
-        out.lines = parse_csv(text, lay, 1, &mut out);
+        out.got.lines = parse_csv(text, lay, 1, &mut out);
         return out;
     }
     let cols = columns(lay);
@@ -1081,63 +1140,42 @@ fn parse_range(text: &[u8], lay: &Layout, quoted: bool, piece: Stream) -> Chunk 
             .iter()
             .position(|&c| c == b'\n')
             .map_or(rest.len(), |p| p + 1);
-        out.quoted |= rest[..end].contains(&b'"');
+        out.got.quoted |= rest[..end].contains(&b'"');
         parse_csv(&rest[..end], lay, line, &mut out);
         pos += end;
     }
-    out.lines = line;
+    out.got.lines = line;
     out
 }
 
-/// Bytes read past a range's end to find the end of its last line (more when a line is
-/// longer).
-const RANGE_OVERLAP: u64 = 64 * 1024;
-
-/// The lines of the body that start in `a..b` (file offsets), read into `buf`: the bytes of
-/// those lines are `buf[start..end]`. Ranges that partition the body partition its lines.
-fn read_range(
-    file: &std::fs::File,
-    (body, len): (u64, u64),
-    (a, b): (u64, u64),
-    buf: &mut Vec<u8>,
-) -> std::io::Result<(usize, usize)> {
-    use std::os::unix::fs::FileExt;
-    let from = if a > body { a - 1 } else { a };
-    let mut over = RANGE_OVERLAP;
-    loop {
-        let to = (b + over).min(len);
-        buf.resize((to - from) as usize, 0);
-        file.read_exact_at(buf, from)?;
-        // the first line start at or after file offset x, as an index into buf
-        let start_at = |x: u64| -> Option<usize> {
-            if x <= body {
-                return Some((x - from) as usize);
-            }
-            if x >= len {
-                return Some(buf.len());
-            }
-            let i = (x - 1 - from) as usize;
-            buf[i..].iter().position(|&c| c == b'\n').map(|p| i + p + 1)
-        };
-        match (start_at(a), start_at(b)) {
-            (Some(s), Some(e)) => return Ok((s.min(e), e)),
-            _ if to == len => {
-                let s = start_at(a).unwrap_or(buf.len());
-                return Ok((s, buf.len()));
-            }
-            _ => over *= 4,
-        }
-    }
+/// Rows a range of text can hold: one per line, as [`parse_range`] counts them.
+fn room(text: &[u8]) -> usize {
+    memchr::memchr_iter(b'\n', text).count() + usize::from(text.last().is_some_and(|&c| c != b'\n'))
 }
 
-thread_local! {
-    /// Each parsing thread's range buffer, reused from range to range.
-    static RANGE_BUF: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+/// The lines of the body that start in `a..b` (file offsets): the range of `bytes` they
+/// take. Ranges that partition the body partition its lines.
+fn line_range(bytes: &[u8], body: usize, (a, b): (usize, usize)) -> (usize, usize) {
+    // the first line start at or after offset x
+    let start_at = |x: usize| -> usize {
+        if x <= body {
+            return x;
+        }
+        if x >= bytes.len() {
+            return bytes.len();
+        }
+        bytes[x - 1..]
+            .iter()
+            .position(|&c| c == b'\n')
+            .map_or(bytes.len(), |p| x + p)
+    };
+    let e = start_at(b);
+    (start_at(a).min(e), e)
 }
 
 /// A parsed text log: one stream, and what reading it found.
 pub struct Parsed {
-    /// The samples: pieces of the topic's stream, in file order.
+    /// The samples: the topic's stream.
     pub streams: Vec<Stream>,
     /// Notes (units assumed, stamps out of order, malformed lines).
     pub notes: Vec<String>,
@@ -1149,43 +1187,49 @@ pub struct Parsed {
 pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
-    let len = file.metadata().map_err(io)?.len();
-    let head = read_head(path).map_err(io)?;
-    let lay = layout(path, &head, len, opts)?;
+    let map = crate::mapped::Mapped::of(&file, path)?;
+    let bytes = map.bytes();
+    let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
+    let lay = layout(path, head, bytes.len() as u64, opts)?;
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
-    let piece = || Stream::imu(topic, msg_type);
-    // The body in ranges read and parsed in parallel, each into its own piece of the
-    // topic's stream (no copy of the file nor of the rows). A quoted field may hold a line
-    // break: a file whose lines hold quotes is read by the csv crate whole instead.
-    let body = lay.body as u64;
-    let bounds: Vec<(u64, u64)> = (body..len)
+    // The body in ranges parsed in parallel, each straight into its slot of the topic's
+    // columns (room for one row per line: no copy of the file nor of the rows). A quoted
+    // field may hold a line break: a file whose lines hold quotes is read by the csv crate
+    // whole instead.
+    let ranges: Vec<&[u8]> = (lay.body..bytes.len())
         .step_by(RANGE_BYTES)
-        .map(|a| (a, (a + RANGE_BYTES as u64).min(len)))
-        .collect();
-    let parsed: Result<Vec<(Chunk, bool)>, std::io::Error> = bounds
-        .into_par_iter()
-        .map(|r| {
-            RANGE_BUF.with(|b| {
-                let buf = &mut b.borrow_mut();
-                let (s, e) = read_range(&file, (body, len), r, buf)?;
-                let c = parse_range(&buf[s..e], &lay, false, piece());
-                let quoted = c.quoted;
-                Ok((c, quoted))
-            })
+        .map(|a| {
+            let (s, e) = line_range(bytes, lay.body, (a, (a + RANGE_BYTES).min(bytes.len())));
+            &bytes[s..e]
         })
         .collect();
-    let mut chunks: Vec<Chunk> = Vec::new();
-    let mut quoted = false;
-    for (c, q) in parsed.map_err(io)? {
-        quoted |= q;
-        chunks.push(c);
-    }
-    if quoted && !matches!(lay.delim, Delim::Whitespace(_)) {
-        let bytes = std::fs::read(path).map_err(io)?;
-        chunks = vec![parse_range(&bytes[lay.body..], &lay, true, piece())];
+    let parse_into = |ranges: &[&[u8]], quoted: bool| {
+        let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
+        let mut rows = Rows::zeroed(room.iter().sum());
+        let got: Vec<Summary> = ranges
+            .par_iter()
+            .zip(rows.split(&room))
+            .map(|(r, slot)| parse_range(r, &lay, quoted, slot).got)
+            .collect();
+        // the rows of each range follow those of the ranges before it
+        let mut n = 0;
+        for (g, at) in got.iter().zip(room.iter().scan(0, |a, r| {
+            *a += r;
+            Some(*a - r)
+        })) {
+            if at != n {
+                rows.move_down(at, g.filled, n);
+            }
+            n += g.filled;
+        }
+        rows.truncate(n);
+        (rows, got)
+    };
+    let (mut rows, mut chunks) = parse_into(&ranges, false);
+    if chunks.iter().any(|c| c.quoted) && !matches!(lay.delim, Delim::Whitespace(_)) {
+        (rows, chunks) = parse_into(&[&bytes[lay.body..]], true);
     }
     let mut notes = Vec::new();
-    let total_rows: usize = chunks.iter().map(|c| c.rows.len()).sum();
     let total_bad: u64 = chunks.iter().map(|c| c.bad).sum();
     let total_lines: u64 = chunks.iter().map(|c| c.lines).sum();
     let mut first_bad: Option<(u64, String)> = None;
@@ -1218,50 +1262,56 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
         }
         notes.push(msg);
     }
-    // stamps that go backwards or repeat, with the line of the first of each
-    let (mut back, mut dup) = (0u64, 0u64);
-    let (mut first_back, mut first_dup) = (None, None);
-    let mut prev: Option<u64> = None;
-    let mut k_row = 0u64;
-    for (c, l0) in chunks.iter_mut().zip(&line_starts) {
-        let piece = &mut c.rows;
-        for k in 0..piece.len() {
-            if lay.time.is_none() {
-                // no time column: the rows are numbered at the given rate
-                let t = (k_row as f64 * 1e9 / opts.rate.unwrap_or(1.0)).round() as u64;
-                piece.record[k] = t;
-                piece.rows[k * ROW_LEN..k * ROW_LEN + 8].copy_from_slice(&t.to_le_bytes());
-            }
-            let t = piece.record[k];
-            if let Some(p) = prev {
-                let line = l0 + c.row_lines[k] as u64 - 1;
+    if lay.time.is_none() {
+        // no time column: the rows are numbered at the given rate
+        let rate = opts.rate.unwrap_or(1.0);
+        for (k, (r, s)) in rows.record_time.iter_mut().zip(&mut rows.stamp).enumerate() {
+            let t = RosTime::from_nanos((k as f64 * 1e9 / rate).round() as u64);
+            (*r, *s) = (t, t);
+        }
+    } else {
+        // stamps that go backwards or repeat, with the line of the first of each
+        let (mut back, mut dup) = (0u64, 0u64);
+        let (mut first_back, mut first_dup) = (None, None);
+        let mut prev: Option<u64> = None;
+        for (c, l0) in chunks.iter().zip(&line_starts) {
+            let o = &c.order;
+            let at = |l: u64| l0 + l - 1;
+            if let (Some(p), Some((t, l))) = (prev, o.first) {
                 if t < p {
                     back += 1;
-                    first_back.get_or_insert(line);
+                    first_back.get_or_insert(at(l));
                 } else if t == p {
                     dup += 1;
-                    first_dup.get_or_insert(line);
+                    first_dup.get_or_insert(at(l));
                 }
             }
-            prev = Some(t);
-            k_row += 1;
+            back += o.back;
+            dup += o.dup;
+            if let Some(l) = o.first_back {
+                first_back.get_or_insert(at(l));
+            }
+            if let Some(l) = o.first_dup {
+                first_dup.get_or_insert(at(l));
+            }
+            prev = o.last.or(prev);
+        }
+        if back > 0 {
+            notes.push(format!(
+                "{back} time stamp{} backwards (first at line {})",
+                if back == 1 { " goes" } else { "s go" },
+                first_back.unwrap_or(0)
+            ));
+        }
+        if dup > 0 {
+            notes.push(format!(
+                "{dup} time stamp{} the one before (first at line {}); the rows are kept",
+                if dup == 1 { " repeats" } else { "s repeat" },
+                first_dup.unwrap_or(0)
+            ));
         }
     }
-    if back > 0 {
-        notes.push(format!(
-            "{back} time stamp{} backwards (first at line {})",
-            if back == 1 { " goes" } else { "s go" },
-            first_back.unwrap_or(0)
-        ));
-    }
-    if dup > 0 {
-        notes.push(format!(
-            "{dup} time stamp{} the one before (first at line {}); the rows are kept",
-            if dup == 1 { " repeats" } else { "s repeat" },
-            first_dup.unwrap_or(0)
-        ));
-    }
-    check_plausible(path, &lay, &chunks)?;
+    check_plausible(path, &lay, &rows)?;
     let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
     if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
         notes.push(format!("{}: {}", path.display(), lay.what));
@@ -1276,34 +1326,18 @@ pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Er
             "'{topic}' has no accelerometer columns: its acc values are NaN"
         ));
     }
-    let _ = total_rows;
     Ok(Parsed {
-        streams: {
-            // every piece that holds rows; the topic still exists when none does
-            let mut v: Vec<Stream> = Vec::new();
-            for c in chunks {
-                if !c.rows.is_empty() || v.is_empty() {
-                    v.retain(|p| !p.is_empty());
-                    v.push(c.rows);
-                }
-            }
-            v
-        },
+        streams: vec![Stream::of_rows(topic, msg_type, rows)],
         notes,
         euroc: lay.euroc,
     })
 }
 
 /// Values stated in no unit must be plausible in SI: else the error says which unit to add.
-fn check_plausible(path: &Path, lay: &Layout, chunks: &[Chunk]) -> Result<(), Error> {
-    let n: usize = chunks.iter().map(|c| c.rows.len()).sum();
+fn check_plausible(path: &Path, lay: &Layout, rows: &Rows) -> Result<(), Error> {
+    let n = rows.len();
     let step = (n / PLAUSIBILITY_ROWS).max(1);
-    let sample: Vec<crate::imu_msg::ImuSample> = chunks
-        .iter()
-        .flat_map(|c| c.rows.rows.chunks_exact(ROW_LEN))
-        .step_by(step)
-        .filter_map(|b| Row::decode(b).ok())
-        .collect();
+    let sample: Vec<Row> = (0..n).step_by(step).map(|i| rows.row(i)).collect();
     if sample.is_empty() {
         return Ok(());
     }
@@ -1430,22 +1464,35 @@ mod tests {
         let ws = "  1   0.5 -1e-3\t3 t 1.25e2 -0 7\n2 1 2 3 x 4 5 6 9 9\n";
         for (text, d) in [(csv, Delim::Byte(b',')), (ws, Delim::Whitespace(b' '))] {
             let l = lay(d, Some(0));
-            let fast = parse_range(text.as_bytes(), &l, false, Stream::imu("i", "t"));
+            let n = room(text.as_bytes());
+            let (mut fast_rows, mut slow_rows) = (Rows::zeroed(n), Rows::zeroed(n));
+            let fast = parse_range(text.as_bytes(), &l, false, fast_rows.split(&[n]).remove(0));
             let mut slow = Chunk {
-                rows: Stream::imu("i", "t"),
+                slot: slow_rows.split(&[n]).remove(0),
                 ..Chunk::default()
             };
-            slow.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
-            assert_eq!(fast.rows.record, slow.rows.record, "{text:?}");
-            for (a, b) in fast.rows.rows.iter().zip(&slow.rows.rows) {
-                assert_eq!(a, b, "{text:?}");
-            }
-            assert_eq!(fast.rows.rows.len(), slow.rows.rows.len());
-            assert_eq!(
-                (fast.bad, fast.row_lines.clone()),
-                (slow.bad, slow.row_lines.clone())
+            slow.got.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
+            assert!(
+                fast.got.filled > 0 && fast.got.filled == slow.got.filled,
+                "{text:?}"
             );
-            assert_eq!(fast.first_bad, slow.first_bad);
+            let (fo, so) = (fast.got.order, slow.got.order);
+            assert_eq!(
+                (fo.first, fo.last, fo.back, fo.dup),
+                (so.first, so.last, so.back, so.dup)
+            );
+            assert_eq!(
+                (fast.got.bad, fast.got.lines),
+                (slow.got.bad, slow.got.lines)
+            );
+            assert_eq!(fast.got.first_bad, slow.got.first_bad);
+            let filled = fast.got.filled;
+            drop((fast, slow));
+            for i in 0..filled {
+                let (a, b) = (fast_rows.row(i), slow_rows.row(i));
+                assert_eq!(format!("{a:?}"), format!("{b:?}"), "{text:?}");
+                assert_eq!(fast_rows.record_time[i], slow_rows.record_time[i]);
+            }
         }
     }
 

@@ -127,30 +127,33 @@ impl Scalar {
 }
 
 impl Slot {
-    /// The value as f64, or `None` past the end of `data`.
+    /// The `N` bytes of the value, or `None` past the end of `data`.
+    fn bytes<const N: usize>(&self, data: &[u8]) -> Option<[u8; N]> {
+        data.get(self.offset..)?.first_chunk::<N>().copied()
+    }
+
+    /// The value as f64, or `None` past the end of `data`. (Read for every field of every
+    /// sample: plain little-endian loads, no cursor.)
     fn get(&self, data: &[u8]) -> Option<f64> {
-        let mut c = Cursor::new(data.get(self.offset..)?);
-        let r: Result<f64, CursorError> = match self.ty {
-            Scalar::I8 => c.le::<i8>("").map(f64::from),
-            Scalar::U8 => c.le::<u8>("").map(f64::from),
-            Scalar::I16 => c.le::<i16>("").map(f64::from),
-            Scalar::U16 => c.le::<u16>("").map(f64::from),
-            Scalar::I32 => c.le::<i32>("").map(f64::from),
-            Scalar::U32 => c.le::<u32>("").map(f64::from),
-            Scalar::I64 => c.le::<i64>("").map(|v| v as f64),
-            Scalar::U64 => c.le::<u64>("").map(|v| v as f64),
-            Scalar::F32 => c.le::<f32>("").map(f64::from),
-            Scalar::F64 => c.le::<f64>(""),
-        };
-        r.ok()
+        Some(match self.ty {
+            Scalar::I8 => i8::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U8 => u8::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I16 => i16::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U16 => u16::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I32 => i32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::U32 => u32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::I64 => i64::from_le_bytes(self.bytes(data)?) as f64,
+            Scalar::U64 => u64::from_le_bytes(self.bytes(data)?) as f64,
+            Scalar::F32 => f32::from_le_bytes(self.bytes(data)?).into(),
+            Scalar::F64 => f64::from_le_bytes(self.bytes(data)?),
+        })
     }
 
     fn get_u64(&self, data: &[u8]) -> Option<u64> {
-        let mut c = Cursor::new(data.get(self.offset..)?);
         match self.ty {
-            Scalar::U64 => c.le::<u64>("").ok(),
-            Scalar::I64 => c.le::<i64>("").ok().and_then(|v| u64::try_from(v).ok()),
-            Scalar::U32 => c.le::<u32>("").ok().map(u64::from),
+            Scalar::U64 => Some(u64::from_le_bytes(self.bytes(data)?)),
+            Scalar::I64 => u64::try_from(i64::from_le_bytes(self.bytes(data)?)).ok(),
+            Scalar::U32 => Some(u32::from_le_bytes(self.bytes(data)?).into()),
             _ => None,
         }
     }
@@ -436,33 +439,23 @@ struct Found {
 
 /// Bytes per part: the unit of parallel decoding, at a message boundary.
 const PART_BYTES: u64 = 4 << 20;
-/// Bytes read at a time while hopping over the file.
+/// Bytes searched at a time for the next sync marker.
 const WINDOW: usize = 8 << 20;
 
-/// A window on the file, moved forward as the parser asks for bytes.
+/// The file's bytes up to `len` (the whole file, or a part's end).
 struct Window<'f> {
-    file: &'f std::fs::File,
+    data: &'f [u8],
     len: u64,
-    buf: Vec<u8>,
-    start: u64,
 }
 
-impl Window<'_> {
-    /// Bytes `at..at + n` of the file, or `None` past its end.
-    fn get(&mut self, at: u64, n: usize) -> std::io::Result<Option<&[u8]>> {
-        use std::os::unix::fs::FileExt;
+impl<'f> Window<'f> {
+    /// Bytes `at..at + n` of the file, or `None` past `len`.
+    fn get(&self, at: u64, n: usize) -> Option<&'f [u8]> {
         let end = at.saturating_add(n as u64);
-        if end > self.len {
-            return Ok(None);
+        if end > self.len.min(self.data.len() as u64) {
+            return None;
         }
-        if at < self.start || end > self.start + self.buf.len() as u64 {
-            let to = self.len.min(at + WINDOW.max(n) as u64);
-            self.buf.resize((to - at) as usize, 0);
-            self.file.read_exact_at(&mut self.buf, at)?;
-            self.start = at;
-        }
-        let i = (at - self.start) as usize;
-        Ok(Some(&self.buf[i..i + n]))
+        Some(&self.data[at as usize..end as usize])
     }
 }
 
@@ -480,21 +473,32 @@ enum Step {
 /// The message types of the format.
 const TYPES: &[u8] = b"BFIMPQARDLCSO";
 
+/// True for a message type of the format (a table: asked of every message).
+const IS_TYPE: [bool; 256] = {
+    let mut t = [false; 256];
+    let mut i = 0;
+    while i < TYPES.len() {
+        t[TYPES[i] as usize] = true;
+        i += 1;
+    }
+    t
+};
+
 /// The step at `at`: the hop and every part walk the messages the same way.
-fn step(win: &mut Window, at: u64, appended_at: Option<u64>) -> std::io::Result<Step> {
-    let Some(h) = win.get(at, 3)? else {
-        return Ok(Step::Cut(at));
+fn step(win: &Window, at: u64, appended_at: Option<u64>) -> Step {
+    let Some(h) = win.get(at, 3) else {
+        return Step::Cut(at);
     };
     let (size, ty) = (u16::from_le_bytes([h[0], h[1]]), h[2]);
-    if !TYPES.contains(&ty) {
+    if !IS_TYPE[ty as usize] {
         let n = WINDOW.min((win.len - at) as usize);
-        let rest = win.get(at, n)?.unwrap_or(&[]);
+        let rest = win.get(at, n).unwrap_or(&[]);
         let skip = match rest.windows(SYNC.len()).position(|w| w == SYNC) {
             Some(p) => p.saturating_sub(3),
             None if at + (n as u64) < win.len => n - SYNC.len(),
             None => n,
         };
-        return Ok(Step::Skip(at, skip.max(1) as u64));
+        return Step::Skip(at, skip.max(1) as u64);
     }
     // a message cut by the start of appended data (the logger's DATA_APPENDED flag)
     if let Some(ap) = appended_at
@@ -502,12 +506,12 @@ fn step(win: &mut Window, at: u64, appended_at: Option<u64>) -> std::io::Result<
         && at + 3 + size as u64 > ap
         && ap <= win.len
     {
-        return Ok(Step::Skip(at, ap - at));
+        return Step::Skip(at, ap - at);
     }
     if at + 3 + size as u64 > win.len {
-        return Ok(Step::Cut(at));
+        return Step::Cut(at);
     }
-    Ok(Step::Msg(at, ty, size))
+    Step::Msg(at, ty, size)
 }
 
 /// An `A` message: multi_id, message id, format name.
@@ -535,8 +539,7 @@ struct PartMap {
 /// A PX4 ULog opened for reading: channels and parts from one hop over the file; each part
 /// is read and decoded on its own, in parallel.
 pub struct UlogReader {
-    file: std::fs::File,
-    len: u64,
+    map: crate::mapped::Mapped,
     contents: crate::source::Contents,
     chans: Vec<Chan>,
     by_key: HashMap<(String, u8), u32>,
@@ -548,17 +551,13 @@ pub struct UlogReader {
 pub fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
-    let len = file.metadata().map_err(io)?.len();
-    let mut win = Window {
-        file: &file,
+    let map = crate::mapped::Mapped::of(&file, path)?;
+    let len = map.bytes().len() as u64;
+    let win = Window {
+        data: map.bytes(),
         len,
-        buf: Vec::new(),
-        start: 0,
     };
-    let header = win
-        .get(0, HEADER_LEN.min(len as usize))
-        .map_err(io)?
-        .unwrap_or(&[]);
+    let header = win.get(0, HEADER_LEN.min(len as usize)).unwrap_or(&[]);
     let mut c = Cursor::new(header);
     let magic = c
         .take(MAGIC.len(), "ULog magic")
@@ -585,7 +584,7 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
     let mut part_span: Vec<Option<(u64, u64)>> = Vec::new();
     let mut at = HEADER_LEN as u64;
     while at < len {
-        let (m_at, ty, size) = match step(&mut win, at, appended_at).map_err(io)? {
+        let (m_at, ty, size) = match step(&win, at, appended_at) {
             Step::Msg(a, t, n) => (a, t, n),
             Step::Skip(a, n) => {
                 found.skipped.push((a, n));
@@ -611,7 +610,7 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
             part_counts.push(Vec::new());
             part_span.push(None);
         }
-        let Some(body) = win.get(m_at + 3, size as usize).map_err(io)? else {
+        let Some(body) = win.get(m_at + 3, size as usize) else {
             found.truncated = Some(m_at);
             break;
         };
@@ -762,8 +761,7 @@ pub fn open(path: &Path) -> Result<UlogReader, Error> {
     }
     contents.channels = channels;
     Ok(UlogReader {
-        file,
-        len,
+        map,
         contents,
         chans,
         by_key,
@@ -844,38 +842,58 @@ impl crate::source::Source for UlogReader {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut crate::source::MessageSink<'_>,
     ) -> crate::source::PartRead {
+        self.walk_part(part, want, &mut |ch, t, row| match row {
+            Some(row) => sink(ch, t, &row.encode()),
+            None => sink(ch, t, &[]),
+        })
+    }
+    fn read_part_rows(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        sink: &mut crate::source::RowSink<'_>,
+    ) -> Option<crate::source::PartRead> {
+        let imu = |ch: u32| want(ch) && self.chans[ch as usize].decoder.is_some();
+        Some(self.walk_part(part, &imu, &mut |ch, t, row| {
+            if let Some(row) = row {
+                sink(ch, t, row);
+            }
+        }))
+    }
+}
+
+impl UlogReader {
+    /// Walks part `part`, handing each message of a channel `want` accepts to `deliver`:
+    /// its row for an IMU channel (a FIFO message gives several), `None` for another topic.
+    fn walk_part(
+        &self,
+        part: usize,
+        want: &(dyn Fn(u32) -> bool + Sync),
+        deliver: &mut dyn FnMut(u32, u64, Option<&Row>),
+    ) -> crate::source::PartRead {
         let mut r = crate::source::PartRead::default();
         let Some(p) = self.parts.get(part) else {
             r.error = Some(format!("no part {part}"));
             return r;
         };
-        // each thread's part buffer is reused from part to part
-        let buf = PART_BUF.with(|b| std::mem::take(&mut *b.borrow_mut()));
-        let mut win = Window {
-            file: &self.file,
-            len: p.end.min(self.len),
-            buf,
-            start: u64::MAX,
+        let win = Window {
+            data: self.map.bytes(),
+            len: p.end,
         };
         let mut subs = p.subs.clone();
         let mut at = p.start;
         while at < win.len {
-            let (m_at, ty, size) = match step(&mut win, at, self.appended_at) {
-                Ok(Step::Msg(a, t, n)) => (a, t, n),
-                Ok(Step::Skip(a, n)) => {
+            let (m_at, ty, size) = match step(&win, at, self.appended_at) {
+                Step::Msg(a, t, n) => (a, t, n),
+                Step::Skip(a, n) => {
                     at = a + n;
                     continue;
                 }
-                Ok(Step::Cut(_)) => break,
-                Err(e) => {
-                    r.error = Some(format!("cannot read: {e}"));
-                    break;
-                }
+                Step::Cut(_) => break,
             };
             at = m_at + 3 + size as u64;
-            let body = match win.get(m_at + 3, size as usize) {
-                Ok(Some(b)) => b,
-                _ => break,
+            let Some(body) = win.get(m_at + 3, size as usize) else {
+                break;
             };
             match ty {
                 b'A' => {
@@ -901,9 +919,9 @@ impl crate::source::Source for UlogReader {
                     };
                     let t = t_us.saturating_mul(1000);
                     match &c.decoder {
-                        None => sink(ch, t, &[]),
+                        None => deliver(ch, t, None),
                         Some(d) => match d.rows(t, data, &mut |rt, row| {
-                            sink(ch, rt, &row.encode());
+                            deliver(ch, rt, Some(&row));
                             r.delivered += 1;
                         }) {
                             Ok(()) => continue,
@@ -924,14 +942,8 @@ impl crate::source::Source for UlogReader {
                 _ => {}
             }
         }
-        PART_BUF.with(|b| *b.borrow_mut() = win.buf);
         r
     }
-}
-
-thread_local! {
-    /// Each reading thread's part buffer.
-    static PART_BUF: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 #[cfg(test)]

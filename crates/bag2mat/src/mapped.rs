@@ -1,0 +1,38 @@
+//! A log file's bytes in memory, mapped rather than copied: the text and ULog readers walk
+//! the whole file (several hundred MB for hours of 200 Hz data) and a copy through `read`
+//! cost them as much as the parsing (issue 20's benchmarks).
+//!
+//! A mapping reads what the file holds while it is read: a log that another program
+//! rewrites meanwhile gives what it then holds, as `read` would; one it shortens meanwhile
+//! ends the process (SIGBUS), a risk every mapping reader (ripgrep, git) takes for speed.
+
+use std::fs::File;
+use std::path::Path;
+
+use crate::error::Error;
+
+/// A file's bytes, read only.
+pub struct Mapped {
+    map: Option<memmap2::Mmap>,
+}
+
+impl Mapped {
+    /// Maps `file` (at `path`, for messages); an empty file is an empty slice.
+    pub fn of(file: &File, path: &Path) -> Result<Mapped, Error> {
+        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        if len == 0 {
+            return Ok(Mapped { map: None });
+        }
+        // SAFETY: the mapping is read only and only read as plain bytes. Rust assumes the
+        // slice does not change while borrowed: a file rewritten or cut under the reader
+        // breaks that, the risk the module doc states and every mapping reader takes.
+        let map =
+            unsafe { memmap2::MmapOptions::new().map(file) }.map_err(|e| Error::io(path, e))?;
+        Ok(Mapped { map: Some(map) })
+    }
+
+    /// The bytes.
+    pub fn bytes(&self) -> &[u8] {
+        self.map.as_deref().unwrap_or(&[])
+    }
+}
