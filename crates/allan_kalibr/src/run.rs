@@ -217,7 +217,11 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let absent = data.absent;
     let guess = config
         .ieee952
-        .then(|| config.update_rate.or_else(|| input::measured_rate(&data.t).map(input::snap_rate)))
+        .then(|| {
+            config
+                .update_rate
+                .or_else(|| input::measured_rate(&data.t).map(input::snap_rate))
+        })
         .flatten()
         .filter(|r| r.is_finite() && *r > 0.0);
     let ((check, checks_s), early) = rayon::join(
