@@ -112,8 +112,9 @@ pub struct Timings {
     pub load: f64,
     /// τ grid, sig2 curves and both fits.
     pub analyse: f64,
-    /// The IEEE 952 analysis (0 when disabled): its curves, and the part of its fits that
-    /// outlasted the compat path they run beside.
+    /// The IEEE 952 analysis (0 when disabled): its curves (made beside the record check
+    /// when it keeps the record whole, so the phases then overlap), and the part of its
+    /// fits that outlasted the compat path they run beside.
     pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
@@ -188,6 +189,11 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
     Ok(outs)
 }
 
+/// The section's six series (gyro x y z, then acc x y z) of the `data_imu`-ordered columns.
+fn section_series(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
+    [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]]
+}
+
 /// [`run`] on samples already in memory.
 pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
@@ -209,16 +215,49 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // that is not one continuous stretch are cut, spikes dropped when asked, and what the
     // record breaks of the analysis' assumptions is found.
     let scans = data.scan_checked()?;
-    let checks_start = Instant::now();
-    let check = bag2mat::record_check::check(
-        &data.record(),
-        &bag2mat::record_check::Options {
-            drop_outliers: config.common.drop_outliers,
+    // The section's curves need only the columns and the rate. On a record the check keeps
+    // whole (the usual case) they are made beside it, at the rate the run will most likely
+    // choose (the one given, else the stamps' mean), so the check's serial parts leave no
+    // core idle; they are made again after it only if it cuts the record or the rate
+    // differs.
+    let absent = data.absent;
+    let guess = config
+        .common
+        .ieee952
+        .then(|| {
+            config
+                .common
+                .rate
+                .or_else(|| input::measured_rate(&data.t).map(input::snap_rate))
+        })
+        .flatten()
+        .filter(|r| r.is_finite() && *r > 0.0);
+    let ((check, checks_s), early) = rayon::join(
+        || {
+            let start = Instant::now();
+            let check = bag2mat::record_check::check(
+                &data.record(),
+                &bag2mat::record_check::Options {
+                    drop_outliers: config.common.drop_outliers,
+                },
+            );
+            (check, start.elapsed().as_secs_f64())
+        },
+        || {
+            guess.map(|rate| {
+                let start = Instant::now();
+                let mut notes = Vec::new();
+                let curves = crate::ieee952::imu::section_curves_of(
+                    section_series(&data.axes),
+                    absent,
+                    rate,
+                    &mut notes,
+                );
+                (rate, curves, notes, start.elapsed().as_secs_f64())
+            })
         },
     );
-    let checks_s = checks_start.elapsed().as_secs_f64();
     let mut findings = check.findings.clone();
-    let absent = data.absent;
     bag2mat::record_check::drop_absent(&mut findings, absent);
     notes.extend(absent.map(bag2mat::series::absent_warning));
     let whole = check.keep.is_all();
@@ -260,21 +299,22 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             r.short()
         )));
     }
-    let curves = if config.common.ieee952 && refusal.is_none() {
-        let a = &data.axes;
-        let series = [
-            &a[3][..],
-            &a[4][..],
-            &a[5][..],
-            &a[0][..],
-            &a[1][..],
-            &a[2][..],
-        ];
-        crate::ieee952::imu::section_curves_of(series, absent, rate.section, &mut notes)
-    } else {
-        None
+    let (curves, curves_s) = match early {
+        _ if !config.common.ieee952 || refusal.is_some() => (None, 0.0),
+        Some((r, curves, early_notes, early_s)) if whole && r == rate.section => {
+            notes.extend(early_notes);
+            (curves, early_s)
+        }
+        _ => {
+            let c = crate::ieee952::imu::section_curves_of(
+                section_series(&data.axes),
+                absent,
+                rate.section,
+                &mut notes,
+            );
+            (c, start.elapsed().as_secs_f64())
+        }
     };
-    let curves_s = start.elapsed().as_secs_f64();
     let ImuData { mut axes, .. } = data;
     // the compat path runs on six columns: the absent sensor's get the present one's
     // samples as a stand-in, whose results are dropped below

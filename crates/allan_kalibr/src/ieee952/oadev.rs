@@ -51,7 +51,7 @@ impl Phase {
     /// removing its mean. Uses compensated summation (the running error of each addition
     /// from Knuth's two-sum).
     pub fn from_rate(y: &[f64], tau0: f64) -> Phase {
-        let mean = neumaier_sum(y.iter().copied()) / y.len().max(1) as f64;
+        let mean = compensated_sum(y) / y.len().max(1) as f64;
         // written into a zeroed vector (not pushed: the push's capacity check kept the two
         // running sums in memory, the costliest part of the section's set-up after the sweep)
         let mut x = vec![0.0; y.len() + 1];
@@ -338,20 +338,33 @@ pub fn second_diff_sum(x: &[f64], m: usize) -> f64 {
     second_diff_sum_slices(&x[..cnt], &x[m..m + cnt], &x[2 * m..2 * m + cnt])
 }
 
-/// Neumaier-compensated sum.
-pub(super) fn neumaier_sum(it: impl Iterator<Item = f64>) -> f64 {
-    let (mut s, mut c) = (0.0f64, 0.0f64);
-    for v in it {
-        let t = s + v;
-        if s.abs() >= v.abs() {
-            c += (s - t) + v;
-        } else {
-            c += (v - t) + s;
+/// Compensated sum of `y`: [`SUM_LANES`] running sums, each with the running error of its
+/// additions (Knuth's branch-free two-sum, so the lanes vectorise), then the lanes and the
+/// remainder summed the same way. Exact to a few ulps of the sum like Neumaier's, at a
+/// fraction of the time of one sequential compensated pass.
+pub(super) fn compensated_sum(y: &[f64]) -> f64 {
+    let (chunks, rest) = y.as_chunks::<SUM_LANES>();
+    let (mut s, mut c) = ([0.0f64; SUM_LANES], [0.0f64; SUM_LANES]);
+    for v in chunks {
+        for l in 0..SUM_LANES {
+            let u = s[l] + v[l];
+            let bp = u - s[l];
+            c[l] += (s[l] - (u - bp)) + (v[l] - bp);
+            s[l] = u;
         }
-        s = t;
     }
-    s + c
+    let (mut tot, mut err) = (0.0f64, c.iter().sum::<f64>());
+    for &v in s.iter().chain(rest) {
+        let u = tot + v;
+        let bp = u - tot;
+        err += (tot - (u - bp)) + (v - bp);
+        tot = u;
+    }
+    tot + err
 }
+
+/// Independent running sums of [`compensated_sum`].
+const SUM_LANES: usize = 8;
 
 #[cfg(test)]
 mod tests {
@@ -519,6 +532,23 @@ mod tests {
         for (&m, v) in ms.iter().zip(&many) {
             let one = second_diff_sum(&x, m);
             assert_eq!(v.to_bits(), one.to_bits(), "m={m}: {v:e} vs {one:e}");
+        }
+    }
+
+    /// A sum whose terms cancel to one part in 1e16 (a naive sum loses it all): the
+    /// compensated sum keeps the small part to rounding of the result.
+    #[test]
+    fn compensated_sum_keeps_what_a_naive_sum_loses() {
+        for n in [0usize, 1, 7, 8, 9, 1003] {
+            let mut y: Vec<f64> = Vec::new();
+            for i in 0..n {
+                y.push(if i % 2 == 0 { 1e16 } else { -1e16 });
+            }
+            y.extend([1.0; 13]);
+            if n % 2 == 1 {
+                y.push(-1e16);
+            }
+            assert_eq!(compensated_sum(&y), 13.0, "n={n}");
         }
     }
 
