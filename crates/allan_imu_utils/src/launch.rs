@@ -18,7 +18,7 @@ pub const PARAMS: [(&str, &str); 5] = [
 ];
 
 /// The flag for a parameter name.
-pub fn flag_for(param: &str) -> &'static str {
+pub(crate) fn flag_for(param: &str) -> &'static str {
     PARAMS
         .iter()
         .find(|(p, _)| *p == param)
@@ -44,7 +44,7 @@ pub struct LaunchParams {
 
 impl LaunchParams {
     /// The last value given for `name`.
-    pub fn get(&self, name: &str) -> Option<&LaunchValue> {
+    pub(crate) fn get(&self, name: &str) -> Option<&LaunchValue> {
         self.params
             .iter()
             .rev()
@@ -54,7 +54,7 @@ impl LaunchParams {
 }
 
 /// Reads and parses a launch file.
-pub fn read(path: &Path) -> Result<LaunchParams, Error> {
+pub(crate) fn read(path: &Path) -> Result<LaunchParams, Error> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         cause: e,
@@ -133,7 +133,7 @@ fn attributes(body: &str) -> Result<Vec<(String, String)>, String> {
 }
 
 /// Parses launch-file text.
-pub fn parse(text: &str) -> Result<LaunchParams, String> {
+pub(crate) fn parse(text: &str) -> Result<LaunchParams, String> {
     let text = strip_comments(text);
     if !text.contains("<launch") {
         return Err("not a roslaunch file (no <launch> element)".into());

@@ -8,7 +8,7 @@ use std::io::Write;
 pub const HEADER: &str = "tau1,ax,ay,az,wx,wy,wz,acc_avg,gyro_avg";
 
 /// A float in the CSV: shortest round-trip digits, `NaN`/`Inf`/`-Inf` like the reference.
-pub fn csv_float(x: f64) -> String {
+pub(crate) fn csv_float(x: f64) -> String {
     if x.is_nan() {
         "NaN".into()
     } else if x.is_infinite() {
@@ -33,7 +33,7 @@ pub fn write_csv(
 
 /// [`write_csv`] for a topic that may lack a sensor: that sensor's three columns and its
 /// average are left out (the others keep their names, so readers by name still work).
-pub fn write_csv_of(
+pub(crate) fn write_csv_of(
     w: &mut dyn Write,
     tau1: &[f64],
     sig2: &[Vec<f64>; 6],

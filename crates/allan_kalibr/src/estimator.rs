@@ -32,7 +32,7 @@ pub enum Estimator {
 /// `axes` are the six sample columns ax ay az wx wy wz, each of length `grid.n`; the fast
 /// path turns each column into its prefix sums in place (no second copy of the samples).
 /// `on_progress` is called once per finished (axis, m) job.
-pub fn sig2_curves(
+pub(crate) fn sig2_curves(
     mut axes: [Vec<f64>; 6],
     grid: &TauGrid,
     estimator: Estimator,
@@ -289,7 +289,7 @@ fn walk_tiles(p: &mut [f64], ms: &[u64], mut prepare: impl FnMut(&mut [f64])) ->
 ///
 /// Mirrors Octave squaring a single difference with glibc `pow(d, 2)` when there are
 /// exactly 2 clusters (spec §2.1; see `quirk_two_clusters_square_with_pow`).
-pub fn sig2_recursive(x: &[f64], m: usize) -> f64 {
+pub(crate) fn sig2_recursive(x: &[f64], m: usize) -> f64 {
     let n = x.len();
     if m == 0 || m > n {
         return f64::NAN;

@@ -36,11 +36,11 @@ pub struct ChartFit {
 
 impl ChartFit {
     /// The −½ line `tau^(-1/2) * exp(c1)` at `tau` (the red line of the plot).
-    pub fn h_fit1(&self, tau: f64) -> f64 {
+    pub(crate) fn h_fit1(&self, tau: f64) -> f64 {
         pow(tau, -0.5) * self.c1.exp()
     }
     /// The +½ line `tau^(1/2) * exp(c2)` at `tau` (the blue line of the plot).
-    pub fn h_fit2(&self, tau: f64) -> f64 {
+    pub(crate) fn h_fit2(&self, tau: f64) -> f64 {
         pow(tau, 0.5) * self.c2.exp()
     }
 }

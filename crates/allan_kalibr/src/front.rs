@@ -112,7 +112,7 @@ pub enum Input {
 
 impl Input {
     /// The paths the run reads (never an output).
-    pub fn paths(&self) -> Vec<&Path> {
+    pub(crate) fn paths(&self) -> Vec<&Path> {
         match self {
             Input::Samples(p) => vec![p.as_path()],
             Input::Curves(c) => c.paths.iter().map(|p| p.as_path()).collect(),
@@ -120,7 +120,7 @@ impl Input {
     }
 
     /// The first path: what the default output folder is named after.
-    pub fn first(&self) -> &Path {
+    pub(crate) fn first(&self) -> &Path {
         self.paths().first().copied().unwrap_or(Path::new("."))
     }
 }
@@ -200,7 +200,7 @@ impl Common {
 }
 
 /// No topic named: `imu` when the input has it, else its only Imu topic.
-pub fn default_topics() -> bag2mat::TopicSelector {
+pub(crate) fn default_topics() -> bag2mat::TopicSelector {
     bag2mat::TopicSelector {
         preferred: Some(DEFAULT_TOPIC.to_string()),
         ..Default::default()
@@ -209,7 +209,7 @@ pub fn default_topics() -> bag2mat::TopicSelector {
 
 /// The default output folder of `tool` for `input`: `<stem>_<tool>` beside it (a bag
 /// directory's or curves directory's name stands for the stem), never the data folder.
-pub fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
+pub(crate) fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
     let input = if input.file_name().is_some_and(|n| n == "metadata.yaml") {
         input.parent().unwrap_or(Path::new("."))
     } else {

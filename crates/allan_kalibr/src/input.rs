@@ -64,7 +64,7 @@ impl ImuData {
 
     /// Builds the columns from a bag2mat series with the chosen time column (bagconvert's
     /// record time by default), through bag2mat's one series-to-matrix conversion.
-    pub fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
+    pub(crate) fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
         let absent = s.stand_in_absent(bag2mat::series::StandIn::Zeros);
         let topic = s.topic.clone();
         let notes = s.notes.clone();
@@ -91,7 +91,7 @@ impl ImuData {
     }
 
     /// The samples `keep` names (all of them: unchanged).
-    pub fn select(self, keep: &bag2mat::record_check::Keep) -> ImuData {
+    pub(crate) fn select(self, keep: &bag2mat::record_check::Keep) -> ImuData {
         if keep.is_all() {
             return self;
         }
@@ -113,7 +113,7 @@ impl ImuData {
     }
 
     /// Drops the first `k` samples.
-    pub fn drop_first(&mut self, k: usize) {
+    pub(crate) fn drop_first(&mut self, k: usize) {
         self.t.drain(..k);
         for c in self.axes.iter_mut() {
             c.drain(..k);
@@ -129,7 +129,7 @@ impl ImuData {
     }
 
     /// The record the check reads: gyro x y z, then acc x y z, with the clock.
-    pub fn record(&self) -> bag2mat::record_check::Record<'_> {
+    pub(crate) fn record(&self) -> bag2mat::record_check::Record<'_> {
         let a = &self.axes;
         bag2mat::record_check::Record {
             time: self.clock.time,
@@ -149,7 +149,7 @@ impl ImuData {
     /// One pass over each column (the six in parallel): fails like [`ImuData::check_finite`]
     /// on the first non-finite sample (axes in order), else returns what [`value_problem`]
     /// needs, so the run reads the columns once for both checks.
-    pub fn scan_checked(&self) -> Result<[ColumnScan; 6], Error> {
+    pub(crate) fn scan_checked(&self) -> Result<[ColumnScan; 6], Error> {
         use rayon::prelude::*;
         let scans: Vec<ColumnScan> = self.axes.par_iter().map(|c| ColumnScan::of(c)).collect();
         for (a, (scan, col)) in scans.iter().zip(&self.axes).enumerate() {
@@ -185,7 +185,7 @@ pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
 }
 
 /// Reads the selected topics of a bag or log in one pass, or the one `data_imu` of a `.mat`.
-pub fn load_all(
+pub(crate) fn load_all(
     path: &Path,
     sel: &bag2mat::TopicSelector,
     time: bag2mat::TimeColumn,
@@ -247,7 +247,7 @@ pub struct ColumnScan {
 
 impl ColumnScan {
     /// Scans `col` once (8 independent lanes, so the compiler vectorises it).
-    pub fn of(col: &[f64]) -> ColumnScan {
+    pub(crate) fn of(col: &[f64]) -> ColumnScan {
         const L: usize = 8;
         let first = col.first().copied();
         let f = first.unwrap_or(0.0);
@@ -281,7 +281,7 @@ impl ColumnScan {
     }
 
     /// [`value_problem`] of the scanned column, named `axis`.
-    pub fn problem(&self, axis: &str) -> Option<(bool, String)> {
+    pub(crate) fn problem(&self, axis: &str) -> Option<(bool, String)> {
         let max = self.max_abs;
         if max > MAX_ABS_VALUE {
             return Some((
@@ -378,7 +378,7 @@ pub fn snap_rate(m: f64) -> f64 {
 
 /// Mean rate of the timestamps, `(N-1)/(t_N - t_1)`; None without a positive span (the
 /// obviously correct reference of the nominal rate on a record without gaps).
-pub fn measured_rate(t: &[f64]) -> Option<f64> {
+pub(crate) fn measured_rate(t: &[f64]) -> Option<f64> {
     let (first, last) = (t.first()?, t.last()?);
     let span = last - first;
     (t.len() >= 2 && span.is_finite() && span > 0.0).then(|| (t.len() - 1) as f64 / span)
@@ -388,7 +388,7 @@ pub fn measured_rate(t: &[f64]) -> Option<f64> {
 /// (`bag2mat::timing`: lost samples do not change it): the given one for the
 /// upstream-compatible grid (as upstream), the measured one, snapped to an integer within
 /// [`RATE_SNAP_REL`], otherwise and for the IEEE 952 section.
-pub fn choose_rate(
+pub(crate) fn choose_rate(
     given: Option<f64>,
     measured: Option<f64>,
     n: usize,

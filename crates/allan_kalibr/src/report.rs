@@ -4,7 +4,7 @@
 use crate::fit::ChartFit;
 
 /// MATLAB `fprintf('%.<prec>f', x)`: fixed notation, `NaN` / `Inf` / `-Inf` when not finite.
-pub fn matlab_fixed(x: f64, prec: usize) -> String {
+pub(crate) fn matlab_fixed(x: f64, prec: usize) -> String {
     if x.is_nan() {
         "NaN".to_owned()
     } else if x.is_infinite() {
@@ -70,7 +70,11 @@ pub fn full_text(accel: &ChartFit, gyro: &ChartFit) -> String {
 
 /// [`full_text`] for a topic that may lack a sensor: the absent sensor's chart and final
 /// lines are replaced by one line saying it is absent (no figures for it).
-pub fn full_text_of(accel: &ChartFit, gyro: &ChartFit, absent: Option<bag2mat::Sensor>) -> String {
+pub(crate) fn full_text_of(
+    accel: &ChartFit,
+    gyro: &ChartFit,
+    absent: Option<bag2mat::Sensor>,
+) -> String {
     use bag2mat::Sensor;
     let absent_line =
         |s: Sensor| format!("=> {}: absent from this topic (not analysed)\n", s.name());

@@ -512,7 +512,7 @@ pub fn run_curves(
 }
 
 /// Writes `allan_accel.{png,svg}` and `allan_gyro.{png,svg}` into `dir`.
-pub fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+pub(crate) fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let join = |name: &str| {
         if title.is_empty() {
             name.to_owned()

@@ -87,7 +87,7 @@ impl TauGrid {
 /// MATLAB's `linspace(d1, d2, n)`: `d1 + (i*(d2-d1))/(n-1)` with both end points set
 /// exactly (kalibr_allan.md §2 "The m grid"; Octave's symmetric formula gives the same m on
 /// every case in §7, MATLAB's is the contract).
-pub fn matlab_linspace(d1: f64, d2: f64, n: usize) -> Vec<f64> {
+pub(crate) fn matlab_linspace(d1: f64, d2: f64, n: usize) -> Vec<f64> {
     let n1 = (n - 1) as f64;
     let mut v: Vec<f64> = (0..n).map(|i| d1 + (i as f64 * (d2 - d1)) / n1).collect();
     if let Some(first) = v.first_mut() {

@@ -28,7 +28,7 @@ pub struct ImuYaml {
 
 /// A float as YAML 1.1 reads it back bit-for-bit: shortest round-trip digits, a `.` always
 /// present, `.nan` / `.inf` / `-.inf` for non-finite values.
-pub fn yaml_float(x: f64) -> String {
+pub(crate) fn yaml_float(x: f64) -> String {
     if x.is_nan() {
         return ".nan".into();
     }
@@ -41,7 +41,7 @@ pub fn yaml_float(x: f64) -> String {
 }
 
 /// A topic string as a YAML plain scalar when safe, otherwise single-quoted.
-pub fn yaml_str(s: &str) -> String {
+pub(crate) fn yaml_str(s: &str) -> String {
     let plain = !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || "/_-.".contains(c))
@@ -54,14 +54,14 @@ pub fn yaml_str(s: &str) -> String {
 }
 
 /// One `key: value   #comment` line of the imu.yaml layout (aligned columns).
-pub fn key_line(key: &str, value: &str, comment: &str) -> String {
+pub(crate) fn key_line(key: &str, value: &str, comment: &str) -> String {
     format!("{:<29}{:<24}#{comment}\n", format!("{key}:"), value)
 }
 
 impl ImuYaml {
     /// The file text of the kalibr_allan-compatible run. `source` (input file name) goes
     /// into a comment.
-    pub fn render(&self, source: &str) -> String {
+    pub(crate) fn render(&self, source: &str) -> String {
         let first = format!("IMU noise model for Kalibr, written by allan_kalibr from {source}");
         self.render_with(&[
             &first,
@@ -77,7 +77,7 @@ impl ImuYaml {
     }
 
     /// The file text after the given comment lines (each written as `# line`).
-    pub fn render_with(&self, comments: &[&str]) -> String {
+    pub(crate) fn render_with(&self, comments: &[&str]) -> String {
         let mut o = String::new();
         for c in comments {
             let _ = writeln!(o, "# {c}");

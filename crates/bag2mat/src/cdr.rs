@@ -203,7 +203,7 @@ fn f64_at(body: &[u8], i: usize, endian: Endian) -> f64 {
 }
 
 /// Decodes stamp, gyro and acc (`seq` is 0: ROS 2 has none) without allocating.
-pub fn decode_sample(data: &[u8]) -> Result<ImuSample, Error> {
+pub(crate) fn decode_sample(data: &[u8]) -> Result<ImuSample, Error> {
     let s = split(data)?;
     let f = |i| f64_at(s.body, i, s.endian);
     Ok(ImuSample {

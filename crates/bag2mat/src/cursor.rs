@@ -65,12 +65,12 @@ impl<'a> Cursor<'a> {
     }
 
     /// At the start of `data`, which lies at file offset `base`.
-    pub fn at(data: &'a [u8], base: u64) -> Cursor<'a> {
+    pub(crate) fn at(data: &'a [u8], base: u64) -> Cursor<'a> {
         Cursor { data, pos: 0, base }
     }
 
     /// File offset of the next byte.
-    pub fn offset(&self) -> u64 {
+    pub(crate) fn offset(&self) -> u64 {
         self.base + self.pos as u64
     }
 
@@ -80,7 +80,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// Bytes left.
-    pub fn remaining(&self) -> usize {
+    pub(crate) fn remaining(&self) -> usize {
         self.data.len() - self.pos
     }
 
@@ -90,12 +90,12 @@ impl<'a> Cursor<'a> {
     }
 
     /// The bytes not read yet.
-    pub fn rest(&self) -> &'a [u8] {
+    pub(crate) fn rest(&self) -> &'a [u8] {
         &self.data[self.pos..]
     }
 
     /// The error for a field whose bytes are there but wrong, at the current offset.
-    pub fn invalid(&self, what: impl Into<String>) -> CursorError {
+    pub(crate) fn invalid(&self, what: impl Into<String>) -> CursorError {
         CursorError::Invalid {
             offset: self.offset(),
             what: what.into(),
@@ -103,7 +103,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// The next `n` bytes.
-    pub fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], CursorError> {
+    pub(crate) fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], CursorError> {
         if n > self.remaining() {
             return Err(CursorError::Short {
                 offset: self.offset(),
@@ -118,17 +118,17 @@ impl<'a> Cursor<'a> {
     }
 
     /// Skips `n` bytes.
-    pub fn skip(&mut self, n: usize, what: &'static str) -> Result<(), CursorError> {
+    pub(crate) fn skip(&mut self, n: usize, what: &'static str) -> Result<(), CursorError> {
         self.take(n, what).map(|_| ())
     }
 
     /// The next number.
-    pub fn le<T: Le>(&mut self, what: &'static str) -> Result<T, CursorError> {
+    pub(crate) fn le<T: Le>(&mut self, what: &'static str) -> Result<T, CursorError> {
         self.take(T::SIZE, what).map(T::from_le)
     }
 
     /// The next `n` bytes as UTF-8 text.
-    pub fn str(&mut self, n: usize, what: &'static str) -> Result<&'a str, CursorError> {
+    pub(crate) fn str(&mut self, n: usize, what: &'static str) -> Result<&'a str, CursorError> {
         let at = self.offset();
         let b = self.take(n, what)?;
         std::str::from_utf8(b).map_err(|e| CursorError::Invalid {

@@ -36,7 +36,7 @@ pub struct Row {
 
 impl Row {
     /// The payload.
-    pub fn encode(&self) -> [u8; ROW_LEN] {
+    pub(crate) fn encode(&self) -> [u8; ROW_LEN] {
         let mut b = [0u8; ROW_LEN];
         b[..8].copy_from_slice(&self.stamp.to_le_bytes());
         for (i, v) in self.acc.iter().chain(&self.gyro).enumerate() {
@@ -46,7 +46,7 @@ impl Row {
     }
 
     /// The sample of a payload.
-    pub fn decode(b: &[u8]) -> Result<ImuSample, Error> {
+    pub(crate) fn decode(b: &[u8]) -> Result<ImuSample, Error> {
         let Some(b) = b.first_chunk::<ROW_LEN>().filter(|_| b.len() == ROW_LEN) else {
             return Err(Error::BadMessage {
                 what: format!("a decoded row is {ROW_LEN} bytes, this one {}", b.len()),
@@ -106,7 +106,7 @@ impl Stream {
     }
 
     /// An empty topic of another type (times only).
-    pub fn other(topic: impl Into<String>, msg_type: impl Into<String>) -> Stream {
+    pub(crate) fn other(topic: impl Into<String>, msg_type: impl Into<String>) -> Stream {
         Stream {
             imu: false,
             ..Stream::imu(topic, msg_type)
@@ -122,12 +122,12 @@ impl Stream {
     }
 
     /// Appends a row logged at `record` ns.
-    pub fn push(&mut self, record: u64, row: &Row) {
+    pub(crate) fn push(&mut self, record: u64, row: &Row) {
         self.rows.push_row(record, row);
     }
 
     /// Room for `n` more messages.
-    pub fn reserve(&mut self, n: usize) {
+    pub(crate) fn reserve(&mut self, n: usize) {
         if self.imu {
             self.rows.reserve(n);
         } else {
@@ -136,12 +136,12 @@ impl Stream {
     }
 
     /// Appends a message of a times-only topic.
-    pub fn push_time(&mut self, record: u64) {
+    pub(crate) fn push_time(&mut self, record: u64) {
         self.times.push(record);
     }
 
     /// Messages.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         if self.imu {
             self.rows.len()
         } else {
@@ -155,7 +155,7 @@ impl Stream {
     }
 
     /// Record time of message `i`, ns.
-    pub fn record(&self, i: usize) -> u64 {
+    pub(crate) fn record(&self, i: usize) -> u64 {
         if self.imu {
             self.rows.record_time[i].as_nanos()
         } else {
@@ -185,7 +185,7 @@ impl DecodedSource {
     /// Serves `streams`, with what opening found. Consecutive streams of one topic and type
     /// are pieces of one channel (a reader that parsed in parallel hands its pieces over
     /// without joining them); channel ids count the channels in order.
-    pub fn new(
+    pub(crate) fn new(
         kind: InputKind,
         mut streams: Vec<Stream>,
         notes: Vec<String>,

@@ -163,7 +163,7 @@ impl Imu {
 
 impl ImuSample {
     /// Decodes seq, stamp, gyro and acc from a serialized Imu, skipping the rest.
-    pub fn decode(data: &[u8]) -> Result<ImuSample, Error> {
+    pub(crate) fn decode(data: &[u8]) -> Result<ImuSample, Error> {
         let ((seq, stamp), _, body) = split(data)?;
         Ok(ImuSample {
             seq,

@@ -18,7 +18,7 @@ pub struct Mapped {
 
 impl Mapped {
     /// Maps `file` (at `path`, for messages); an empty file is an empty slice.
-    pub fn of(file: &File, path: &Path) -> Result<Mapped, Error> {
+    pub(crate) fn of(file: &File, path: &Path) -> Result<Mapped, Error> {
         let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
         if len == 0 {
             return Ok(Mapped { map: None });
@@ -32,7 +32,7 @@ impl Mapped {
     }
 
     /// The bytes.
-    pub fn bytes(&self) -> &[u8] {
+    pub(crate) fn bytes(&self) -> &[u8] {
         self.map.as_deref().unwrap_or(&[])
     }
 }

@@ -254,7 +254,7 @@ fn imu_codec(c: &Channel) -> Option<Codec> {
 }
 
 /// True when the channel carries `sensor_msgs/Imu` in an encoding we decode.
-pub fn is_imu(c: &Channel) -> bool {
+pub(crate) fn is_imu(c: &Channel) -> bool {
     imu_codec(c).is_some()
 }
 
@@ -268,7 +268,7 @@ fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
 
 /// Every topic of the source with its type and message count, sorted by topic. Counts the
 /// container does not keep are counted by reading it.
-pub fn topic_summaries(src: &dyn Source) -> Vec<TopicSummary> {
+pub(crate) fn topic_summaries(src: &dyn Source) -> Vec<TopicSummary> {
     let counts = channel_counts(src);
     let mut by: std::collections::BTreeMap<(String, String), u64> = Default::default();
     for c in src.channels() {
@@ -285,7 +285,7 @@ pub fn topic_summaries(src: &dyn Source) -> Vec<TopicSummary> {
 }
 
 /// Messages per channel: the container's counts, or a counting pass when it has none.
-pub fn channel_counts(src: &dyn Source) -> std::collections::BTreeMap<u32, u64> {
+pub(crate) fn channel_counts(src: &dyn Source) -> std::collections::BTreeMap<u32, u64> {
     if src.channels().iter().all(|c| c.count.is_some()) {
         return src
             .channels()
@@ -931,7 +931,7 @@ pub fn read_from(
 
 /// [`read_from`] on a source read once and dropped: a topic its reader decoded whole on
 /// opening moves into the series ([`Source::take_rows`]) instead of being copied.
-pub fn read_owned(
+pub(crate) fn read_owned(
     src: Box<dyn Source>,
     sel: &TopicSelector,
     opts: &ReadOptions,

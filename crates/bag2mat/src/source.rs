@@ -83,7 +83,7 @@ pub enum Encoding {
 
 impl Encoding {
     /// From a container's encoding name (`ros1`, `cdr`, …).
-    pub fn from_name(name: &str) -> Encoding {
+    pub(crate) fn from_name(name: &str) -> Encoding {
         match name {
             "ros1" => Encoding::Ros1,
             "cdr" => Encoding::Cdr,
@@ -91,7 +91,7 @@ impl Encoding {
         }
     }
     /// The name.
-    pub fn name(&self) -> &str {
+    pub(crate) fn name(&self) -> &str {
         match self {
             Encoding::Ros1 => "ros1",
             Encoding::Cdr => "cdr",
@@ -157,7 +157,7 @@ pub struct Loss {
 
 impl Loss {
     /// A loss of unknown size, on no particular channel.
-    pub fn new(what: impl Into<String>) -> Loss {
+    pub(crate) fn new(what: impl Into<String>) -> Loss {
         Loss {
             what: what.into(),
             ..Loss::default()
@@ -356,7 +356,7 @@ pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
 }
 
 /// [`open`], with what the user said about a log whose content does not say it all.
-pub fn open_with(
+pub(crate) fn open_with(
     path: &Path,
     opts: &crate::formats::InputOptions,
 ) -> Result<Box<dyn Source>, Error> {
@@ -391,7 +391,7 @@ pub struct Decompressed {
 
 /// Decompresses every zstd frame of `src` into a temporary file (FILE-mode rosbag2
 /// compression stores each storage file as one `.zstd` file).
-pub fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
+pub(crate) fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
     let dir = tempfile::Builder::new()
         .prefix("bag2mat-zstd.")
         .tempdir()

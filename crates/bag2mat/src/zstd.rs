@@ -3,7 +3,7 @@
 use std::io::{Read, Write};
 
 /// Decompresses one or more concatenated zstd frames from `input` into `out`.
-pub fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std::io::Result<u64> {
+pub(crate) fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std::io::Result<u64> {
     let mut input = std::io::BufReader::new(input);
     let mut total = 0u64;
     loop {
@@ -19,7 +19,7 @@ pub fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std::io::R
 
 /// Decompresses `data` (whole zstd frames) into `out`, which is cleared first. At most
 /// `limit` bytes are accepted (a damaged size field cannot make it allocate more).
-pub fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Result<(), String> {
+pub(crate) fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Result<(), String> {
     out.clear();
     let mut w = LimitedWriter { out, limit };
     decompress_stream(data, &mut w).map_err(|e| format!("zstd: {e}"))?;

@@ -200,7 +200,7 @@ impl ImuBagSink {
 const MAX_ROS_NS: u64 = (u32::MAX as u64 + 1) * 1_000_000_000 - 1;
 
 /// `--rate` must be a positive number of Hz.
-pub fn validate_rate(rate: f64) -> Result<()> {
+pub(crate) fn validate_rate(rate: f64) -> Result<()> {
     if !(rate.is_finite() && rate > 0.0) {
         return Err(SimError::InvalidArgument(format!(
             "--rate must be a positive number of Hz, got {rate}"
@@ -210,7 +210,7 @@ pub fn validate_rate(rate: f64) -> Result<()> {
 }
 
 /// Validate a bag configuration.
-pub fn validate(cfg: &BagConfig) -> Result<()> {
+pub(crate) fn validate(cfg: &BagConfig) -> Result<()> {
     validate_rate(cfg.rate)?;
     cfg.model.validate(cfg.rate)?;
     if !(cfg.duration.is_finite() && cfg.duration > 0.0) {
@@ -399,7 +399,7 @@ impl Noise {
 }
 
 /// Now, ns since the UNIX epoch (upstream: `ros::Time::now()`).
-pub fn now_ns() -> u64 {
+pub(crate) fn now_ns() -> u64 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_nanos() as u64)
@@ -407,7 +407,7 @@ pub fn now_ns() -> u64 {
 }
 
 /// Parse `--start-time` (UNIX seconds, decimal) into ns, exactly.
-pub fn parse_start_time(s: &str) -> Result<u64> {
+pub(crate) fn parse_start_time(s: &str) -> Result<u64> {
     match crate::textio::parse_time_ns(s) {
         Some(ns) if (0..=MAX_ROS_NS as i64).contains(&ns) => Ok(ns as u64),
         Some(_) => Err(SimError::InvalidArgument(format!(

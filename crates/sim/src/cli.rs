@@ -153,7 +153,7 @@ pub struct NoiseArgs {
 
 impl NoiseArgs {
     /// Resolve against a default preset; rejects negative or non-finite values.
-    pub fn resolve(&self, default: PresetArg) -> Result<ContinuousNoise> {
+    pub(crate) fn resolve(&self, default: PresetArg) -> Result<ContinuousNoise> {
         let mut c = self.preset.unwrap_or(default).params();
         for (name, v, slot) in [
             ("--gyro-noise", self.gyro_noise, &mut c.gyro_noise),

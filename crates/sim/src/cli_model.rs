@@ -31,7 +31,7 @@ pub enum SensorArg {
 
 impl SensorArg {
     /// The profile.
-    pub fn profile(self) -> Profile {
+    pub(crate) fn profile(self) -> Profile {
         match self {
             SensorArg::Low => Profile::Low,
             SensorArg::Medium => Profile::Medium,
@@ -126,7 +126,7 @@ pub const DEFAULT_BI_TAUS: (f64, f64) = (1.0, 1000.0);
 
 impl ModelArgs {
     /// The model: base (profile, preset, or medium), spec, then flags; validated at `rate`.
-    pub fn resolve(&self, noise: &NoiseArgs, rate: f64) -> Result<ImuModel> {
+    pub(crate) fn resolve(&self, noise: &NoiseArgs, rate: f64) -> Result<ImuModel> {
         // Checks the N/K flags the way every subcommand does.
         noise.resolve(crate::cli::PresetArg::Medium)?;
         let base = match (self.sensor, noise.preset) {

@@ -60,7 +60,7 @@ pub type Result<T> = std::result::Result<T, SimError>;
 
 impl SimError {
     /// An I/O error with its path.
-    pub fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Self {
+    pub(crate) fn io(path: impl Into<PathBuf>, cause: std::io::Error) -> Self {
         SimError::Io {
             path: path.into(),
             cause,

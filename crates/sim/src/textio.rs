@@ -169,7 +169,7 @@ pub fn read_pose_rows(path: &Path) -> Result<Vec<PoseRow>> {
 
 /// Parse a decimal time in seconds into integer nanoseconds exactly (no f64 rounding for
 /// plain decimals; exponent forms go through f64).
-pub fn parse_time_ns(s: &str) -> Option<i64> {
+pub(crate) fn parse_time_ns(s: &str) -> Option<i64> {
     let s = s.trim();
     if s.contains(['e', 'E']) {
         let x: f64 = s.parse().ok()?;

@@ -93,7 +93,7 @@ fn k_at_least(k: &Term, n: &Term, record: f64) -> TermAdvice {
 }
 
 /// The advice for an analysed axis (None without a sample count: no precision known).
-pub fn advise(a: &Analysis) -> Option<Advice> {
+pub(crate) fn advise(a: &Analysis) -> Option<Advice> {
     let n = a.n?;
     let record = n as f64 * a.tau0;
     Some(Advice {
@@ -108,7 +108,7 @@ pub fn advise(a: &Analysis) -> Option<Advice> {
 }
 
 /// A duration in the unit that reads best (s, min, h, d).
-pub fn duration_text(s: f64) -> String {
+pub(crate) fn duration_text(s: f64) -> String {
     if !s.is_finite() {
         return "-".into();
     }

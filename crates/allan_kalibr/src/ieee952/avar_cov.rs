@@ -293,7 +293,7 @@ pub struct CovBasis {
 impl CovBasis {
     /// Basis for the estimates at cluster sizes `ms` (ascending, distinct) of `n` rate
     /// samples at period `tau0`, for the estimator `kind`.
-    pub fn new(ms: &[usize], n: usize, tau0: f64, kind: Overlap) -> CovBasis {
+    pub(crate) fn new(ms: &[usize], n: usize, tau0: f64, kind: Overlap) -> CovBasis {
         let counts: Vec<usize> = ms.iter().map(|&m| (n + 1).saturating_sub(2 * m)).collect();
         let k = ms.len();
         let sums: Vec<[f64; 10]> = (0..k)
@@ -319,7 +319,7 @@ impl CovBasis {
     }
 
     /// Cluster sizes of the basis.
-    pub fn ms(&self) -> &[usize] {
+    pub(crate) fn ms(&self) -> &[usize] {
         &self.ms
     }
 
@@ -330,7 +330,7 @@ impl CovBasis {
     }
 
     /// Variance of point `i` for coefficients `c` (Q², N², B², K², R²).
-    pub fn var(&self, i: usize, c: &[f64]) -> f64 {
+    pub(crate) fn var(&self, i: usize, c: &[f64]) -> f64 {
         match self.kind {
             Overlap::Overlapping => quad(&self.sums[self.tri(i, i)], c),
             Overlap::Normal => quad(&self.normal_var[i], c),
@@ -338,7 +338,7 @@ impl CovBasis {
     }
 
     /// Covariance matrix of the points `idx` (indices into [`CovBasis::ms`]) for `c`.
-    pub fn cov(&self, idx: &[usize], c: &[f64]) -> Vec<Vec<f64>> {
+    pub(crate) fn cov(&self, idx: &[usize], c: &[f64]) -> Vec<Vec<f64>> {
         let mut one = [0.0; TERM_COUNT];
         for (o, v) in one.iter_mut().zip(c) {
             *o = *v;
@@ -350,7 +350,7 @@ impl CovBasis {
     /// Covariance matrix of the points `idx` when point a has the effective coefficients
     /// `c[a]` (a component standing in for one of another shape, see the fit's Gauss–Markov
     /// term): Cov_ab = Σ_{t,u} c_a,t c_b,u S_ab^{tu}.
-    pub fn cov_pointwise(&self, idx: &[usize], c: &[[f64; TERM_COUNT]]) -> Vec<Vec<f64>> {
+    pub(crate) fn cov_pointwise(&self, idx: &[usize], c: &[[f64; TERM_COUNT]]) -> Vec<Vec<f64>> {
         let k = idx.len();
         let mut out = vec![vec![0.0; k]; k];
         for a in 0..k {

@@ -885,7 +885,7 @@ fn read_ieee952(path: &Path, text: &str, opts: &Options) -> Result<Curves, Curve
 }
 
 /// A unit of a plain CSV: (sensor, factor to rad/s or m/s²).
-pub fn parse_unit(u: &str) -> Option<(Sensor, f64)> {
+pub(crate) fn parse_unit(u: &str) -> Option<(Sensor, f64)> {
     let d = std::f64::consts::PI / 180.0;
     Some(match u.trim().to_ascii_lowercase().as_str() {
         "rad/s" => (Sensor::Gyro, 1.0),

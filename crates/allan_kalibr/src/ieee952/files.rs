@@ -141,7 +141,7 @@ pub const VINS_FILE: &str = "vins_imu_ieee952.yaml";
 pub const ORBSLAM3_FILE: &str = "orbslam3_imu_ieee952.yaml";
 
 /// The sample count a curves file states in its `# samples=N` comment line.
-pub fn stated_samples(text: &str) -> Option<usize> {
+pub(crate) fn stated_samples(text: &str) -> Option<usize> {
     text.lines()
         .take_while(|l| l.starts_with('#'))
         .find_map(|l| {
@@ -204,7 +204,7 @@ fn fit_code(v: &AxisVerdict) -> &'static str {
 /// Per axis and term: value, standard error, 95 % interval, verdict, unit, the axis' fit,
 /// the region reading and the advice. Rust's `{}` float output is the shortest text that
 /// reads back to the same double.
-pub fn terms_csv(a: &ImuAnalysis) -> String {
+pub(crate) fn terms_csv(a: &ImuAnalysis) -> String {
     let mut s = String::from(
         "# IEEE 952 terms per axis, continuous time (N: noise density, K: random walk, B: bias instability, Q: quantization, R: ramp; G: Gauss-Markov bias sigma, GT its correlation time; BT: the bias-instability floor's lower corner, 0 for a flat floor)\n",
     );
@@ -303,7 +303,7 @@ pub fn terms_csv(a: &ImuAnalysis) -> String {
 }
 
 /// The Allan deviation of every axis with its bounds, range flag and the fitted model.
-pub fn curves_csv(a: &ImuAnalysis) -> String {
+pub(crate) fn curves_csv(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     if let Some(x) = a.axes.first() {
         let _ = writeln!(
@@ -334,7 +334,7 @@ pub fn curves_csv(a: &ImuAnalysis) -> String {
 
 /// The Welch PSD of every axis (one-sided, unit²/Hz: rad²/s²/Hz, m²/s⁴/Hz), its local
 /// floor, and the fitted model's PSD; comment lines list the lines found per axis.
-pub fn psd_csv(a: &ImuAnalysis) -> String {
+pub(crate) fn psd_csv(a: &ImuAnalysis) -> String {
     let mut s = String::from(
         "# Welch PSD per axis: one-sided, in the axis unit squared per Hz (gyro rad^2/s^2/Hz, accelerometer m^2/s^4/Hz); white noise of density N has the level 2*N^2. floor: the running median the lines are found against; model_psd: the fitted IEEE 952 terms (a sinusoidal line has no density: listed below)\n",
     );
@@ -479,7 +479,7 @@ fn key_line(o: &mut String, key: &str, v: Option<SensorValue>, comment: &str) {
 
 /// Kalibr `imu.yaml` (continuous-time, as Kalibr expects), in the layout of the compat file
 /// ([`crate::yaml::ImuYaml`]).
-pub fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
+pub(crate) fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
     let v = file_values(
         a,
         [
@@ -544,7 +544,7 @@ pub fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
 /// VINS-Mono / VINS-Fusion keys. Their comments say "standard deviation"; VINS uses them as
 /// continuous-time densities (it multiplies by the integration period), so these are the
 /// continuous-time values, stated in the file.
-pub fn vins_yaml(a: &ImuAnalysis) -> String {
+pub(crate) fn vins_yaml(a: &ImuAnalysis) -> String {
     let v = file_values(a, ["acc_n", "acc_w", "gyr_n", "gyr_w"]);
     let mut o = String::from("%YAML:1.0\n");
     let _ = writeln!(
@@ -597,7 +597,7 @@ pub fn vins_yaml(a: &ImuAnalysis) -> String {
 
 /// ORB-SLAM3 settings keys (continuous-time densities; ORB-SLAM3 discretises with
 /// IMU.Frequency).
-pub fn orbslam3_yaml(a: &ImuAnalysis) -> String {
+pub(crate) fn orbslam3_yaml(a: &ImuAnalysis) -> String {
     let v = file_values(
         a,
         [

@@ -138,7 +138,7 @@ impl ImuCurves {
 
     /// [`ImuCurves::from_samples`] without the `absent` sensor's three series (a
     /// one-sensor topic: they are a stand-in, not read).
-    pub fn from_samples_of(
+    pub(crate) fn from_samples_of(
         series: [&[f64]; 6],
         absent: Option<Sensor>,
         rate: f64,
@@ -174,7 +174,7 @@ impl ImuCurves {
     }
 
     /// The fits and the advice; `checks` as in [`analyse_imu`].
-    pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
+    pub(crate) fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
         an.checks = checks;
         an
@@ -216,7 +216,7 @@ pub fn section_curves(
 }
 
 /// [`section_curves`] without the `absent` sensor (a one-sensor topic).
-pub fn section_curves_of(
+pub(crate) fn section_curves_of(
     series: [&[f64]; 6],
     absent: Option<Sensor>,
     rate: f64,
@@ -243,7 +243,7 @@ impl ImuAnalysis {
     }
 
     /// The axes of one sensor.
-    pub fn sensor_axes(&self, s: Sensor) -> impl Iterator<Item = &AxisResult> {
+    pub(crate) fn sensor_axes(&self, s: Sensor) -> impl Iterator<Item = &AxisResult> {
         self.axes.iter().filter(move |a| a.sensor == s)
     }
 
@@ -256,7 +256,7 @@ impl ImuAnalysis {
 
     /// [`ImuAnalysis::sensor_value`] with every axis' value at most `bound` of its analysis
     /// (the curve's own 95 % bound of the term, [`super::Analysis::bounds`]).
-    pub fn sensor_value_within(
+    pub(crate) fn sensor_value_within(
         &self,
         s: Sensor,
         term: fn(&super::Terms) -> &Term,
@@ -311,18 +311,22 @@ impl ImuAnalysis {
 
     /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
     /// what the curve allows.
-    pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
+    pub(crate) fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
         self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
     }
 
     /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
     /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
-    pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
+    pub(crate) fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
         self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
     }
 
     /// The record check's warnings on one axis (a warm-up, a spike).
-    pub fn axis_checks(&self, sensor: Sensor, axis: usize) -> impl Iterator<Item = &Finding> {
+    pub(crate) fn axis_checks(
+        &self,
+        sensor: Sensor,
+        axis: usize,
+    ) -> impl Iterator<Item = &Finding> {
         self.checks.iter().filter(move |f| {
             f.level >= Level::Warning
                 && f.axis
@@ -331,12 +335,12 @@ impl ImuAnalysis {
     }
 
     /// The record check's warnings, for the files' caveats.
-    pub fn warnings(&self) -> impl Iterator<Item = &Finding> {
+    pub(crate) fn warnings(&self) -> impl Iterator<Item = &Finding> {
         self.checks.iter().filter(|f| f.level >= Level::Warning)
     }
 
     /// Axes without a reliable fit, as `gyro y` labels.
-    pub fn failed_axes(&self, s: Sensor) -> Vec<&'static str> {
+    pub(crate) fn failed_axes(&self, s: Sensor) -> Vec<&'static str> {
         self.sensor_axes(s)
             .filter(|a| !a.analysis.verdict.fits())
             .map(|a| a.sensor.axis_label(a.axis))
@@ -345,7 +349,7 @@ impl ImuAnalysis {
 
     /// Axes of one sensor whose fitted range was cut at the long end, by label, with the
     /// range's last τ.
-    pub fn truncated_axes(&self, s: Sensor) -> Vec<String> {
+    pub(crate) fn truncated_axes(&self, s: Sensor) -> Vec<String> {
         self.sensor_axes(s)
             .filter_map(|a| match a.analysis.verdict {
                 AxisVerdict::Fits {
@@ -364,7 +368,7 @@ impl ImuAnalysis {
 
     /// Axes of one sensor whose fit is declared only approximately (see
     /// [`AxisVerdict::Fits`]), by label.
-    pub fn approximate_axes(&self, s: Sensor) -> Vec<&'static str> {
+    pub(crate) fn approximate_axes(&self, s: Sensor) -> Vec<&'static str> {
         self.sensor_axes(s)
             .filter(|a| {
                 matches!(
@@ -574,7 +578,7 @@ pub const SAME_LINE_REL: f64 = 0.02;
 /// The vibration lines the PSDs show, per sensor: "a line at 0.52 Hz, 6× the floor, on acc x
 /// y z" (× the floor: the line's Allan bump over the white noise's deviation there, the
 /// largest of its axes), and whether the model holds it.
-pub fn lines_text(a: &ImuAnalysis) -> String {
+pub(crate) fn lines_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     for sensor in a.sensors() {
         let mut groups: Vec<LineGroup> = Vec::new();
@@ -649,7 +653,7 @@ pub fn lines_text(a: &ImuAnalysis) -> String {
 }
 
 /// The record-length advice lines.
-pub fn advice_text(a: &ImuAnalysis) -> String {
+pub(crate) fn advice_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     let Some(record) = a.axes.iter().find_map(|x| x.advice.map(|v| v.record)) else {
         return s;
@@ -698,7 +702,7 @@ pub fn advice_text(a: &ImuAnalysis) -> String {
 
 /// The record check's findings that concern no single axis (clocks, gaps, motion), one
 /// line each; the warnings themselves are on stderr.
-pub fn checks_text(a: &ImuAnalysis) -> String {
+pub(crate) fn checks_text(a: &ImuAnalysis) -> String {
     let mut s = String::new();
     for f in a
         .checks

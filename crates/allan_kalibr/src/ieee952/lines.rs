@@ -125,7 +125,7 @@ impl Cx {
 
 /// One-sided PSD (U²/Hz) of a resonance of variance σ² = 1 at `f` Hz: the continuous 2nd-order
 /// system driven by white noise, |H(f)|² normalised so that its integral over f > 0 is 1.
-pub fn resonance_psd(f: f64, f0: f64, bandwidth: f64) -> f64 {
+pub(crate) fn resonance_psd(f: f64, f0: f64, bandwidth: f64) -> f64 {
     let zeta = bandwidth / (2.0 * f0);
     let (w, w0) = (2.0 * PI * f, 2.0 * PI * f0);
     // two-sided S(ω) = q²/((ω0² − ω²)² + (2ζω0ω)²) with σ² = q²/(4ζω0³); one-sided in Hz:

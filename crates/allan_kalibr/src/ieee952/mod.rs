@@ -259,7 +259,7 @@ impl CurveData {
     /// The lines the model holds: the strongest ([`fit::LINE_SLOTS`] at most) whose own Allan
     /// variance (as the PSD measured them) reaches [`LINE_MIN_SHARE`] of the curve at one of
     /// its points at least; weaker ones leave the curve alone.
-    pub fn model_lines(&self) -> fit::LineSlots {
+    pub(crate) fn model_lines(&self) -> fit::LineSlots {
         let mut out: fit::LineSlots = Default::default();
         let mut k = 0;
         for l in &self.lines {
@@ -285,7 +285,11 @@ impl CurveData {
         out
     }
     /// Overlapping Allan variance of `y` on the grid of `cfg`, with the noise identification.
-    pub fn from_samples(y: &[f64], tau0: f64, cfg: &Config) -> Result<CurveData, Ieee952Error> {
+    pub(crate) fn from_samples(
+        y: &[f64],
+        tau0: f64,
+        cfg: &Config,
+    ) -> Result<CurveData, Ieee952Error> {
         check_config(tau0, cfg)?;
         if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(Ieee952Error::NonFinite { index, value });
@@ -317,7 +321,7 @@ impl CurveData {
     }
 
     /// Cluster sizes of the fit grid (the valid points nearest 2^(k/p)).
-    pub fn fit_ms(&self, per_octave: u32) -> Vec<usize> {
+    pub(crate) fn fit_ms(&self, per_octave: u32) -> Vec<usize> {
         let valid: Vec<usize> = self
             .points
             .iter()
@@ -430,7 +434,7 @@ pub struct Term {
 impl Term {
     /// The value when resolved (or read from its region), else `None` ("say so instead of
     /// printing a number").
-    pub fn reported(&self) -> Option<f64> {
+    pub(crate) fn reported(&self) -> Option<f64> {
         matches!(self.verdict, Verdict::Resolved | Verdict::RegionReading).then_some(self.value)
     }
 
@@ -507,7 +511,7 @@ pub struct LineTerm {
 
 impl Terms {
     /// Terms in the order Q, N, B, K, R.
-    pub fn as_array(&self) -> [Term; 5] {
+    pub(crate) fn as_array(&self) -> [Term; 5] {
         [self.q, self.n, self.b, self.k, self.r]
     }
 }
@@ -544,12 +548,12 @@ pub enum AxisVerdict {
 
 impl AxisVerdict {
     /// The model describes a declared range.
-    pub fn fits(&self) -> bool {
+    pub(crate) fn fits(&self) -> bool {
         matches!(self, AxisVerdict::Fits { .. })
     }
 
     /// The declared range, when the model fits.
-    pub fn range(&self) -> Option<(f64, f64)> {
+    pub(crate) fn range(&self) -> Option<(f64, f64)> {
         match self {
             AxisVerdict::Fits { range, .. } => Some(*range),
             AxisVerdict::NoReliableFit { .. } => None,
@@ -657,7 +661,7 @@ pub struct FitSummary {
 
 impl FitSummary {
     /// Model AVAR at τ.
-    pub fn predict(&self, tau: f64) -> f64 {
+    pub(crate) fn predict(&self, tau: f64) -> f64 {
         fit::predict(&self.coef, &self.shapes, tau)
     }
 }
@@ -708,7 +712,7 @@ fn z_of(confidence: f64) -> f64 {
 /// Analyses a measured curve. `basis` is the statistical covariance of its fit grid
 /// ([`CurveData::basis`]; shared by the axes of an IMU), `None` when the sample count is
 /// unknown.
-pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
+pub(crate) fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
     let fit_ms = data.fit_ms(cfg.fit.per_octave);
     let valid: Vec<&CurvePoint> = data
         .points

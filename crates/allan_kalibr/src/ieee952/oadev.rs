@@ -79,7 +79,7 @@ impl Phase {
     }
 
     /// Number of rate samples n.
-    pub fn n_rate(&self) -> usize {
+    pub(crate) fn n_rate(&self) -> usize {
         self.x.len() - 1
     }
 

@@ -44,7 +44,7 @@ pub fn find_truth(input: &Path, a: &ImuAnalysis) -> Option<Truth> {
 }
 
 /// Parses a `sim` truth CSV for the axes of `a`.
-pub fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
+pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next()?.split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name);

@@ -74,7 +74,7 @@ pub struct Psd {
 
 impl Psd {
     /// Bin width, Hz.
-    pub fn resolution(&self) -> f64 {
+    pub(crate) fn resolution(&self) -> f64 {
         self.rate / self.segment as f64
     }
 }
@@ -101,7 +101,7 @@ impl Line {
     /// The line's own Allan deviation at its bump over the white noise's there, with the
     /// white level from the local floor (N² = S/2): how much the line stands out of the
     /// Allan curve (the "× the floor" of the verdict).
-    pub fn allan_ratio(&self) -> f64 {
+    pub(crate) fn allan_ratio(&self) -> f64 {
         let tau = BUMP_X / (PI * self.frequency);
         let white = (self.floor / 2.0 / tau).sqrt();
         BUMP_PEAK.sqrt() * self.amplitude / white
@@ -116,7 +116,7 @@ pub const BUMP_PEAK: f64 = 0.525_013_282_891_573;
 /// The white-noise density N the PSD shows: √(S/2) of its floor's median over 0.5–2 Hz
 /// (within the bins' range; where IEEE 952 reads N, τ ≈ 1 s), the section's cross-check of
 /// the fitted N.
-pub fn white_density(p: &Psd) -> Option<f64> {
+pub(crate) fn white_density(p: &Psd) -> Option<f64> {
     let fl = floor(p);
     let top = 0.4 * p.rate;
     let (lo, hi) = (0.5f64.min(top / 4.0), 2.0f64.min(top));
@@ -140,7 +140,7 @@ pub fn white_density(p: &Psd) -> Option<f64> {
 /// bias instability B²/(πf), random walk K²/(2π²f²), the Gauss–Markov bias
 /// 4σ²T/(1 + (2πfT)²), and the resonance lines' own densities (a sinusoid is a line of zero
 /// width: not in a density; the ramp has no spectral form).
-pub fn model_psd(
+pub(crate) fn model_psd(
     f: f64,
     coef: &[f64; super::fit::TERM_COUNT],
     shapes: &super::fit::Shapes,
@@ -240,7 +240,7 @@ pub fn welch(y: &[f64], rate: f64) -> Option<Psd> {
 /// ([`FLOOR_PASSES`] times; a resonance's wings reach far beyond a quarter octave, and a
 /// floor that counts them hides the resonance). Where lines cover most of a window it is
 /// widened until a third of its bins are free.
-pub fn floor(p: &Psd) -> Vec<f64> {
+pub(crate) fn floor(p: &Psd) -> Vec<f64> {
     p.floor.clone()
 }
 

@@ -26,7 +26,7 @@ pub const STEM: &str = "ieee952_psd";
 
 /// Draws `<dir>/<prefix>ieee952_psd.{png,svg}`; `None` when no axis has a PSD (a curve
 /// given without its samples).
-pub fn write_psd_chart(
+pub(crate) fn write_psd_chart(
     a: &ImuAnalysis,
     title: &str,
     dir: &Path,

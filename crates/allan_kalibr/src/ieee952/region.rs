@@ -64,7 +64,7 @@ pub struct Readings {
 }
 
 /// Local log-log slopes at each point (central differences; one-sided at the ends).
-pub fn local_slopes(tau: &[f64], adev: &[f64]) -> Vec<f64> {
+pub(crate) fn local_slopes(tau: &[f64], adev: &[f64]) -> Vec<f64> {
     let n = tau.len();
     (0..n)
         .map(|i| {
@@ -84,7 +84,7 @@ pub fn local_slopes(tau: &[f64], adev: &[f64]) -> Vec<f64> {
 /// not all of them: a curve can fall like white noise again beyond a Gauss–Markov bump, and
 /// a long run that bends slowly (a filtered sensor) would be read at its middle rather than
 /// at 1 s.
-pub fn white_near_1s(tau: &[f64], is_white: &[bool]) -> Vec<usize> {
+pub(crate) fn white_near_1s(tau: &[f64], is_white: &[bool]) -> Vec<usize> {
     let Some(centre) = (0..tau.len())
         .filter(|&i| is_white[i])
         .min_by(|&a, &b| tau[a].ln().abs().total_cmp(&tau[b].ln().abs()))
@@ -104,7 +104,7 @@ pub const N_WINDOW: f64 = 2.0;
 /// `per_unit` being the term's Allan deviation per unit of its value (∞ when no point
 /// bounds it). The region readings' upper bounds and the fit's bound on a term it left at
 /// zero both come from here.
-pub fn upper_bound<'a>(
+pub(crate) fn upper_bound<'a>(
     points: impl IntoIterator<Item = &'a Point>,
     per_unit: impl Fn(f64) -> f64,
 ) -> f64 {
@@ -118,7 +118,7 @@ pub fn upper_bound<'a>(
 /// Readings from `points` (the usable range of one curve, ascending τ, on the fit grid) with
 /// their 95 % bounds `lo95`/`hi95` (NaN when the sample count is unknown: then the readings
 /// carry no interval).
-pub fn read(points: &[Point]) -> Readings {
+pub(crate) fn read(points: &[Point]) -> Readings {
     let pts: Vec<&Point> = points
         .iter()
         .filter(|p| p.adev > 0.0 && p.adev.is_finite())

@@ -28,7 +28,7 @@ impl Default for GridSpec {
 
 impl GridSpec {
     /// Largest cluster size for n rate samples.
-    pub fn m_max(&self, n: usize) -> usize {
+    pub(crate) fn m_max(&self, n: usize) -> usize {
         n / self.min_clusters.max(3)
     }
 

@@ -79,13 +79,13 @@ pub(super) struct Case {
 }
 
 impl Case {
-    pub fn n_err(&self) -> f64 {
+    pub(crate) fn n_err(&self) -> f64 {
         self.n_est / self.n_true - 1.0
     }
-    pub fn k_err(&self) -> f64 {
+    pub(crate) fn k_err(&self) -> f64 {
         self.k_est / self.k_true - 1.0
     }
-    pub fn is_gyro(&self) -> bool {
+    pub(crate) fn is_gyro(&self) -> bool {
         self.axis.starts_with('g')
     }
 }

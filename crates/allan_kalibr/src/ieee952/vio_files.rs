@@ -33,7 +33,7 @@ pub const OPENVINS_FILE: &str = "openvins_kalibr_imu_chain_ieee952.yaml";
 pub const BASALT_FILE: &str = "basalt_imu_noise_ieee952.json";
 
 /// OpenVINS' `kalibr_imu_chain.yaml` with the IEEE 952 values.
-pub fn openvins_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
+pub(crate) fn openvins_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
     let v: FileValues = file_values(
         a,
         [
@@ -147,7 +147,7 @@ fn per_axis(
 }
 
 /// Basalt's calibration noise fields, per axis, with the convention stated in the file.
-pub fn basalt_json(a: &ImuAnalysis) -> String {
+pub(crate) fn basalt_json(a: &ImuAnalysis) -> String {
     let mut bounds = Vec::new();
     let fields = [
         (

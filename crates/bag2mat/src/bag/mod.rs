@@ -60,7 +60,7 @@ impl RosTime {
     }
 
     /// Reads the 8-byte bag form; `None` when `b` is not 8 bytes long.
-    pub fn from_bytes(b: &[u8]) -> Option<RosTime> {
+    pub(crate) fn from_bytes(b: &[u8]) -> Option<RosTime> {
         if b.len() != 8 {
             return None;
         }
@@ -100,7 +100,7 @@ impl Compression {
     }
 
     /// Parses the `compression` field value.
-    pub fn from_name(name: &str) -> Option<Compression> {
+    pub(crate) fn from_name(name: &str) -> Option<Compression> {
         match name {
             "none" => Some(Compression::None),
             "bz2" => Some(Compression::Bz2),

@@ -33,7 +33,7 @@ pub enum Op {
 
 impl Op {
     /// The op for a header's `op` byte.
-    pub fn from_byte(b: u8) -> Option<Op> {
+    pub(crate) fn from_byte(b: u8) -> Option<Op> {
         Some(match b {
             0x02 => Op::MessageData,
             0x03 => Op::BagHeader,
@@ -63,7 +63,7 @@ pub fn push_record(out: &mut Vec<u8>, header: &[u8], data: &[u8]) {
 }
 
 /// The fields of a record header, in file order. Fails on a field that overruns the header.
-pub fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, String> {
+pub(crate) fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, String> {
     let mut out = Vec::new();
     let mut pos = 0usize;
     while pos < header.len() {
@@ -89,7 +89,7 @@ pub type OpConnTime = (Option<u8>, Option<u32>, Option<RosTime>);
 
 /// The `op`, `conn` and `time` fields of a record header, found without allocating: the hot
 /// path of reading, run once per message. Fields missing from the header stay `None`.
-pub fn op_conn_time(header: &[u8]) -> Result<OpConnTime, String> {
+pub(crate) fn op_conn_time(header: &[u8]) -> Result<OpConnTime, String> {
     let (mut op, mut conn, mut time) = (None, None, None);
     let mut pos = 0usize;
     while pos < header.len() {
@@ -124,7 +124,7 @@ impl<'a> Header<'a> {
     }
 
     /// The raw value of a field.
-    pub fn get(&self, name: &str) -> Option<&'a [u8]> {
+    pub(crate) fn get(&self, name: &str) -> Option<&'a [u8]> {
         self.fields
             .iter()
             .find(|(n, _)| *n == name)
@@ -140,7 +140,7 @@ impl<'a> Header<'a> {
     }
 
     /// A required u32 field.
-    pub fn u32(&self, name: &str) -> Result<u32, String> {
+    pub(crate) fn u32(&self, name: &str) -> Result<u32, String> {
         match self.get(name) {
             Some(v) if v.len() == 4 => Ok(u32::from_le_bytes([v[0], v[1], v[2], v[3]])),
             _ => Err(format!("record header lacks a 4-byte '{name}' field")),
@@ -148,7 +148,7 @@ impl<'a> Header<'a> {
     }
 
     /// A required u64 field.
-    pub fn u64(&self, name: &str) -> Result<u64, String> {
+    pub(crate) fn u64(&self, name: &str) -> Result<u64, String> {
         match self.get(name) {
             Some(v) if v.len() == 8 => {
                 let mut b = [0u8; 8];
@@ -160,14 +160,14 @@ impl<'a> Header<'a> {
     }
 
     /// A required time field.
-    pub fn time(&self, name: &str) -> Result<RosTime, String> {
+    pub(crate) fn time(&self, name: &str) -> Result<RosTime, String> {
         self.get(name)
             .and_then(RosTime::from_bytes)
             .ok_or_else(|| format!("record header lacks an 8-byte '{name}' time field"))
     }
 
     /// A required text field.
-    pub fn str(&self, name: &str) -> Result<&'a str, String> {
+    pub(crate) fn str(&self, name: &str) -> Result<&'a str, String> {
         let v = self
             .get(name)
             .ok_or_else(|| format!("record header lacks a '{name}' field"))?;
@@ -252,7 +252,7 @@ impl Connection {
     }
 
     /// Decodes a connection record from its header and data.
-    pub fn decode(header: &Header<'_>, data: &[u8]) -> Result<Connection, String> {
+    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<Connection, String> {
         let id = header.u32("conn")?;
         let storage_topic = header.str("topic")?;
         let d = Header::parse(data)?;
@@ -305,7 +305,7 @@ impl ChunkInfo {
     }
 
     /// Decodes the record.
-    pub fn decode(header: &Header<'_>, data: &[u8]) -> Result<ChunkInfo, String> {
+    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<ChunkInfo, String> {
         let count = header.u32("count")? as usize;
         if data.len() != count * 8 {
             return Err(format!(

@@ -29,7 +29,7 @@ pub struct Stated {
 
 impl Stated {
     /// One line: every figure stated, with its unit.
-    pub fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         let mut v = Vec::new();
         for (name, val, unit) in [
             (
@@ -63,7 +63,7 @@ impl Stated {
 }
 
 /// The `sensor.yaml` beside `data_csv`, if there is one that parses.
-pub fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, String>> {
+pub(crate) fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, String>> {
     let p = data_csv.parent()?.join("sensor.yaml");
     let text = std::fs::read_to_string(&p).ok()?;
     Some(serde_saphyr::from_str::<Stated>(&text).map_err(|e| format!("{}: {e}", p.display())))
@@ -87,14 +87,14 @@ pub fn stated_for(path: &Path, topic: &str) -> Option<Stated> {
 }
 
 /// The topic of an `imuN` folder: its name.
-pub fn folder_topic(dir: &Path) -> String {
+pub(crate) fn folder_topic(dir: &Path) -> String {
     dir.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "imu0".into())
 }
 
 /// True when `dir` holds a `data.csv` with the EuRoC/ASL IMU header.
-pub fn is_imu_folder(dir: &Path) -> bool {
+pub(crate) fn is_imu_folder(dir: &Path) -> bool {
     let f = dir.join("data.csv");
     let Ok(file) = std::fs::File::open(&f) else {
         return false;
@@ -107,7 +107,7 @@ pub fn is_imu_folder(dir: &Path) -> bool {
 
 /// Every IMU `data.csv` of an EuRoC/ASL layout at `path` (the `imuN` folder, the `mav0`
 /// folder or the dataset root), with its topic, sorted by topic.
-pub fn imu_files(path: &Path) -> Vec<(String, PathBuf)> {
+pub(crate) fn imu_files(path: &Path) -> Vec<(String, PathBuf)> {
     if is_imu_folder(path) {
         return vec![(folder_topic(path), path.join("data.csv"))];
     }
@@ -130,12 +130,12 @@ pub fn imu_files(path: &Path) -> Vec<(String, PathBuf)> {
 }
 
 /// Opens the dataset at `path`.
-pub fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
+pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
     open_files(imu_files(path), opts)
 }
 
 /// Opens the given `(topic, data.csv)` files as one source.
-pub fn open_files(
+pub(crate) fn open_files(
     files: Vec<(String, PathBuf)>,
     opts: &InputOptions,
 ) -> Result<DecodedSource, Error> {

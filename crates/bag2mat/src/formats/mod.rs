@@ -89,7 +89,7 @@ impl InputArgs {
 /// The topic of instance `k` of a logged message `name`: `name` when the log holds only
 /// instance 0 of it, else `name:k` (ULog `multi_id`, DataFlash `I`/`instance`); `topics`
 /// come in as `name:k` and are renamed in place.
-pub fn instance_topics<'a>(topics: impl Iterator<Item = &'a mut String>) {
+pub(crate) fn instance_topics<'a>(topics: impl Iterator<Item = &'a mut String>) {
     let topics: Vec<&mut String> = topics.collect();
     let mut count: std::collections::HashMap<String, usize> = Default::default();
     for t in &topics {
@@ -134,7 +134,7 @@ pub const NPY_MAGIC: &[u8] = b"\x93NUMPY";
 
 /// Recognises a file of this module from its first bytes (at least 16 where the file has
 /// them) and, for text, its first [`text::SNIFF_BYTES`].
-pub fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
+pub(crate) fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
     if head.starts_with(ULOG_MAGIC) {
         return Some(InputKind::Ulog);
     }
@@ -148,12 +148,16 @@ pub fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
 }
 
 /// Recognises a directory of this module (an EuRoC/ASL layout).
-pub fn detect_dir(path: &Path) -> Option<InputKind> {
+pub(crate) fn detect_dir(path: &Path) -> Option<InputKind> {
     (!euroc::imu_files(path).is_empty()).then_some(InputKind::EurocDir)
 }
 
 /// Opens an input of this module's kinds.
-pub fn open(kind: InputKind, path: &Path, opts: &InputOptions) -> Result<Box<dyn Source>, Error> {
+pub(crate) fn open(
+    kind: InputKind,
+    path: &Path,
+    opts: &InputOptions,
+) -> Result<Box<dyn Source>, Error> {
     Ok(match kind {
         InputKind::Text => Box::new(text::open(path, opts)?),
         InputKind::EurocDir => Box::new(euroc::open(path, opts)?),

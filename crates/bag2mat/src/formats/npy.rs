@@ -80,7 +80,7 @@ fn header(path: &Path, c: &mut Cursor) -> Result<Header, Error> {
 
 /// Seconds (as `sec + 1e-9·nsec`, bagconvert's t) back to nanoseconds: the whole seconds and
 /// the rounded fraction, so that the row's t is written back unchanged.
-pub fn seconds_to_ns(t: f64) -> Option<u64> {
+pub(crate) fn seconds_to_ns(t: f64) -> Option<u64> {
     if !(t.is_finite() && t >= 0.0 && t < u32::MAX as f64) {
         return None;
     }
@@ -90,7 +90,7 @@ pub fn seconds_to_ns(t: f64) -> Option<u64> {
 }
 
 /// Opens a `.npy` of bag2mat's layout: one topic, `imu`.
-pub fn open(path: &Path) -> Result<DecodedSource, Error> {
+pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let mut c = Cursor::new(&bytes);
     let h = header(path, &mut c)?;

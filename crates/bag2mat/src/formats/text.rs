@@ -64,7 +64,7 @@ pub enum TimeUnit {
 
 impl TimeUnit {
     /// Nanoseconds per unit.
-    pub fn nanos(self) -> u64 {
+    pub(crate) fn nanos(self) -> u64 {
         match self {
             TimeUnit::S => 1_000_000_000,
             TimeUnit::Ms => 1_000_000,
@@ -73,7 +73,7 @@ impl TimeUnit {
         }
     }
     /// The name.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             TimeUnit::S => "s",
             TimeUnit::Ms => "ms",
@@ -82,7 +82,7 @@ impl TimeUnit {
         }
     }
     /// From a flag or header text.
-    pub fn parse(s: &str) -> Result<TimeUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<TimeUnit, String> {
         match unit_key(s).as_str() {
             "s" | "sec" | "secs" | "second" | "seconds" => Ok(TimeUnit::S),
             "ms" | "msec" => Ok(TimeUnit::Ms),
@@ -104,21 +104,21 @@ pub enum GyroUnit {
 
 impl GyroUnit {
     /// rad/s per unit.
-    pub fn si(self) -> f64 {
+    pub(crate) fn si(self) -> f64 {
         match self {
             GyroUnit::RadS => 1.0,
             GyroUnit::DegS => std::f64::consts::PI / 180.0,
         }
     }
     /// The name.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             GyroUnit::RadS => "rad/s",
             GyroUnit::DegS => "deg/s",
         }
     }
     /// From a flag or header text.
-    pub fn parse(s: &str) -> Result<GyroUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<GyroUnit, String> {
         match unit_key(s).as_str() {
             "rad/s" | "rads^-1" | "rad*s^-1" | "rads-1" | "radps" => Ok(GyroUnit::RadS),
             "deg/s" | "°/s" | "dps" | "degs^-1" | "degps" => Ok(GyroUnit::DegS),
@@ -140,7 +140,7 @@ pub enum AccUnit {
 
 impl AccUnit {
     /// m/s² per unit.
-    pub fn si(self) -> f64 {
+    pub(crate) fn si(self) -> f64 {
         match self {
             AccUnit::Ms2 => 1.0,
             AccUnit::G => STANDARD_GRAVITY,
@@ -148,7 +148,7 @@ impl AccUnit {
         }
     }
     /// The name.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             AccUnit::Ms2 => "m/s^2",
             AccUnit::G => "g",
@@ -156,7 +156,7 @@ impl AccUnit {
         }
     }
     /// From a flag or header text.
-    pub fn parse(s: &str) -> Result<AccUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<AccUnit, String> {
         match unit_key(s).as_str() {
             "m/s^2" | "m/s2" | "ms^-2" | "m*s^-2" | "ms-2" | "m/s/s" | "mps2" => Ok(AccUnit::Ms2),
             "g" => Ok(AccUnit::G),
@@ -231,7 +231,7 @@ const ACC_PREFIXES: [&str; 9] = [
 ];
 
 /// The role a column name means, and the time unit a suffix states (`time_ms`), if any.
-pub fn role_of(name: &str) -> Option<(Role, Option<TimeUnit>)> {
+pub(crate) fn role_of(name: &str) -> Option<(Role, Option<TimeUnit>)> {
     let n: String = name
         .chars()
         .filter(|c| c.is_ascii_alphanumeric())
@@ -275,7 +275,7 @@ pub fn role_of(name: &str) -> Option<(Role, Option<TimeUnit>)> {
 }
 
 /// True when the first bytes of `path` are text (UTF-8, no control bytes but tab, CR, LF).
-pub fn looks_like_text(path: &Path) -> bool {
+pub(crate) fn looks_like_text(path: &Path) -> bool {
     let Ok(head) = read_head(path) else {
         return false;
     };
@@ -754,7 +754,7 @@ fn layout(path: &Path, head: &[u8], file_len: u64, opts: &InputOptions) -> Resul
 }
 
 /// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
-pub fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {
+pub(crate) fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {
     let s = trim(s);
     let mult = unit.nanos();
     let (int, frac) = match s.iter().position(|&b| b == b'.') {
@@ -1184,7 +1184,7 @@ pub struct Parsed {
 }
 
 /// Parses the text log at `path` into a stream named `topic`.
-pub fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
+pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
@@ -1388,7 +1388,7 @@ fn check_plausible(path: &Path, lay: &Layout, rows: &Rows) -> Result<(), Error> 
 }
 
 /// Opens a text log: one topic, `imu`.
-pub fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
+pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
     // a data.csv in an EuRoC imuN folder is that folder's topic, with its sensor.yaml
     if let Some(dir) = path.parent()
         && path.file_name().is_some_and(|n| n == "data.csv")

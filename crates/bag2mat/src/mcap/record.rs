@@ -53,7 +53,7 @@ pub enum Op {
 impl Op {
     /// The op of an opcode byte; `None` for opcodes this version does not know (which the
     /// spec says readers skip).
-    pub fn from_byte(b: u8) -> Option<Op> {
+    pub(crate) fn from_byte(b: u8) -> Option<Op> {
         use Op::*;
         Some(match b {
             0x01 => Header,
@@ -90,12 +90,12 @@ impl<'a> Cursor<'a> {
     }
 
     /// Bytes consumed so far.
-    pub fn pos(&self) -> usize {
+    pub(crate) fn pos(&self) -> usize {
         self.pos
     }
 
     /// The next `n` bytes.
-    pub fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+    pub(crate) fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
         let end = self
             .pos
             .checked_add(n)
@@ -119,38 +119,38 @@ impl<'a> Cursor<'a> {
     }
 
     /// A `u8`.
-    pub fn u8(&mut self) -> Result<u8, String> {
+    pub(crate) fn u8(&mut self) -> Result<u8, String> {
         Ok(self.take(1)?[0])
     }
     /// A `u16`.
-    pub fn u16(&mut self) -> Result<u16, String> {
+    pub(crate) fn u16(&mut self) -> Result<u16, String> {
         Ok(u16::from_le_bytes(self.array()?))
     }
     /// A `u32`.
-    pub fn u32(&mut self) -> Result<u32, String> {
+    pub(crate) fn u32(&mut self) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.array()?))
     }
     /// A `u64`.
-    pub fn u64(&mut self) -> Result<u64, String> {
+    pub(crate) fn u64(&mut self) -> Result<u64, String> {
         Ok(u64::from_le_bytes(self.array()?))
     }
     /// `u32` length-prefixed bytes.
-    pub fn bytes32(&mut self) -> Result<&'a [u8], String> {
+    pub(crate) fn bytes32(&mut self) -> Result<&'a [u8], String> {
         let n = self.u32()? as usize;
         self.take(n)
     }
     /// `u64` length-prefixed bytes.
-    pub fn bytes64(&mut self) -> Result<&'a [u8], String> {
+    pub(crate) fn bytes64(&mut self) -> Result<&'a [u8], String> {
         let n = usize::try_from(self.u64()?).map_err(|_| "length does not fit memory")?;
         self.take(n)
     }
     /// A `u32` length-prefixed UTF-8 string.
-    pub fn string(&mut self) -> Result<String, String> {
+    pub(crate) fn string(&mut self) -> Result<String, String> {
         let b = self.bytes32()?;
         String::from_utf8(b.to_vec()).map_err(|_| "string field is not UTF-8".to_string())
     }
     /// A `Map<string, string>`.
-    pub fn string_map(&mut self) -> Result<Vec<(String, String)>, String> {
+    pub(crate) fn string_map(&mut self) -> Result<Vec<(String, String)>, String> {
         let mut c = Cursor::new(self.bytes32()?);
         let mut out = Vec::new();
         while c.pos < c.buf.len() {
@@ -159,7 +159,7 @@ impl<'a> Cursor<'a> {
         Ok(out)
     }
     /// A `Map<u16, u64>`.
-    pub fn u16_u64_map(&mut self) -> Result<Vec<(u16, u64)>, String> {
+    pub(crate) fn u16_u64_map(&mut self) -> Result<Vec<(u16, u64)>, String> {
         let mut c = Cursor::new(self.bytes32()?);
         let mut out = Vec::new();
         while c.pos < c.buf.len() {
@@ -273,7 +273,7 @@ pub struct Footer {
 
 impl Footer {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<Footer, String> {
+    pub(crate) fn decode(c: &[u8]) -> Result<Footer, String> {
         let mut c = Cursor::new(c);
         Ok(Footer {
             summary_start: c.u64()?,
@@ -420,7 +420,7 @@ pub struct ChunkHeader {
 impl ChunkHeader {
     /// Parses the header from the start of a chunk's content; returns it and the offset of
     /// the records within the content.
-    pub fn decode(c: &[u8]) -> Result<(ChunkHeader, usize), String> {
+    pub(crate) fn decode(c: &[u8]) -> Result<(ChunkHeader, usize), String> {
         let mut c = Cursor::new(c);
         let h = ChunkHeader {
             message_start_time: c.u64()?,

@@ -84,7 +84,7 @@ pub enum Kind {
 
 impl Kind {
     /// The name the section and the yaml caveats use.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Kind::ExtraRows => "extra rows",
             Kind::Duplicates => "duplicated samples",
@@ -127,7 +127,7 @@ impl Axis {
     }
 
     /// `gyro x` … `acc z`.
-    pub fn label(self) -> &'static str {
+    pub(crate) fn label(self) -> &'static str {
         self.sensor.axis_label(self.index)
     }
 }
@@ -402,12 +402,12 @@ impl Check {
 }
 
 /// Seconds of `ns` for messages.
-pub(crate) fn secs(ns: i64) -> f64 {
+pub fn secs(ns: i64) -> f64 {
     ns as f64 * 1e-9
 }
 
 /// A stamp in ns as `sec.nsec`.
-pub(crate) fn stamp_text(ns: i64) -> String {
+pub fn stamp_text(ns: i64) -> String {
     format!(
         "{}.{:09}",
         ns.div_euclid(1_000_000_000),

@@ -53,7 +53,7 @@ struct MetadataFile {
 
 impl BagInfo {
     /// Parses the text of a `metadata.yaml`.
-    pub fn parse(text: &str) -> Result<BagInfo, String> {
+    pub(crate) fn parse(text: &str) -> Result<BagInfo, String> {
         // The parser's message: its first line (the excerpt after it is the file's text),
         // without its own "error: ".
         serde_saphyr::from_str::<MetadataFile>(text)
@@ -66,12 +66,12 @@ impl BagInfo {
     }
 
     /// The compression format, empty when none.
-    pub fn compression_format(&self) -> &str {
+    pub(crate) fn compression_format(&self) -> &str {
         self.compression_format.as_deref().unwrap_or("")
     }
 
     /// The compression mode in lower case, empty when none.
-    pub fn compression_mode(&self) -> String {
+    pub(crate) fn compression_mode(&self) -> String {
         self.compression_mode
             .as_deref()
             .unwrap_or("")

@@ -84,7 +84,7 @@ fn open_storage(path: &Path) -> Result<(Box<dyn Source>, Option<Decompressed>), 
 
 impl BagDir {
     /// Opens the bag directory `dir` (its `metadata.yaml` lists the storage files).
-    pub fn open(dir: &Path) -> Result<BagDir, Error> {
+    pub(crate) fn open(dir: &Path) -> Result<BagDir, Error> {
         let meta_path = dir.join("metadata.yaml");
         let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
         let mut notes = Vec::new();
@@ -212,7 +212,7 @@ impl BagDir {
     }
 
     /// Opens a bare FILE-mode compressed storage file (`.mcap.zstd`, `.db3.zstd`).
-    pub fn open_compressed_file(path: &Path) -> Result<BagDir, Error> {
+    pub(crate) fn open_compressed_file(path: &Path) -> Result<BagDir, Error> {
         let (src, tmp) = open_storage(path)?;
         Ok(Self::assemble(
             vec![(src, tmp)],

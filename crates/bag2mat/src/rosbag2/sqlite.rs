@@ -158,7 +158,7 @@ fn seek_past(conn: &Connection, after: i64, stop: Option<i64>, capacity: u64) ->
 
 impl Sqlite3Reader {
     /// Opens a rosbag2 `.db3` read-only, lists its topics and plans its parts.
-    pub fn open(path: &Path) -> Result<Sqlite3Reader, Error> {
+    pub(crate) fn open(path: &Path) -> Result<Sqlite3Reader, Error> {
         let tables_of = |conn: &Connection| -> Result<Vec<String>, rusqlite::Error> {
             conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
                 .and_then(|mut s| {

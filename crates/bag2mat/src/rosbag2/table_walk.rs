@@ -33,7 +33,7 @@ pub(crate) struct Run {
 
 impl Run {
     /// Its last id.
-    pub fn last(&self) -> i64 {
+    pub(crate) fn last(&self) -> i64 {
         self.first.saturating_add(self.len as i64 - 1)
     }
 }
@@ -60,7 +60,7 @@ pub(crate) struct Walk {
 
 impl Walk {
     /// Appends the next row of the walk.
-    pub fn push(&mut self, id: i64, ts: i64) {
+    pub(crate) fn push(&mut self, id: i64, ts: i64) {
         if let Some(r) = self.runs.last_mut()
             && r.last().checked_add(1) == Some(id)
         {
@@ -77,7 +77,7 @@ impl Walk {
     }
 
     /// Rows walked.
-    pub fn rows(&self) -> u64 {
+    pub(crate) fn rows(&self) -> u64 {
         self.runs.iter().map(|r| r.len).sum()
     }
 }

@@ -109,7 +109,7 @@ pub fn describe(e: &std::io::Error) -> String {
 }
 
 /// An OS error's text without its "(os error N)".
-pub fn without_errno(s: &str) -> String {
+pub(crate) fn without_errno(s: &str) -> String {
     match s.find(" (os error") {
         Some(i) => s[..i].to_string(),
         None => s.to_string(),

@@ -80,7 +80,7 @@ pub enum Warmup {
 
 impl Warmup {
     /// A, U (b(t) = A·e^(−t/T) relative to the settled bias).
-    pub fn amplitude(&self) -> f64 {
+    pub(crate) fn amplitude(&self) -> f64 {
         match *self {
             Warmup::Exponential { amplitude, .. } => amplitude,
             Warmup::Thermal {
@@ -92,7 +92,7 @@ impl Warmup {
     }
 
     /// T, s.
-    pub fn tau(&self) -> f64 {
+    pub(crate) fn tau(&self) -> f64 {
         match *self {
             Warmup::Exponential { tau, .. } | Warmup::Thermal { tau, .. } => tau,
         }
@@ -280,7 +280,7 @@ impl ImuModel {
     }
 
     /// Mutable sensor model by kind.
-    pub fn sensor_mut(&mut self, s: Sensor) -> &mut SensorModel {
+    pub(crate) fn sensor_mut(&mut self, s: Sensor) -> &mut SensorModel {
         match s {
             Sensor::Gyro => &mut self.gyro,
             Sensor::Acc => &mut self.acc,
@@ -318,7 +318,7 @@ impl ImuModel {
 
     /// Checks every parameter (finite, non-negative where it must be, corner times ordered,
     /// chain compatible with the output rate). Messages name sensor, axis and field.
-    pub fn validate(&self, output_rate: f64) -> Result<()> {
+    pub(crate) fn validate(&self, output_rate: f64) -> Result<()> {
         for s in Sensor::BOTH {
             let sm = self.sensor(s);
             sm.chain.resolve(s, output_rate)?;

@@ -71,7 +71,7 @@ impl Profile {
     }
 
     /// By name.
-    pub fn from_name(name: &str) -> Option<Profile> {
+    pub(crate) fn from_name(name: &str) -> Option<Profile> {
         Profile::ALL.into_iter().find(|p| p.name() == name)
     }
 

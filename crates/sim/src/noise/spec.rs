@@ -182,13 +182,13 @@ fn err(path: &Path, msg: impl std::fmt::Display) -> SimError {
 }
 
 /// Reads and parses a spec (or truth) file.
-pub fn read(path: &Path) -> Result<SpecFile> {
+pub(crate) fn read(path: &Path) -> Result<SpecFile> {
     let text = std::fs::read_to_string(path).map_err(|e| SimError::io(path, e))?;
     parse(&text).map_err(|m| err(path, m))
 }
 
 /// Parses spec text; the message says what is wrong and where.
-pub fn parse(text: &str) -> std::result::Result<SpecFile, String> {
+pub(crate) fn parse(text: &str) -> std::result::Result<SpecFile, String> {
     if let Ok(t) = serde_saphyr::from_str::<TruthAsSpec>(text)
         && t.format.as_deref() == Some(TRUTH_FORMAT)
     {
@@ -329,7 +329,7 @@ fn apply_sensor(m: &mut SensorModel, s: &SensorSpec) -> std::result::Result<(), 
 }
 
 /// An all-zero model generated at the output rate.
-pub fn zero_model(label: &str) -> ImuModel {
+pub(crate) fn zero_model(label: &str) -> ImuModel {
     ImuModel {
         label: label.to_string(),
         gyro: SensorModel::uniform(AxisModel::default()),
@@ -338,7 +338,7 @@ pub fn zero_model(label: &str) -> ImuModel {
 }
 
 /// Applies `spec` on top of `base` (or on the spec's own `base:` profile, or on the zero model).
-pub fn apply(spec: &SpecFile, base: Option<ImuModel>, path: &Path) -> Result<ImuModel> {
+pub(crate) fn apply(spec: &SpecFile, base: Option<ImuModel>, path: &Path) -> Result<ImuModel> {
     let mut m = match (base, &spec.base) {
         (Some(b), _) => b,
         (None, Some(name)) => Profile::from_name(name)

@@ -163,7 +163,7 @@ pub struct FitData<'a> {
 
 impl FitData<'_> {
     /// The power laws and this curve's lines: the shapes every fit starts from.
-    pub fn base_shapes(&self) -> Shapes {
+    pub(crate) fn base_shapes(&self) -> Shapes {
         Shapes::with_lines(self.lines)
     }
 }
@@ -171,7 +171,7 @@ impl FitData<'_> {
 /// Indices of the points nearest (in log m) to each 2^(k/p), k = 0, 1, …, without repeats.
 /// When the curve's grid is a refinement of the p-per-octave grid these are exactly its
 /// points; otherwise the nearest ones.
-pub fn thin_to_grid(ms: &[usize], p: u32) -> Vec<usize> {
+pub(crate) fn thin_to_grid(ms: &[usize], p: u32) -> Vec<usize> {
     let p = p.max(1) as f64;
     let Some(&max_m) = ms.iter().max() else {
         return Vec::new();
@@ -254,13 +254,13 @@ pub const PROFILE_CHI2_95: f64 = 3.841_458_820_694_124;
 
 impl FitResult {
     /// Model AVAR at τ.
-    pub fn predict(&self, tau: f64) -> f64 {
+    pub(crate) fn predict(&self, tau: f64) -> f64 {
         predict(&self.coef, &self.shapes, tau)
     }
 }
 
 /// Model AVAR at τ for coefficients `coef` and shapes `shapes`.
-pub fn predict(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> f64 {
+pub(crate) fn predict(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> f64 {
     (0..TERM_COUNT)
         .filter(|&j| coef[j] != 0.0)
         .map(|j| coef[j] * basis_at(j, tau, shapes))
@@ -695,7 +695,7 @@ fn ieee_only(terms: [bool; TERM_COUNT]) -> [bool; TERM_COUNT] {
 ///    whitened residual over the median of χ²(1): the scale comes from the data, so a model
 ///    that misses the curve elsewhere does not decide it, and neither do the band-limited
 ///    points still in).
-pub fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
+pub(crate) fn choose_start(data: &FitData, cfg: &FitConfig) -> usize {
     let n = data.points.len();
     if !cfg.trim || n < MIN_FIT_POINTS + 1 {
         return 0;
@@ -777,7 +777,7 @@ pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
 /// refitted with its own δ. Terms left out are reported at 0 with the upper bound of the
 /// all-terms fit (ĉ + z·se); a quantization taken out again (below) with that of the
 /// selected fit that had it.
-pub fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
+pub(crate) fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
     let f = fit_terms(data, used, cfg)?;
     // A quantization term whose line never comes near the curve is not one the curve shows:
     // it is the model's τ⁻² shape bending the white-noise region (a filter, aliasing), and
@@ -1111,7 +1111,7 @@ fn shape_grid(data: &FitData, used: &[usize], g: ShapeGrid) -> Vec<f64> {
 }
 
 /// The model term contributing most AVAR at τ.
-pub fn dominant_term(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> usize {
+pub(crate) fn dominant_term(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> usize {
     (0..TERM_COUNT)
         .max_by(|&x, &y| {
             (coef[x] * basis_at(x, tau, shapes)).total_cmp(&(coef[y] * basis_at(y, tau, shapes)))
@@ -1129,7 +1129,7 @@ pub fn dominant_term(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> usi
 /// basis, or if the covariance cannot be evaluated, the plain interval is returned.
 /// Returns (lo, hi) of the coefficient (a squared term), lo ≥ 0; hi = ∞ when the data bound
 /// the term from above at no value (se(c) grows as fast as c/z).
-pub fn inverted_interval(
+pub(crate) fn inverted_interval(
     data: &FitData,
     res: &FitResult,
     cfg: &FitConfig,

@@ -137,13 +137,13 @@ impl LineShape {
     /// far more than the short-τ points' precision, while the Allan bump pins A² once the
     /// points it dominates carry their own variance ([`LineShape::edf`]); kept as the one
     /// switch should a record need it.
-    pub fn fixed(&self) -> bool {
+    pub(crate) fn fixed(&self) -> bool {
         false
     }
 
     /// Degrees of freedom of the line's own Allan variance estimate (∞ for a sinusoid,
     /// whose estimate is deterministic up to the noise's cross term).
-    pub fn edf(&self) -> f64 {
+    pub(crate) fn edf(&self) -> f64 {
         if self.bandwidth > 0.0 {
             (2.0 * std::f64::consts::PI * self.bandwidth * self.record).max(1.0)
         } else {
@@ -152,7 +152,7 @@ impl LineShape {
     }
 
     /// Allan variance per unit A² at τ.
-    pub fn avar(&self, tau: f64) -> f64 {
+    pub(crate) fn avar(&self, tau: f64) -> f64 {
         let m = tau / self.tau0;
         if self.bandwidth == 0.0 {
             crate::ieee952::lines::sinusoid_avar(m, self.frequency * self.tau0)
@@ -190,7 +190,7 @@ impl Shapes {
     };
 
     /// The power laws with the lines `lines`.
-    pub fn with_lines(lines: LineSlots) -> Shapes {
+    pub(crate) fn with_lines(lines: LineSlots) -> Shapes {
         Shapes {
             lines,
             ..Shapes::FLAT
@@ -199,12 +199,12 @@ impl Shapes {
 
     /// Whether coefficient j is a fitted term here (a line slot only when it holds a line
     /// whose A² is fitted, [`LineShape::fixed`]).
-    pub fn has(&self, j: usize) -> bool {
+    pub(crate) fn has(&self, j: usize) -> bool {
         j < LINE0 || self.lines[j - LINE0].is_some_and(|l| !l.fixed())
     }
 
     /// The coefficients of the fixed lines (0 elsewhere).
-    pub fn fixed_coef(&self) -> [f64; TERM_COUNT] {
+    pub(crate) fn fixed_coef(&self) -> [f64; TERM_COUNT] {
         let mut c = [0.0; TERM_COUNT];
         for (k, l) in self.lines.iter().enumerate() {
             if let Some(l) = l

@@ -33,7 +33,7 @@ pub const FMT_LEN: usize = 89;
 pub const ISBD_SAMPLES: usize = 32;
 
 /// The bytes a format character takes.
-pub fn char_size(c: u8) -> Option<usize> {
+pub(crate) fn char_size(c: u8) -> Option<usize> {
     Some(match c {
         b'b' | b'B' | b'M' => 1,
         b'h' | b'H' | b'c' | b'C' => 2,
@@ -136,13 +136,13 @@ struct Batch {
 }
 
 /// Opens a DataFlash log.
-pub fn open(path: &Path) -> Result<DecodedSource, Error> {
+pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     read(path, &bytes)
 }
 
 /// Reads a DataFlash log held in memory.
-pub fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
+pub(crate) fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
     let mut defs: HashMap<u8, Def> = HashMap::new();
     let mut streams: Vec<Stream> = Vec::new();
     let mut by_key: HashMap<(String, u32), usize> = HashMap::new();

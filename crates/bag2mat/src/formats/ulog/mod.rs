@@ -58,7 +58,7 @@ pub struct Field {
 }
 
 /// The bytes of a scalar type, or `None` for a nested format.
-pub fn scalar_size(ty: &str) -> Option<usize> {
+pub(crate) fn scalar_size(ty: &str) -> Option<usize> {
     Some(match ty {
         "int8_t" | "uint8_t" | "bool" | "char" => 1,
         "int16_t" | "uint16_t" => 2,
@@ -69,7 +69,7 @@ pub fn scalar_size(ty: &str) -> Option<usize> {
 }
 
 /// Parses a format message's text `name:type field;…`.
-pub fn parse_format(text: &str) -> Option<(String, Vec<Field>)> {
+pub(crate) fn parse_format(text: &str) -> Option<(String, Vec<Field>)> {
     let (name, rest) = text.split_once(':')?;
     let mut fields = Vec::new();
     for f in rest.split(';').filter(|f| !f.trim().is_empty()) {
@@ -248,7 +248,7 @@ fn array(s: &HashMap<String, Slot>, base: &str) -> Vec<Slot> {
 
 /// The offset, ns, of sample `k` of `n` before the newest one, `dt_us` apart (rounded half
 /// up, the same arithmetic as the pyulog cross-check's).
-pub fn fifo_offset_ns(n: usize, k: usize, dt_us: f64) -> u64 {
+pub(crate) fn fifo_offset_ns(n: usize, k: usize, dt_us: f64) -> u64 {
     (((n - 1 - k) as f64) * dt_us * 1000.0 + 0.5).floor() as u64
 }
 
@@ -548,7 +548,7 @@ pub struct UlogReader {
 }
 
 /// Opens a ULog file.
-pub fn open(path: &Path) -> Result<UlogReader, Error> {
+pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
