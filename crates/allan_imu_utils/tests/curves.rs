@@ -23,29 +23,10 @@ fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
-/// Every `key: number` of a yaml file, in order, with the section path (`Gyr/x-axis/gyr_n`).
+/// Every number of a yaml file, in order, with the section path (`Gyr/x-axis/gyr_n`).
 fn yaml_numbers(path: &Path) -> Vec<(String, f64)> {
     let body = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut out = Vec::new();
-    let mut stack: Vec<(usize, String)> = Vec::new();
-    for line in body.lines().filter(|l| !l.starts_with('%')) {
-        let indent = line.len() - line.trim_start().len();
-        let Some((k, v)) = line.trim().split_once(':') else {
-            continue;
-        };
-        while stack.last().is_some_and(|(i, _)| *i >= indent) {
-            stack.pop();
-        }
-        let v = v.trim();
-        if v.is_empty() {
-            stack.push((indent, k.to_string()));
-        } else if let Ok(x) = v.parse::<f64>() {
-            let mut key: Vec<&str> = stack.iter().map(|(_, s)| s.as_str()).collect();
-            key.push(k);
-            out.push((key.join("/"), x));
-        }
-    }
-    out
+    bag2mat::test_tools::yaml_numbers(&body)
 }
 
 fn real(name: &str) -> PathBuf {

@@ -34,16 +34,7 @@ fn s(b: &[u8]) -> String {
 }
 
 fn yaml_value(text: &str, key: &str) -> f64 {
-    let line = text
-        .lines()
-        .find(|l| l.starts_with(&format!("{key}:")))
-        .unwrap_or_else(|| panic!("no {key} in imu.yaml:\n{text}"));
-    let v = line.split_whitespace().nth(1).unwrap();
-    if v == ".nan" {
-        f64::NAN
-    } else {
-        v.parse().unwrap()
-    }
+    bag2mat::test_tools::yaml_number(text, key)
 }
 
 fn assert_no_outputs(dir: &Path) {

@@ -30,11 +30,7 @@ fn analyse(input: &Path, dir: &Path, extra: &[&str]) -> (String, String) {
 /// The value of `key:` in a yaml file of `dir`.
 fn yaml_number(dir: &Path, file: &str, key: &str) -> f64 {
     let text = std::fs::read_to_string(dir.join(file)).unwrap();
-    text.lines()
-        .find_map(|l| l.strip_prefix(&format!("{key}:")))
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("no {key} in {file}:\n{text}"))
+    bag2mat::test_tools::yaml_number(&text, key)
 }
 
 /// Each axis' N over its truth, gyro x y z then acc x y z.

@@ -51,7 +51,7 @@ pub mod sensor;
 pub mod series;
 pub mod shared;
 pub mod source;
-#[doc(hidden)]
+#[cfg(any(test, feature = "test-support"))]
 pub mod test_tools;
 pub mod timing;
 pub mod zstd;

@@ -631,3 +631,116 @@ pub fn retopic(src: &Path, topic: &str, dst: &Path, topics: &[&str]) {
     }
     w.finish().expect("finish the bag");
 }
+
+/// A parsed YAML document as the tests read it: maps keep their order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum YamlNode {
+    /// A mapping, its entries in document order.
+    Map(Vec<(String, YamlNode)>),
+    /// A sequence.
+    Seq(Vec<YamlNode>),
+    /// A number (YAML's `.nan`/`.inf` included).
+    Number(f64),
+    /// Any other scalar.
+    Text(String),
+    /// `true`/`false`.
+    Bool(bool),
+    /// `~`, `null` or nothing.
+    Null,
+}
+
+impl<'de> serde::Deserialize<'de> for YamlNode {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = YamlNode;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a YAML node")
+            }
+            fn visit_bool<E>(self, v: bool) -> Result<YamlNode, E> {
+                Ok(YamlNode::Bool(v))
+            }
+            fn visit_i64<E>(self, v: i64) -> Result<YamlNode, E> {
+                Ok(YamlNode::Number(v as f64))
+            }
+            fn visit_u64<E>(self, v: u64) -> Result<YamlNode, E> {
+                Ok(YamlNode::Number(v as f64))
+            }
+            fn visit_f64<E>(self, v: f64) -> Result<YamlNode, E> {
+                Ok(YamlNode::Number(v))
+            }
+            fn visit_str<E>(self, v: &str) -> Result<YamlNode, E> {
+                Ok(YamlNode::Text(v.to_string()))
+            }
+            fn visit_unit<E>(self) -> Result<YamlNode, E> {
+                Ok(YamlNode::Null)
+            }
+            fn visit_none<E>(self) -> Result<YamlNode, E> {
+                Ok(YamlNode::Null)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<YamlNode, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = a.next_element()? {
+                    v.push(x);
+                }
+                Ok(YamlNode::Seq(v))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut a: A) -> Result<YamlNode, A::Error> {
+                let mut v = Vec::new();
+                while let Some((k, x)) = a.next_entry::<String, YamlNode>()? {
+                    v.push((k, x));
+                }
+                Ok(YamlNode::Map(v))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Every number of a YAML file (also OpenCV's `%YAML:1.0` files, whose directive line a YAML
+/// 1.2 parser refuses and which spell NaN `.Nan`), in document order, keyed by its path of
+/// map keys joined with `/` (`Gyr/x-axis/gyr_n`); parsed by the YAML library the workspace
+/// uses, not by lines. Panics with the text when it is not YAML.
+pub fn yaml_numbers(text: &str) -> Vec<(String, f64)> {
+    let body: String = text
+        .lines()
+        .filter(|l| !l.starts_with("%YAML"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    // The tools write NaN where a term has no value (`.nan`): read it as the number it is.
+    let options = serde_saphyr::Options {
+        non_finite_float_policy: serde_saphyr::NonFiniteFloatPolicy::PassThrough,
+        ..serde_saphyr::Options::default()
+    };
+    let doc: YamlNode = serde_saphyr::from_str_with_options(&body, options)
+        .unwrap_or_else(|e| panic!("not YAML ({e}):\n{text}"));
+    fn walk(n: &YamlNode, path: &mut Vec<String>, out: &mut Vec<(String, f64)>) {
+        match n {
+            YamlNode::Map(m) => {
+                for (k, v) in m {
+                    path.push(k.clone());
+                    walk(v, path, out);
+                    path.pop();
+                }
+            }
+            YamlNode::Number(x) => out.push((path.join("/"), *x)),
+            YamlNode::Text(s) if s.eq_ignore_ascii_case(".nan") => {
+                out.push((path.join("/"), f64::NAN))
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(&doc, &mut Vec::new(), &mut out);
+    out
+}
+
+/// The number at `path` (see [`yaml_numbers`]) of a YAML text; panics with the text when it
+/// has none.
+pub fn yaml_number(text: &str, path: &str) -> f64 {
+    yaml_numbers(text)
+        .into_iter()
+        .find(|(k, _)| k == path)
+        .map(|(_, x)| x)
+        .unwrap_or_else(|| panic!("no number at {path} in:\n{text}"))
+}
