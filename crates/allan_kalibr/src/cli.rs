@@ -2,8 +2,8 @@
 
 use clap::Parser;
 
-use crate::estimator::Estimator;
 use crate::front::CommonArgs;
+use crate::kalibr::estimator::Estimator;
 use crate::run::Config;
 
 /// kalibr_allan's Allan-deviation results (rpng/kalibr_allan 9d38ea9), in seconds, without

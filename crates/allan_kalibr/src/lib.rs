@@ -7,12 +7,14 @@
 //! The behaviour contract is `shared/specs/kalibr_allan.md`.
 //!
 //! ## Brief overview
-//! * [`tau_grid`]: the 2000-point τ grid exactly as upstream builds it.
-//! * [`estimator`]: the non-overlapping `sig2` per axis (prefix-sum fast path, bit-exact
-//!   replay of upstream's recursion, slow oracle).
-//! * [`fit`]: gen_chart's fixed-slope fits and read-offs.
-//! * [`report`]: the exact printed text; [`yaml`]: Kalibr imu.yaml; [`curves`]: the CSV;
-//!   [`plot`]: the two charts.
+//! The crate holds two analyses in two module trees, [`kalibr`] and [`ieee952`], no module
+//! name shared between them:
+//! * [`kalibr`]: the kalibr_allan reproduction: [`kalibr::grid`], the 2000-point τ grid
+//!   exactly as upstream builds it; [`kalibr::estimator`], the non-overlapping `sig2` per
+//!   axis (prefix-sum fast path, bit-exact replay of upstream's recursion, slow oracle);
+//!   [`kalibr::chart_fit`], gen_chart's fixed-slope fits and read-offs; [`kalibr::report`],
+//!   the exact printed text; [`kalibr::curves`], the CSV; [`kalibr::chart`], the two charts.
+//! * [`yaml`]: Kalibr imu.yaml and the YAML spelling both halves write.
 //! * [`input`]: `.mat`/`.bag` loading and the update-rate check; [`run`](mod@run): the whole
 //!   job.
 //! * [`ieee952`]: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
@@ -36,33 +38,28 @@
 //!
 //! ## Quirks reproduced on purpose (compat)
 //! * The τ grid starts at δ² (issue #25), keeps its m = 0 points (NaN), duplicates, and the
-//!   knife-edge last point (`tau_grid`, `quirk_25_grid_starts_at_delta_squared`,
+//!   knife-edge last point (`kalibr::grid`, `quirk_25_grid_starts_at_delta_squared`,
 //!   `quirk_knife_edge_last_point`).
 //! * `sig2` is the non-overlapping deviation; the overlapping one upstream also computes is
-//!   never used (`estimator`).
-//! * With exactly two clusters Octave squares with `pow(d, 2)` (`estimator`,
+//!   never used (`kalibr::estimator`).
+//! * With exactly two clusters Octave squares with `pow(d, 2)` (`kalibr::estimator`,
 //!   `quirk_two_clusters_square_with_pow`).
 //! * Deviations (not variances) are averaged over axes (issue #27); fit windows are grid
 //!   indices `1:minid-50` and `minid+50:end`; empty windows give NaN (issues #12/#13,
-//!   `quirk_12_13_*` in `fit`).
+//!   `quirk_12_13_*` in `kalibr::chart_fit`).
 //! * The update rate drives the grid; timestamps are only counted (they are checked here
 //!   and a warning printed, which upstream never does).
 
 pub mod cli;
-pub mod curves;
 pub mod error;
-pub mod estimator;
-pub mod fit;
 pub mod front;
 pub mod ieee952;
 pub mod input;
-pub mod plot;
-pub mod report;
+pub mod kalibr;
 pub mod run;
-pub mod tau_grid;
 pub mod yaml;
 
 pub use error::Error;
-pub use estimator::Estimator;
 pub use front::{Common, CurvesInput, Input};
+pub use kalibr::estimator::Estimator;
 pub use run::{Analysis, Config, CurvesOutput, RunOutput, analyse, run, run_curves, run_on};

@@ -6,14 +6,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::curves;
 use crate::error::Error;
-use crate::estimator::{Estimator, sig2_curves};
-use crate::fit::{ChartFit, gen_chart};
 use crate::input::{self, ImuData, RateChoice};
-use crate::plot::{self, Chart};
-use crate::report;
-use crate::tau_grid::TauGrid;
+use crate::kalibr::chart::{self, Chart};
+use crate::kalibr::chart_fit::{ChartFit, gen_chart};
+use crate::kalibr::curves;
+use crate::kalibr::estimator::{Estimator, sig2_curves};
+use crate::kalibr::grid::TauGrid;
+use crate::kalibr::report;
 use crate::yaml::ImuYaml;
 use bag2mat::shared::note::Note;
 
@@ -542,10 +542,10 @@ pub(crate) fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<P
     };
     let mut out = Vec::new();
     if a.absent != Some(bag2mat::Sensor::Acc) {
-        out.extend(plot::write_chart(&accel, dir, "allan_accel")?);
+        out.extend(chart::write_chart(&accel, dir, "allan_accel")?);
     }
     if a.absent != Some(bag2mat::Sensor::Gyro) {
-        out.extend(plot::write_chart(&gyro, dir, "allan_gyro")?);
+        out.extend(chart::write_chart(&gyro, dir, "allan_gyro")?);
     }
     Ok(out)
 }

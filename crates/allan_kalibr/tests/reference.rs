@@ -4,10 +4,10 @@
 //! lines identical.
 
 use allan_kalibr::Estimator;
-use allan_kalibr::fit::gen_chart;
 use allan_kalibr::input::{self, ImuData};
-use allan_kalibr::report;
-use allan_kalibr::tau_grid::TauGrid;
+use allan_kalibr::kalibr::chart_fit::gen_chart;
+use allan_kalibr::kalibr::grid::TauGrid;
+use allan_kalibr::kalibr::report;
 
 use crate::common::{CASES, Case, final_full, n_rows, process_lines, ref_curves, rel_err};
 
@@ -83,7 +83,11 @@ fn fit_on_reference_curves_matches_final_numbers_and_text() {
     }
 }
 
-fn check_text(case: &Case, acc: &allan_kalibr::fit::ChartFit, gyr: &allan_kalibr::fit::ChartFit) {
+fn check_text(
+    case: &Case,
+    acc: &allan_kalibr::kalibr::chart_fit::ChartFit,
+    gyr: &allan_kalibr::kalibr::chart_fit::ChartFit,
+) {
     let mut lines: Vec<String> = report::chart_lines(acc).into();
     lines.extend(report::chart_lines(gyr));
     assert_eq!(lines, process_lines(case), "{}: gen_chart lines", case.name);

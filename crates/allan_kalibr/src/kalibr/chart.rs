@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::chart_fit::ChartFit;
 use crate::error::Error;
-use crate::fit::ChartFit;
 
 /// MATLAB's default colour order (lines 1–4: x, y, z, average).
 const MATLAB_COLORS: [RGBColor; 4] = [
@@ -162,7 +162,7 @@ where
         "−½ fit: σ = {} {} (τ = {} s)",
         value6(fit.white),
         chart.unit_white,
-        crate::report::matlab_fixed(fit.tau_at1, 2)
+        super::report::matlab_fixed(fit.tau_at1, 2)
     );
     let bias_label = if fit.bias.is_nan() {
         // kalibr_allan's +½ window starts 50 grid points past the curve's minimum: on a
@@ -174,7 +174,7 @@ where
             "+½ fit: σ_b = {} {} (τ = {} s)",
             value6(fit.bias),
             chart.unit_bias,
-            crate::report::matlab_fixed(fit.tau_at2, 2)
+            super::report::matlab_fixed(fit.tau_at2, 2)
         )
     };
     ctx.draw_series(LineSeries::new(
@@ -255,7 +255,7 @@ where
 
 /// `%.6f` as upstream's text box, but NaN spelled out.
 fn value6(v: f64) -> String {
-    crate::report::matlab_fixed(v, 6)
+    super::report::matlab_fixed(v, 6)
 }
 
 /// Tick labels on log axes: powers of ten as `1e-3`, others compactly.

@@ -1,7 +1,7 @@
 //! The text `SCRIPT_process_results.m` prints (kalibr_allan.md §3.2), line for line, with
 //! MATLAB's `fprintf` spelling of non-finite values (`NaN`, `Inf`, `-Inf`, not C's `nan`).
 
-use crate::fit::ChartFit;
+use super::chart_fit::ChartFit;
 
 /// MATLAB `fprintf('%.<prec>f', x)`: fixed notation, `NaN` / `Inf` / `-Inf` when not finite.
 pub(crate) fn matlab_fixed(x: f64, prec: usize) -> String {

@@ -15,7 +15,7 @@ use std::hint::black_box;
 
 use rayon::prelude::*;
 
-use crate::tau_grid::TauGrid;
+use super::grid::TauGrid;
 
 /// How `sig2` is computed (chosen once, by `--bit-exact`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -1,0 +1,19 @@
+//! The kalibr_allan reproduction: the MATLAB half of rpng/kalibr_allan (`9d38ea9`) bit for
+//! bit, and the upstream-compatible files written from it (spec `kalibr_allan.md`).
+//!
+//! * [`grid`]: the 2000-point τ grid exactly as `SCRIPT_allan_matparallel.m` builds it.
+//! * [`estimator`]: the non-overlapping `sig2` per axis of `allan.m` (prefix-sum fast path,
+//!   bit-exact replay of upstream's recursion, slow oracle).
+//! * [`chart_fit`]: `gen_chart.m`'s fixed-slope fits and read-offs.
+//! * [`report`]: the exact text `SCRIPT_process_results.m` prints; [`curves`]: the curves as
+//!   CSV; [`chart`]: `gen_chart.m`'s two charts.
+//!
+//! Kalibr's `imu.yaml` ([`crate::yaml`]) is written from these numbers too, but its YAML
+//! spelling is shared with the IEEE 952 files and lives at the crate root.
+
+pub mod chart;
+pub mod chart_fit;
+pub mod curves;
+pub mod estimator;
+pub mod grid;
+pub mod report;
