@@ -1,0 +1,223 @@
+//! The analysis of one axis, step by step: the fit grid's data, the declared fit
+//! ([`super::declare`]), the curve with its bounds, what the left-out short τ are, the region
+//! readings, the terms ([`super::terms`]) and the fit's diagnostics.
+
+use super::declare::declare_fit;
+use super::terms::{make_terms, region_terms};
+use super::{
+    AlphaSource, Analysis, AxisVerdict, Config, CovBasis, CurveData, CurvePoint, FIT_TOL,
+    FitSummary, IdMethod, Ieee952Error, Point, ci, edf, fit, region,
+};
+
+/// Analyses one rate series y (unit U, sample period `tau0` s).
+pub fn analyse(y: &[f64], tau0: f64, cfg: &Config) -> Result<Analysis, Ieee952Error> {
+    let data = CurveData::from_samples(y, tau0, cfg)?;
+    let basis = data.basis(cfg.fit.per_octave);
+    Ok(analyse_curve(&data, cfg, basis.as_ref()))
+}
+
+/// Analyses a measured curve. `basis` is the statistical covariance of its fit grid
+/// ([`CurveData::basis`]; shared by the axes of an IMU), `None` when the sample count is
+/// unknown.
+pub(crate) fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
+    let valid: Vec<&CurvePoint> = data
+        .points
+        .iter()
+        .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+        .collect();
+    let fd = fit_data(data, cfg, &valid, basis);
+
+    // the range and the fit, then the declared-fit check
+    let (fitted, mut verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg);
+    // the curve with its bounds
+    let range = verdict.range();
+    let curve = curve_points(data, cfg, fitted.as_ref(), range);
+    if let Some(f) = &fitted {
+        name_short_cut(&mut verdict, f, &curve);
+    }
+    let verdict = verdict;
+    // region readings on the fit grid of the declared range (all of it without a fit)
+    let (rlo, rhi) = range.unwrap_or((0.0, f64::INFINITY));
+    let region_pts: Vec<Point> = fd
+        .points
+        .iter()
+        .filter(|fp| fp.tau >= rlo * (1.0 - 1e-12) && fp.tau <= rhi * (1.0 + 1e-12))
+        .filter_map(|fp| curve.iter().find(|c| c.m == fp.m).copied())
+        .collect();
+    let region = region::read(&region_pts);
+
+    let terms = match (&fitted, verdict.fits()) {
+        (Some(f), true) => make_terms(f, &fd, &curve, cfg),
+        _ => region_terms(&region, &curve),
+    };
+    let fit = fitted.map(|f| FitSummary {
+        coef: f.coef,
+        cov: f.cov,
+        shapes: f.shapes,
+        iterations: f.iterations,
+        converged: f.converged,
+        chi2_per_dof: f.chi2_per_dof,
+        delta: f.delta,
+        tau_range: (
+            fd.points[f.used[0]].tau,
+            fd.points[*f.used.last().unwrap_or(&0)].tau,
+        ),
+        points: f.used.len(),
+        max_misfit,
+    });
+    let bounds = (
+        region::upper_bound(curve.iter(), |t| fit::basis(1, t).sqrt()),
+        region::upper_bound(curve.iter(), |t| fit::basis(3, t).sqrt()),
+    );
+    Analysis {
+        n: data.n,
+        tau0: data.tau0,
+        kind: data.kind,
+        curve,
+        terms,
+        fit,
+        verdict,
+        region,
+        psd: data.psd.clone(),
+        lines: data.lines.clone(),
+        bounds,
+    }
+}
+
+/// The fit's data: the `valid` points of the curve on the fit grid, where each sits on the
+/// curve and in `basis` (kept only when it holds every point of the grid), and the lines
+/// the model holds.
+fn fit_data<'a>(
+    data: &CurveData,
+    cfg: &Config,
+    valid: &[&CurvePoint],
+    basis: Option<&'a CovBasis>,
+) -> fit::FitData<'a> {
+    let fit_ms = data.fit_ms(cfg.fit.per_octave);
+    let basis = basis.filter(|b| fit_ms.iter().all(|m| b.ms().binary_search(m).is_ok()));
+    fit::FitData {
+        points: fit_ms
+            .iter()
+            .map(|&m| {
+                let p = valid
+                    .iter()
+                    .find(|p| p.m == m)
+                    .expect("fit grid from valid");
+                fit::FitPoint {
+                    m,
+                    tau: p.tau,
+                    avar: p.avar,
+                }
+            })
+            .collect(),
+        curve_index: fit_ms
+            .iter()
+            .map(|&m| data.points.iter().position(|p| p.m == m).unwrap_or(0))
+            .collect(),
+        basis,
+        basis_index: fit_ms
+            .iter()
+            .map(|m| basis.map_or(0, |b| b.ms().binary_search(m).unwrap_or(0)))
+            .collect(),
+        lines: data.model_lines(),
+    }
+}
+
+/// The analysed curve: each valid point with its α (identified, else the fitted model's
+/// dominant term), its Greenhall EDF, its bounds at `cfg.curve_confidence` and at 95 %,
+/// whether it is in the declared `range`, and the model there.
+fn curve_points(
+    data: &CurveData,
+    cfg: &Config,
+    fitted: Option<&fit::FitResult>,
+    range: Option<(f64, f64)>,
+) -> Vec<Point> {
+    let n_phase = data.n.map(|n| n + 1);
+    data.points
+        .iter()
+        .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+        .map(|p| {
+            let (alpha, alpha_source) = match (p.id, p.id_method) {
+                (Some(a), IdMethod::Lag1) => (a, AlphaSource::Lag1),
+                (Some(a), _) => (a, AlphaSource::B1),
+                (None, _) => match fitted {
+                    Some(f) => (
+                        fit::TERM_ALPHA[fit::dominant_term(&f.coef, &f.shapes, p.tau)],
+                        AlphaSource::Model,
+                    ),
+                    None => (0, AlphaSource::Assumed),
+                },
+            };
+            let nu = n_phase
+                .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
+                .unwrap_or(f64::NAN);
+            let adev = p.avar.sqrt();
+            let (lo, hi) =
+                ci::chi2_interval(adev, nu, cfg.curve_confidence).unwrap_or((f64::NAN, f64::NAN));
+            let (lo95, hi95) = ci::chi2_interval(adev, nu, 0.95).unwrap_or((f64::NAN, f64::NAN));
+            let in_range = range
+                .is_some_and(|(a, b)| p.tau >= a * (1.0 - 1e-12) && p.tau <= b * (1.0 + 1e-12));
+            Point {
+                m: p.m,
+                tau: p.tau,
+                avar: p.avar,
+                adev,
+                lo,
+                hi,
+                lo95,
+                hi95,
+                edf: nu,
+                alpha,
+                alpha_source,
+                in_range,
+                model: fitted.map_or(f64::NAN, |f| f.predict(p.tau).max(0.0).sqrt()),
+            }
+        })
+        .collect()
+}
+
+/// What the left-out short τ of a declared fit `f` are: below the model's white-noise line
+/// (band-limited), above it (a bump), or both — said from the points themselves, not from
+/// how the range was cut.
+fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]) {
+    let AxisVerdict::Fits {
+        range,
+        short_cut: true,
+        short_feature,
+        band_limited,
+        ..
+    } = verdict
+    else {
+        return;
+    };
+    let (mut above, mut below, mut lean) = (false, false, 0.0);
+    for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
+        let model = f.predict(p.tau).max(0.0).sqrt();
+        let band = (p.hi95 / p.adev - 1.0).max(0.0);
+        if !fit::is_positive(model) {
+            continue;
+        }
+        let mis = p.adev / model - 1.0;
+        // below the white-noise line (with the quantization's): what a band limit does;
+        // a point under the model but over that line is the model's line or bump shape
+        let white = (f.coef[0].max(0.0) * fit::basis(0, p.tau) + f.coef[1] * fit::basis(1, p.tau))
+            .max(0.0)
+            .sqrt();
+        let under_white = p.adev / white - 1.0;
+        lean += under_white.min(0.0) + mis.max(0.0);
+        if band.is_finite() && mis > FIT_TOL.max(band) {
+            above = true;
+        } else if band.is_finite() && under_white < -FIT_TOL.max(band) {
+            below = true;
+        }
+    }
+    // by the misses beyond the points' bands; without any, as the range was cut (a
+    // feature the start moved past, else the band limit of old)
+    if above || below {
+        *short_feature = above;
+        *band_limited = below;
+    } else {
+        // within their bands: below the model's white-noise line only if they lean below
+        *band_limited = lean < 0.0 && !*short_feature;
+    }
+}

@@ -1,0 +1,357 @@
+//! What the analysis finds for one axis: the analysed curve ([`Point`]), the IEEE 952
+//! terms with their intervals and verdicts ([`Terms`], [`Verdict`]), the verdict on the
+//! axis ([`AxisVerdict`]), the fit's diagnostics ([`FitSummary`]), all in [`Analysis`].
+
+#[cfg(doc)]
+use super::{APPROX_DELTA, B_FLOOR_TOL, FIT_TOL, analyse};
+use super::{Overlap, fit, psd, region};
+
+/// Where a point's α (used for its EDF) came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlphaSource {
+    /// Lag-1 autocorrelation noise identification.
+    Lag1,
+    /// B1 ratio noise identification (few clusters).
+    B1,
+    /// Not identifiable from the data at this τ: α of the fitted model's dominant term.
+    Model,
+    /// Nothing available; white FM (α = 0) assumed.
+    Assumed,
+}
+
+/// One point of the analysed Allan deviation curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// Cluster size in samples.
+    pub m: usize,
+    /// τ = m·τ0 in seconds.
+    pub tau: f64,
+    /// Allan variance, U².
+    pub avar: f64,
+    /// Allan deviation, U.
+    pub adev: f64,
+    /// Lower bound of the deviation at `Config::curve_confidence`, U (NaN: no sample count).
+    pub lo: f64,
+    /// Upper bound of the deviation at `Config::curve_confidence`, U.
+    pub hi: f64,
+    /// Lower bound at 95 %, U.
+    pub lo95: f64,
+    /// Upper bound at 95 %, U.
+    pub hi95: f64,
+    /// Greenhall EDF used for the bounds.
+    pub edf: f64,
+    /// Power-law α used for the EDF.
+    pub alpha: i32,
+    /// Where α came from.
+    pub alpha_source: AlphaSource,
+    /// Inside the fitted range.
+    pub in_range: bool,
+    /// Fitted model deviation at this τ (NaN without a fit).
+    pub model: f64,
+}
+
+/// Whether a term can be reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Positive with its lower bound above 0, and its own line within 20 % of the curve
+    /// somewhere in the fitted range.
+    Resolved,
+    /// The lower bound of its interval is 0: the data do not show the term.
+    NotSignificant,
+    /// Significant, but the curve never shows it on its own: its line never comes within
+    /// 20 % of the curve in the fitted range (e.g. a bias instability under the V of the
+    /// white-noise and random-walk lines), or, for B, the curve's lowest point is not at
+    /// 0.664·B within [`B_FLOOR_TOL`]. Its value leans on the model.
+    NeverDominant,
+    /// No reliable fit: the value is the IEEE 952 region reading, with its own interval.
+    RegionReading,
+    /// No reliable fit and no region for the term: only the 95 % upper bound is known.
+    RegionBound,
+    /// Fitted, but the whole record does not agree with it: its value is above what every
+    /// point's upper 95 % band allows, or the model it lifts rises above the curve's upper
+    /// band beyond the fitted range. Only the record's 95 % upper bound is reported.
+    Contradicted,
+    /// Not in the fitted model, or nothing could be computed.
+    NotFitted,
+}
+
+/// One IEEE 952 term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Term {
+    /// Estimate in the term's unit (see module docs); 0 when the fit puts it at its bound.
+    pub value: f64,
+    /// Standard error of `value` (delta method from the coefficient's); NaN when value = 0.
+    pub std_err: f64,
+    /// Lower end of the interval at `Config::term_confidence`, in the term's unit: the
+    /// square root of the coefficient interval {c ≥ 0 : |ĉ − c| ≤ z·se(c)}
+    /// ([`fit::inverted_interval`]). NaN without a sample count.
+    pub lo: f64,
+    /// Upper end of the interval.
+    pub hi: f64,
+    /// Can this term be reported?
+    pub verdict: Verdict,
+}
+
+impl Term {
+    /// The value when resolved (or read from its region), else `None` ("say so instead of
+    /// printing a number").
+    pub(crate) fn reported(&self) -> Option<f64> {
+        matches!(self.verdict, Verdict::Resolved | Verdict::RegionReading).then_some(self.value)
+    }
+
+    pub(super) fn not_fitted() -> Term {
+        Term {
+            value: f64::NAN,
+            std_err: f64::NAN,
+            lo: f64::NAN,
+            hi: f64::NAN,
+            verdict: Verdict::NotFitted,
+        }
+    }
+
+    pub(super) fn from_reading(r: Option<region::Reading>) -> Term {
+        match r {
+            Some(r) if r.kind == region::ReadingKind::Line => Term {
+                value: r.value,
+                std_err: f64::NAN,
+                lo: r.lo,
+                hi: r.hi,
+                verdict: Verdict::RegionReading,
+            },
+            Some(r) => Term {
+                value: 0.0,
+                std_err: f64::NAN,
+                lo: 0.0,
+                hi: r.hi,
+                verdict: Verdict::RegionBound,
+            },
+            None => Term::not_fitted(),
+        }
+    }
+}
+
+/// The five IEEE 952 terms and the exponentially correlated (Gauss–Markov) bias.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Terms {
+    /// Quantization, U·s.
+    pub q: Term,
+    /// White noise density, U/√Hz.
+    pub n: Term,
+    /// Bias instability, U.
+    pub b: Term,
+    /// Random walk, U·√Hz (= U/s/√Hz).
+    pub k: Term,
+    /// Ramp, U/s.
+    pub r: Term,
+    /// Gauss–Markov (exponentially correlated) bias: its σ, U. Not one of the five power-law
+    /// terms: in the model so that a bump is not read as bias instability or random walk.
+    pub g: Term,
+    /// Its correlation time, s (NaN when it is not in the model).
+    pub g_time: f64,
+    /// The flicker floor's lower corner T_lo, s: the shortest correlation time of its 1/f
+    /// spectrum (0: IEEE 952's flat floor; see [`fit::flicker_band`]). The floor is within
+    /// 2 % of 0.664·B from τ ≈ 40·T_lo on.
+    pub b_corner: f64,
+    /// The lines in the model (IEEE 952 sinusoidal noise), by slot.
+    pub lines: [Option<LineTerm>; fit::LINE_SLOTS],
+}
+
+/// A vibration line of the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineTerm {
+    /// Frequency (from the PSD), Hz.
+    pub frequency: f64,
+    /// −3 dB bandwidth (from the PSD), Hz; 0 for a sinusoid.
+    pub bandwidth: f64,
+    /// Amplitude A the Allan fit gives (√ of its coefficient; 0 when the fit puts it at or
+    /// below 0), U.
+    pub amplitude: f64,
+    /// Amplitude the PSD gives (√(2·power)), U.
+    pub psd_amplitude: f64,
+}
+
+impl Terms {
+    /// Terms in the order Q, N, B, K, R.
+    pub(crate) fn as_array(&self) -> [Term; 5] {
+        [self.q, self.n, self.b, self.k, self.r]
+    }
+}
+
+/// What the fit says about one axis.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AxisVerdict {
+    /// The model describes the curve over `range` (τ of the first and last fit point, s):
+    /// every curve point there is within [`FIT_TOL`] or its own 95 % band of the model.
+    Fits {
+        /// Declared range, s.
+        range: (f64, f64),
+        /// Shorter τ left out.
+        short_cut: bool,
+        /// Among the shorter τ left out, points above the model (a bump over the white-noise
+        /// line: a vibration, a resonance).
+        short_feature: bool,
+        /// Among the shorter τ left out, points below the model's white-noise line: the
+        /// sensor's low-pass filter or decimation (the only case called "band-limited").
+        band_limited: bool,
+        /// Longer τ left out: the curve does something the model has no term for there (a
+        /// bump, a dip, a turn-down).
+        long_cut: bool,
+        /// The model misses the curve beyond its statistics by this relative discrepancy δ
+        /// (when above [`APPROX_DELTA`]: within [`FIT_TOL`] but the terms are approximate).
+        approximate: Option<f64>,
+    },
+    /// No reliable fit; the terms are the IEEE 952 region readings.
+    NoReliableFit {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+impl AxisVerdict {
+    /// The model describes a declared range.
+    pub(crate) fn fits(&self) -> bool {
+        matches!(self, AxisVerdict::Fits { .. })
+    }
+
+    /// The declared range, when the model fits.
+    pub(crate) fn range(&self) -> Option<(f64, f64)> {
+        match self {
+            AxisVerdict::Fits { range, .. } => Some(*range),
+            AxisVerdict::NoReliableFit { .. } => None,
+        }
+    }
+}
+
+impl std::fmt::Display for AxisVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AxisVerdict::Fits {
+                range,
+                short_cut,
+                short_feature,
+                band_limited,
+                long_cut,
+                approximate,
+            } => {
+                let why_short = match (band_limited, short_feature) {
+                    (true, true) => "band-limited, and a bump above the white-noise line",
+                    (true, false) => "band-limited",
+                    (false, true) => "a bump above the white-noise line",
+                    (false, false) => "its first points are out of line with the rest",
+                };
+                if let Some(d) = approximate {
+                    write!(
+                        f,
+                        "approximately (the model misses the curve by {:.0} % beyond its statistics; the terms are approximate): ",
+                        100.0 * d
+                    )?;
+                }
+                if !short_cut && !long_cut {
+                    return write!(f, "model fits");
+                }
+                write!(
+                    f,
+                    "model fits τ = {} – {} s; ",
+                    short(range.0),
+                    short(range.1)
+                )?;
+                match (short_cut, long_cut) {
+                    (true, true) => write!(
+                        f,
+                        "does not describe τ < {} s ({why_short}) nor τ > {} s (the curve bends where the model has no term)",
+                        short(range.0),
+                        short(range.1)
+                    ),
+                    (true, false) => write!(
+                        f,
+                        "does not describe τ < {} s ({why_short})",
+                        short(range.0)
+                    ),
+                    _ => write!(
+                        f,
+                        "does not describe τ > {} s (the curve bends where the model has no term)",
+                        short(range.1)
+                    ),
+                }
+            }
+            AxisVerdict::NoReliableFit { reason } => write!(f, "no reliable fit: {reason}"),
+        }
+    }
+}
+
+/// A number in 3 significant digits for messages.
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let e = x.abs().log10().floor() as i32;
+    if (-3..5).contains(&e) {
+        let d = (2 - e).max(0) as usize;
+        format!("{x:.d$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// Fit diagnostics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitSummary {
+    /// Coefficients Q², N², B², K², R², σ_GM² (Q² < 0: the low-pass correction).
+    pub coef: [f64; fit::TERM_COUNT],
+    /// Their covariance.
+    pub cov: [[f64; fit::TERM_COUNT]; fit::TERM_COUNT],
+    /// Shapes of the Gauss–Markov bias and of the flicker floor.
+    pub shapes: fit::Shapes,
+    /// Re-weighting iterations.
+    pub iterations: usize,
+    /// Whether the re-weighting converged.
+    pub converged: bool,
+    /// Statistical χ² per degree of freedom over the fitted range (NaN without a sample
+    /// count); ≈ 1 when the model describes the points within their statistics.
+    pub chi2_per_dof: f64,
+    /// Relative model discrepancy δ: the fraction by which the model misses a point beyond
+    /// the statistics (0 when it does not).
+    pub delta: f64,
+    /// Fitted range (τ of the first and last fit point), s.
+    pub tau_range: (f64, f64),
+    /// Fit points used.
+    pub points: usize,
+    /// Largest |model/data − 1| (ADEV) over the curve points of the range.
+    pub max_misfit: f64,
+}
+
+impl FitSummary {
+    /// Model AVAR at τ.
+    pub(crate) fn predict(&self, tau: f64) -> f64 {
+        fit::predict(&self.coef, &self.shapes, tau)
+    }
+}
+
+/// Everything [`analyse`] finds for one series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    /// Number of samples analysed (None: unknown, curve given without it).
+    pub n: Option<usize>,
+    /// Sample period, s.
+    pub tau0: f64,
+    /// Estimator of the curve.
+    pub kind: Overlap,
+    /// Allan deviation curve.
+    pub curve: Vec<Point>,
+    /// IEEE 952 terms.
+    pub terms: Terms,
+    /// Fit diagnostics (`None` when no fit was possible).
+    pub fit: Option<FitSummary>,
+    /// The verdict on the axis.
+    pub verdict: AxisVerdict,
+    /// The region readings (cross-check; the terms when there is no reliable fit).
+    pub region: region::Readings,
+    /// The Welch PSD of the samples (none for a curve alone).
+    pub psd: Option<psd::Psd>,
+    /// Every line the PSD shows, strongest first (those in the model are in `terms.lines`).
+    pub lines: Vec<psd::Line>,
+    /// The largest N and K every curve point allows at 95 % (its upper band over the
+    /// term's Allan deviation per unit, the minimum over the whole curve: for K,
+    /// min σ_hi95(τ)·√(3/τ)); the yaml files never write more.
+    pub bounds: (f64, f64),
+}
