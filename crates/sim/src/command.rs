@@ -70,7 +70,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Command::Sensors(a) => {
             if a.spec_example {
-                out(crate::cli_model::SPEC_EXAMPLE)?;
+                out(crate::cli::SPEC_EXAMPLE)?;
             } else {
                 crate::bag_sim::validate_rate(a.rate)?;
                 out(&crate::noise::profiles::listing(a.rate))?;

@@ -320,11 +320,15 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
             tracks.push((m, states));
         }
         if cfg.plots {
-            let t: Vec<crate::plot::Track> = tracks
+            let positions: Vec<(Method, Vec<Vector3<f64>>)> = tracks
                 .iter()
-                .map(|(m, s)| crate::plot::Track {
+                .map(|(m, s)| (*m, s.iter().map(|s| s.p).collect()))
+                .collect();
+            let t: Vec<crate::plot::Track> = positions
+                .iter()
+                .map(|(m, p)| crate::plot::Track {
                     label: m.name(),
-                    states: s,
+                    positions: p,
                 })
                 .collect();
             let stem = cfg.out_dir.join(format!("integrate_{name}"));

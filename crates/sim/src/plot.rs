@@ -2,8 +2,8 @@
 //! time, position error over time), PNG and SVG, with bag2mat's embedded font.
 
 use crate::error::Result;
-use crate::integrate::State;
 use crate::textio::PoseRow;
+use nalgebra::Vector3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -12,8 +12,8 @@ use std::path::Path;
 pub struct Track<'a> {
     /// Legend label.
     pub label: &'a str,
-    /// States, one per truth row.
-    pub states: &'a [State],
+    /// Positions (world, m), one per truth row.
+    pub positions: &'a [Vector3<f64>],
 }
 
 const SIZE: (u32, u32) = (1800, 600);
@@ -58,11 +58,11 @@ where
     let xs = truth
         .iter()
         .map(|r| r.p.x)
-        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.x)));
+        .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.x)));
     let ys = truth
         .iter()
         .map(|r| r.p.y)
-        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.y)));
+        .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.y)));
     let (x0, x1) = range(xs);
     let (y0, y1) = range(ys);
     let mut c = ChartBuilder::on(&panels[0])
@@ -82,11 +82,7 @@ where
         if i == 0 {
             truth.iter().map(|r| (r.p.x, r.p.y)).collect()
         } else {
-            tracks[i - 1]
-                .states
-                .iter()
-                .map(|s| (s.p.x, s.p.y))
-                .collect()
+            tracks[i - 1].positions.iter().map(|p| (p.x, p.y)).collect()
         }
     };
     for i in 0..=tracks.len() {
@@ -122,7 +118,7 @@ where
         truth
             .iter()
             .map(|r| r.p.z)
-            .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.z))),
+            .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.z))),
     );
     let mut c = ChartBuilder::on(&panels[1])
         .caption("z over time", ("sans-serif", 22))
@@ -144,7 +140,7 @@ where
     .map_err(|x| e(&x))?;
     for (i, tr) in tracks.iter().enumerate() {
         c.draw_series(LineSeries::new(
-            truth.iter().zip(tr.states).map(|(r, s)| (r.t, s.p.z)),
+            truth.iter().zip(tr.positions).map(|(r, p)| (r.t, p.z)),
             COLORS[(i + 1) % 3].stroke_width(2),
         ))
         .map_err(|x| e(&x))?;
@@ -156,8 +152,8 @@ where
         .map(|tr| {
             truth
                 .iter()
-                .zip(tr.states)
-                .map(|(r, s)| (r.t, (s.p - r.p).norm()))
+                .zip(tr.positions)
+                .map(|(r, p)| (r.t, (p - r.p).norm()))
                 .collect()
         })
         .collect();

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use crate::cli::NoiseArgs;
+use super::noise_args::{NoiseArgs, PresetArg};
 use crate::error::{Result, SimError};
 use crate::noise::model::{BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup};
 use crate::noise::profiles::Profile;
@@ -128,7 +128,7 @@ impl ModelArgs {
     /// The model: base (profile, preset, or medium), spec, then flags; validated at `rate`.
     pub(crate) fn resolve(&self, noise: &NoiseArgs, rate: f64) -> Result<ImuModel> {
         // Checks the N/K flags the way every subcommand does.
-        noise.resolve(crate::cli::PresetArg::Medium)?;
+        noise.resolve(PresetArg::Medium)?;
         let base = match (self.sensor, noise.preset) {
             (Some(s), _) => Some(s.profile().model()),
             (None, Some(p)) => Some(ImuModel::from_continuous(
