@@ -4,7 +4,7 @@
 
 use clap::{Args, ValueEnum};
 
-use crate::error::{Result, SimError};
+use crate::error::{Result, SeedError, SimError};
 use crate::noise::{ContinuousNoise, DEFAULT_SEED, MASTER_PARAMS, Preset};
 
 /// Noise parameter presets (continuous time).
@@ -33,10 +33,8 @@ impl PresetArg {
 
 /// `--seed`: a whole number from 0 to 2^64 − 1, said so (not the parser's "unexpected
 /// argument" for a negative one).
-fn seed_value(s: &str) -> std::result::Result<u64, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a seed: a whole number from 0 to {}", u64::MAX))
+fn seed_value(s: &str) -> std::result::Result<u64, SeedError> {
+    s.trim().parse().map_err(|_| SeedError(s.to_string()))
 }
 
 /// Noise flags shared by the subcommands: a preset plus explicit overrides.
