@@ -102,6 +102,7 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    // Long on purpose: one chart written top to bottom (axes, truth, tools' curves, legend).
     let e = |x: &dyn std::fmt::Display| x.to_string();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let all = curves.iter().flat_map(|c| c.kalibr.iter().chain(&c.ieee));
