@@ -16,6 +16,7 @@ fn out(text: &str) -> anyhow::Result<()> {
 /// Runs the command the user typed and says what it did (stderr) and found (stdout); the
 /// exit code is a failed `--check` or self-check's, errors come back once to the binary.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    // Long on purpose: one arm per subcommand, each parse → run → print.
     match cli.command {
         Command::Bag(a) => {
             let cfg = crate::bag_sim::BagConfig::try_from(*a)?;
@@ -70,7 +71,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Command::Sensors(a) => {
             if a.spec_example {
-                out(crate::cli_model::SPEC_EXAMPLE)?;
+                out(crate::cli::SPEC_EXAMPLE)?;
             } else {
                 crate::bag_sim::validate_rate(a.rate)?;
                 out(&crate::noise::profiles::listing(a.rate))?;

@@ -104,7 +104,7 @@ pub fn run(cfg: &CompareConfig) -> Result<(String, bool)> {
     let md = markdown(&c);
     bag2mat::shared::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
     eprintln!("wrote {}", cfg.output.display());
-    for f in crate::compare_plot::plot(cfg)? {
+    for f in crate::compare_plot::plot(&cfg.root, &cfg.presets, cfg.rate, cfg.duration)? {
         eprintln!("wrote {}", f.display());
     }
     if !cfg.check {
@@ -122,18 +122,9 @@ pub fn run(cfg: &CompareConfig) -> Result<(String, bool)> {
     Ok((text, failures.is_empty()))
 }
 
-/// The preset's name as used in folder names.
-pub fn preset_name(p: Preset) -> &'static str {
-    match p {
-        Preset::Low => "low",
-        Preset::Medium => "medium",
-        Preset::High => "high",
-    }
-}
-
 /// The truth file `sim bag` wrote for a preset's bag under `root`.
 pub fn truth_yaml(root: &Path, p: Preset) -> PathBuf {
-    crate::noise::truth_file::paths(&root.join(preset_name(p)).join("imu.bag")).0
+    crate::noise::truth_file::paths(&root.join(p.name()).join("imu.bag")).0
 }
 
 /// N and K of the truth (mean of the three axes), from the truth file when there is one,
@@ -144,7 +135,7 @@ fn truth_values(root: &Path, p: Preset) -> Result<ContinuousNoise> {
         eprintln!(
             "note: {} not found; using the {} preset's nominal values as the truth",
             path.display(),
-            preset_name(p)
+            p.name()
         );
         return Ok(p.params());
     }
@@ -328,7 +319,7 @@ pub fn compare(cfg: &CompareConfig) -> Result<Comparison> {
     let dt = 1.0 / cfg.rate;
     let mut rows = Vec::new();
     for &p in &cfg.presets {
-        let name = preset_name(p);
+        let name = p.name();
         let dir = cfg.root.join(name);
         let iu =
             read_imu_utils_yaml(&dir.join("imu_utils").join(format!("{name}_imu_param.yaml")))?;

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::compare::{CompareConfig, preset_name};
 use crate::error::{Result, SimError};
+use crate::noise::Preset;
 
 /// One preset's curves for one sensor: (τ, deviation) series.
 struct Curves {
@@ -102,6 +102,7 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    // Long on purpose: one chart written top to bottom (axes, truth, tools' curves, legend).
     let e = |x: &dyn std::fmt::Display| x.to_string();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let all = curves.iter().flat_map(|c| c.kalibr.iter().chain(&c.ieee));
@@ -214,19 +215,19 @@ impl bag2mat::shared::plot::Figure for Compare<'_> {
     }
 }
 
-/// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison root.
-pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
+/// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison `root`
+/// (the presets' folders under it; `rate` and `duration` of the bags for the title).
+pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for (sensor, column, axes, unit) in [
         ("gyro", "gyro_avg", ["gx", "gy", "gz"], "rad/s"),
         ("acc", "acc_avg", ["ax", "ay", "az"], "m/s^2"),
     ] {
         let mut curves = Vec::new();
-        for &p in &cfg.presets {
-            let dir = cfg.root.join(preset_name(p)).join("kalibr");
+        for &p in presets {
+            let dir = root.join(p.name()).join("kalibr");
             let t = p.params();
-            let (_, csv) =
-                crate::noise::truth_file::paths(&cfg.root.join(preset_name(p)).join("imu.bag"));
+            let (_, csv) = crate::noise::truth_file::paths(&root.join(p.name()).join("imu.bag"));
             let sensor_kind = if sensor == "gyro" {
                 crate::noise::model::Sensor::Gyro
             } else {
@@ -240,7 +241,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
                 None
             };
             curves.push(Curves {
-                preset: preset_name(p),
+                preset: p.name(),
                 kalibr: kalibr_curve(&dir.join("allan_curves.csv"), column)?,
                 ieee: ieee_curve(&dir.join(allan_kalibr::ieee952::files::CURVES_FILE), axes)?,
                 truth: if sensor == "gyro" {
@@ -253,7 +254,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
         }
         let title = format!(
             "{sensor}: {} Hz, {} s — kalibr_allan, IEEE 952 and the truth",
-            cfg.rate, cfg.duration
+            rate, duration
         );
         files.extend(bag2mat::shared::plot::write_png_svg(
             &Compare {
@@ -261,7 +262,7 @@ pub fn plot(cfg: &CompareConfig) -> Result<Vec<PathBuf>> {
                 unit,
                 curves: &curves,
             },
-            &cfg.root,
+            root,
             &format!("compare_{sensor}"),
             SIZE,
             SIZE,

@@ -55,6 +55,43 @@ pub enum SimError {
     Bag(#[from] bag2mat::Error),
 }
 
+/// What is wrong inside a `--noise-spec` (or truth) file; [`SimError::Spec`] adds the path.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SpecError {
+    /// The YAML does not deserialise (the parser's message: key, line, column).
+    #[error("{0}")]
+    Yaml(String),
+    /// A truth file (format tag `sim-truth-1`) without its `model:` section.
+    #[error("truth file without a model section")]
+    TruthWithoutModel,
+    /// `warmup:` with neither form complete.
+    #[error("warmup needs either amplitude, or temperature_rise_k and bias_per_k (with tau_s)")]
+    Warmup,
+    /// `filter: {kind: butterworth2}` without its cutoff.
+    #[error("filter butterworth2 needs cutoff_hz")]
+    CutoffMissing,
+    /// A cutoff on a filter kind that has none.
+    #[error("filter {0} takes no cutoff_hz")]
+    CutoffUnused(String),
+    /// An unknown filter kind.
+    #[error("unknown filter kind '{0}' (expected none, butterworth2 or average)")]
+    FilterKind(String),
+    /// A per-axis override is wrong.
+    #[error("axis {axis}: {error}")]
+    Axis {
+        /// `x`, `y` or `z`.
+        axis: &'static str,
+        /// What is wrong with it.
+        error: Box<SpecError>,
+    },
+}
+
+/// `--seed` is not a whole number from 0 to 2^64 − 1 (clap prints it after the flag).
+#[derive(Debug, thiserror::Error)]
+#[error("'{0}' is not a seed: a whole number from 0 to {max}", max = u64::MAX)]
+pub struct SeedError(pub String);
+
 /// Shorthand.
 pub type Result<T> = std::result::Result<T, SimError>;
 

@@ -239,17 +239,10 @@ pub struct TableRow {
     pub errors: Errors,
 }
 
-/// Run `sim integrate`: integrate, write `imu_int_pose*.txt`, plot. Returns the table rows
-/// and the files written.
-pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)> {
-    use crate::textio::{NumFormat, format_int_rows, read_pose_rows, write_string};
-    if !(cfg.dt.is_finite() && cfg.dt > 0.0) {
-        return Err(crate::SimError::InvalidArgument(format!(
-            "the integration step must be positive, got {}",
-            cfg.dt
-        )));
-    }
-    let inputs: Vec<(&'static str, Vec<PoseRow>)> = match &cfg.input {
+/// The inputs of a run, named: the files read, or the model simulated clean and noisy.
+fn inputs(input: &IntegrateInput) -> crate::Result<Vec<(&'static str, Vec<PoseRow>)>> {
+    use crate::textio::read_pose_rows;
+    Ok(match input {
         IntegrateInput::Files { clean, noisy } => {
             let mut v = vec![("clean", read_pose_rows(clean)?)];
             if let Some(n) = noisy {
@@ -274,29 +267,45 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
                 ),
             ]
         }
-    };
+    })
+}
+
+/// The initial state of one input's integration.
+fn init_state(cfg: &IntegrateConfig, rows: &[PoseRow]) -> crate::Result<State> {
+    Ok(match cfg.init {
+        InitState::Model => State::from_motion(&crate::motion::ellipse_with(rows[0].t, cfg.mode)),
+        InitState::File => {
+            if rows.len() < 3 {
+                return Err(crate::SimError::InvalidArgument(
+                    "--init file needs at least 3 rows".into(),
+                ));
+            }
+            let v = (rows[1].p * 4.0 - rows[0].p * 3.0 - rows[2].p) / (2.0 * cfg.dt);
+            State {
+                q: unit_quat(rows[0].q),
+                p: rows[0].p,
+                v,
+            }
+        }
+    })
+}
+
+/// Run `sim integrate`: integrate, write `imu_int_pose*.txt`, plot. Returns the table rows
+/// and the files written.
+pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)> {
+    use crate::textio::{NumFormat, format_int_rows, write_string};
+    if !(cfg.dt.is_finite() && cfg.dt > 0.0) {
+        return Err(crate::SimError::InvalidArgument(format!(
+            "the integration step must be positive, got {}",
+            cfg.dt
+        )));
+    }
+    let inputs = inputs(&cfg.input)?;
     std::fs::create_dir_all(&cfg.out_dir).map_err(|e| crate::SimError::io(&cfg.out_dir, e))?;
     let mut table = Vec::new();
     let mut files = Vec::new();
     for (name, rows) in &inputs {
-        let init = match cfg.init {
-            InitState::Model => {
-                State::from_motion(&crate::motion::ellipse_with(rows[0].t, cfg.mode))
-            }
-            InitState::File => {
-                if rows.len() < 3 {
-                    return Err(crate::SimError::InvalidArgument(
-                        "--init file needs at least 3 rows".into(),
-                    ));
-                }
-                let v = (rows[1].p * 4.0 - rows[0].p * 3.0 - rows[2].p) / (2.0 * cfg.dt);
-                State {
-                    q: unit_quat(rows[0].q),
-                    p: rows[0].p,
-                    v,
-                }
-            }
-        };
+        let init = init_state(cfg, rows)?;
         let mut tracks = Vec::new();
         for &m in &cfg.methods {
             let states = integrate(rows, init, cfg.dt, m);
@@ -320,11 +329,15 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
             tracks.push((m, states));
         }
         if cfg.plots {
-            let t: Vec<crate::plot::Track> = tracks
+            let positions: Vec<(Method, Vec<Vector3<f64>>)> = tracks
                 .iter()
-                .map(|(m, s)| crate::plot::Track {
+                .map(|(m, s)| (*m, s.iter().map(|s| s.p).collect()))
+                .collect();
+            let t: Vec<crate::plot::Track> = positions
+                .iter()
+                .map(|(m, p)| crate::plot::Track {
                     label: m.name(),
-                    states: s,
+                    positions: p,
                 })
                 .collect();
             let stem = cfg.out_dir.join(format!("integrate_{name}"));

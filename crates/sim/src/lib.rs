@@ -42,7 +42,6 @@
 
 pub mod bag_sim;
 pub mod cli;
-pub mod cli_model;
 pub mod command;
 pub mod compare;
 pub mod compare_plot;

@@ -2,8 +2,8 @@
 //! time, position error over time), PNG and SVG, with bag2mat's embedded font.
 
 use crate::error::Result;
-use crate::integrate::State;
 use crate::textio::PoseRow;
+use nalgebra::Vector3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -12,8 +12,8 @@ use std::path::Path;
 pub struct Track<'a> {
     /// Legend label.
     pub label: &'a str,
-    /// States, one per truth row.
-    pub states: &'a [State],
+    /// Positions (world, m), one per truth row.
+    pub positions: &'a [Vector3<f64>],
 }
 
 const SIZE: (u32, u32) = (1800, 600);
@@ -39,54 +39,48 @@ fn range(it: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, Shift>,
-    title: &str,
+/// What drawing one panel can fail with (plotters' own error).
+type PanelResult<DB> = std::result::Result<
+    (),
+    plotters::drawing::DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>,
+>;
+
+/// The top view: truth and tracks in x–y, the start as a red dot.
+fn top_view<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
     truth: &[PoseRow],
     tracks: &[Track],
-) -> std::result::Result<(), String>
+) -> PanelResult<DB>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: &dyn std::fmt::Display| x.to_string();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let root = root.titled(title, ("sans-serif", 28)).map_err(|x| e(&x))?;
-    let panels = root.split_evenly((1, 3));
     let label_font = ("sans-serif", 20);
-
-    // Top view.
     let xs = truth
         .iter()
         .map(|r| r.p.x)
-        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.x)));
+        .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.x)));
     let ys = truth
         .iter()
         .map(|r| r.p.y)
-        .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.y)));
+        .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.y)));
     let (x0, x1) = range(xs);
     let (y0, y1) = range(ys);
-    let mut c = ChartBuilder::on(&panels[0])
+    let mut c = ChartBuilder::on(panel)
         .caption("top view", ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d(x0..x1, y0..y1)?;
     c.configure_mesh()
         .x_desc("x [m]")
         .y_desc("y [m]")
         .label_style(label_font)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     let series = |i: usize| -> Vec<(f64, f64)> {
         if i == 0 {
             truth.iter().map(|r| (r.p.x, r.p.y)).collect()
         } else {
-            tracks[i - 1]
-                .states
-                .iter()
-                .map(|s| (s.p.x, s.p.y))
-                .collect()
+            tracks[i - 1].positions.iter().map(|p| (p.x, p.y)).collect()
         }
     };
     for i in 0..=tracks.len() {
@@ -97,8 +91,7 @@ where
             tracks[i - 1].label
         };
         let width = if i == 0 { 3 } else { 2 };
-        c.draw_series(LineSeries::new(series(i), col.stroke_width(width)))
-            .map_err(|x| e(&x))?
+        c.draw_series(LineSeries::new(series(i), col.stroke_width(width)))?
             .label(label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 25, y)], col.stroke_width(3)));
     }
@@ -106,58 +99,75 @@ where
         (truth[0].p.x, truth[0].p.y),
         6,
         RED.filled(),
-    )))
-    .map_err(|x| e(&x))?;
+    )))?;
     c.configure_series_labels()
         .position(SeriesLabelPosition::MiddleMiddle)
         .label_font(label_font)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
+    Ok(())
+}
 
-    // z over time.
-    let (t0, t1) = range(truth.iter().map(|r| r.t));
+/// z over time, truth under the tracks; `t` the time range.
+fn z_over_time<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    truth: &[PoseRow],
+    tracks: &[Track],
+    (t0, t1): (f64, f64),
+) -> PanelResult<DB>
+where
+    DB::ErrorType: 'static,
+{
+    let label_font = ("sans-serif", 20);
     let (z0, z1) = range(
         truth
             .iter()
             .map(|r| r.p.z)
-            .chain(tracks.iter().flat_map(|t| t.states.iter().map(|s| s.p.z))),
+            .chain(tracks.iter().flat_map(|t| t.positions.iter().map(|p| p.z))),
     );
-    let mut c = ChartBuilder::on(&panels[1])
+    let mut c = ChartBuilder::on(panel)
         .caption("z over time", ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(t0..t1, z0..z1)
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d(t0..t1, z0..z1)?;
     c.configure_mesh()
         .x_desc("t [s]")
         .y_desc("z [m]")
         .label_style(label_font)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     c.draw_series(LineSeries::new(
         truth.iter().map(|r| (r.t, r.p.z)),
         COLORS[0].stroke_width(4),
-    ))
-    .map_err(|x| e(&x))?;
+    ))?;
     for (i, tr) in tracks.iter().enumerate() {
         c.draw_series(LineSeries::new(
-            truth.iter().zip(tr.states).map(|(r, s)| (r.t, s.p.z)),
+            truth.iter().zip(tr.positions).map(|(r, p)| (r.t, p.z)),
             COLORS[(i + 1) % 3].stroke_width(2),
-        ))
-        .map_err(|x| e(&x))?;
+        ))?;
     }
+    Ok(())
+}
 
-    // Position error over time.
+/// |p − p_true| over time on a log scale; `t` the time range.
+fn position_error<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    truth: &[PoseRow],
+    tracks: &[Track],
+    (t0, t1): (f64, f64),
+) -> PanelResult<DB>
+where
+    DB::ErrorType: 'static,
+{
+    let label_font = ("sans-serif", 20);
     let errs: Vec<Vec<(f64, f64)>> = tracks
         .iter()
         .map(|tr| {
             truth
                 .iter()
-                .zip(tr.states)
-                .map(|(r, s)| (r.t, (s.p - r.p).norm()))
+                .zip(tr.positions)
+                .map(|(r, p)| (r.t, (p - r.p).norm()))
                 .collect()
         })
         .collect();
@@ -180,24 +190,21 @@ where
         .into_iter()
         .map(|v| v.into_iter().map(|(t, e)| (t, e.max(emin))).collect())
         .collect();
-    let mut c = ChartBuilder::on(&panels[2])
+    let mut c = ChartBuilder::on(panel)
         .caption("position error |p - p_true|", ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1, (emin..emax).log_scale())
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d(t0..t1, (emin..emax).log_scale())?;
     c.configure_mesh()
         .x_desc("t [s]")
         .y_desc("error [m] (log)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(label_font)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     for (i, (tr, pts)) in tracks.iter().zip(errs).enumerate() {
         let col = COLORS[(i + 1) % 3];
-        c.draw_series(LineSeries::new(pts, col.stroke_width(2)))
-            .map_err(|x| e(&x))?
+        c.draw_series(LineSeries::new(pts, col.stroke_width(2)))?
             .label(tr.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 25, y)], col.stroke_width(3)));
     }
@@ -206,8 +213,28 @@ where
         .label_font(label_font)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
+    Ok(())
+}
+
+/// Three panels side by side under the title: top view, z over time, position error.
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    truth: &[PoseRow],
+    tracks: &[Track],
+) -> std::result::Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |x: &dyn std::fmt::Display| x.to_string();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let root = root.titled(title, ("sans-serif", 28)).map_err(|x| e(&x))?;
+    let panels = root.split_evenly((1, 3));
+    let (t0, t1) = range(truth.iter().map(|r| r.t));
+    top_view(&panels[0], truth, tracks).map_err(|x| e(&x))?;
+    z_over_time(&panels[1], truth, tracks, (t0, t1)).map_err(|x| e(&x))?;
+    position_error(&panels[2], truth, tracks, (t0, t1)).map_err(|x| e(&x))?;
     bag2mat::shared::plot::present(&root)?;
     Ok(())
 }

@@ -94,6 +94,8 @@ pub const TRIM_KNOTS: i64 = 10;
 
 /// Run `sim spline`.
 pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
+    // Long on purpose: the command top to bottom (checks, fit, emission, text files, bag,
+    // truth); the steps share the window, the paths and the rows, a split would pass them all.
     if !(cfg.rate.is_finite() && cfg.rate > 0.0) {
         return Err(SimError::InvalidArgument(format!(
             "--rate must be positive, got {}",

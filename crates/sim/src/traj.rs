@@ -163,6 +163,7 @@ fn g_line(out: &mut String, vals: &[f64], trailing_space: bool) {
 
 /// Write every file of `sim traj` into `cfg.out_dir`.
 pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
+    // Long on purpose: the upstream `master` file writer top to bottom, one block per file.
     if !(cfg.duration > 0.0 && cfg.rate > 0.0 && cfg.cam_rate > 0.0) {
         return Err(SimError::InvalidArgument(
             "duration, rate and cam-rate must be positive".into(),

@@ -194,6 +194,15 @@ pub enum Preset {
 }
 
 impl Preset {
+    /// The preset's name, as `sim compare` names its folders.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Low => "low",
+            Preset::Medium => "medium",
+            Preset::High => "high",
+        }
+    }
+
     /// The preset's continuous-time parameters.
     pub fn params(self) -> ContinuousNoise {
         match self {

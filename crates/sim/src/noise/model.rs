@@ -319,6 +319,7 @@ impl ImuModel {
     /// Checks every parameter (finite, non-negative where it must be, corner times ordered,
     /// chain compatible with the output rate). Messages name sensor, axis and field.
     pub(crate) fn validate(&self, output_rate: f64) -> Result<()> {
+        // Long on purpose: a flat list of independent checks, one per rule, in the model's order.
         for s in Sensor::BOTH {
             let sm = self.sensor(s);
             sm.chain.resolve(s, output_rate)?;
@@ -423,6 +424,7 @@ impl ImuModel {
     /// Human-readable table of every term, continuous and discrete at `rate` Hz (printed by
     /// `sim bag` and `sim sensors`).
     pub fn describe(&self, rate: f64) -> String {
+        // Long on purpose: a report template written top to bottom, one line per term.
         if let Some(c) = self.legacy(rate) {
             return c.describe(rate);
         }

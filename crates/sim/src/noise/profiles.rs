@@ -115,6 +115,7 @@ fn legacy(p: Profile, c: ContinuousNoise) -> ImuModel {
 }
 
 fn bmi088() -> ImuModel {
+    // Long on purpose: a datasheet transcribed figure by figure with its sources.
     // Gyroscope. Datasheet rev. 1.4, Table 5: output noise "BW = 47 Hz (@ 0.014 °/s/√Hz)
     // 0.1 °/s"; the product flyer gives the same 0.014 °/s/√Hz.
     let gyro_n = 0.014 * DEG;

@@ -34,7 +34,7 @@ use super::model::{
     Warmup,
 };
 use super::profiles::Profile;
-use crate::error::{Result, SimError};
+use crate::error::{Result, SimError, SpecError};
 
 /// `bias_instability:` in a spec.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -188,18 +188,16 @@ pub(crate) fn read(path: &Path) -> Result<SpecFile> {
 }
 
 /// Parses spec text; the message says what is wrong and where.
-pub(crate) fn parse(text: &str) -> std::result::Result<SpecFile, String> {
+pub(crate) fn parse(text: &str) -> std::result::Result<SpecFile, SpecError> {
     if let Ok(t) = serde_saphyr::from_str::<TruthAsSpec>(text)
         && t.format.as_deref() == Some(TRUTH_FORMAT)
     {
-        return t
-            .model
-            .ok_or_else(|| "truth file without a model section".to_string());
+        return t.model.ok_or(SpecError::TruthWithoutModel);
     }
-    serde_saphyr::from_str::<SpecFile>(text).map_err(|e| e.to_string())
+    serde_saphyr::from_str::<SpecFile>(text).map_err(|e| SpecError::Yaml(e.to_string()))
 }
 
-fn apply_terms(a: &mut AxisModel, s: &AxisSpecRef<'_>) -> std::result::Result<(), String> {
+fn apply_terms(a: &mut AxisModel, s: &AxisSpecRef<'_>) -> std::result::Result<(), SpecError> {
     if let Some(v) = s.white_noise {
         a.white_noise = v;
     }
@@ -254,10 +252,7 @@ fn apply_terms(a: &mut AxisModel, s: &AxisSpecRef<'_>) -> std::result::Result<()
                 sensitivity: s,
             }),
             _ => {
-                return Err(
-                    "warmup needs either amplitude, or temperature_rise_k and bias_per_k (with tau_s)"
-                        .into(),
-                );
+                return Err(SpecError::Warmup);
             }
         };
     }
@@ -293,7 +288,7 @@ macro_rules! terms_ref {
     };
 }
 
-fn apply_sensor(m: &mut SensorModel, s: &SensorSpec) -> std::result::Result<(), String> {
+fn apply_sensor(m: &mut SensorModel, s: &SensorSpec) -> std::result::Result<(), SpecError> {
     if let Some(r) = s.internal_rate_hz {
         m.chain.internal_rate_hz = Some(r);
     }
@@ -302,14 +297,12 @@ fn apply_sensor(m: &mut SensorModel, s: &SensorSpec) -> std::result::Result<(), 
             ("none", None) => Filter::None,
             ("average", None) => Filter::Average,
             ("butterworth2", Some(c)) => Filter::Butterworth2 { cutoff_hz: c },
-            ("butterworth2", None) => return Err("filter butterworth2 needs cutoff_hz".into()),
+            ("butterworth2", None) => return Err(SpecError::CutoffMissing),
             ("none" | "average", Some(_)) => {
-                return Err(format!("filter {} takes no cutoff_hz", f.kind));
+                return Err(SpecError::CutoffUnused(f.kind.clone()));
             }
             (k, _) => {
-                return Err(format!(
-                    "unknown filter kind '{k}' (expected none, butterworth2 or average)"
-                ));
+                return Err(SpecError::FilterKind(k.to_string()));
             }
         };
     }
@@ -320,8 +313,10 @@ fn apply_sensor(m: &mut SensorModel, s: &SensorSpec) -> std::result::Result<(), 
     if let Some(axes) = &s.axes {
         for (i, ax) in [&axes.x, &axes.y, &axes.z].into_iter().enumerate() {
             if let Some(ax) = ax {
-                apply_terms(&mut m.axes[i], &terms_ref!(ax))
-                    .map_err(|e| format!("axis {}: {e}", super::model::AXES[i]))?;
+                apply_terms(&mut m.axes[i], &terms_ref!(ax)).map_err(|e| SpecError::Axis {
+                    axis: super::model::AXES[i],
+                    error: Box::new(e),
+                })?;
             }
         }
     }

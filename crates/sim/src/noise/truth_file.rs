@@ -16,7 +16,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::filter::{Biquad, autocorrelation, enbw, impulse_response};
-use super::model::{AXES, AxisModel, Filter, ImuModel, ResolvedChain, Sensor, Warmup};
+use super::model::{
+    AXES, AxisModel, BiasInstability, Filter, ImuModel, ResolvedChain, Sensor, Warmup,
+};
 use super::truth::{AxisTruth, TERM_NAMES, TermAvar, WIDROW_MIN, tau_grid};
 use crate::error::{Result, SimError};
 
@@ -102,24 +104,7 @@ fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
         g(a.random_walk),
         u("random_walk")
     );
-    match a.bias_instability {
-        Some(b) => {
-            let _ = writeln!(
-                o,
-                "{indent}bias_instability: {{value: {}, tau_lo_s: {}, tau_hi_s: {}}}   # B [{}]; Allan floor 0.664*B between the corner times",
-                g(b.b),
-                g(b.tau_lo),
-                g(b.tau_hi),
-                s.unit()
-            );
-        }
-        None => {
-            let _ = writeln!(
-                o,
-                "{indent}bias_instability: {{value: 0.0, tau_lo_s: 1.0, tau_hi_s: 10.0}}   # off"
-            );
-        }
-    }
+    bias_instability_yaml(o, s, a.bias_instability, indent);
     let gm: Vec<String> = a
         .gauss_markov
         .iter()
@@ -149,7 +134,51 @@ fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
         g(a.resolution),
         s.unit()
     );
-    match a.warmup {
+    warmup_yaml(o, s, a.warmup, indent);
+    let lines: Vec<String> = a
+        .lines
+        .iter()
+        .map(|l| {
+            format!(
+                "{{frequency_hz: {}, amplitude: {}, bandwidth_hz: {}}}",
+                g(l.frequency),
+                g(l.amplitude),
+                g(l.bandwidth)
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        o,
+        "{indent}lines: [{}]   # vibration lines at the output: amplitude [{}] of A*sin(2*pi*f*t + phase); bandwidth_hz > 0: a 2nd-order resonance of that -3 dB width, rms A/sqrt(2)",
+        lines.join(", "),
+        s.unit()
+    );
+}
+/// The `bias_instability:` line of [`axis_model_yaml`] (off: the keys with B = 0).
+fn bias_instability_yaml(o: &mut String, s: Sensor, b: Option<BiasInstability>, indent: &str) {
+    match b {
+        Some(b) => {
+            let _ = writeln!(
+                o,
+                "{indent}bias_instability: {{value: {}, tau_lo_s: {}, tau_hi_s: {}}}   # B [{}]; Allan floor 0.664*B between the corner times",
+                g(b.b),
+                g(b.tau_lo),
+                g(b.tau_hi),
+                s.unit()
+            );
+        }
+        None => {
+            let _ = writeln!(
+                o,
+                "{indent}bias_instability: {{value: 0.0, tau_lo_s: 1.0, tau_hi_s: 10.0}}   # off"
+            );
+        }
+    }
+}
+
+/// The `warmup:` line of [`axis_model_yaml`], in the form the model has.
+fn warmup_yaml(o: &mut String, s: Sensor, w: Option<Warmup>, indent: &str) {
+    match w {
         Some(Warmup::Exponential { amplitude, tau }) => {
             let _ = writeln!(
                 o,
@@ -178,29 +207,41 @@ fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
             let _ = writeln!(o, "{indent}warmup: {{amplitude: 0.0, tau_s: 1.0}}   # off");
         }
     }
-    let lines: Vec<String> = a
-        .lines
-        .iter()
-        .map(|l| {
-            format!(
-                "{{frequency_hz: {}, amplitude: {}, bandwidth_hz: {}}}",
-                g(l.frequency),
-                g(l.amplitude),
-                g(l.bandwidth)
-            )
-        })
-        .collect();
-    let _ = writeln!(
-        o,
-        "{indent}lines: [{}]   # vibration lines at the output: amplitude [{}] of A*sin(2*pi*f*t + phase); bandwidth_hz > 0: a 2nd-order resonance of that -3 dB width, rms A/sqrt(2)",
-        lines.join(", "),
-        s.unit()
-    );
 }
 
-/// The yaml text.
+/// The yaml text: the header, the units, the model (a valid `--noise-spec`), then what the
+/// generator does per output sample.
 pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
     let mut o = String::new();
+    header_yaml(&mut o, info);
+    let _ = writeln!(o, "units:");
+    for s in Sensor::BOTH {
+        let _ = writeln!(
+            o,
+            "  {}: {{white_noise: {}, random_walk: {}, bias_instability: {u}, gauss_markov_sigma: {u}, rate_ramp: {}, quantization: {}, resolution: {u}, warmup_amplitude: {u}, line_amplitude: {u}, allan_deviation: {u}}}",
+            s.name(),
+            s.term_unit("white_noise"),
+            s.term_unit("random_walk"),
+            s.term_unit("rate_ramp"),
+            s.term_unit("quantization"),
+            u = s.unit()
+        );
+    }
+    model_yaml(&mut o, info.model);
+    let dt = 1.0 / info.rate;
+    let _ = writeln!(
+        o,
+        "discrete:   # what the generator does per output sample (period {} s)",
+        g(dt)
+    );
+    for s in Sensor::BOTH {
+        discrete_sensor_yaml(&mut o, info, s)?;
+    }
+    Ok(o)
+}
+
+/// The lines above `units:`: what the file is, the bag, the run.
+fn header_yaml(o: &mut String, info: &TruthInfo<'_>) {
     let dt = 1.0 / info.rate;
     let (_, csv) = paths(info.bag);
     let _ = writeln!(
@@ -231,22 +272,13 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
         "duration_s: {}   # samples / output rate",
         g(info.samples as f64 * dt)
     );
-    let _ = writeln!(o, "units:");
-    for s in Sensor::BOTH {
-        let _ = writeln!(
-            o,
-            "  {}: {{white_noise: {}, random_walk: {}, bias_instability: {u}, gauss_markov_sigma: {u}, rate_ramp: {}, quantization: {}, resolution: {u}, warmup_amplitude: {u}, line_amplitude: {u}, allan_deviation: {u}}}",
-            s.name(),
-            s.term_unit("white_noise"),
-            s.term_unit("random_walk"),
-            s.term_unit("rate_ramp"),
-            s.term_unit("quantization"),
-            u = s.unit()
-        );
-    }
+}
+
+/// The `model:` section, a valid `--noise-spec`.
+fn model_yaml(o: &mut String, model: &ImuModel) {
     let _ = writeln!(o, "model:");
     for s in Sensor::BOTH {
-        let sm = info.model.sensor(s);
+        let sm = model.sensor(s);
         let _ = writeln!(o, "  {}:", s.name());
         if let Some(r) = sm.chain.internal_rate_hz {
             let _ = writeln!(o, "    internal_rate_hz: {}", g(r));
@@ -267,143 +299,167 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
         let _ = writeln!(o, "    axes:");
         for (axis, a) in AXES.iter().zip(&sm.axes) {
             let _ = writeln!(o, "      {axis}:");
-            axis_model_yaml(&mut o, s, a, "        ");
+            axis_model_yaml(o, s, a, "        ");
         }
+    }
+}
+
+/// One sensor of the `discrete:` section: its chain, then each axis.
+fn discrete_sensor_yaml(o: &mut String, info: &TruthInfo<'_>, s: Sensor) -> Result<()> {
+    let (chain, truths) = sensor_truths(info, s)?;
+    let sm = info.model.sensor(s);
+    let h = impulse_response(&chain);
+    let _ = writeln!(o, "  {}:", s.name());
+    let _ = writeln!(o, "    internal_rate_hz: {}", g(chain.internal_rate));
+    let _ = writeln!(o, "    decimation: {}", chain.decimation);
+    if let Filter::Butterworth2 { cutoff_hz } = chain.filter {
+        let bq = Biquad::butterworth(cutoff_hz, chain.internal_rate);
+        let _ = writeln!(
+            o,
+            "    filter_coefficients: {{b: [{}, {}, {}], a: [1.0, {}, {}]}}",
+            g(bq.b[0]),
+            g(bq.b[1]),
+            g(bq.b[2]),
+            g(bq.a[0]),
+            g(bq.a[1])
+        );
     }
     let _ = writeln!(
         o,
-        "discrete:   # what the generator does per output sample (period {} s)",
-        g(dt)
+        "    impulse_response_energy: {}   # sum h^2 (internal rate)",
+        g(autocorrelation(&h, 0))
     );
-    for s in Sensor::BOTH {
-        let (chain, truths) = sensor_truths(info, s)?;
-        let sm = info.model.sensor(s);
-        let h = impulse_response(&chain);
-        let _ = writeln!(o, "  {}:", s.name());
-        let _ = writeln!(o, "    internal_rate_hz: {}", g(chain.internal_rate));
-        let _ = writeln!(o, "    decimation: {}", chain.decimation);
-        if let Filter::Butterworth2 { cutoff_hz } = chain.filter {
-            let bq = Biquad::butterworth(cutoff_hz, chain.internal_rate);
-            let _ = writeln!(
-                o,
-                "    filter_coefficients: {{b: [{}, {}, {}], a: [1.0, {}, {}]}}",
-                g(bq.b[0]),
-                g(bq.b[1]),
-                g(bq.b[2]),
-                g(bq.a[0]),
-                g(bq.a[1])
-            );
-        }
-        let _ = writeln!(
-            o,
-            "    impulse_response_energy: {}   # sum h^2 (internal rate)",
-            g(autocorrelation(&h, 0))
-        );
-        let _ = writeln!(
-            o,
-            "    equivalent_noise_bandwidth_hz: {}   # one-sided; white per-sample variance = 2*N^2*ENBW",
-            g(enbw(&chain))
-        );
-        let _ = writeln!(o, "    axes:");
-        for ((axis, a), t) in AXES.iter().zip(&sm.axes).zip(&truths) {
-            let u = s.unit();
-            let _ = writeln!(o, "      {axis}:");
-            let w = t.white();
-            let _ = writeln!(
-                o,
-                "        white_per_sample_sigma: {}   # [{u}] sqrt(N^2 * f_internal * sum h^2): filtered and decimated",
-                g(w.variance().sqrt())
-            );
-            let _ = writeln!(
-                o,
-                "        white_per_sample_sigma_naive: {}   # [{u}] N*sqrt(f_output), what an unfiltered sensor would give",
-                g(super::white_to_discrete(a.white_noise, dt))
-            );
-            let _ = writeln!(
-                o,
-                "        white_noise_density_effective: {}   # [{}] sqrt(sum_k R(k) * dt): the -1/2 line at long tau, aliasing included",
-                g((w.s0() * dt).sqrt()),
-                s.term_unit("white_noise")
-            );
-            let _ = writeln!(
-                o,
-                "        random_walk_step_sigma: {}   # [{u}] K*sqrt(dt), bias applied before its update",
-                g(super::random_walk_to_discrete(a.random_walk, dt))
-            );
-            let comps = a
-                .bias_instability
-                .map(|b| super::flicker::components(&b))
-                .unwrap_or_default();
-            let cs: Vec<String> = comps
-                .iter()
-                .map(|c| format!("{{sigma: {}, tau_s: {}}}", g(c.sigma), g(c.tau)))
-                .collect();
-            let _ = writeln!(
-                o,
-                "        flicker_components: [{}]   # AR(1) x' = a*x + sigma*sqrt(1-a^2)*e, a = exp(-dt/tau_s)",
-                cs.join(", ")
-            );
-            let _ = writeln!(
-                o,
-                "        rate_ramp_per_sample: {}   # [{u}] R*dt",
-                g(a.rate_ramp * dt)
-            );
-            let _ = writeln!(
-                o,
-                "        quantization_step: {}   # [{}] sqrt(12)*Q on the integrated value",
-                g(super::quantization_step(a.quantization)),
-                s.term_unit("quantization")
-            );
-            for l in &a.lines {
-                let (pa, pb) =
-                    allan_kalibr::ieee952::lines::resonance_poles(l.frequency, l.bandwidth, dt);
-                let _ = writeln!(
-                    o,
-                    "        line_{}hz: {{cycles_per_sample: {}, decay_per_sample: {}, radians_per_sample: {}}}   # nu0 = f*dt; a resonance's autocovariance (A^2/2)*exp(-a|k|)*(cos(b k) + (a/b) sin(b|k|))",
-                    g(l.frequency),
-                    g(l.frequency * dt),
-                    g(pa),
-                    g(pb)
-                );
-            }
-            if let Some(wu) = a.warmup {
-                let _ = writeln!(
-                    o,
-                    "        warmup_amplitude: {}   # [{u}] A",
-                    g(wu.amplitude())
-                );
-                let _ = writeln!(
-                    o,
-                    "        warmup_factor_per_sample: {}   # exp(-dt/T)",
-                    g((-dt / wu.tau()).exp())
-                );
-            }
-            // Widrow ratios: how well the rounding errors are uniform and white.
-            if let Some(r) = t.widrow_resolution() {
-                let _ = writeln!(
-                    o,
-                    "        widrow_ratio_resolution: {}   # sd of the change per sample / LSB; >= 1: rounding error white (truth exact)",
-                    g(r)
-                );
-            }
-            if let Some(r) = t.widrow_quantization() {
-                let _ = writeln!(
-                    o,
-                    "        widrow_ratio_quantization: {}   # sd of the increment of the integrated value per sample / step",
-                    g(r)
-                );
-            }
-            let m1 = (info.rate.round() as usize).max(1);
-            if 2 * m1 <= info.samples {
-                let _ = writeln!(
-                    o,
-                    "        allan_deviation_at_1s: {}   # [{u}] exact, from the curves file",
-                    g(t.avar(m1).sqrt())
-                );
-            }
-        }
+    let _ = writeln!(
+        o,
+        "    equivalent_noise_bandwidth_hz: {}   # one-sided; white per-sample variance = 2*N^2*ENBW",
+        g(enbw(&chain))
+    );
+    let _ = writeln!(o, "    axes:");
+    for ((axis, a), t) in AXES.iter().zip(&sm.axes).zip(&truths) {
+        discrete_axis_yaml(o, info, s, axis, a, t);
     }
-    Ok(o)
+    Ok(())
+}
+
+/// One axis of the `discrete:` section: the random terms' per-sample figures, then
+/// [`deterministic_axis_yaml`].
+fn discrete_axis_yaml(
+    o: &mut String,
+    info: &TruthInfo<'_>,
+    s: Sensor,
+    axis: &str,
+    a: &AxisModel,
+    t: &AxisTruth,
+) {
+    let dt = 1.0 / info.rate;
+    let u = s.unit();
+    let _ = writeln!(o, "      {axis}:");
+    let w = t.white();
+    let _ = writeln!(
+        o,
+        "        white_per_sample_sigma: {}   # [{u}] sqrt(N^2 * f_internal * sum h^2): filtered and decimated",
+        g(w.variance().sqrt())
+    );
+    let _ = writeln!(
+        o,
+        "        white_per_sample_sigma_naive: {}   # [{u}] N*sqrt(f_output), what an unfiltered sensor would give",
+        g(super::white_to_discrete(a.white_noise, dt))
+    );
+    let _ = writeln!(
+        o,
+        "        white_noise_density_effective: {}   # [{}] sqrt(sum_k R(k) * dt): the -1/2 line at long tau, aliasing included",
+        g((w.s0() * dt).sqrt()),
+        s.term_unit("white_noise")
+    );
+    let _ = writeln!(
+        o,
+        "        random_walk_step_sigma: {}   # [{u}] K*sqrt(dt), bias applied before its update",
+        g(super::random_walk_to_discrete(a.random_walk, dt))
+    );
+    let comps = a
+        .bias_instability
+        .map(|b| super::flicker::components(&b))
+        .unwrap_or_default();
+    let cs: Vec<String> = comps
+        .iter()
+        .map(|c| format!("{{sigma: {}, tau_s: {}}}", g(c.sigma), g(c.tau)))
+        .collect();
+    let _ = writeln!(
+        o,
+        "        flicker_components: [{}]   # AR(1) x' = a*x + sigma*sqrt(1-a^2)*e, a = exp(-dt/tau_s)",
+        cs.join(", ")
+    );
+    let _ = writeln!(
+        o,
+        "        rate_ramp_per_sample: {}   # [{u}] R*dt",
+        g(a.rate_ramp * dt)
+    );
+    let _ = writeln!(
+        o,
+        "        quantization_step: {}   # [{}] sqrt(12)*Q on the integrated value",
+        g(super::quantization_step(a.quantization)),
+        s.term_unit("quantization")
+    );
+    deterministic_axis_yaml(o, info, s, a, t);
+}
+
+/// The rest of one axis of the `discrete:` section: lines, warm-up, the Widrow ratios of the
+/// rounding terms, the exact Allan deviation at 1 s.
+fn deterministic_axis_yaml(
+    o: &mut String,
+    info: &TruthInfo<'_>,
+    s: Sensor,
+    a: &AxisModel,
+    t: &AxisTruth,
+) {
+    let dt = 1.0 / info.rate;
+    let u = s.unit();
+    for l in &a.lines {
+        let (pa, pb) = allan_kalibr::ieee952::lines::resonance_poles(l.frequency, l.bandwidth, dt);
+        let _ = writeln!(
+            o,
+            "        line_{}hz: {{cycles_per_sample: {}, decay_per_sample: {}, radians_per_sample: {}}}   # nu0 = f*dt; a resonance's autocovariance (A^2/2)*exp(-a|k|)*(cos(b k) + (a/b) sin(b|k|))",
+            g(l.frequency),
+            g(l.frequency * dt),
+            g(pa),
+            g(pb)
+        );
+    }
+    if let Some(wu) = a.warmup {
+        let _ = writeln!(
+            o,
+            "        warmup_amplitude: {}   # [{u}] A",
+            g(wu.amplitude())
+        );
+        let _ = writeln!(
+            o,
+            "        warmup_factor_per_sample: {}   # exp(-dt/T)",
+            g((-dt / wu.tau()).exp())
+        );
+    }
+    // Widrow ratios: how well the rounding errors are uniform and white.
+    if let Some(r) = t.widrow_resolution() {
+        let _ = writeln!(
+            o,
+            "        widrow_ratio_resolution: {}   # sd of the change per sample / LSB; >= 1: rounding error white (truth exact)",
+            g(r)
+        );
+    }
+    if let Some(r) = t.widrow_quantization() {
+        let _ = writeln!(
+            o,
+            "        widrow_ratio_quantization: {}   # sd of the increment of the integrated value per sample / step",
+            g(r)
+        );
+    }
+    let m1 = (info.rate.round() as usize).max(1);
+    if 2 * m1 <= info.samples {
+        let _ = writeln!(
+            o,
+            "        allan_deviation_at_1s: {}   # [{u}] exact, from the curves file",
+            g(t.avar(m1).sqrt())
+        );
+    }
 }
 
 /// The csv text.

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use crate::cli::NoiseArgs;
+use super::noise_args::{NoiseArgs, PresetArg};
 use crate::error::{Result, SimError};
 use crate::noise::model::{BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup};
 use crate::noise::profiles::Profile;
@@ -127,8 +127,18 @@ pub const DEFAULT_BI_TAUS: (f64, f64) = (1.0, 1000.0);
 impl ModelArgs {
     /// The model: base (profile, preset, or medium), spec, then flags; validated at `rate`.
     pub(crate) fn resolve(&self, noise: &NoiseArgs, rate: f64) -> Result<ImuModel> {
+        let mut m = self.base_and_spec(noise)?;
+        apply_white_and_random_walk(&mut m, noise);
+        self.apply_chain(&mut m);
+        self.apply_terms(&mut m)?;
+        m.validate(rate)?;
+        Ok(m)
+    }
+
+    /// The base (profile, preset, or medium), then the spec on it.
+    fn base_and_spec(&self, noise: &NoiseArgs) -> Result<ImuModel> {
         // Checks the N/K flags the way every subcommand does.
-        noise.resolve(crate::cli::PresetArg::Medium)?;
+        noise.resolve(PresetArg::Medium)?;
         let base = match (self.sensor, noise.preset) {
             (Some(s), _) => Some(s.profile().model()),
             (None, Some(p)) => Some(ImuModel::from_continuous(
@@ -138,27 +148,17 @@ impl ModelArgs {
             (None, None) if self.noise_spec.is_none() => Some(Profile::Medium.model()),
             (None, None) => None,
         };
-        let mut m = match &self.noise_spec {
+        Ok(match &self.noise_spec {
             Some(path) => {
                 let spec = crate::noise::spec::read(path)?;
                 crate::noise::spec::apply(&spec, base, path)?
             }
             None => base.expect("a base without a spec"),
-        };
-        // The existing N/K flags (shared with traj/spline), validated there.
-        for (s, n, k) in [
-            (Sensor::Gyro, noise.gyro_noise, noise.gyro_bias_rw),
-            (Sensor::Acc, noise.acc_noise, noise.acc_bias_rw),
-        ] {
-            for a in m.sensor_mut(s).axes.iter_mut() {
-                if let Some(n) = n {
-                    a.white_noise = n;
-                }
-                if let Some(k) = k {
-                    a.random_walk = k;
-                }
-            }
-        }
+        })
+    }
+
+    /// `--internal-rate` and the low-pass flags.
+    fn apply_chain(&self, m: &mut ImuModel) {
         if let Some(r) = self.internal_rate {
             m.gyro.chain.internal_rate_hz = Some(r);
             m.acc.chain.internal_rate_hz = Some(r);
@@ -176,6 +176,11 @@ impl ModelArgs {
                 };
             }
         }
+    }
+
+    /// The per-sensor term flags (bias instability, Gauss–Markov, ramp, quantization,
+    /// resolution, warm-up), checked.
+    fn apply_terms(&self, m: &mut ImuModel) -> Result<()> {
         let per_sensor = [
             (
                 Sensor::Gyro,
@@ -267,8 +272,24 @@ impl ModelArgs {
                 }
             }
         }
-        m.validate(rate)?;
-        Ok(m)
+        Ok(())
+    }
+}
+
+/// The existing N/K flags (shared with traj/spline, validated there) on every axis.
+fn apply_white_and_random_walk(m: &mut ImuModel, noise: &NoiseArgs) {
+    for (s, n, k) in [
+        (Sensor::Gyro, noise.gyro_noise, noise.gyro_bias_rw),
+        (Sensor::Acc, noise.acc_noise, noise.acc_bias_rw),
+    ] {
+        for a in m.sensor_mut(s).axes.iter_mut() {
+            if let Some(n) = n {
+                a.white_noise = n;
+            }
+            if let Some(k) = k {
+                a.random_walk = k;
+            }
+        }
     }
 }
 
