@@ -260,7 +260,7 @@ pub(crate) fn is_imu(c: &Channel) -> bool {
 
 fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
-        Codec::Ros1 => ImuSample::decode(data),
+        Codec::Ros1 => ImuSample::decode(data).map_err(Error::from),
         Codec::Cdr => crate::cdr::decode_sample(data),
         Codec::Row => crate::decoded::Row::decode(data),
     }
