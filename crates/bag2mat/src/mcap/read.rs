@@ -25,9 +25,10 @@ use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
 use super::record::{
-    self, ChunkHeader, ChunkIndex, Cursor, FOOTER_CONTENT_LEN, Footer, Header, MAGIC,
-    MESSAGE_FIXED_LEN, Op, RECORD_PREFIX, Schema, Statistics,
+    self, ChunkHeader, ChunkIndex, FOOTER_CONTENT_LEN, Footer, Header, MAGIC, MESSAGE_FIXED_LEN,
+    McapFields, Op, RECORD_PREFIX, Schema, Statistics,
 };
+use crate::cursor::{Cursor, CursorError};
 use crate::error::Error;
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
 
@@ -380,13 +381,13 @@ impl McapReader {
         while c.pos() < b.len() {
             // Framing first: an untrusted summary skips a record whose content does not
             // parse, and ends at framing that does not hold.
-            let framed = c.u8().and_then(|op| Ok((op, c.bytes64()?)));
+            let framed = c.le::<u8>("opcode").and_then(|op| Ok((op, c.bytes64()?)));
             let (op, content) = match framed {
                 Ok(x) => x,
-                Err(e) if trusted => return Err(e),
+                Err(e) if trusted => return Err(e.to_string()),
                 Err(_) => break,
             };
-            let rec = (|| -> Result<(), String> {
+            let rec = (|| -> Result<(), CursorError> {
                 match Op::from_byte(op) {
                     Some(Op::Schema) => {
                         let s = Schema::decode(content)?;
@@ -410,7 +411,7 @@ impl McapReader {
             if let Err(e) = rec
                 && trusted
             {
-                return Err(e);
+                return Err(e.to_string());
             }
         }
         Ok(chunk_indexes)
@@ -813,7 +814,7 @@ impl McapReader {
                 ChunkHeader::decode(b).map_err(|e| Error::Corrupt {
                     path: self.path.clone(),
                     offset: pos,
-                    what: e,
+                    what: e.to_string(),
                 })?
             }
             Some(ci) => {
@@ -1294,7 +1295,7 @@ impl McapReader {
             while at < total {
                 let rec = (|| {
                     let mut c = Cursor::new(&records[at..]);
-                    let op = c.u8().ok()?;
+                    let op = c.le::<u8>("opcode").ok()?;
                     let content = c.bytes64().ok()?;
                     Some((op, content, c.pos()))
                 })();
