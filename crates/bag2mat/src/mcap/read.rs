@@ -500,6 +500,9 @@ impl McapReader {
     /// Walks the top-level records of the data section, up to `end`. Returns the summary
     /// records found after a Data End when the file has no usable footer (a file cut in
     /// its summary section).
+    // Long: one loop over the records whose state (position, the chunk the next index
+    // follows, Data End seen, resync) every opcode's arm reads and moves; split per opcode
+    // it would thread that state through each arm.
     fn walk(&mut self, end: u64, hints: &[u64]) -> Result<Option<Summary>, Error> {
         let file = self
             .file
