@@ -9,7 +9,7 @@
 
 use crate::bag::RosTime;
 use crate::error::Error;
-use crate::imu_msg::{Imu, ImuSample};
+use crate::imu_msg::{BODY_DOUBLES, Imu, ImuSample};
 
 /// The ROS 2 type name.
 pub const TYPE: &str = "sensor_msgs/msg/Imu";
@@ -58,8 +58,6 @@ pub fn definition() -> String {
     s
 }
 
-/// Doubles after `frame_id`: 4 + 9 + 3 + 9 + 3 + 9.
-const BODY_DOUBLES: usize = 37;
 /// Encapsulation header of little-endian plain CDR.
 const CDR_LE: [u8; 4] = [0, 1, 0, 0];
 /// Encapsulation header of big-endian plain CDR.
@@ -114,16 +112,8 @@ pub fn encode(imu: &Imu, endian: Endian, out: &mut Vec<u8>) -> Result<(), Error>
     out.extend_from_slice(id);
     out.push(0);
     out.resize(start + 4 + body_at, 0);
-    for v in imu
-        .orientation
-        .iter()
-        .chain(&imu.orientation_covariance)
-        .chain(&imu.angular_velocity)
-        .chain(&imu.angular_velocity_covariance)
-        .chain(&imu.linear_acceleration)
-        .chain(&imu.linear_acceleration_covariance)
-    {
-        put!(*v);
+    for v in imu.body() {
+        put!(v);
     }
     Ok(())
 }
@@ -205,35 +195,17 @@ fn f64_at(body: &[u8], i: usize, endian: Endian) -> f64 {
 /// Decodes stamp, gyro and acc (`seq` is 0: ROS 2 has none) without allocating.
 pub(crate) fn decode_sample(data: &[u8]) -> Result<ImuSample, Error> {
     let s = split(data)?;
-    let f = |i| f64_at(s.body, i, s.endian);
-    Ok(ImuSample {
-        seq: 0,
-        stamp: s.stamp,
-        gyro: [f(13), f(14), f(15)],
-        acc: [f(25), f(26), f(27)],
-    })
+    Ok(ImuSample::from_body(0, s.stamp, |i| {
+        f64_at(s.body, i, s.endian)
+    }))
 }
 
 /// Decodes a whole message (`seq` = 0).
 pub fn decode(data: &[u8]) -> Result<Imu, Error> {
     let s = split(data)?;
-    let d: Vec<f64> = (0..BODY_DOUBLES)
-        .map(|i| f64_at(s.body, i, s.endian))
-        .collect();
-    let mut imu = Imu {
-        seq: 0,
-        stamp: s.stamp,
-        frame_id: String::from_utf8_lossy(s.frame_id).into_owned(),
-        ..Imu::default()
-    };
-    imu.orientation.copy_from_slice(&d[0..4]);
-    imu.orientation_covariance.copy_from_slice(&d[4..13]);
-    imu.angular_velocity.copy_from_slice(&d[13..16]);
-    imu.angular_velocity_covariance.copy_from_slice(&d[16..25]);
-    imu.linear_acceleration.copy_from_slice(&d[25..28]);
-    imu.linear_acceleration_covariance
-        .copy_from_slice(&d[28..37]);
-    Ok(imu)
+    Ok(Imu::from_body(0, s.stamp, s.frame_id, |i| {
+        f64_at(s.body, i, s.endian)
+    }))
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub enum Error {
     /// An operating-system error on a path.
     // The cause is part of the message and deliberately not a `source`: anyhow's chained
     // output would print it twice.
-    #[error("{}: {}", .path.display(), crate::shared::output::describe(.cause))]
+    #[error("{}: {}", .path.display(), describe(.cause))]
     Io {
         /// The file.
         path: PathBuf,
@@ -233,5 +233,36 @@ impl Error {
             path: path.into(),
             cause,
         }
+    }
+}
+
+impl From<crate::imu_msg::BadMessage> for Error {
+    fn from(e: crate::imu_msg::BadMessage) -> Error {
+        Error::BadMessage { what: e.0 }
+    }
+}
+
+/// A plain description of an OS error: no "(os error N)", and the usual causes named the
+/// way a person reads them.
+pub fn describe(e: &std::io::Error) -> String {
+    use std::io::ErrorKind as K;
+    match e.kind() {
+        K::NotFound => "no such file or directory".into(),
+        K::PermissionDenied => "permission denied".into(),
+        K::AlreadyExists => "a file is in the way (it already exists)".into(),
+        K::IsADirectory => "it is a directory".into(),
+        K::NotADirectory => "a component of the path is not a directory".into(),
+        K::StorageFull => "no space left on the device".into(),
+        K::ReadOnlyFilesystem => "the file system is read-only".into(),
+        K::DirectoryNotEmpty => "a directory that is not empty is in the way".into(),
+        _ => without_errno(&e.to_string()),
+    }
+}
+
+/// An OS error's text without its "(os error N)".
+pub(crate) fn without_errno(s: &str) -> String {
+    match s.find(" (os error") {
+        Some(i) => s[..i].to_string(),
+        None => s.to_string(),
     }
 }

@@ -9,7 +9,7 @@
 use std::sync::LazyLock;
 
 use crate::bag::RosTime;
-use crate::error::Error;
+use crate::cursor::Cursor;
 
 /// The ROS type name.
 pub const TYPE: &str = "sensor_msgs/Imu";
@@ -94,8 +94,22 @@ impl Default for Imu {
     }
 }
 
-/// Serialized size of everything after `frame_id`: 4 + 9 + 3 + 9 + 3 + 9 doubles.
-const BODY_LEN: usize = 37 * 8;
+/// Doubles after `frame_id`, in the order ROS 1 and CDR both serialize them: orientation (4),
+/// its covariance (9), angular velocity (3), its covariance (9), linear acceleration (3), its
+/// covariance (9).
+pub(crate) const BODY_DOUBLES: usize = 37;
+/// Serialized size of everything after `frame_id`.
+const BODY_LEN: usize = BODY_DOUBLES * 8;
+/// Index of `angular_velocity.x` among the body doubles.
+const GYRO_AT: usize = 13;
+/// Index of `linear_acceleration.x` among the body doubles.
+const ACC_AT: usize = 25;
+
+/// A message whose bytes do not decode as `sensor_msgs/Imu`; the library reports it as
+/// [`crate::Error::BadMessage`] (this module stays below the error type).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct BadMessage(pub String);
 
 /// The part of a message the analysers need, decoded without allocating.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,37 +130,33 @@ impl Imu {
         16 + self.frame_id.len() + BODY_LEN
     }
 
-    /// Appends the ROS 1 serialization of `self` to `out`.
-    pub fn encode(&self, out: &mut Vec<u8>) {
-        out.reserve(self.encoded_len());
-        out.extend_from_slice(&self.seq.to_le_bytes());
-        out.extend_from_slice(&self.stamp.sec.to_le_bytes());
-        out.extend_from_slice(&self.stamp.nsec.to_le_bytes());
-        out.extend_from_slice(&(self.frame_id.len() as u32).to_le_bytes());
-        out.extend_from_slice(self.frame_id.as_bytes());
-        let doubles = self
-            .orientation
+    /// The [`BODY_DOUBLES`] body values in serialization order (ROS 1 and CDR alike).
+    pub(crate) fn body(&self) -> impl Iterator<Item = f64> + '_ {
+        self.orientation
             .iter()
             .chain(&self.orientation_covariance)
             .chain(&self.angular_velocity)
             .chain(&self.angular_velocity_covariance)
             .chain(&self.linear_acceleration)
-            .chain(&self.linear_acceleration_covariance);
-        for v in doubles {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
+            .chain(&self.linear_acceleration_covariance)
+            .copied()
     }
 
-    /// Decodes a whole message; errors if `data` is not exactly one Imu.
-    pub fn decode(data: &[u8]) -> Result<Imu, Error> {
-        let (head, frame_id, body) = split(data)?;
-        let mut d = [0.0f64; 37];
+    /// A message from its header fields and its body, `body(i)` being double `i` of
+    /// [`Imu::body`]'s order.
+    pub(crate) fn from_body(
+        seq: u32,
+        stamp: RosTime,
+        frame_id: &[u8],
+        body: impl Fn(usize) -> f64,
+    ) -> Imu {
+        let mut d = [0.0f64; BODY_DOUBLES];
         for (i, v) in d.iter_mut().enumerate() {
-            *v = f64_at(body, i);
+            *v = body(i);
         }
         let mut imu = Imu {
-            seq: head.0,
-            stamp: head.1,
+            seq,
+            stamp,
             frame_id: String::from_utf8_lossy(frame_id).into_owned(),
             ..Imu::default()
         };
@@ -157,54 +167,85 @@ impl Imu {
         imu.linear_acceleration.copy_from_slice(&d[25..28]);
         imu.linear_acceleration_covariance
             .copy_from_slice(&d[28..37]);
-        Ok(imu)
+        imu
+    }
+
+    /// Appends the ROS 1 serialization of `self` to `out`.
+    pub fn encode(&self, out: &mut Vec<u8>) {
+        out.reserve(self.encoded_len());
+        out.extend_from_slice(&self.seq.to_le_bytes());
+        out.extend_from_slice(&self.stamp.sec.to_le_bytes());
+        out.extend_from_slice(&self.stamp.nsec.to_le_bytes());
+        out.extend_from_slice(&(self.frame_id.len() as u32).to_le_bytes());
+        out.extend_from_slice(self.frame_id.as_bytes());
+        for v in self.body() {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+
+    /// Decodes a whole message; errors if `data` is not exactly one Imu.
+    pub fn decode(data: &[u8]) -> Result<Imu, BadMessage> {
+        let (head, frame_id, body) = split(data)?;
+        Ok(Imu::from_body(head.0, head.1, frame_id, |i| {
+            f64_at(body, i)
+        }))
     }
 }
 
 impl ImuSample {
-    /// Decodes seq, stamp, gyro and acc from a serialized Imu, skipping the rest.
-    pub(crate) fn decode(data: &[u8]) -> Result<ImuSample, Error> {
-        let ((seq, stamp), _, body) = split(data)?;
-        Ok(ImuSample {
+    /// Seq, stamp, gyro and acc, `body(i)` being double `i` of [`Imu::body`]'s order.
+    pub(crate) fn from_body(seq: u32, stamp: RosTime, body: impl Fn(usize) -> f64) -> ImuSample {
+        ImuSample {
             seq,
             stamp,
-            gyro: [f64_at(body, 13), f64_at(body, 14), f64_at(body, 15)],
-            acc: [f64_at(body, 25), f64_at(body, 26), f64_at(body, 27)],
-        })
+            gyro: [body(GYRO_AT), body(GYRO_AT + 1), body(GYRO_AT + 2)],
+            acc: [body(ACC_AT), body(ACC_AT + 1), body(ACC_AT + 2)],
+        }
+    }
+
+    /// Decodes seq, stamp, gyro and acc from a serialized Imu, skipping the rest.
+    pub(crate) fn decode(data: &[u8]) -> Result<ImuSample, BadMessage> {
+        let ((seq, stamp), _, body) = split(data)?;
+        Ok(ImuSample::from_body(seq, stamp, |i| f64_at(body, i)))
     }
 }
 
 type Head = (u32, RosTime);
 
 /// Splits a serialized Imu into (seq, stamp), frame_id bytes and the fixed body.
-fn split(data: &[u8]) -> Result<(Head, &[u8], &[u8]), Error> {
-    let bad = |what: String| Error::BadMessage { what };
-    if data.len() < 16 {
-        return Err(bad(format!(
+fn split(data: &[u8]) -> Result<(Head, &[u8], &[u8]), BadMessage> {
+    let mut c = Cursor::new(data);
+    let head = (|| {
+        Ok::<_, crate::cursor::CursorError>((
+            c.le::<u32>("seq")?,
+            c.le::<u32>("sec")?,
+            c.le::<u32>("nsec")?,
+            c.le::<u32>("frame_id length")?,
+        ))
+    })();
+    let Ok((seq, sec, nsec, id_len)) = head else {
+        return Err(BadMessage(format!(
             "Imu message of {} bytes is shorter than its header",
             data.len()
         )));
-    }
-    let u32_at = |o: usize| u32::from_le_bytes([data[o], data[o + 1], data[o + 2], data[o + 3]]);
-    let seq = u32_at(0);
-    let stamp = RosTime {
-        sec: u32_at(4),
-        nsec: u32_at(8),
     };
-    let id_len = u32_at(12) as usize;
+    let id_len = id_len as usize;
     let expected = 16usize
         .checked_add(id_len)
         .and_then(|n| n.checked_add(BODY_LEN));
     if expected != Some(data.len()) {
-        return Err(bad(format!(
+        return Err(BadMessage(format!(
             "Imu message of {} bytes does not match its frame_id length {id_len} (expected {} bytes)",
             data.len(),
             16u64 + id_len as u64 + BODY_LEN as u64
         )));
     }
-    Ok(((seq, stamp), &data[16..16 + id_len], &data[16 + id_len..]))
+    let rest = c.rest();
+    let stamp = RosTime { sec, nsec };
+    Ok(((seq, stamp), &rest[..id_len], &rest[id_len..]))
 }
 
+/// Body double `i` (the body is [`BODY_LEN`] bytes: checked by [`split`]).
 fn f64_at(body: &[u8], i: usize) -> f64 {
     let mut b = [0u8; 8];
     b.copy_from_slice(&body[8 * i..8 * i + 8]);

@@ -260,7 +260,7 @@ pub(crate) fn is_imu(c: &Channel) -> bool {
 
 fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
-        Codec::Ros1 => ImuSample::decode(data),
+        Codec::Ros1 => ImuSample::decode(data).map_err(Error::from),
         Codec::Cdr => crate::cdr::decode_sample(data),
         Codec::Row => crate::decoded::Row::decode(data),
     }
@@ -347,79 +347,12 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         why.extend(src.losses().iter().map(|l| l.to_string()));
         return Err(Error::NoTopics { why });
     }
-    let on = |t: &str| chans.iter().filter(|c| c.topic == t).collect::<Vec<_>>();
+    let on = |t: &str| channels_on(chans, t);
     let mut out: Vec<Selected> = Vec::new();
-    let push = |out: &mut Vec<Selected>, topic: String, cs: Vec<&Channel>, note, named: bool| {
-        if out.iter().any(|s| s.topic == topic) {
-            return Ok(());
-        }
-        let mut channels = Vec::new();
-        let mut others: Vec<&Channel> = Vec::new();
-        for c in &cs {
-            match imu_codec(c) {
-                Some(k) => channels.push((c.id, k)),
-                None => others.push(c),
-            }
-        }
-        let Some(first_other) = others.first() else {
-            out.push(Selected {
-                topic,
-                msg_type: cs[0].msg_type.clone(),
-                channels,
-                note,
-                named,
-            });
-            return Ok(());
-        };
-        if channels.is_empty() {
-            return Err(Error::WrongType {
-                topic: topic.clone(),
-                msg_type: first_other.msg_type.clone(),
-                md5sum: first_other
-                    .md5sum
-                    .clone()
-                    .unwrap_or_else(|| format!("encoding {}", first_other.encoding.name())),
-            });
-        }
-        // Imu plus another type on one topic: the Imu connection is converted, as
-        // bagconvert's rosbag::View + instantiate<sensor_msgs::Imu>() skips the others.
-        let other_types: Vec<String> = others
-            .iter()
-            .map(|c| {
-                format!(
-                    "{} ({} messages)",
-                    crate::shared::cli::escape(&c.msg_type),
-                    c.count.map_or("?".to_string(), |n| n.to_string())
-                )
-            })
-            .collect();
-        let mixed = format!(
-            "topic '{}' also carries {}; only its sensor_msgs/Imu connection is converted, as bagconvert does",
-            crate::shared::cli::escape(&topic),
-            other_types.join(", ")
-        );
-        let note = Some(match note {
-            Some(n) => format!("{n}; {mixed}"),
-            None => mixed,
-        });
-        let msg_type = cs
-            .iter()
-            .find(|c| is_imu(c))
-            .map(|c| c.msg_type.clone())
-            .unwrap_or_default();
-        out.push(Selected {
-            topic,
-            msg_type,
-            channels,
-            note,
-            named,
-        });
-        Ok(())
-    };
     for t in &sel.topics {
         let cs = on(t);
         if !cs.is_empty() {
-            push(&mut out, t.clone(), cs, None, true)?;
+            push_selected(&mut out, t.clone(), cs, None, true)?;
             continue;
         }
         let other = other_slash_form(t);
@@ -435,42 +368,17 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
             crate::shared::cli::escape(t),
             crate::shared::cli::escape(&other)
         );
-        push(&mut out, other, cs, Some(note), true)?;
+        push_selected(&mut out, other, cs, Some(note), true)?;
     }
     if sel.topics.is_empty() && !sel.all_imu {
-        if let Some(p) = &sel.preferred {
-            let other = other_slash_form(p);
-            if let Some(t) = [p, &other].into_iter().find(|t| !on(t).is_empty()) {
-                push(&mut out, t.clone(), on(t), None, true)?;
-                return Ok(out);
-            }
-        }
-        return match imu_topics(chans)[..] {
-            [] => Err(Error::NoImuTopic {
-                available: topic_summaries(src),
-            }),
-            [t] => {
-                let missing = match &sel.preferred {
-                    Some(p) => format!(" and no '{}'", crate::shared::cli::escape(p)),
-                    None => String::new(),
-                };
-                let note = format!(
-                    "no topic named{missing}: reading '{}', the only sensor_msgs/Imu topic",
-                    crate::shared::cli::escape(t)
-                );
-                push(&mut out, t.to_string(), on(t), Some(note), true)?;
-                Ok(out)
-            }
-            _ => Err(Error::SeveralImuTopics {
-                available: topic_summaries(src),
-            }),
-        };
+        select_default(src, sel, &mut out)?;
+        return Ok(out);
     }
     if sel.all_imu {
         let before = out.len();
         for t in imu_topics(chans) {
             // A topic that mixes Imu with another type gives its Imu connection (with a note).
-            push(&mut out, t.to_string(), on(t), None, false)?;
+            push_selected(&mut out, t.to_string(), on(t), None, false)?;
         }
         if out.is_empty() && before == 0 {
             return Err(Error::NoImuTopic {
@@ -479,6 +387,122 @@ fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Selected>, Error>
         }
     }
     Ok(out)
+}
+
+/// The channels recorded on `topic`.
+fn channels_on<'a>(chans: &'a [Channel], topic: &str) -> Vec<&'a Channel> {
+    chans.iter().filter(|c| c.topic == topic).collect()
+}
+
+/// No topic named: the preferred one (in either slash form), else the only Imu topic.
+fn select_default(
+    src: &dyn Source,
+    sel: &TopicSelector,
+    out: &mut Vec<Selected>,
+) -> Result<(), Error> {
+    let chans = src.channels();
+    let on = |t: &str| channels_on(chans, t);
+    if let Some(p) = &sel.preferred {
+        let other = other_slash_form(p);
+        if let Some(t) = [p, &other].into_iter().find(|t| !on(t).is_empty()) {
+            return push_selected(out, t.clone(), on(t), None, true);
+        }
+    }
+    match imu_topics(chans)[..] {
+        [] => Err(Error::NoImuTopic {
+            available: topic_summaries(src),
+        }),
+        [t] => {
+            let missing = match &sel.preferred {
+                Some(p) => format!(" and no '{}'", crate::shared::cli::escape(p)),
+                None => String::new(),
+            };
+            let note = format!(
+                "no topic named{missing}: reading '{}', the only sensor_msgs/Imu topic",
+                crate::shared::cli::escape(t)
+            );
+            push_selected(out, t.to_string(), on(t), Some(note), true)
+        }
+        _ => Err(Error::SeveralImuTopics {
+            available: topic_summaries(src),
+        }),
+    }
+}
+
+/// Adds `topic` (its channels `cs`) to the selection, once: its Imu channels, with a note
+/// when it also carries another type; an error when it carries no Imu at all.
+fn push_selected(
+    out: &mut Vec<Selected>,
+    topic: String,
+    cs: Vec<&Channel>,
+    note: Option<String>,
+    named: bool,
+) -> Result<(), Error> {
+    if out.iter().any(|s| s.topic == topic) {
+        return Ok(());
+    }
+    let mut channels = Vec::new();
+    let mut others: Vec<&Channel> = Vec::new();
+    for c in &cs {
+        match imu_codec(c) {
+            Some(k) => channels.push((c.id, k)),
+            None => others.push(c),
+        }
+    }
+    let Some(first_other) = others.first() else {
+        out.push(Selected {
+            topic,
+            msg_type: cs[0].msg_type.clone(),
+            channels,
+            note,
+            named,
+        });
+        return Ok(());
+    };
+    if channels.is_empty() {
+        return Err(Error::WrongType {
+            topic: topic.clone(),
+            msg_type: first_other.msg_type.clone(),
+            md5sum: first_other
+                .md5sum
+                .clone()
+                .unwrap_or_else(|| format!("encoding {}", first_other.encoding.name())),
+        });
+    }
+    // Imu plus another type on one topic: the Imu connection is converted, as
+    // bagconvert's rosbag::View + instantiate<sensor_msgs::Imu>() skips the others.
+    let other_types: Vec<String> = others
+        .iter()
+        .map(|c| {
+            format!(
+                "{} ({} messages)",
+                crate::shared::cli::escape(&c.msg_type),
+                c.count.map_or("?".to_string(), |n| n.to_string())
+            )
+        })
+        .collect();
+    let mixed = format!(
+        "topic '{}' also carries {}; only its sensor_msgs/Imu connection is converted, as bagconvert does",
+        crate::shared::cli::escape(&topic),
+        other_types.join(", ")
+    );
+    let note = Some(match note {
+        Some(n) => format!("{n}; {mixed}"),
+        None => mixed,
+    });
+    let msg_type = cs
+        .iter()
+        .find(|c| is_imu(c))
+        .map(|c| c.msg_type.clone())
+        .unwrap_or_default();
+    out.push(Selected {
+        topic,
+        msg_type,
+        channels,
+        note,
+        named,
+    });
+    Ok(())
 }
 
 /// The smallest payload a decodable `sensor_msgs/Imu` has (ROS 1: 16 header bytes and 37
@@ -946,255 +970,19 @@ fn read_source(
     take: bool,
 ) -> Result<ImuRead, Error> {
     let selected = select(src, sel)?;
-    // Channel id → (selected topic, codec); a dense table for the usual small ids.
-    let max_id = src.channels().iter().map(|c| c.id).max().unwrap_or(0) as usize;
-    let mut lookup: Lookup = vec![None; max_id + 1];
-    for (k, s) in selected.iter().enumerate() {
-        for &(id, codec) in &s.channels {
-            lookup[id as usize] = Some((k, codec));
-        }
-    }
-    let promised_of = |ids: &[(u32, Codec)]| -> Option<u64> {
-        ids.iter()
-            .map(|(id, _)| src.channels().iter().find(|c| c.id == *id)?.count)
-            .sum()
-    };
-    let promised: Vec<Option<u64>> = selected.iter().map(|s| promised_of(&s.channels)).collect();
-    let parts = src.parts();
-    let (bar_len, per_part_unit) = match promised.iter().copied().sum::<Option<u64>>() {
-        Some(n) => (n, false),
-        None => (parts.len() as u64, true),
-    };
-    let pb = crate::shared::progress::bar(
-        bar_len.max(1),
-        opts.quiet,
-        if per_part_unit { "parts" } else { "msgs" },
-    );
-    pb.set_message("reading");
-    // A topic of one channel of rows its reader decoded whole is taken as it is; the parts
-    // then deliver only the other topics.
-    let taken: Vec<Option<Rows>> = selected
+    let mut lookup = channel_lookup(src, &selected);
+    let promised: Vec<Option<u64>> = selected
         .iter()
-        .map(|s| match s.channels[..] {
-            [(id, Codec::Row)] if take => src.take_rows(id),
-            _ => None,
-        })
+        .map(|s| promised_of(src, &s.channels))
         .collect();
-    for (s, t) in selected.iter().zip(&taken) {
-        if t.is_some() {
-            s.channels
-                .iter()
-                .for_each(|(id, _)| lookup[*id as usize] = None);
-            pb.inc(t.as_ref().map_or(0, |r| r.len() as u64));
-        }
-    }
-    let (mut columns, mut outs) = decode_all(src, &lookup, &selected, &pb, per_part_unit);
-    for (k, (s, t)) in selected.iter().zip(taken).enumerate() {
-        let Some(rows) = t else { continue };
-        // what each part holds of the topic, as if its parts had delivered them
-        for (o, p) in outs.iter_mut().zip(parts) {
-            let n: u64 = p
-                .counts
-                .iter()
-                .flatten()
-                .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
-                .map(|(_, n)| *n)
-                .sum();
-            o.rows[k] = n;
-            o.read.delivered += n;
-        }
-        columns[k] = rows;
-    }
-    pb.finish_and_clear();
+    let (columns, outs) = read_columns(src, &selected, &mut lookup, &promised, opts, take);
     let after = src.losses_after_read();
 
     let n_sel = selected.len();
     let mut series = Vec::with_capacity(n_sel);
     let mut dropped: Vec<String> = Vec::new();
-    for ((k, s), mut rows) in selected.into_iter().enumerate().zip(columns) {
-        let storage_order = rows.sort_by_record_time();
-        let sorted = storage_order.is_some();
-        let Rows {
-            record_time,
-            stamp,
-            seq,
-            acc,
-            gyro,
-        } = rows;
-        let mut out = ImuSeries {
-            topic: s.topic.clone(),
-            msg_type: s.msg_type.clone(),
-            record_time,
-            stamp,
-            seq,
-            acc,
-            gyro,
-            storage_order,
-            ..ImuSeries::default()
-        };
-        let r = &mut out.report;
-        r.promised = promised[k];
-        r.delivered = out.record_time.len() as u64;
-        for o in &outs {
-            r.undecodable += o.bad[k];
-            if r.first_error.is_none() {
-                r.first_error = o.first_bad[k].clone();
-            }
-        }
-        let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
-        // A loss on no particular channel is this topic's when the source has no other.
-        let only_topic = src.channels().iter().all(|c| mine_ch(&c.id));
-        // Messages lost on this topic (counted), of unknown topic (could be this one's), and
-        // whether some loss has no count at all.
-        let mut exact = 0u64;
-        let mut unknown_topic = 0u64;
-        let mut uncounted = false;
-        let mut count = |l: &Loss, mine: bool| match (l.messages, l.at_most) {
-            (Some(n), _) if mine || only_topic => exact = exact.saturating_add(n),
-            (Some(n), _) => unknown_topic = unknown_topic.saturating_add(n),
-            (None, Some(n)) => unknown_topic = unknown_topic.saturating_add(n),
-            (None, None) => uncounted = true,
-        };
-        for (i, o) in outs.iter().enumerate() {
-            let p = &parts[i];
-            let mine: Option<u64> = p.counts.as_ref().map(|v| {
-                v.iter()
-                    .filter(|(c, _)| mine_ch(c))
-                    .map(|(_, n)| *n)
-                    .fold(0u64, |a, b| a.saturating_add(b))
-            });
-            let got = o.rows[k] + o.bad[k];
-            // What the part itself found lost on this topic (or on no particular channel).
-            let mut known = 0u64;
-            for l in &o.read.lost {
-                match l.channel {
-                    Some(c) if mine_ch(&c) => {
-                        known += l.messages.unwrap_or(0);
-                        count(l, true);
-                        r.losses.push(l.clone());
-                    }
-                    None if mine != Some(0) => {
-                        count(l, false);
-                        r.losses.push(l.clone());
-                    }
-                    _ => {}
-                }
-            }
-            let reason = match (&o.read.error, o.read.skipped) {
-                (Some(e), _) => Some(e.clone()),
-                (None, n) if n > 0 => o.read.skip_reason.clone(),
-                _ => None,
-            };
-            let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
-            let l = if let Some(reason) = reason {
-                if mine == Some(0) {
-                    continue;
-                }
-                Loss {
-                    what: format!("{}: {reason}", p.label),
-                    messages: rest,
-                    span: p.span,
-                    ..Loss::default()
-                }
-            } else if rest.is_some_and(|n| n > 0) {
-                Loss {
-                    what: format!(
-                        "{} holds {got} messages of '{}', its index says {}",
-                        p.label,
-                        s.topic,
-                        mine.unwrap_or(0)
-                    ),
-                    messages: rest,
-                    span: p.span,
-                    ..Loss::default()
-                }
-            } else {
-                continue;
-            };
-            // Counted from this topic's own promise for the part.
-            count(&l, true);
-            r.losses.push(l);
-        }
-        let container: Vec<&Loss> = src
-            .losses()
-            .iter()
-            .chain(after.iter())
-            .filter(|l| l.channel.is_none_or(|c| mine_ch(&c)))
-            .collect();
-        for l in &container {
-            count(l, l.channel.is_some());
-        }
-        let mut notes: Vec<String> = src.notes().to_vec();
-        for o in &outs {
-            notes.extend(o.read.notes.iter().cloned());
-        }
-        notes.extend(
-            src.losses()
-                .iter()
-                .chain(after.iter())
-                .map(|l| l.to_string()),
-        );
-        notes.extend(s.note.iter().cloned());
-        notes.extend(r.losses.iter().map(|l| l.to_string()));
-        // Whatever the parts said, the container's own promise is checked as a whole.
-        let missing = match r.promised {
-            Some(p) => p.saturating_sub(r.delivered + r.undecodable).max(exact),
-            None => exact,
-        };
-        // Without a promise, losses of unknown topic may be this topic's: said as a bound.
-        // With a promise, what it finds missing beyond the counted losses may be those of
-        // unknown topic; the rest of them are said as a bound.
-        let (more, uncounted) = match r.promised {
-            Some(_) => (
-                unknown_topic.saturating_sub(missing.saturating_sub(exact)),
-                false,
-            ),
-            None => (unknown_topic, uncounted),
-        };
-        let see = if r.losses.is_empty() && container.is_empty() {
-            " (the container promises them; none of its parts could say where)"
-        } else {
-            " (see above)"
-        };
-        let tail = if uncounted {
-            ", and more that the damaged data does not count (see above)"
-        } else {
-            see
-        };
-        if missing > 0 {
-            notes.push(format!(
-                "{missing} of {} messages on '{}' were lost{}{tail}",
-                r.promised.unwrap_or(r.delivered + missing),
-                s.topic,
-                if more > 0 {
-                    format!(", and up to {more} more (messages of unknown topic were lost)")
-                } else {
-                    String::new()
-                }
-            ));
-        } else if more > 0 {
-            notes.push(format!(
-                "up to {more} messages on '{}' were lost (messages of unknown topic were lost){tail}",
-                s.topic
-            ));
-        } else if uncounted {
-            notes.push(format!(
-                "messages on '{}' may have been lost: the damaged data does not count them (see above)",
-                s.topic
-            ));
-        }
-        if r.undecodable > 0 {
-            notes.push(format!(
-                "{} messages on '{}' do not decode as sensor_msgs/Imu and were skipped (first: {})",
-                r.undecodable,
-                s.topic,
-                r.first_error.as_deref().unwrap_or("?")
-            ));
-        }
-        if sorted {
-            notes.push(SORTED_NOTE.to_string());
-        }
-        out.notes = notes;
+    for ((k, s), rows) in selected.into_iter().enumerate().zip(columns) {
+        let out = topic_series(src, &s, k, rows, promised[k], &outs, &after);
         if out.is_empty() {
             // Nothing to convert is an error for a topic the user named; an Imu topic that
             // --all-imu-topics found empty is left out, and said so.
@@ -1215,6 +1003,334 @@ fn read_source(
     for s in series.iter_mut() {
         s.notes.extend(dropped.iter().cloned());
     }
+    Ok(ImuRead {
+        kind: src.kind(),
+        series,
+        skipped_topics: skipped_topics(src, &lookup),
+        losses: src.losses().iter().chain(after.iter()).cloned().collect(),
+    })
+}
+
+/// Channel id → (selected topic, codec); a dense table for the usual small ids.
+fn channel_lookup(src: &dyn Source, selected: &[Selected]) -> Lookup {
+    let max_id = src.channels().iter().map(|c| c.id).max().unwrap_or(0) as usize;
+    let mut lookup: Lookup = vec![None; max_id + 1];
+    for (k, s) in selected.iter().enumerate() {
+        for &(id, codec) in &s.channels {
+            lookup[id as usize] = Some((k, codec));
+        }
+    }
+    lookup
+}
+
+/// The messages the container promises on these channels, if it counts them all.
+fn promised_of(src: &dyn Source, ids: &[(u32, Codec)]) -> Option<u64> {
+    ids.iter()
+        .map(|(id, _)| src.channels().iter().find(|c| c.id == *id)?.count)
+        .sum()
+}
+
+/// Reads the parts once, with a progress bar: the selected topics' rows and what each part
+/// delivered. A topic of one channel of rows its reader decoded whole is taken as it is
+/// (`take`); the parts then deliver only the other topics (its channels leave `lookup`).
+fn read_columns(
+    src: &dyn Source,
+    selected: &[Selected],
+    lookup: &mut Lookup,
+    promised: &[Option<u64>],
+    opts: &ReadOptions,
+    take: bool,
+) -> (Vec<Rows>, Vec<PartOut>) {
+    let parts = src.parts();
+    let (bar_len, per_part_unit) = match promised.iter().copied().sum::<Option<u64>>() {
+        Some(n) => (n, false),
+        None => (parts.len() as u64, true),
+    };
+    let pb = crate::shared::progress::bar(
+        bar_len.max(1),
+        opts.quiet,
+        if per_part_unit { "parts" } else { "msgs" },
+    );
+    pb.set_message("reading");
+    let taken: Vec<Option<Rows>> = selected
+        .iter()
+        .map(|s| match s.channels[..] {
+            [(id, Codec::Row)] if take => src.take_rows(id),
+            _ => None,
+        })
+        .collect();
+    for (s, t) in selected.iter().zip(&taken) {
+        if t.is_some() {
+            s.channels
+                .iter()
+                .for_each(|(id, _)| lookup[*id as usize] = None);
+            pb.inc(t.as_ref().map_or(0, |r| r.len() as u64));
+        }
+    }
+    let (mut columns, mut outs) = decode_all(src, lookup, selected, &pb, per_part_unit);
+    for (k, (s, t)) in selected.iter().zip(taken).enumerate() {
+        let Some(rows) = t else { continue };
+        // what each part holds of the topic, as if its parts had delivered them
+        for (o, p) in outs.iter_mut().zip(parts) {
+            let n: u64 = p
+                .counts
+                .iter()
+                .flatten()
+                .filter(|(c, _)| s.channels.iter().any(|(id, _)| id == c))
+                .map(|(_, n)| *n)
+                .sum();
+            o.rows[k] = n;
+            o.read.delivered += n;
+        }
+        columns[k] = rows;
+    }
+    pb.finish_and_clear();
+    (columns, outs)
+}
+
+/// Messages lost on one topic, as the losses found count them.
+#[derive(Default)]
+struct LossTally {
+    /// Counted on this topic.
+    exact: u64,
+    /// Of unknown topic (could be this one's), counted or bounded.
+    unknown_topic: u64,
+    /// Some loss has no count at all.
+    uncounted: bool,
+    /// A loss on no particular channel is this topic's: the source has no other.
+    only_topic: bool,
+}
+
+impl LossTally {
+    fn count(&mut self, l: &Loss, mine: bool) {
+        match (l.messages, l.at_most) {
+            (Some(n), _) if mine || self.only_topic => self.exact = self.exact.saturating_add(n),
+            (Some(n), _) => self.unknown_topic = self.unknown_topic.saturating_add(n),
+            (None, Some(n)) => self.unknown_topic = self.unknown_topic.saturating_add(n),
+            (None, None) => self.uncounted = true,
+        }
+    }
+}
+
+/// Topic `k`'s series from its rows: its report (promised, delivered, undecodable, the
+/// losses of its parts and of the container) and its notes.
+fn topic_series(
+    src: &dyn Source,
+    s: &Selected,
+    k: usize,
+    mut rows: Rows,
+    promised: Option<u64>,
+    outs: &[PartOut],
+    after: &[Loss],
+) -> ImuSeries {
+    let storage_order = rows.sort_by_record_time();
+    let sorted = storage_order.is_some();
+    let Rows {
+        record_time,
+        stamp,
+        seq,
+        acc,
+        gyro,
+    } = rows;
+    let mut out = ImuSeries {
+        topic: s.topic.clone(),
+        msg_type: s.msg_type.clone(),
+        record_time,
+        stamp,
+        seq,
+        acc,
+        gyro,
+        storage_order,
+        ..ImuSeries::default()
+    };
+    let r = &mut out.report;
+    r.promised = promised;
+    r.delivered = out.record_time.len() as u64;
+    for o in outs {
+        r.undecodable += o.bad[k];
+        if r.first_error.is_none() {
+            r.first_error = o.first_bad[k].clone();
+        }
+    }
+    let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
+    let mut tally = LossTally {
+        only_topic: src.channels().iter().all(|c| mine_ch(&c.id)),
+        ..LossTally::default()
+    };
+    part_losses(src.parts(), outs, k, s, r, &mut tally);
+    let container: Vec<&Loss> = src
+        .losses()
+        .iter()
+        .chain(after.iter())
+        .filter(|l| l.channel.is_none_or(|c| mine_ch(&c)))
+        .collect();
+    for l in &container {
+        tally.count(l, l.channel.is_some());
+    }
+    let mut notes: Vec<String> = src.notes().to_vec();
+    for o in outs {
+        notes.extend(o.read.notes.iter().cloned());
+    }
+    notes.extend(
+        src.losses()
+            .iter()
+            .chain(after.iter())
+            .map(|l| l.to_string()),
+    );
+    notes.extend(s.note.iter().cloned());
+    notes.extend(r.losses.iter().map(|l| l.to_string()));
+    loss_notes(&mut notes, r, &s.topic, &tally, container.is_empty());
+    if sorted {
+        notes.push(SORTED_NOTE.to_string());
+    }
+    out.notes = notes;
+    out
+}
+
+/// The losses of topic `k` (selected as `s`) the parts found, or that their counts show,
+/// into its report and tally.
+fn part_losses(
+    parts: &[source::Part],
+    outs: &[PartOut],
+    k: usize,
+    s: &Selected,
+    r: &mut TopicReport,
+    tally: &mut LossTally,
+) {
+    let mine_ch = |c: &u32| s.channels.iter().any(|(id, _)| id == c);
+    for (i, o) in outs.iter().enumerate() {
+        let p = &parts[i];
+        let mine: Option<u64> = p.counts.as_ref().map(|v| {
+            v.iter()
+                .filter(|(c, _)| mine_ch(c))
+                .map(|(_, n)| *n)
+                .fold(0u64, |a, b| a.saturating_add(b))
+        });
+        let got = o.rows[k] + o.bad[k];
+        // What the part itself found lost on this topic (or on no particular channel).
+        let mut known = 0u64;
+        for l in &o.read.lost {
+            match l.channel {
+                Some(c) if mine_ch(&c) => {
+                    known += l.messages.unwrap_or(0);
+                    tally.count(l, true);
+                    r.losses.push(l.clone());
+                }
+                None if mine != Some(0) => {
+                    tally.count(l, false);
+                    r.losses.push(l.clone());
+                }
+                _ => {}
+            }
+        }
+        let reason = match (&o.read.error, o.read.skipped) {
+            (Some(e), _) => Some(e.clone()),
+            (None, n) if n > 0 => o.read.skip_reason.clone(),
+            _ => None,
+        };
+        let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
+        let l = if let Some(reason) = reason {
+            if mine == Some(0) {
+                continue;
+            }
+            Loss {
+                what: format!("{}: {reason}", p.label),
+                messages: rest,
+                span: p.span,
+                ..Loss::default()
+            }
+        } else if rest.is_some_and(|n| n > 0) {
+            Loss {
+                what: format!(
+                    "{} holds {got} messages of '{}', its index says {}",
+                    p.label,
+                    s.topic,
+                    mine.unwrap_or(0)
+                ),
+                messages: rest,
+                span: p.span,
+                ..Loss::default()
+            }
+        } else {
+            continue;
+        };
+        // Counted from this topic's own promise for the part.
+        tally.count(&l, true);
+        r.losses.push(l);
+    }
+}
+
+/// The notes that say how many messages of `topic` were lost, or may have been, and how
+/// many did not decode. `no_container_loss`: the container itself reported none.
+fn loss_notes(
+    notes: &mut Vec<String>,
+    r: &TopicReport,
+    topic: &str,
+    tally: &LossTally,
+    no_container_loss: bool,
+) {
+    let exact = tally.exact;
+    // Whatever the parts said, the container's own promise is checked as a whole.
+    let missing = match r.promised {
+        Some(p) => p.saturating_sub(r.delivered + r.undecodable).max(exact),
+        None => exact,
+    };
+    // Without a promise, losses of unknown topic may be this topic's: said as a bound.
+    // With a promise, what it finds missing beyond the counted losses may be those of
+    // unknown topic; the rest of them are said as a bound.
+    let (more, uncounted) = match r.promised {
+        Some(_) => (
+            tally
+                .unknown_topic
+                .saturating_sub(missing.saturating_sub(exact)),
+            false,
+        ),
+        None => (tally.unknown_topic, tally.uncounted),
+    };
+    let see = if r.losses.is_empty() && no_container_loss {
+        " (the container promises them; none of its parts could say where)"
+    } else {
+        " (see above)"
+    };
+    let tail = if uncounted {
+        ", and more that the damaged data does not count (see above)"
+    } else {
+        see
+    };
+    if missing > 0 {
+        notes.push(format!(
+            "{missing} of {} messages on '{}' were lost{}{tail}",
+            r.promised.unwrap_or(r.delivered + missing),
+            topic,
+            if more > 0 {
+                format!(", and up to {more} more (messages of unknown topic were lost)")
+            } else {
+                String::new()
+            }
+        ));
+    } else if more > 0 {
+        notes.push(format!(
+            "up to {more} messages on '{}' were lost (messages of unknown topic were lost){tail}",
+            topic
+        ));
+    } else if uncounted {
+        notes.push(format!(
+            "messages on '{}' may have been lost: the damaged data does not count them (see above)",
+            topic
+        ));
+    }
+    if r.undecodable > 0 {
+        notes.push(format!(
+            "{} messages on '{}' do not decode as sensor_msgs/Imu and were skipped (first: {})",
+            r.undecodable,
+            topic,
+            r.first_error.as_deref().unwrap_or("?")
+        ));
+    }
+}
+
+/// The topics not read, with their message counts, by topic and type.
+fn skipped_topics(src: &dyn Source, lookup: &Lookup) -> Vec<TopicSummary> {
     let read_ids: std::collections::BTreeSet<u32> = lookup
         .iter()
         .enumerate()
@@ -1227,19 +1343,14 @@ fn read_source(
             .entry((c.topic.clone(), c.msg_type.clone()))
             .or_default() += c.count.unwrap_or(0);
     }
-    Ok(ImuRead {
-        kind: src.kind(),
-        series,
-        skipped_topics: skipped
-            .into_iter()
-            .map(|((topic, msg_type), count)| TopicSummary {
-                topic,
-                msg_type,
-                count,
-            })
-            .collect(),
-        losses: src.losses().iter().chain(after.iter()).cloned().collect(),
-    })
+    skipped
+        .into_iter()
+        .map(|((topic, msg_type), count)| TopicSummary {
+            topic,
+            msg_type,
+            count,
+        })
+        .collect()
 }
 
 const SORTED_NOTE: &str =

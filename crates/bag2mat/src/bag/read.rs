@@ -21,7 +21,10 @@ use std::io::Read;
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-use super::record::{self, ChunkInfo, Connection, Header, MAGIC, Op};
+use super::record::{
+    self, BagHeader, ChunkHeader, ChunkInfo, Connection, Header, INDEX_ENTRY_LEN, IndexData, MAGIC,
+    Op, RecordError,
+};
 use super::{Compression, RosTime};
 use crate::error::{Error, TopicSummary};
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
@@ -143,15 +146,12 @@ impl BagReader {
         let header = record::raw_record(&head, MAGIC.len())
             .ok_or_else(|| "the bag header record is incomplete".to_string())
             .and_then(|rec| {
-                let h = Header::parse(rec.header)?;
-                if h.op()? != Op::BagHeader {
-                    return Err("the first record is not the bag header".into());
-                }
-                Ok((
-                    h.u64("index_pos").unwrap_or(0),
-                    h.u32("chunk_count").ok(),
-                    rec.end as u64,
-                ))
+                let h = Header::parse(rec.header).map_err(|e| e.to_string())?;
+                let b = BagHeader::decode(&h).map_err(|e| match e {
+                    RecordError::Unexpected(_) => "the first record is not the bag header".into(),
+                    e => e.to_string(),
+                })?;
+                Ok((b.index_pos.unwrap_or(0), b.chunk_count, rec.end as u64))
             });
         let mut header_damage = None;
         let (index_pos, chunk_count, first) = match header {
@@ -312,7 +312,7 @@ impl BagReader {
             let decoded = Header::parse(&hb).and_then(|h| match h.op()? {
                 Op::Connection => Connection::decode(&h, &data).map(|c| connections.push(c)),
                 Op::ChunkInfo => ChunkInfo::decode(&h, &data).map(|i| infos.push(i)),
-                other => Err(format!("unexpected {other:?} record")),
+                other => Err(RecordError::Unexpected(other)),
             });
             if let Err(e) = decoded {
                 damaged += 1;
@@ -365,34 +365,32 @@ impl BagReader {
             let h = match Header::parse(&hb) {
                 Ok(h) => h,
                 Err(e) => {
-                    self.damaged_at(pos, end, &e, info_positions, &mut pos);
+                    self.damaged_at(pos, end, &e.to_string(), info_positions, &mut pos);
                     continue;
                 }
             };
             match h.op() {
                 Ok(Op::Chunk) => {
-                    let compression = h.str("compression").ok().and_then(Compression::from_name);
-                    let size = h.u32("size").ok();
-                    if compression.is_none() || size.is_none() {
+                    let Ok(chunk) = ChunkHeader::decode(&h) else {
                         self.damaged_at(pos, end, "damaged chunk header", info_positions, &mut pos);
                         continue;
-                    }
+                    };
                     w.chunks.push(ChunkLoc {
                         pos,
                         stored: Some(dlen as u64),
-                        size: size.map(|s| s as u64),
+                        size: Some(chunk.size as u64),
                         index_data: BTreeMap::new(),
                         info_counts: None,
                         span: None,
                     });
                 }
                 Ok(Op::IndexData) => {
-                    if let (Some(c), Ok(conn)) = (w.chunks.last_mut(), h.u32("conn")) {
+                    if let (Some(c), Ok(ix)) = (w.chunks.last_mut(), IndexData::decode(&h)) {
                         // The entries the file holds, whatever the count field says.
-                        let count =
-                            (h.u32("count").unwrap_or(u32::MAX) as u64).min(dlen as u64 / 12);
+                        let count = (ix.count.unwrap_or(u32::MAX) as u64)
+                            .min(dlen as u64 / INDEX_ENTRY_LEN as u64);
                         c.index_data
-                            .entry(conn)
+                            .entry(ix.conn)
                             .or_insert(ChunkIndexData { count, data_pos });
                     }
                 }
@@ -465,12 +463,7 @@ impl BagReader {
                     if let Some((hb, data_pos, dlen)) = self.record_at(p, end)
                         && data_pos > q
                         && let Ok(h) = Header::parse(&hb)
-                        && h.op() == Ok(Op::Chunk)
-                        && h.str("compression")
-                            .ok()
-                            .and_then(Compression::from_name)
-                            .is_some()
-                        && h.u32("size").is_ok()
+                        && ChunkHeader::decode(&h).is_ok()
                         && data_pos + dlen as u64 <= end
                     {
                         return Some(p);
@@ -734,14 +727,13 @@ impl BagReader {
         raw: &mut Vec<u8>,
         body: &mut Vec<u8>,
     ) -> Result<Compression, String> {
-        let h = Header::parse(h_bytes)?;
-        if h.op()? != Op::Chunk {
+        let h = Header::parse(h_bytes).map_err(|e| e.to_string())?;
+        if h.op().map_err(|e| e.to_string())? != Op::Chunk {
             return Err("not a chunk record".into());
         }
-        let name = h.str("compression")?;
-        let compression = Compression::from_name(name)
-            .ok_or_else(|| format!("unknown chunk compression '{name}'"))?;
-        let size = h.u32("size")? as usize;
+        let ChunkHeader { compression, size } =
+            ChunkHeader::decode(&h).map_err(|e| e.to_string())?;
+        let size = size as usize;
         raw.resize(dlen as usize, 0);
         self.file
             .read_exact_at(raw, data_pos)

@@ -2,9 +2,92 @@
 //!
 //! Every record is `u32 header_len | header | u32 data_len | data`; a header is a list of
 //! `u32 len | name=value` fields. Each record type has its op code and its fields here, so
-//! the byte layout is written down once (rust_stack.md §3.2–3.3).
+//! the byte layout is written down once (rust_stack.md §3.2–3.3). Bytes are read through
+//! the crate's bounds-checked [`Cursor`]; what does not parse is a typed [`RecordError`],
+//! which the reader turns into the crate's error (or a note) with the file offset.
+//!
+//! Records as types, parsed from the header fields (as rosbag-rs does): [`BagHeader`],
+//! [`ChunkHeader`], [`Connection`], [`MessageData`], [`IndexData`], [`ChunkInfo`].
 
 use super::{Compression, RosTime};
+use crate::cursor::Cursor;
+
+/// What is wrong with a record's header or data.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RecordError {
+    /// A field's `u32` length is cut off by the end of the header.
+    #[error("header field length overruns the header")]
+    FieldLengthOverruns,
+    /// A field's bytes run past the end of the header.
+    #[error("header field overruns the header")]
+    FieldOverruns,
+    /// A field that is not `name=value`.
+    #[error("header field without '='")]
+    NoEquals,
+    /// A field name that is not text.
+    #[error("header field name is not UTF-8")]
+    NameNotUtf8,
+    /// An `op` this format does not define.
+    #[error("unknown record op 0x{0:02x}")]
+    UnknownOp(u8),
+    /// No `op` field, or not one byte.
+    #[error("record header without a one-byte 'op' field")]
+    NoOp,
+    /// A required field absent or of the wrong width.
+    #[error("record header lacks {} '{name}' {}", .kind.article(), .kind.noun())]
+    Missing {
+        /// The field.
+        name: String,
+        /// What it should hold.
+        kind: FieldKind,
+    },
+    /// A text field that is not UTF-8.
+    #[error("field '{0}' is not UTF-8")]
+    NotUtf8(String),
+    /// A chunk's `compression` this format does not define.
+    #[error("unknown chunk compression '{0}'")]
+    UnknownCompression(String),
+    /// A chunk-info record whose data does not hold its `count` entries.
+    #[error("chunk info lists {count} connections in {len} bytes")]
+    ChunkInfoLength {
+        /// The `count` field.
+        count: usize,
+        /// The data length.
+        len: usize,
+    },
+    /// A record of another op where this one was expected.
+    #[error("unexpected {0:?} record")]
+    Unexpected(Op),
+}
+
+/// What a required header field holds (for [`RecordError::Missing`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FieldKind {
+    /// A `u32`.
+    U32,
+    /// A `u64`.
+    U64,
+    /// A [`RosTime`].
+    Time,
+    /// Text.
+    Text,
+}
+
+impl FieldKind {
+    fn article(self) -> &'static str {
+        match self {
+            FieldKind::U32 => "a 4-byte",
+            FieldKind::U64 | FieldKind::Time => "an 8-byte",
+            FieldKind::Text => "a",
+        }
+    }
+    fn noun(self) -> &'static str {
+        match self {
+            FieldKind::Time => "time field",
+            _ => "field",
+        }
+    }
+}
 
 /// The 13-byte magic line that opens every version 2.0 bag.
 pub const MAGIC: &[u8; 13] = b"#ROSBAG V2.0\n";
@@ -62,24 +145,27 @@ pub fn push_record(out: &mut Vec<u8>, header: &[u8], data: &[u8]) {
     out.extend_from_slice(data);
 }
 
+/// The next `len | name=value` field of a header, as its raw bytes.
+fn next_field<'a>(c: &mut Cursor<'a>) -> Result<&'a [u8], RecordError> {
+    let len = c
+        .le::<u32>("header field length")
+        .map_err(|_| RecordError::FieldLengthOverruns)? as usize;
+    c.take(len, "header field")
+        .map_err(|_| RecordError::FieldOverruns)
+}
+
 /// The fields of a record header, in file order. Fails on a field that overruns the header.
-pub(crate) fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, String> {
+pub(crate) fn fields(header: &[u8]) -> Result<Vec<(&str, &[u8])>, RecordError> {
     let mut out = Vec::new();
-    let mut pos = 0usize;
-    while pos < header.len() {
-        let len = read_u32(header, pos).ok_or("header field length overruns the header")? as usize;
-        pos += 4;
-        let field = header
-            .get(pos..pos + len)
-            .ok_or("header field overruns the header")?;
+    let mut c = Cursor::new(header);
+    while !c.is_empty() {
+        let field = next_field(&mut c)?;
         let eq = field
             .iter()
             .position(|&b| b == b'=')
-            .ok_or("header field without '='")?;
-        let name =
-            std::str::from_utf8(&field[..eq]).map_err(|_| "header field name is not UTF-8")?;
+            .ok_or(RecordError::NoEquals)?;
+        let name = std::str::from_utf8(&field[..eq]).map_err(|_| RecordError::NameNotUtf8)?;
         out.push((name, &field[eq + 1..]));
-        pos += len;
     }
     Ok(out)
 }
@@ -89,23 +175,18 @@ pub type OpConnTime = (Option<u8>, Option<u32>, Option<RosTime>);
 
 /// The `op`, `conn` and `time` fields of a record header, found without allocating: the hot
 /// path of reading, run once per message. Fields missing from the header stay `None`.
-pub(crate) fn op_conn_time(header: &[u8]) -> Result<OpConnTime, String> {
+pub(crate) fn op_conn_time(header: &[u8]) -> Result<OpConnTime, RecordError> {
     let (mut op, mut conn, mut time) = (None, None, None);
-    let mut pos = 0usize;
-    while pos < header.len() {
-        let len = read_u32(header, pos).ok_or("header field length overruns the header")? as usize;
-        let field = header
-            .get(pos + 4..pos + 4 + len)
-            .ok_or("header field overruns the header")?;
-        match field {
+    let mut c = Cursor::new(header);
+    while !c.is_empty() {
+        match next_field(&mut c)? {
             [b'o', b'p', b'=', v] => op = Some(*v),
             [b'c', b'o', b'n', b'n', b'=', v @ ..] if v.len() == 4 => {
-                conn = Some(u32::from_le_bytes([v[0], v[1], v[2], v[3]]))
+                conn = Cursor::new(v).le::<u32>("conn").ok()
             }
             [b't', b'i', b'm', b'e', b'=', v @ ..] => time = RosTime::from_bytes(v),
             _ => {}
         }
-        pos += 4 + len;
     }
     Ok((op, conn, time))
 }
@@ -117,7 +198,7 @@ pub struct Header<'a> {
 
 impl<'a> Header<'a> {
     /// Parses the header bytes of one record.
-    pub fn parse(bytes: &'a [u8]) -> Result<Header<'a>, String> {
+    pub fn parse(bytes: &'a [u8]) -> Result<Header<'a>, RecordError> {
         Ok(Header {
             fields: fields(bytes)?,
         })
@@ -132,53 +213,59 @@ impl<'a> Header<'a> {
     }
 
     /// The record's op.
-    pub fn op(&self) -> Result<Op, String> {
+    pub fn op(&self) -> Result<Op, RecordError> {
         match self.get("op") {
-            Some([b]) => Op::from_byte(*b).ok_or_else(|| format!("unknown record op 0x{b:02x}")),
-            _ => Err("record header without a one-byte 'op' field".into()),
+            Some([b]) => Op::from_byte(*b).ok_or(RecordError::UnknownOp(*b)),
+            _ => Err(RecordError::NoOp),
         }
+    }
+
+    /// A required fixed-width field.
+    fn fixed<T: crate::cursor::Le>(&self, name: &str, kind: FieldKind) -> Result<T, RecordError> {
+        self.get(name)
+            .filter(|v| v.len() == T::SIZE)
+            .and_then(|v| Cursor::new(v).le::<T>("header field").ok())
+            .ok_or_else(|| RecordError::Missing {
+                name: name.to_string(),
+                kind,
+            })
     }
 
     /// A required u32 field.
-    pub(crate) fn u32(&self, name: &str) -> Result<u32, String> {
-        match self.get(name) {
-            Some(v) if v.len() == 4 => Ok(u32::from_le_bytes([v[0], v[1], v[2], v[3]])),
-            _ => Err(format!("record header lacks a 4-byte '{name}' field")),
-        }
+    pub(crate) fn u32(&self, name: &str) -> Result<u32, RecordError> {
+        self.fixed(name, FieldKind::U32)
     }
 
     /// A required u64 field.
-    pub(crate) fn u64(&self, name: &str) -> Result<u64, String> {
-        match self.get(name) {
-            Some(v) if v.len() == 8 => {
-                let mut b = [0u8; 8];
-                b.copy_from_slice(v);
-                Ok(u64::from_le_bytes(b))
-            }
-            _ => Err(format!("record header lacks an 8-byte '{name}' field")),
-        }
+    pub(crate) fn u64(&self, name: &str) -> Result<u64, RecordError> {
+        self.fixed(name, FieldKind::U64)
     }
 
     /// A required time field.
-    pub(crate) fn time(&self, name: &str) -> Result<RosTime, String> {
+    pub(crate) fn time(&self, name: &str) -> Result<RosTime, RecordError> {
         self.get(name)
             .and_then(RosTime::from_bytes)
-            .ok_or_else(|| format!("record header lacks an 8-byte '{name}' time field"))
+            .ok_or_else(|| RecordError::Missing {
+                name: name.to_string(),
+                kind: FieldKind::Time,
+            })
     }
 
     /// A required text field.
-    pub(crate) fn str(&self, name: &str) -> Result<&'a str, String> {
-        let v = self
-            .get(name)
-            .ok_or_else(|| format!("record header lacks a '{name}' field"))?;
-        std::str::from_utf8(v).map_err(|_| format!("field '{name}' is not UTF-8"))
+    pub(crate) fn str(&self, name: &str) -> Result<&'a str, RecordError> {
+        let v = self.get(name).ok_or_else(|| RecordError::Missing {
+            name: name.to_string(),
+            kind: FieldKind::Text,
+        })?;
+        std::str::from_utf8(v).map_err(|_| RecordError::NotUtf8(name.to_string()))
     }
 }
 
 /// Little-endian u32 at `pos`, if the bytes are there.
 pub fn read_u32(buf: &[u8], pos: usize) -> Option<u32> {
-    let b = buf.get(pos..pos.checked_add(4)?)?;
-    Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    let mut c = Cursor::new(buf);
+    c.skip(pos, "record").ok()?;
+    c.le::<u32>("length").ok()
 }
 
 /// One record inside a byte buffer: its header and data, and where the next one starts.
@@ -193,18 +280,140 @@ pub struct RawRecord<'a> {
 
 /// Splits the record at `pos` of `buf`; `None` if it is incomplete.
 pub fn raw_record(buf: &[u8], pos: usize) -> Option<RawRecord<'_>> {
-    let hlen = read_u32(buf, pos)? as usize;
-    let hstart = pos + 4;
-    let header = buf.get(hstart..hstart.checked_add(hlen)?)?;
-    let dlen_pos = hstart + hlen;
-    let dlen = read_u32(buf, dlen_pos)? as usize;
-    let dstart = dlen_pos + 4;
-    let data = buf.get(dstart..dstart.checked_add(dlen)?)?;
+    let mut c = Cursor::new(buf);
+    c.skip(pos, "record").ok()?;
+    let hlen = c.le::<u32>("header length").ok()? as usize;
+    let header = c.take(hlen, "header").ok()?;
+    let dlen = c.le::<u32>("data length").ok()? as usize;
+    let data = c.take(dlen, "data").ok()?;
     Some(RawRecord {
         header,
         data,
-        end: dstart + dlen,
+        end: c.pos(),
     })
+}
+
+/// The bag header record's fields, each `None` when absent or of the wrong width: a damaged
+/// bag header leaves the chunks to be walked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BagHeader {
+    /// File offset of the index section (0 while a writer has not finished).
+    pub index_pos: Option<u64>,
+    /// Connections in the index section.
+    pub conn_count: Option<u32>,
+    /// Chunks in the file.
+    pub chunk_count: Option<u32>,
+}
+
+impl BagHeader {
+    /// Reads the fields of a bag header record.
+    pub(crate) fn decode(header: &Header<'_>) -> Result<BagHeader, RecordError> {
+        match header.op()? {
+            Op::BagHeader => Ok(BagHeader {
+                index_pos: header.u64("index_pos").ok(),
+                conn_count: header.u32("conn_count").ok(),
+                chunk_count: header.u32("chunk_count").ok(),
+            }),
+            other => Err(RecordError::Unexpected(other)),
+        }
+    }
+}
+
+/// A chunk record's header: how its data is stored and how long it is once decompressed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChunkHeader {
+    /// How the data is stored.
+    pub compression: Compression,
+    /// Length of the decompressed body.
+    pub size: u32,
+}
+
+impl ChunkHeader {
+    /// Reads a chunk record's header (an error for any other op).
+    pub(crate) fn decode(header: &Header<'_>) -> Result<ChunkHeader, RecordError> {
+        match header.op()? {
+            Op::Chunk => {
+                let name = header.str("compression")?;
+                let compression = Compression::from_name(name)
+                    .ok_or_else(|| RecordError::UnknownCompression(name.to_string()))?;
+                Ok(ChunkHeader {
+                    compression,
+                    size: header.u32("size")?,
+                })
+            }
+            other => Err(RecordError::Unexpected(other)),
+        }
+    }
+
+    /// Encodes the header fields (`op`, `compression`, `size`).
+    pub fn encode(&self) -> Vec<u8> {
+        let mut header = Vec::with_capacity(48);
+        push_field(&mut header, "op", &[Op::Chunk as u8]);
+        push_field(
+            &mut header,
+            "compression",
+            self.compression.name().as_bytes(),
+        );
+        push_field(&mut header, "size", &self.size.to_le_bytes());
+        header
+    }
+}
+
+/// A message-data record's header: its connection and record time. (The reader's hot path
+/// finds these fields with [`op_conn_time`], which does not allocate.)
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MessageData {
+    /// The connection id.
+    pub conn: u32,
+    /// The record time.
+    pub time: RosTime,
+}
+
+impl MessageData {
+    /// Encodes the header fields (`op`, `conn`, `time`).
+    pub fn encode_header(&self, out: &mut Vec<u8>) {
+        push_field(out, "op", &[Op::MessageData as u8]);
+        push_field(out, "conn", &self.conn.to_le_bytes());
+        push_field(out, "time", &self.time.to_bytes());
+    }
+}
+
+/// An index-data record's header: the connection and how many `(time, offset)` entries its
+/// data holds (a damaged `count` is `None`; the data length then bounds the entries).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IndexData {
+    /// The connection id.
+    pub conn: u32,
+    /// Entries, as the `count` field says.
+    pub count: Option<u32>,
+}
+
+/// Bytes of one index-data entry: a time and a `u32` offset into the chunk body.
+pub const INDEX_ENTRY_LEN: usize = 12;
+
+impl IndexData {
+    /// Reads the header fields of an index-data record.
+    pub(crate) fn decode(header: &Header<'_>) -> Result<IndexData, RecordError> {
+        Ok(IndexData {
+            conn: header.u32("conn")?,
+            count: header.u32("count").ok(),
+        })
+    }
+
+    /// Encodes the record: `(time, offset into the uncompressed chunk body)` per message.
+    pub fn encode(out: &mut Vec<u8>, conn: u32, entries: &[(RosTime, u32)]) {
+        let mut header = Vec::with_capacity(48);
+        push_field(&mut header, "op", &[Op::IndexData as u8]);
+        push_field(&mut header, "ver", &1u32.to_le_bytes());
+        push_field(&mut header, "conn", &conn.to_le_bytes());
+        push_field(&mut header, "count", &(entries.len() as u32).to_le_bytes());
+        let mut data = Vec::with_capacity(INDEX_ENTRY_LEN * entries.len());
+        for (t, off) in entries {
+            data.extend_from_slice(&t.to_bytes());
+            data.extend_from_slice(&off.to_le_bytes());
+        }
+        push_record(out, &header, &data);
+    }
 }
 
 /// A connection: one topic with its message type.
@@ -252,7 +461,7 @@ impl Connection {
     }
 
     /// Decodes a connection record from its header and data.
-    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<Connection, String> {
+    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<Connection, RecordError> {
         let id = header.u32("conn")?;
         let storage_topic = header.str("topic")?;
         let d = Header::parse(data)?;
@@ -305,23 +514,22 @@ impl ChunkInfo {
     }
 
     /// Decodes the record.
-    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<ChunkInfo, String> {
+    pub(crate) fn decode(header: &Header<'_>, data: &[u8]) -> Result<ChunkInfo, RecordError> {
         let count = header.u32("count")? as usize;
-        if data.len() != count * 8 {
-            return Err(format!(
-                "chunk info lists {count} connections in {} bytes",
-                data.len()
-            ));
+        if Some(data.len()) != count.checked_mul(8) {
+            return Err(RecordError::ChunkInfoLength {
+                count,
+                len: data.len(),
+            });
         }
-        let counts = data
-            .chunks_exact(8)
-            .map(|c| {
-                (
-                    u32::from_le_bytes([c[0], c[1], c[2], c[3]]),
-                    u32::from_le_bytes([c[4], c[5], c[6], c[7]]),
-                )
-            })
-            .collect();
+        let mut c = Cursor::new(data);
+        let counts = (0..count)
+            .map(|_| Ok((c.le::<u32>("conn")?, c.le::<u32>("count")?)))
+            .collect::<Result<Vec<_>, crate::cursor::CursorError>>()
+            .map_err(|_| RecordError::ChunkInfoLength {
+                count,
+                len: data.len(),
+            })?;
         Ok(ChunkInfo {
             chunk_pos: header.u64("chunk_pos")?,
             start_time: header.time("start_time")?,
@@ -333,33 +541,21 @@ impl ChunkInfo {
 
 /// Encodes a chunk record header (`compression`, `size` = uncompressed length).
 pub fn chunk_header(compression: Compression, uncompressed_len: u32) -> Vec<u8> {
-    let mut header = Vec::with_capacity(48);
-    push_field(&mut header, "op", &[Op::Chunk as u8]);
-    push_field(&mut header, "compression", compression.name().as_bytes());
-    push_field(&mut header, "size", &uncompressed_len.to_le_bytes());
-    header
+    ChunkHeader {
+        compression,
+        size: uncompressed_len,
+    }
+    .encode()
 }
 
 /// Encodes an index-data record: `(time, offset into the uncompressed chunk body)` per message.
 pub fn encode_index_data(out: &mut Vec<u8>, conn: u32, entries: &[(RosTime, u32)]) {
-    let mut header = Vec::with_capacity(48);
-    push_field(&mut header, "op", &[Op::IndexData as u8]);
-    push_field(&mut header, "ver", &1u32.to_le_bytes());
-    push_field(&mut header, "conn", &conn.to_le_bytes());
-    push_field(&mut header, "count", &(entries.len() as u32).to_le_bytes());
-    let mut data = Vec::with_capacity(12 * entries.len());
-    for (t, off) in entries {
-        data.extend_from_slice(&t.to_bytes());
-        data.extend_from_slice(&off.to_le_bytes());
-    }
-    push_record(out, &header, &data);
+    IndexData::encode(out, conn, entries)
 }
 
 /// Encodes a message-data record header (`op`, `conn`, `time`).
 pub fn message_header(out: &mut Vec<u8>, conn: u32, time: RosTime) {
-    push_field(out, "op", &[Op::MessageData as u8]);
-    push_field(out, "conn", &conn.to_le_bytes());
-    push_field(out, "time", &time.to_bytes());
+    MessageData { conn, time }.encode_header(out)
 }
 
 /// Encodes the bag header record, padded with spaces to 4096 bytes of header plus data.

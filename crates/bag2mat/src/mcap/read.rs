@@ -25,9 +25,10 @@ use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
 use super::record::{
-    self, ChunkHeader, ChunkIndex, Cursor, FOOTER_CONTENT_LEN, Footer, Header, MAGIC,
-    MESSAGE_FIXED_LEN, Op, RECORD_PREFIX, Schema, Statistics,
+    self, ChunkHeader, ChunkIndex, FOOTER_CONTENT_LEN, Footer, Header, MAGIC, MESSAGE_FIXED_LEN,
+    McapFields, Op, RECORD_PREFIX, Schema, Statistics,
 };
+use crate::cursor::{Cursor, CursorError};
 use crate::error::Error;
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
 
@@ -380,13 +381,13 @@ impl McapReader {
         while c.pos() < b.len() {
             // Framing first: an untrusted summary skips a record whose content does not
             // parse, and ends at framing that does not hold.
-            let framed = c.u8().and_then(|op| Ok((op, c.bytes64()?)));
+            let framed = c.le::<u8>("opcode").and_then(|op| Ok((op, c.bytes64()?)));
             let (op, content) = match framed {
                 Ok(x) => x,
-                Err(e) if trusted => return Err(e),
+                Err(e) if trusted => return Err(e.to_string()),
                 Err(_) => break,
             };
-            let rec = (|| -> Result<(), String> {
+            let rec = (|| -> Result<(), CursorError> {
                 match Op::from_byte(op) {
                     Some(Op::Schema) => {
                         let s = Schema::decode(content)?;
@@ -410,7 +411,7 @@ impl McapReader {
             if let Err(e) = rec
                 && trusted
             {
-                return Err(e);
+                return Err(e.to_string());
             }
         }
         Ok(chunk_indexes)
@@ -499,6 +500,9 @@ impl McapReader {
     /// Walks the top-level records of the data section, up to `end`. Returns the summary
     /// records found after a Data End when the file has no usable footer (a file cut in
     /// its summary section).
+    // Long: one loop over the records whose state (position, the chunk the next index
+    // follows, Data End seen, resync) every opcode's arm reads and moves; split per opcode
+    // it would thread that state through each arm.
     fn walk(&mut self, end: u64, hints: &[u64]) -> Result<Option<Summary>, Error> {
         let file = self
             .file
@@ -813,7 +817,7 @@ impl McapReader {
                 ChunkHeader::decode(b).map_err(|e| Error::Corrupt {
                     path: self.path.clone(),
                     offset: pos,
-                    what: e,
+                    what: e.to_string(),
                 })?
             }
             Some(ci) => {
@@ -1294,7 +1298,7 @@ impl McapReader {
             while at < total {
                 let rec = (|| {
                     let mut c = Cursor::new(&records[at..]);
-                    let op = c.u8().ok()?;
+                    let op = c.le::<u8>("opcode").ok()?;
                     let content = c.bytes64().ok()?;
                     Some((op, content, c.pos()))
                 })();

@@ -5,7 +5,10 @@
 //! Strings are `u32 length | UTF-8`, byte fields `u32` (or, for chunk records and attachments,
 //! `u64`) length-prefixed, maps and arrays `u32 byte length | entries`, timestamps `u64`
 //! nanoseconds. Each record type has its op code and fields here, parsed through a
-//! bounds-checked [`Cursor`], so a damaged file gives an error, never a panic.
+//! bounds-checked [`Cursor`] (the crate's one, [`crate::cursor`]), so a damaged file gives a
+//! typed [`CursorError`], never a panic.
+
+use crate::cursor::{Cursor, CursorError};
 
 /// The 8 bytes that open and close every MCAP file (`0x30` is the major version `0`).
 pub const MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
@@ -76,102 +79,62 @@ impl Op {
     }
 }
 
-/// A bounds-checked little-endian reader over one record's content.
-#[derive(Debug, Clone)]
-pub struct Cursor<'a> {
-    buf: &'a [u8],
-    pos: usize,
+/// MCAP's length-prefixed fields, read through the crate's bounds-checked [`Cursor`].
+pub(crate) trait McapFields<'a> {
+    /// `u32` length-prefixed bytes.
+    fn bytes32(&mut self) -> Result<&'a [u8], CursorError>;
+    /// `u64` length-prefixed bytes.
+    fn bytes64(&mut self) -> Result<&'a [u8], CursorError>;
+    /// A `u32` length-prefixed UTF-8 string.
+    fn string(&mut self) -> Result<String, CursorError>;
+    /// A `Map<string, string>`.
+    fn string_map(&mut self) -> Result<Vec<(String, String)>, CursorError>;
+    /// A `Map<u16, u64>`.
+    fn u16_u64_map(&mut self) -> Result<Vec<(u16, u64)>, CursorError>;
 }
 
-impl<'a> Cursor<'a> {
-    /// Starts at the beginning of `buf`.
-    pub fn new(buf: &'a [u8]) -> Cursor<'a> {
-        Cursor { buf, pos: 0 }
+impl<'a> McapFields<'a> for Cursor<'a> {
+    fn bytes32(&mut self) -> Result<&'a [u8], CursorError> {
+        let n = self.le::<u32>("byte-field length")? as usize;
+        self.take(n, "byte field")
     }
-
-    /// Bytes consumed so far.
-    pub(crate) fn pos(&self) -> usize {
-        self.pos
+    fn bytes64(&mut self) -> Result<&'a [u8], CursorError> {
+        let at = self.clone();
+        let n = usize::try_from(self.le::<u64>("byte-field length")?)
+            .map_err(|_| at.invalid("length does not fit memory"))?;
+        self.take(n, "byte field")
     }
-
-    /// The next `n` bytes.
-    pub(crate) fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .pos
-            .checked_add(n)
-            .filter(|&e| e <= self.buf.len())
-            .ok_or_else(|| {
-                format!(
-                    "record content ends early: {n} bytes needed at offset {} of {}",
-                    self.pos,
-                    self.buf.len()
-                )
-            })?;
-        let s = &self.buf[self.pos..end];
-        self.pos = end;
-        Ok(s)
+    fn string(&mut self) -> Result<String, CursorError> {
+        let n = self.le::<u32>("string length")? as usize;
+        self.str(n, "string field").map(str::to_string)
     }
-
-    fn array<const N: usize>(&mut self) -> Result<[u8; N], String> {
-        let mut a = [0u8; N];
-        a.copy_from_slice(self.take(N)?);
-        Ok(a)
-    }
-
-    /// A `u8`.
-    pub(crate) fn u8(&mut self) -> Result<u8, String> {
-        Ok(self.take(1)?[0])
-    }
-    /// A `u16`.
-    pub(crate) fn u16(&mut self) -> Result<u16, String> {
-        Ok(u16::from_le_bytes(self.array()?))
-    }
-    /// A `u32`.
-    pub(crate) fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.array()?))
-    }
-    /// A `u64`.
-    pub(crate) fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.array()?))
-    }
-    /// `u32` length-prefixed bytes.
-    pub(crate) fn bytes32(&mut self) -> Result<&'a [u8], String> {
-        let n = self.u32()? as usize;
-        self.take(n)
-    }
-    /// `u64` length-prefixed bytes.
-    pub(crate) fn bytes64(&mut self) -> Result<&'a [u8], String> {
-        let n = usize::try_from(self.u64()?).map_err(|_| "length does not fit memory")?;
-        self.take(n)
-    }
-    /// A `u32` length-prefixed UTF-8 string.
-    pub(crate) fn string(&mut self) -> Result<String, String> {
-        let b = self.bytes32()?;
-        String::from_utf8(b.to_vec()).map_err(|_| "string field is not UTF-8".to_string())
-    }
-    /// A `Map<string, string>`.
-    pub(crate) fn string_map(&mut self) -> Result<Vec<(String, String)>, String> {
-        let mut c = Cursor::new(self.bytes32()?);
+    fn string_map(&mut self) -> Result<Vec<(String, String)>, CursorError> {
+        let mut c = self.sub_bytes32()?;
         let mut out = Vec::new();
-        while c.pos < c.buf.len() {
+        while !c.is_empty() {
             out.push((c.string()?, c.string()?));
         }
         Ok(out)
     }
-    /// A `Map<u16, u64>`.
-    pub(crate) fn u16_u64_map(&mut self) -> Result<Vec<(u16, u64)>, String> {
-        let mut c = Cursor::new(self.bytes32()?);
+    fn u16_u64_map(&mut self) -> Result<Vec<(u16, u64)>, CursorError> {
+        let mut c = self.sub_bytes32()?;
         let mut out = Vec::new();
-        while c.pos < c.buf.len() {
-            out.push((c.u16()?, c.u64()?));
+        while !c.is_empty() {
+            out.push((c.le::<u16>("map key")?, c.le::<u64>("map value")?));
         }
         Ok(out)
     }
-    /// The rest of the content.
-    pub fn rest(&mut self) -> &'a [u8] {
-        let s = &self.buf[self.pos..];
-        self.pos = self.buf.len();
-        s
+}
+
+/// A map's entries: a sub-cursor over its `u32` byte length (file offsets kept).
+trait SubBytes32<'a> {
+    fn sub_bytes32(&mut self) -> Result<Cursor<'a>, CursorError>;
+}
+
+impl<'a> SubBytes32<'a> for Cursor<'a> {
+    fn sub_bytes32(&mut self) -> Result<Cursor<'a>, CursorError> {
+        let n = self.le::<u32>("map length")? as usize;
+        self.sub(n, "map")
     }
 }
 
@@ -243,7 +206,7 @@ pub struct Header {
 
 impl Header {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<Header, String> {
+    pub fn decode(c: &[u8]) -> Result<Header, CursorError> {
         let mut c = Cursor::new(c);
         Ok(Header {
             profile: c.string()?,
@@ -273,12 +236,12 @@ pub struct Footer {
 
 impl Footer {
     /// Parses the content.
-    pub(crate) fn decode(c: &[u8]) -> Result<Footer, String> {
+    pub(crate) fn decode(c: &[u8]) -> Result<Footer, CursorError> {
         let mut c = Cursor::new(c);
         Ok(Footer {
-            summary_start: c.u64()?,
-            summary_offset_start: c.u64()?,
-            summary_crc: c.u32()?,
+            summary_start: c.le::<u64>("summary_start")?,
+            summary_offset_start: c.le::<u64>("summary_offset_start")?,
+            summary_crc: c.le::<u32>("summary_crc")?,
         })
     }
 }
@@ -298,10 +261,10 @@ pub struct Schema {
 
 impl Schema {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<Schema, String> {
+    pub fn decode(c: &[u8]) -> Result<Schema, CursorError> {
         let mut c = Cursor::new(c);
         Ok(Schema {
-            id: c.u16()?,
+            id: c.le::<u16>("id")?,
             name: c.string()?,
             encoding: c.string()?,
             data: c.bytes32()?.to_vec(),
@@ -336,11 +299,11 @@ pub struct Channel {
 
 impl Channel {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<Channel, String> {
+    pub fn decode(c: &[u8]) -> Result<Channel, CursorError> {
         let mut c = Cursor::new(c);
         Ok(Channel {
-            id: c.u16()?,
-            schema_id: c.u16()?,
+            id: c.le::<u16>("id")?,
+            schema_id: c.le::<u16>("schema_id")?,
             topic: c.string()?,
             message_encoding: c.string()?,
             metadata: c.string_map()?,
@@ -378,13 +341,13 @@ pub struct MessageRef<'a> {
 
 impl<'a> MessageRef<'a> {
     /// Parses the content.
-    pub fn decode(c: &'a [u8]) -> Result<MessageRef<'a>, String> {
+    pub fn decode(c: &'a [u8]) -> Result<MessageRef<'a>, CursorError> {
         let mut c = Cursor::new(c);
         Ok(MessageRef {
-            channel_id: c.u16()?,
-            sequence: c.u32()?,
-            log_time: c.u64()?,
-            publish_time: c.u64()?,
+            channel_id: c.le::<u16>("channel_id")?,
+            sequence: c.le::<u32>("sequence")?,
+            log_time: c.le::<u64>("log_time")?,
+            publish_time: c.le::<u64>("publish_time")?,
             data: c.rest(),
         })
     }
@@ -420,15 +383,15 @@ pub struct ChunkHeader {
 impl ChunkHeader {
     /// Parses the header from the start of a chunk's content; returns it and the offset of
     /// the records within the content.
-    pub(crate) fn decode(c: &[u8]) -> Result<(ChunkHeader, usize), String> {
+    pub(crate) fn decode(c: &[u8]) -> Result<(ChunkHeader, usize), CursorError> {
         let mut c = Cursor::new(c);
         let h = ChunkHeader {
-            message_start_time: c.u64()?,
-            message_end_time: c.u64()?,
-            uncompressed_size: c.u64()?,
-            uncompressed_crc: c.u32()?,
+            message_start_time: c.le::<u64>("message_start_time")?,
+            message_end_time: c.le::<u64>("message_end_time")?,
+            uncompressed_size: c.le::<u64>("uncompressed_size")?,
+            uncompressed_crc: c.le::<u32>("uncompressed_crc")?,
             compression: c.string()?,
-            compressed_size: c.u64()?,
+            compressed_size: c.le::<u64>("compressed_size")?,
         };
         Ok((h, c.pos()))
     }
@@ -457,9 +420,12 @@ pub struct MessageIndex {
 
 impl MessageIndex {
     /// Channel id and message count, read from the first 6 bytes of the content.
-    pub fn count(c: &[u8]) -> Result<(u16, u64), String> {
+    pub fn count(c: &[u8]) -> Result<(u16, u64), CursorError> {
         let mut c = Cursor::new(c);
-        Ok((c.u16()?, c.u32()? as u64 / 16))
+        Ok((
+            c.le::<u16>("channel_id")?,
+            c.le::<u32>("records length")? as u64 / 16,
+        ))
     }
     /// Appends the record.
     pub fn encode(&self, out: &mut Vec<u8>) {
@@ -499,18 +465,18 @@ pub struct ChunkIndex {
 
 impl ChunkIndex {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<ChunkIndex, String> {
+    pub fn decode(c: &[u8]) -> Result<ChunkIndex, CursorError> {
         let mut c = Cursor::new(c);
         Ok(ChunkIndex {
-            message_start_time: c.u64()?,
-            message_end_time: c.u64()?,
-            chunk_start_offset: c.u64()?,
-            chunk_length: c.u64()?,
+            message_start_time: c.le::<u64>("message_start_time")?,
+            message_end_time: c.le::<u64>("message_end_time")?,
+            chunk_start_offset: c.le::<u64>("chunk_start_offset")?,
+            chunk_length: c.le::<u64>("chunk_length")?,
             message_index_offsets: c.u16_u64_map()?,
-            message_index_length: c.u64()?,
+            message_index_length: c.le::<u64>("message_index_length")?,
             compression: c.string()?,
-            compressed_size: c.u64()?,
-            uncompressed_size: c.u64()?,
+            compressed_size: c.le::<u64>("compressed_size")?,
+            uncompressed_size: c.le::<u64>("uncompressed_size")?,
         })
     }
     /// Appends the record.
@@ -554,17 +520,17 @@ pub struct Statistics {
 
 impl Statistics {
     /// Parses the content.
-    pub fn decode(c: &[u8]) -> Result<Statistics, String> {
+    pub fn decode(c: &[u8]) -> Result<Statistics, CursorError> {
         let mut c = Cursor::new(c);
         Ok(Statistics {
-            message_count: c.u64()?,
-            schema_count: c.u16()?,
-            channel_count: c.u32()?,
-            attachment_count: c.u32()?,
-            metadata_count: c.u32()?,
-            chunk_count: c.u32()?,
-            message_start_time: c.u64()?,
-            message_end_time: c.u64()?,
+            message_count: c.le::<u64>("message_count")?,
+            schema_count: c.le::<u16>("schema_count")?,
+            channel_count: c.le::<u32>("channel_count")?,
+            attachment_count: c.le::<u32>("attachment_count")?,
+            metadata_count: c.le::<u32>("metadata_count")?,
+            chunk_count: c.le::<u32>("chunk_count")?,
+            message_start_time: c.le::<u64>("message_start_time")?,
+            message_end_time: c.le::<u64>("message_end_time")?,
             channel_message_counts: c.u16_u64_map()?,
         })
     }

@@ -91,30 +91,10 @@ pub fn protect_input(path: &Path) {
     }
 }
 
-/// A plain description of an OS error: no "(os error N)", and the usual causes named the
-/// way a person reads them.
-pub fn describe(e: &std::io::Error) -> String {
-    use std::io::ErrorKind as K;
-    match e.kind() {
-        K::NotFound => "no such file or directory".into(),
-        K::PermissionDenied => "permission denied".into(),
-        K::AlreadyExists => "a file is in the way (it already exists)".into(),
-        K::IsADirectory => "it is a directory".into(),
-        K::NotADirectory => "a component of the path is not a directory".into(),
-        K::StorageFull => "no space left on the device".into(),
-        K::ReadOnlyFilesystem => "the file system is read-only".into(),
-        K::DirectoryNotEmpty => "a directory that is not empty is in the way".into(),
-        _ => without_errno(&e.to_string()),
-    }
-}
-
-/// An OS error's text without its "(os error N)".
-pub(crate) fn without_errno(s: &str) -> String {
-    match s.find(" (os error") {
-        Some(i) => s[..i].to_string(),
-        None => s.to_string(),
-    }
-}
+// The OS-error wording lives with the error type (error.rs), which every crate's `Io`
+// variant formats with; re-exported here where callers have always found it.
+pub use crate::error::describe;
+pub(crate) use crate::error::without_errno;
 
 /// Symlinks followed at most (the kernel's limit, `MAXSYMLINKS`).
 const MAX_SYMLINKS: usize = 40;
