@@ -708,9 +708,8 @@ pub fn yaml_numbers(text: &str) -> Vec<(String, f64)> {
         .map(|l| format!("{l}\n"))
         .collect();
     // The tools write NaN where a term has no value (`.nan`): read it as the number it is.
-    let options = serde_saphyr::Options {
+    let options = serde_saphyr::options! {
         non_finite_float_policy: serde_saphyr::NonFiniteFloatPolicy::PassThrough,
-        ..serde_saphyr::Options::default()
     };
     let doc: YamlNode = serde_saphyr::from_str_with_options(&body, options)
         .unwrap_or_else(|e| panic!("not YAML ({e}):\n{text}"));
