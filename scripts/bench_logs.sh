@@ -5,8 +5,10 @@
 #     interpreter's start) and `wc -l` (targets: >= 3x faster than pandas, within 5x of wc -l);
 #   * a 4 h ULog (sensor_combined, 2 x sensor_gyro/sensor_accel at 200 Hz, vehicle_imu,
 #     vehicle_status; ~800 MB) vs pyulog's ULog() (target: >= 20x faster).
-# Wall seconds, best of 3 (pyulog: 1 run); CPU seconds beside them, since the 2-core machine
-# is often shared. Needs target/py-venv (scripts/test.sh installs pandas and pyulog).
+# Wall seconds, best of 3 (pyulog: 1 run); CPU seconds (user + sys) beside them, and the load
+# average before each line, since the 2-core machine is often shared: on a loaded machine the
+# wall ratio says little and the CPU ratio is the one to read. Needs target/py-venv
+# (scripts/test.sh installs pandas and pyulog).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/lib.sh
@@ -50,6 +52,7 @@ for _ in range(3):
         best = (w, u)
 assert len(df) == 2880000, len(df)
 print('%.3f %.2f' % best)" "$csv")
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "$(( $(stat -c %s "$csv") / 1048576 )) MiB: wc -l ${t_wc} s; bag2mat ${t_ours} s (CPU ${c_ours} s); pandas.read_csv ${t_pd} s (CPU ${c_pd} s)"
 echo "pandas/bag2mat: $(ratio "$t_pd" "$t_ours")x [target >= 3x] (CPU $(ratio "$c_pd" "$c_ours")x); bag2mat/wc -l: $(ratio "$t_ours" "$t_wc")x [target <= 5x]"
 
@@ -64,5 +67,6 @@ from pyulog import ULog
 t, c = time.perf_counter(), time.process_time()
 ULog(sys.argv[1])
 print('%.3f %.2f' % (time.perf_counter() - t, time.process_time() - c))" "$work/flight.ulg")
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "$(( $(stat -c %s "$work/flight.ulg") / 1048576 )) MiB: bag2mat ${t_ul} s (CPU ${c_ul} s); pyulog ${t_py} s (CPU ${c_py} s)"
 echo "pyulog/bag2mat: $(ratio "$t_py" "$t_ul")x [target >= 20x] (CPU $(ratio "$c_py" "$c_ul")x)"
