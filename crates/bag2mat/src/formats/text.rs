@@ -1188,7 +1188,6 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
-    map.prefault_all();
     let bytes = map.bytes();
     let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
     let lay = layout(path, head, bytes.len() as u64, opts)?;

@@ -134,7 +134,6 @@ impl Slot {
 
     /// The value as f64, or `None` past the end of `data`. (Read for every field of every
     /// sample: plain little-endian loads, no cursor.)
-    #[inline]
     fn get(&self, data: &[u8]) -> Option<f64> {
         Some(match self.ty {
             Scalar::I8 => i8::from_le_bytes(self.bytes(data)?).into(),
@@ -150,7 +149,6 @@ impl Slot {
         })
     }
 
-    #[inline]
     fn get_u64(&self, data: &[u8]) -> Option<u64> {
         match self.ty {
             Scalar::U64 => Some(u64::from_le_bytes(self.bytes(data)?)),
@@ -314,12 +312,11 @@ impl Decoder {
 
     /// Every row of a data message logged at `t_ns` (`data` starts with the timestamp),
     /// each with its record time, or why not.
-    #[inline]
     fn rows(
         &self,
         t_ns: u64,
         data: &[u8],
-        mut out: impl FnMut(u64, Row),
+        out: &mut dyn FnMut(u64, Row),
     ) -> Result<(), &'static str> {
         let Decoder::Fifo {
             acc,
@@ -365,7 +362,6 @@ impl Decoder {
     }
 
     /// The row of a one-sample data message (`data` starts with the timestamp), or why not.
-    #[inline]
     fn row(&self, t_ns: u64, data: &[u8]) -> Result<Row, &'static str> {
         let v3 = |s: &[Slot; 3]| -> Result<[f64; 3], &'static str> {
             let mut v = [0.0; 3];
@@ -556,8 +552,6 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
-    // the hop below reads every message header: map the file in on every worker first
-    map.prefault_all();
     let len = map.bytes().len() as u64;
     let win = Window {
         data: map.bytes(),
@@ -848,7 +842,7 @@ impl crate::source::Source for UlogReader {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut crate::source::MessageSink<'_>,
     ) -> crate::source::PartRead {
-        self.walk_part(part, want, |ch, t, row| match row {
+        self.walk_part(part, want, &mut |ch, t, row| match row {
             Some(row) => sink(ch, t, &row.encode()),
             None => sink(ch, t, &[]),
         })
@@ -860,7 +854,7 @@ impl crate::source::Source for UlogReader {
         sink: &mut crate::source::RowSink<'_>,
     ) -> Option<crate::source::PartRead> {
         let imu = |ch: u32| want(ch) && self.chans[ch as usize].decoder.is_some();
-        Some(self.walk_part(part, imu, |ch, t, row| {
+        Some(self.walk_part(part, &imu, &mut |ch, t, row| {
             if let Some(row) = row {
                 sink(ch, t, row);
             }
@@ -874,8 +868,8 @@ impl UlogReader {
     fn walk_part(
         &self,
         part: usize,
-        want: impl Fn(u32) -> bool,
-        mut deliver: impl FnMut(u32, u64, Option<&Row>),
+        want: &(dyn Fn(u32) -> bool + Sync),
+        deliver: &mut dyn FnMut(u32, u64, Option<&Row>),
     ) -> crate::source::PartRead {
         let mut r = crate::source::PartRead::default();
         let Some(p) = self.parts.get(part) else {
@@ -886,8 +880,6 @@ impl UlogReader {
             data: self.map.bytes(),
             len: p.end,
         };
-        // the channels wanted, asked once rather than for every message
-        let wanted: Vec<bool> = (0..self.chans.len() as u32).map(&want).collect();
         let mut subs = p.subs.clone();
         let mut at = p.start;
         while at < win.len {
@@ -917,7 +909,7 @@ impl UlogReader {
                 b'D' if body.len() >= 2 => {
                     let id = u16::from_le_bytes([body[0], body[1]]);
                     let ch = subs[id as usize];
-                    if ch == NO_CHANNEL || !wanted.get(ch as usize).copied().unwrap_or(false) {
+                    if ch == NO_CHANNEL || !want(ch) {
                         continue;
                     }
                     let data = &body[2..];
@@ -928,7 +920,7 @@ impl UlogReader {
                     let t = t_us.saturating_mul(1000);
                     match &c.decoder {
                         None => deliver(ch, t, None),
-                        Some(d) => match d.rows(t, data, |rt, row| {
+                        Some(d) => match d.rows(t, data, &mut |rt, row| {
                             deliver(ch, rt, Some(&row));
                             r.delivered += 1;
                         }) {
