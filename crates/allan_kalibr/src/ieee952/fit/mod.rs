@@ -321,6 +321,23 @@ struct Problem<'d, 'a> {
 }
 
 impl<'d, 'a> Problem<'d, 'a> {
+    /// The problem on the points `sel` and the terms fitted in it (those `enabled` that have
+    /// a shape); `None` without a term or with no more points than terms.
+    fn with_terms(
+        data: &'d FitData<'a>,
+        sel: &[usize],
+        enabled: [bool; TERM_COUNT],
+        shapes: Shapes,
+    ) -> Option<(Self, Vec<usize>)> {
+        let terms: Vec<usize> = (0..TERM_COUNT)
+            .filter(|&j| enabled[j] && shapes.has(j))
+            .collect();
+        if terms.is_empty() || sel.len() < terms.len() + 1 {
+            return None;
+        }
+        Some((Problem::new(data, sel, shapes), terms))
+    }
+
     /// The points `sel` of `data` under `shapes`; the fixed lines' Allan variance is taken
     /// off the data (their columns are zero: they are not solved for).
     fn new(data: &'d FitData<'a>, sel: &[usize], shapes: Shapes) -> Self {
@@ -490,13 +507,7 @@ fn gls(
     max_iter: usize,
     shapes: Shapes,
 ) -> Option<Solve> {
-    let p = Problem::new(data, sel, shapes);
-    let terms: Vec<usize> = (0..TERM_COUNT)
-        .filter(|&j| enabled[j] && shapes.has(j))
-        .collect();
-    if terms.is_empty() || sel.len() < terms.len() + 1 {
-        return None;
-    }
+    let (p, terms) = Problem::with_terms(data, sel, enabled, shapes)?;
     let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
     // start: relative weights 1/A²
     let w0: Vec<f64> = p.a.iter().map(|a| 1.0 / (a * a)).collect();
@@ -607,13 +618,7 @@ fn fixed_ls(
     delta: f64,
     shapes: Shapes,
 ) -> Option<FixedLs> {
-    let p = Problem::new(data, sel, shapes);
-    let terms: Vec<usize> = (0..TERM_COUNT)
-        .filter(|&j| enabled[j] && shapes.has(j))
-        .collect();
-    if terms.is_empty() || sel.len() < terms.len() + 1 {
-        return None;
-    }
+    let (p, terms) = Problem::with_terms(data, sel, enabled, shapes)?;
     let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
     let sigma = p.sigma(at);
     let v = p.v(&sigma, delta);
