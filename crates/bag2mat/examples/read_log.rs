@@ -2,6 +2,10 @@
 //! and prints the rows per topic and the seconds the read took: what `scripts/bench.sh`
 //! times against pandas and pyulog. `read_log INPUT`.
 
+/// The binaries' allocator, so that the read is timed as the tools run it.
+#[global_allocator]
+static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new("read_log");
+
 fn main() -> anyhow::Result<()> {
     let path = std::env::args()
         .nth(1)
