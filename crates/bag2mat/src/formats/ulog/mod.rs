@@ -547,187 +547,52 @@ pub struct UlogReader {
     appended_at: Option<u64>,
 }
 
-/// Opens a ULog file.
+/// Opens a ULog file: one serial hop over the message headers (definitions, subscriptions,
+/// the parts), then each part counted in parallel ([`count_part`]).
 pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
-    let len = map.bytes().len() as u64;
-    let win = Window {
-        data: map.bytes(),
-        len,
-    };
-    let header = win.get(0, HEADER_LEN.min(len as usize)).unwrap_or(&[]);
-    let mut c = Cursor::new(header);
-    let magic = c
-        .take(MAGIC.len(), "ULog magic")
-        .map_err(|e| corrupt(path, e))?;
-    if magic != MAGIC {
-        return Err(corrupt(path, c.invalid("not a ULog file")));
-    }
-    let _version = c.le::<u8>("ULog version").map_err(|e| corrupt(path, e))?;
-    let _start_us = c
-        .le::<u64>("ULog start time")
-        .map_err(|e| corrupt(path, e))?;
-    let mut formats = Formats {
-        defs: HashMap::new(),
-    };
-    let mut channels: Vec<crate::source::Channel> = Vec::new();
-    let mut chans: Vec<Chan> = Vec::new();
-    let mut by_key: HashMap<(String, u8), u32> = HashMap::new();
-    let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
-    let mut found = Found::default();
-    let mut last_t: u64 = 0;
-    let mut appended_at: Option<u64> = None;
-    let mut parts: Vec<PartMap> = Vec::new();
-    let mut part_counts: Vec<Vec<u64>> = Vec::new();
-    let mut part_span: Vec<Option<(u64, u64)>> = Vec::new();
-    let mut at = HEADER_LEN as u64;
-    while at < len {
-        let (m_at, ty, size) = match step(&win, at, appended_at) {
-            Step::Msg(a, t, n) => (a, t, n),
-            Step::Skip(a, n) => {
-                found.skipped.push((a, n));
-                at = a + n;
-                continue;
-            }
-            Step::Cut(a) => {
-                found.truncated = Some(a);
-                break;
-            }
-        };
-        at = m_at + 3 + size as u64;
-        // parts start at message boundaries in the data, each with the subscriptions then
-        if ty == b'D' && parts.last().is_none_or(|p| m_at - p.start >= PART_BYTES) {
-            if let Some(p) = parts.last_mut() {
-                p.end = m_at;
-            }
-            parts.push(PartMap {
-                start: m_at,
-                end: len,
-                subs: subs.clone(),
-            });
-            part_counts.push(Vec::new());
-            part_span.push(None);
-        }
-        let Some(body) = win.get(m_at + 3, size as usize) else {
-            found.truncated = Some(m_at);
-            break;
-        };
-        let mut m = Cursor::at(body, m_at + 3);
-        match ty {
-            b'B' => {
-                // flag bits: compat[8], incompat[8], appended offsets[3]
-                if let (Ok(_), Ok(incompat)) =
-                    (m.take(8, "compat flags"), m.take(8, "incompat flags"))
-                    && incompat[0] & 1 != 0
-                    && let Ok(off) = m.le::<u64>("appended offset")
-                    && off > 0
-                {
-                    appended_at = Some(off);
-                }
-            }
-            b'F' => {
-                if let Some((name, fields)) =
-                    std::str::from_utf8(m.rest()).ok().and_then(parse_format)
-                {
-                    formats.defs.insert(name, fields);
-                }
-            }
-            b'A' => {
-                let Some((multi, id, name)) = subscription(body) else {
-                    found.skipped.push((m_at, size as u64 + 3));
-                    continue;
-                };
-                let key = (name.to_string(), multi);
-                let ch = match by_key.get(&key) {
-                    Some(&ch) => ch,
-                    None => {
-                        let slots = formats.slots(name);
-                        let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
-                        let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
-                        let ch = channels.len() as u32;
-                        channels.push(crate::source::Channel {
-                            id: ch,
-                            topic: format!("{name}:{multi}"),
-                            msg_type: Decoder::msg_type(name),
-                            encoding: if decoder.is_some() {
-                                crate::source::Encoding::Row
-                            } else {
-                                crate::source::Encoding::Other("ulog".into())
-                            },
-                            md5sum: None,
-                            count: Some(0),
-                        });
-                        chans.push(Chan { decoder, ts });
-                        by_key.insert(key, ch);
-                        ch
-                    }
-                };
-                subs[id as usize] = ch;
-            }
-            b'R' => {
-                if let Ok(id) = m.le::<u16>("msg_id") {
-                    subs[id as usize] = NO_CHANNEL;
-                }
-            }
-            b'D' => {
-                let Ok(id) = m.le::<u16>("msg_id") else {
-                    found.skipped.push((m_at, size as u64 + 3));
-                    continue;
-                };
-                let ch = subs[id as usize];
-                if ch == NO_CHANNEL {
-                    found.orphans += 1;
-                    continue;
-                }
-                let Some(t_us) = chans[ch as usize].ts.and_then(|s| s.get_u64(m.rest())) else {
-                    found.orphans += 1;
-                    continue;
-                };
-                let t = t_us.saturating_mul(1000);
-                last_t = last_t.max(t);
-                // a FIFO message is several rows, the oldest (n−1)·dt before its time
-                let (rows, first) = match &chans[ch as usize].decoder {
-                    Some(d @ Decoder::Fifo { dt, .. }) => {
-                        let n = d.rows_in(m.rest());
-                        let dt = dt.get(m.rest()).unwrap_or(0.0).max(0.0);
-                        (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
-                    }
-                    _ => (1, t),
-                };
-                if rows == 0 {
-                    continue;
-                }
-                let k = parts.len() - 1;
-                let pc = &mut part_counts[k];
-                if pc.len() <= ch as usize {
-                    pc.resize(ch as usize + 1, 0);
-                }
-                pc[ch as usize] += rows;
-                let sp = &mut part_span[k];
-                *sp = Some(sp.map_or((first, t), |(a, b)| (a.min(first), b.max(t))));
-                if let Some(c) = channels[ch as usize].count.as_mut() {
-                    *c += rows;
-                }
-            }
-            b'O' => {
-                if let Ok(ms) = m.le::<u16>("dropout duration") {
-                    found.dropouts.push((last_t, ms));
-                }
-            }
-            _ => {} // info, parameters, log text, sync
-        }
-    }
-    if let Some(p) = parts.last_mut() {
-        p.end = at.min(len);
-    }
-    if formats.defs.is_empty() && channels.is_empty() {
+    check_header(path, map.bytes())?;
+    let hop = hop(map.bytes());
+    if hop.formats.defs.is_empty() && hop.channels.is_empty() {
         return Err(Error::Corrupt {
             path: path.to_path_buf(),
             offset: HEADER_LEN as u64,
             what: "ULog: no format or subscription could be read".into(),
         });
+    }
+    let mut reader = UlogReader {
+        map,
+        contents: crate::source::Contents::default(),
+        chans: hop.chans,
+        by_key: hop.by_key,
+        parts: hop.parts,
+        appended_at: hop.appended_at,
+    };
+    let counted: Vec<PartCount> = {
+        use rayon::prelude::*;
+        let r = &reader;
+        (0..r.parts.len())
+            .into_par_iter()
+            .map(|k| r.count_part(k))
+            .collect()
+    };
+    let mut found = hop.found;
+    found.dropouts = dropout_times(&hop.dropouts, &counted);
+    for c in &counted {
+        found.skipped.extend_from_slice(&c.skipped);
+        found.orphans += c.orphans;
+    }
+    // in file order, as one walk over the file would have met them
+    found.skipped.sort_by_key(|s| s.0);
+    let mut channels = hop.channels;
+    for c in &counted {
+        for (ch, n) in c.counts.iter().enumerate() {
+            if let Some(total) = channels[ch].count.as_mut() {
+                *total += n;
+            }
+        }
     }
     super::instance_topics(channels.iter_mut().map(|c| &mut c.topic));
     let mut contents = crate::source::Contents {
@@ -739,35 +604,250 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
             "the log ends inside a message at byte {at} (cut short): read to there"
         ));
     }
-    for (i, p) in parts.iter().enumerate() {
-        let counts: Vec<(u32, u64)> = part_counts[i]
+    for (p, c) in reader.parts.iter().zip(&counted) {
+        let counts: Vec<(u32, u64)> = c
+            .counts
             .iter()
             .enumerate()
             .filter(|(_, n)| **n > 0)
-            .map(|(c, n)| (c as u32, *n))
+            .map(|(ch, n)| (ch as u32, *n))
             .collect();
         // what the part delivers: one Row payload per message of an IMU channel
         let rows: u64 = counts
             .iter()
-            .filter(|(c, _)| chans[*c as usize].decoder.is_some())
+            .filter(|(ch, _)| reader.chans[*ch as usize].decoder.is_some())
             .map(|(_, n)| *n)
             .sum();
         contents.parts.push(crate::source::Part {
             label: format!("bytes {}..{}", p.start, p.end),
-            span: part_span[i],
+            span: c.span,
             counts: Some(counts),
             bytes: rows * crate::decoded::ROW_LEN as u64,
         });
     }
     contents.channels = channels;
-    Ok(UlogReader {
-        map,
-        contents,
-        chans,
-        by_key,
-        parts,
-        appended_at,
-    })
+    reader.contents = contents;
+    Ok(reader)
+}
+
+/// The file header: the magic, a version byte and the start time.
+fn check_header(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let mut c = Cursor::new(&bytes[..bytes.len().min(HEADER_LEN)]);
+    let magic = c
+        .take(MAGIC.len(), "ULog magic")
+        .map_err(|e| corrupt(path, e))?;
+    if magic != MAGIC {
+        return Err(corrupt(path, c.invalid("not a ULog file")));
+    }
+    c.le::<u8>("ULog version").map_err(|e| corrupt(path, e))?;
+    c.le::<u64>("ULog start time")
+        .map_err(|e| corrupt(path, e))?;
+    Ok(())
+}
+
+/// What the serial hop over the message headers finds.
+struct Hop {
+    formats: Formats,
+    channels: Vec<crate::source::Channel>,
+    chans: Vec<Chan>,
+    by_key: HashMap<(String, u8), u32>,
+    parts: Vec<PartMap>,
+    /// Skipped stretches and a cut end (the data messages are counted per part).
+    found: Found,
+    /// Each dropout in file order: the part it lies in (`None` before the data) and its ms.
+    dropouts: Vec<(Option<usize>, u16)>,
+    appended_at: Option<u64>,
+}
+
+/// The hop: every message's header, the body only of definitions, subscriptions and
+/// dropouts, so that the data messages (nearly all of a log) cost a step each here and are
+/// counted in parallel. Parts start at data messages, every [`PART_BYTES`], each with the
+/// subscriptions then.
+fn hop(bytes: &[u8]) -> Hop {
+    let len = bytes.len() as u64;
+    let win = Window { data: bytes, len };
+    let mut h = Hop {
+        formats: Formats {
+            defs: HashMap::new(),
+        },
+        channels: Vec::new(),
+        chans: Vec::new(),
+        by_key: HashMap::new(),
+        parts: Vec::new(),
+        found: Found::default(),
+        dropouts: Vec::new(),
+        appended_at: None,
+    };
+    let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
+    let mut at = HEADER_LEN as u64;
+    while at < len {
+        let (m_at, ty, size) = match step(&win, at, h.appended_at) {
+            Step::Msg(a, t, n) => (a, t, n),
+            Step::Skip(a, n) => {
+                h.found.skipped.push((a, n));
+                at = a + n;
+                continue;
+            }
+            Step::Cut(a) => {
+                h.found.truncated = Some(a);
+                break;
+            }
+        };
+        at = m_at + 3 + size as u64;
+        if ty == b'D' {
+            if h.parts.last().is_none_or(|p| m_at - p.start >= PART_BYTES) {
+                if let Some(p) = h.parts.last_mut() {
+                    p.end = m_at;
+                }
+                h.parts.push(PartMap {
+                    start: m_at,
+                    end: len,
+                    subs: subs.clone(),
+                });
+            }
+            continue;
+        }
+        let Some(body) = win.get(m_at + 3, size as usize) else {
+            h.found.truncated = Some(m_at);
+            break;
+        };
+        h.definition(m_at, ty, body, &mut subs);
+    }
+    if let Some(p) = h.parts.last_mut() {
+        p.end = at.min(len);
+    }
+    h
+}
+
+impl Hop {
+    /// A message other than data at `m_at` (body `body`): what it defines or records.
+    fn definition(&mut self, m_at: u64, ty: u8, body: &[u8], subs: &mut Subs) {
+        let mut m = Cursor::at(body, m_at + 3);
+        match ty {
+            b'B' => {
+                // flag bits: compat[8], incompat[8], appended offsets[3]
+                if let (Ok(_), Ok(incompat)) =
+                    (m.take(8, "compat flags"), m.take(8, "incompat flags"))
+                    && incompat[0] & 1 != 0
+                    && let Ok(off) = m.le::<u64>("appended offset")
+                    && off > 0
+                {
+                    self.appended_at = Some(off);
+                }
+            }
+            b'F' => {
+                if let Some((name, fields)) =
+                    std::str::from_utf8(m.rest()).ok().and_then(parse_format)
+                {
+                    self.formats.defs.insert(name, fields);
+                }
+            }
+            b'A' => match subscription(body) {
+                Some((multi, id, name)) => subs[id as usize] = self.channel(name, multi),
+                None => self.found.skipped.push((m_at, body.len() as u64 + 3)),
+            },
+            b'R' => {
+                if let Ok(id) = m.le::<u16>("msg_id") {
+                    subs[id as usize] = NO_CHANNEL;
+                }
+            }
+            b'O' => {
+                if let Ok(ms) = m.le::<u16>("dropout duration") {
+                    self.dropouts.push((self.parts.len().checked_sub(1), ms));
+                }
+            }
+            _ => {} // info, parameters, log text, sync
+        }
+    }
+
+    /// The channel of topic `name` instance `multi`, made at its first subscription.
+    fn channel(&mut self, name: &str, multi: u8) -> u32 {
+        let key = (name.to_string(), multi);
+        if let Some(&ch) = self.by_key.get(&key) {
+            return ch;
+        }
+        let slots = self.formats.slots(name);
+        let decoder = slots.as_ref().and_then(|s| Decoder::for_topic(name, s));
+        let ts = slots.as_ref().and_then(|s| s.get("timestamp").copied());
+        let ch = self.channels.len() as u32;
+        self.channels.push(crate::source::Channel {
+            id: ch,
+            topic: format!("{name}:{multi}"),
+            msg_type: Decoder::msg_type(name),
+            encoding: if decoder.is_some() {
+                crate::source::Encoding::Row
+            } else {
+                crate::source::Encoding::Other("ulog".into())
+            },
+            md5sum: None,
+            count: Some(0),
+        });
+        self.chans.push(Chan { decoder, ts });
+        self.by_key.insert(key, ch);
+        ch
+    }
+}
+
+/// What counting one part's data messages finds.
+#[derive(Default)]
+struct PartCount {
+    /// Rows per channel (a FIFO message is several).
+    counts: Vec<u64>,
+    /// The record times the part spans (a FIFO message from its oldest sample).
+    span: Option<(u64, u64)>,
+    /// Data messages too short for their id: offset and length.
+    skipped: Vec<(u64, u64)>,
+    orphans: u64,
+    /// The latest record time before each of the part's dropouts, in order (0 for none).
+    dropout_latest: Vec<u64>,
+    /// The latest record time of the part (0 for none).
+    latest: u64,
+}
+
+/// Each dropout's time: the latest record time logged before it (0 before any), as the
+/// logger's `O` message has no time of its own.
+fn dropout_times(dropouts: &[(Option<usize>, u16)], counted: &[PartCount]) -> Vec<(u64, u16)> {
+    let before: Vec<u64> = counted
+        .iter()
+        .scan(0u64, |m, c| {
+            let b = *m;
+            *m = (*m).max(c.latest);
+            Some(b)
+        })
+        .collect();
+    let mut next = vec![0usize; counted.len()];
+    dropouts
+        .iter()
+        .map(|&(part, ms)| {
+            let t = part.map_or(0, |k| {
+                let i = next[k];
+                next[k] += 1;
+                before[k].max(counted[k].dropout_latest.get(i).copied().unwrap_or(0))
+            });
+            (t, ms)
+        })
+        .collect()
+}
+
+/// The messages from `start` to the window's end, each given to `on` with its offset, type
+/// and body: the hop and every part walk the messages the same way ([`step`]).
+fn walk(win: &Window, start: u64, appended_at: Option<u64>, on: &mut dyn FnMut(u64, u8, &[u8])) {
+    let mut at = start;
+    while at < win.len {
+        let (m_at, ty, size) = match step(win, at, appended_at) {
+            Step::Msg(a, t, n) => (a, t, n),
+            Step::Skip(a, n) => {
+                at = a + n;
+                continue;
+            }
+            Step::Cut(_) => break,
+        };
+        at = m_at + 3 + size as u64;
+        let Some(body) = win.get(m_at + 3, size as usize) else {
+            break;
+        };
+        on(m_at, ty, body);
+    }
 }
 
 fn corrupt(path: &Path, e: CursorError) -> Error {
@@ -863,6 +943,86 @@ impl crate::source::Source for UlogReader {
 }
 
 impl UlogReader {
+    /// A subscription (`A`) or its end (`R`) met walking a part: `subs` follows it (the
+    /// hop made every channel).
+    fn follow(&self, ty: u8, body: &[u8], subs: &mut Subs) {
+        match ty {
+            b'A' => {
+                if let Some((multi, id, name)) = subscription(body)
+                    && let Some(&ch) = self.by_key.get(&(name.to_string(), multi))
+                {
+                    subs[id as usize] = ch;
+                }
+            }
+            b'R' if body.len() >= 2 => {
+                subs[u16::from_le_bytes([body[0], body[1]]) as usize] = NO_CHANNEL;
+            }
+            _ => {}
+        }
+    }
+
+    /// The window, start and subscriptions of part `part`.
+    fn part_walk(&self, part: usize) -> Option<(Window<'_>, u64, Subs)> {
+        let p = self.parts.get(part)?;
+        let win = Window {
+            data: self.map.bytes(),
+            len: p.end,
+        };
+        Some((win, p.start, p.subs.clone()))
+    }
+
+    /// Counts part `part`'s data messages: rows per channel, the times spanned, orphans and
+    /// the latest time before each dropout.
+    fn count_part(&self, part: usize) -> PartCount {
+        let mut c = PartCount::default();
+        let Some((win, start, mut subs)) = self.part_walk(part) else {
+            return c;
+        };
+        walk(
+            &win,
+            start,
+            self.appended_at,
+            &mut |m_at, ty, body| match ty {
+                b'A' | b'R' => self.follow(ty, body, &mut subs),
+                b'O' if body.len() >= 2 => c.dropout_latest.push(c.latest),
+                b'D' if body.len() < 2 => c.skipped.push((m_at, body.len() as u64 + 3)),
+                b'D' => {
+                    let ch = subs[u16::from_le_bytes([body[0], body[1]]) as usize];
+                    let data = &body[2..];
+                    let Some(chan) = self.chans.get(ch as usize) else {
+                        c.orphans += 1;
+                        return;
+                    };
+                    let Some(t_us) = chan.ts.and_then(|s| s.get_u64(data)) else {
+                        c.orphans += 1;
+                        return;
+                    };
+                    let t = t_us.saturating_mul(1000);
+                    c.latest = c.latest.max(t);
+                    // a FIFO message is several rows, the oldest (n−1)·dt before its time
+                    let (rows, first) = match &chan.decoder {
+                        Some(d @ Decoder::Fifo { dt, .. }) => {
+                            let n = d.rows_in(data);
+                            let dt = dt.get(data).unwrap_or(0.0).max(0.0);
+                            (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
+                        }
+                        _ => (1, t),
+                    };
+                    if rows == 0 {
+                        return;
+                    }
+                    if c.counts.len() <= ch as usize {
+                        c.counts.resize(ch as usize + 1, 0);
+                    }
+                    c.counts[ch as usize] += rows;
+                    c.span = Some(c.span.map_or((first, t), |(a, b)| (a.min(first), b.max(t))));
+                }
+                _ => {}
+            },
+        );
+        c
+    }
+
     /// Walks part `part`, handing each message of a channel `want` accepts to `deliver`:
     /// its row for an IMU channel (a FIFO message gives several), `None` for another topic.
     fn walk_part(
@@ -872,76 +1032,41 @@ impl UlogReader {
         deliver: &mut dyn FnMut(u32, u64, Option<&Row>),
     ) -> crate::source::PartRead {
         let mut r = crate::source::PartRead::default();
-        let Some(p) = self.parts.get(part) else {
+        let Some((win, start, mut subs)) = self.part_walk(part) else {
             r.error = Some(format!("no part {part}"));
             return r;
         };
-        let win = Window {
-            data: self.map.bytes(),
-            len: p.end,
-        };
-        let mut subs = p.subs.clone();
-        let mut at = p.start;
-        while at < win.len {
-            let (m_at, ty, size) = match step(&win, at, self.appended_at) {
-                Step::Msg(a, t, n) => (a, t, n),
-                Step::Skip(a, n) => {
-                    at = a + n;
-                    continue;
+        walk(&win, start, self.appended_at, &mut |_, ty, body| match ty {
+            b'A' | b'R' => self.follow(ty, body, &mut subs),
+            b'D' if body.len() >= 2 => {
+                let ch = subs[u16::from_le_bytes([body[0], body[1]]) as usize];
+                if ch == NO_CHANNEL || !want(ch) {
+                    return;
                 }
-                Step::Cut(_) => break,
-            };
-            at = m_at + 3 + size as u64;
-            let Some(body) = win.get(m_at + 3, size as usize) else {
-                break;
-            };
-            match ty {
-                b'A' => {
-                    if let Some((multi, id, name)) = subscription(body)
-                        && let Some(&ch) = self.by_key.get(&(name.to_string(), multi))
-                    {
-                        subs[id as usize] = ch;
-                    }
-                }
-                b'R' if body.len() >= 2 => {
-                    subs[u16::from_le_bytes([body[0], body[1]]) as usize] = NO_CHANNEL;
-                }
-                b'D' if body.len() >= 2 => {
-                    let id = u16::from_le_bytes([body[0], body[1]]);
-                    let ch = subs[id as usize];
-                    if ch == NO_CHANNEL || !want(ch) {
-                        continue;
-                    }
-                    let data = &body[2..];
-                    let c = &self.chans[ch as usize];
-                    let Some(t_us) = c.ts.and_then(|s| s.get_u64(data)) else {
-                        continue;
-                    };
-                    let t = t_us.saturating_mul(1000);
-                    match &c.decoder {
-                        None => deliver(ch, t, None),
-                        Some(d) => match d.rows(t, data, &mut |rt, row| {
-                            deliver(ch, rt, Some(&row));
-                            r.delivered += 1;
-                        }) {
-                            Ok(()) => continue,
-                            Err(why) => {
-                                r.skipped += d.rows_in(data).max(1) as u64;
-                                r.skip_reason.get_or_insert_with(|| {
-                                    format!(
-                                        "'{}': {why}",
-                                        self.contents.channels[ch as usize].topic
-                                    )
-                                });
-                                continue;
-                            }
-                        },
-                    }
+                let data = &body[2..];
+                let c = &self.chans[ch as usize];
+                let Some(t_us) = c.ts.and_then(|s| s.get_u64(data)) else {
+                    return;
+                };
+                let t = t_us.saturating_mul(1000);
+                let Some(d) = &c.decoder else {
+                    deliver(ch, t, None);
                     r.delivered += 1;
+                    return;
+                };
+                let rows = d.rows(t, data, &mut |rt, row| {
+                    deliver(ch, rt, Some(&row));
+                    r.delivered += 1;
+                });
+                if let Err(why) = rows {
+                    r.skipped += d.rows_in(data).max(1) as u64;
+                    r.skip_reason.get_or_insert_with(|| {
+                        format!("'{}': {why}", self.contents.channels[ch as usize].topic)
+                    });
                 }
-                _ => {}
             }
-        }
+            _ => {}
+        });
         r
     }
 }
