@@ -4,7 +4,8 @@
 
 /// The binaries' allocator, so that the read is timed as the tools run it.
 #[global_allocator]
-static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new("read_log");
+static ALLOC: bag2mat::shared::alloc::ExitOnOom =
+    bag2mat::shared::alloc::ExitOnOom::new("read_log");
 
 fn main() -> anyhow::Result<()> {
     let path = std::env::args()

@@ -1,0 +1,510 @@
+//! A text log's body, a byte range at a time: plain lines in one pass ([`fast_row`]), any
+//! other line by the `csv` crate; each range straight into its slot of the columns.
+
+use super::layout::{Delim, Layout};
+use super::units::TimeUnit;
+use crate::decoded::Row;
+use crate::series::RowsMut;
+
+/// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
+pub(crate) fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {
+    let s = trim(s);
+    let mult = unit.nanos();
+    let (int, frac) = match s.iter().position(|&b| b == b'.') {
+        Some(p) => (&s[..p], &s[p + 1..]),
+        None => (s, &s[..0]),
+    };
+    let digits = |d: &[u8]| d.iter().all(u8::is_ascii_digit);
+    if !int.is_empty() && digits(int) && digits(frac) && int.len() <= 19 {
+        // 19 digits stay below u64::MAX (1.8e19)
+        let v = int.iter().fold(0u64, |v, &b| v * 10 + (b - b'0') as u64);
+        let mut ns = v.checked_mul(mult)?;
+        // the fraction, to the nanosecond (rounded half up)
+        let mut scale = mult;
+        let mut add = 0u64;
+        for (k, &b) in frac.iter().enumerate() {
+            let d = (b - b'0') as u64;
+            if scale >= 10 {
+                scale /= 10;
+                add += d * scale;
+            } else {
+                if d >= 5 && k < frac.len() {
+                    add += 1;
+                }
+                break;
+            }
+        }
+        ns = ns.checked_add(add)?;
+        return Some(ns);
+    }
+    let v: f64 = fast_float2::parse(s).ok()?;
+    let ns = v * mult as f64;
+    (ns.is_finite() && ns >= 0.0 && ns < u64::MAX as f64).then(|| ns.round() as u64)
+}
+
+pub(super) fn trim(s: &[u8]) -> &[u8] {
+    let a = s
+        .iter()
+        .position(|b| !b.is_ascii_whitespace() && *b != b'"')
+        .unwrap_or(s.len());
+    let b = s
+        .iter()
+        .rposition(|b| !b.is_ascii_whitespace() && *b != b'"')
+        .map_or(a, |p| p + 1);
+    &s[a..b.max(a)]
+}
+
+pub(super) fn num(s: &[u8]) -> Option<f64> {
+    fast_float2::parse(trim(s)).ok()
+}
+
+/// What one byte range of the body gave; its rows are written into its slot of the
+/// topic's columns.
+#[derive(Default)]
+pub(super) struct Chunk<'a> {
+    /// The range's rows: its slot of the columns, filled from the start.
+    pub(super) slot: RowsMut<'a>,
+    pub(super) got: Summary,
+}
+
+/// What a range gave besides its rows.
+#[derive(Default)]
+pub(super) struct Summary {
+    /// Rows in the slot.
+    pub(super) filled: usize,
+    /// Lines in the range (so later ranges know their line numbers).
+    pub(super) lines: u64,
+    pub(super) bad: u64,
+    /// Line (in the range, 1-based) and reason of the first malformed line.
+    pub(super) first_bad: Option<(u64, String)>,
+    /// A line the csv crate read held a quote: a quoted field may hold a line break, so the
+    /// file is read by the csv crate whole.
+    pub(super) quoted: bool,
+    /// The order of the range's stamps.
+    pub(super) order: Order,
+}
+
+/// How the stamps of a range follow each other: counts and first lines (in the range) of
+/// those that go backwards or repeat, and the range's first and last stamps (with the
+/// first one's line), for the check across ranges.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Order {
+    pub(super) first: Option<(u64, u64)>,
+    pub(super) last: Option<u64>,
+    pub(super) back: u64,
+    pub(super) first_back: Option<u64>,
+    pub(super) dup: u64,
+    pub(super) first_dup: Option<u64>,
+}
+
+impl Order {
+    pub(super) fn next(&mut self, line: u64, t: u64) {
+        match self.last {
+            None => self.first = Some((t, line)),
+            Some(p) if t < p => {
+                self.back += 1;
+                self.first_back.get_or_insert(line);
+            }
+            Some(p) if t == p => {
+                self.dup += 1;
+                self.first_dup.get_or_insert(line);
+            }
+            Some(_) => {}
+        }
+        self.last = Some(t);
+    }
+}
+
+/// The row of a record's fields (`get(i)`: field `i`), or why not. Without a time column
+/// the stamp is 0 and numbered later.
+pub(super) fn row_of<'f>(
+    lay: &Layout,
+    n_fields: usize,
+    get: impl Fn(usize) -> Option<&'f [u8]>,
+) -> Result<Row, String> {
+    let t = match lay.time {
+        Some(i) => {
+            let f =
+                get(i).ok_or_else(|| format!("{n_fields} fields, the time is field {}", i + 1))?;
+            parse_time_ns(f, lay.time_unit).ok_or_else(|| {
+                format!(
+                    "time '{}' is not a non-negative number",
+                    String::from_utf8_lossy(f)
+                )
+            })?
+        }
+        None => 0,
+    };
+    let three = |cols: Option<[usize; 3]>, si: f64| -> Result<[f64; 3], String> {
+        let Some(c) = cols else {
+            return Ok([f64::NAN; 3]);
+        };
+        let mut v = [0.0; 3];
+        for a in 0..3 {
+            let f = get(c[a])
+                .ok_or_else(|| format!("{n_fields} fields, expected at least {}", c[a] + 1))?;
+            v[a] = num(f).ok_or_else(|| {
+                format!(
+                    "field {} '{}' is not a number",
+                    c[a] + 1,
+                    String::from_utf8_lossy(f)
+                )
+            })? * si;
+        }
+        Ok(v)
+    };
+    let gyro = three(lay.gyro, lay.gyro_si)?;
+    let acc = three(lay.acc, lay.acc_si)?;
+    Ok(Row {
+        stamp: t,
+        acc,
+        gyro,
+    })
+}
+
+impl Chunk<'_> {
+    pub(super) fn take(&mut self, line: u64, r: Result<Row, String>) {
+        match r {
+            Ok(row) if self.got.filled < self.slot.cap() => {
+                self.slot.set_row(self.got.filled, row.stamp, &row);
+                self.got.filled += 1;
+                self.got.order.next(line, row.stamp);
+            }
+            Ok(_) => self.take(
+                line,
+                Err("more rows than lines in a range (a reader defect)".into()),
+            ),
+            Err(why) => {
+                self.got.bad += 1;
+                self.got.first_bad.get_or_insert((line, why));
+            }
+        }
+    }
+}
+
+/// Reads `text` with the `csv` crate (quoting, comments, flexible rows): for a range whose
+/// fields may be quoted, and for each line [`fast_row`] does not take.
+pub(super) fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) -> u64 {
+    let (delim, ws) = match lay.delim {
+        Delim::Byte(b) => (b, false),
+        Delim::Whitespace(b) => (b, true),
+    };
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(delim)
+        .comment(Some(b'#'))
+        .quoting(!ws)
+        .from_reader(text);
+    let mut rec = csv::ByteRecord::new();
+    // a record's line: the line of the last byte the reader took for it (the csv crate's own
+    // record position is where it started reading, before skipped comment and blank lines)
+    let (mut at, mut line) = (0usize, line0);
+    let mut line_of = |end: u64| {
+        let b = (end.saturating_sub(1) as usize).min(text.len()).max(at);
+        line += text[at..b].iter().filter(|&&c| c == b'\n').count() as u64;
+        at = b;
+        line
+    };
+    loop {
+        match rdr.read_byte_record(&mut rec) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => {
+                let line = line_of(rdr.position().byte());
+                out.got.bad += 1;
+                out.got.first_bad.get_or_insert((line, e.to_string()));
+                continue;
+            }
+        }
+        let line = line_of(rdr.position().byte());
+        // whitespace: runs of spaces and tabs separate fields
+        let ws_fields = || {
+            rec.iter()
+                .flat_map(|f| f.split(|&c| c == b'\t'))
+                .filter(|f| !f.is_empty())
+        };
+        let n_fields = if ws { ws_fields().count() } else { rec.len() };
+        if n_fields == 0 || n_fields == 1 && rec.get(0).is_some_and(|f| trim(f).is_empty()) {
+            continue; // blank line
+        }
+        let r = row_of(lay, n_fields, |i| {
+            if ws { ws_fields().nth(i) } else { rec.get(i) }
+        });
+        out.take(line, r);
+    }
+    let lines = text.iter().filter(|&&c| c == b'\n').count() as u64;
+    lines + u64::from(!text.is_empty() && !text.ends_with(b"\n"))
+}
+
+/// What a column of the fast path holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Col {
+    Skip,
+    Time,
+    Gyro(usize),
+    Acc(usize),
+}
+
+/// The columns of a layout, in file order, up to the last one read.
+pub(super) fn columns(lay: &Layout) -> Vec<Col> {
+    let mut c = Vec::new();
+    let mut set = |i: usize, v: Col| {
+        if c.len() <= i {
+            c.resize(i + 1, Col::Skip);
+        }
+        c[i] = v;
+    };
+    if let Some(i) = lay.time {
+        set(i, Col::Time);
+    }
+    for (k, &i) in lay.gyro.iter().flatten().enumerate() {
+        set(i, Col::Gyro(k));
+    }
+    for (k, &i) in lay.acc.iter().flatten().enumerate() {
+        set(i, Col::Acc(k));
+    }
+    c
+}
+
+/// One pass over a plain line (no quotes, no comment, every field where the layout says):
+/// the row and the bytes it took with its line end; `None` hands the line to the `csv`
+/// crate ([`parse_csv`]), which reads it or says why not. Trailing columns past the last
+/// one read are skipped.
+pub(super) fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
+    let ws = matches!(lay.delim, Delim::Whitespace(_));
+    let d = match lay.delim {
+        Delim::Byte(x) => x,
+        Delim::Whitespace(_) => b' ',
+    };
+    let blank = |c: u8| c == b' ' || c == b'\t';
+    let mut i = 0;
+    let mut row = Row {
+        stamp: 0,
+        acc: [f64::NAN; 3],
+        gyro: [f64::NAN; 3],
+    };
+    for (k, col) in cols.iter().enumerate() {
+        while i < b.len() && blank(b[i]) && (ws || d != b'\t') {
+            i += 1;
+        }
+        match col {
+            Col::Time => {
+                // an integer of up to 19 digits (EuRoC's ns) in one pass, else every form
+                let st = i;
+                let mut v = 0u64;
+                while i < b.len() && b[i].is_ascii_digit() && i - st < 19 {
+                    v = v * 10 + (b[i] - b'0') as u64;
+                    i += 1;
+                }
+                if i < b.len() && (b[i] == b'.' || b[i].is_ascii_digit()) || i == st {
+                    i = st
+                        + b[st..]
+                            .iter()
+                            .position(|&c| !(c.is_ascii_digit() || c == b'.'))
+                            .unwrap_or(b.len() - st);
+                    row.stamp = parse_time_ns(&b[st..i], lay.time_unit)?;
+                } else {
+                    row.stamp = v.checked_mul(lay.time_unit.nanos())?;
+                }
+            }
+            Col::Gyro(a) | Col::Acc(a) => {
+                let (v, n) = fast_float2::parse_partial::<f64, _>(&b[i..]).ok()?;
+                i += n;
+                match col {
+                    Col::Gyro(_) => row.gyro[*a] = v * lay.gyro_si,
+                    _ => row.acc[*a] = v * lay.acc_si,
+                }
+            }
+            Col::Skip => {
+                while i < b.len()
+                    && b[i] != d
+                    && b[i] != b'\n'
+                    && b[i] != b'\r'
+                    && !(ws && blank(b[i]))
+                {
+                    if b[i] == b'"' {
+                        return None;
+                    }
+                    i += 1;
+                }
+            }
+        }
+        while i < b.len() && blank(b[i]) && (ws || d != b'\t') {
+            i += 1;
+        }
+        let last = k + 1 == cols.len();
+        if !last {
+            if ws {
+                if i == 0 || !blank(b[i - 1]) {
+                    return None;
+                }
+            } else if b.get(i) == Some(&d) {
+                i += 1;
+            } else {
+                return None;
+            }
+        }
+    }
+    // the line end, straight after the last column read (the usual case)
+    match (b.get(i), b.get(i + 1)) {
+        (None, _) => return (i > 0).then_some((row, i)),
+        (Some(b'\n'), _) => return Some((row, i + 1)),
+        (Some(b'\r'), Some(b'\n')) => return Some((row, i + 2)),
+        _ => {}
+    }
+    // the rest of the line: further columns are skipped (no quote in them)
+    let rest = &b[i..];
+    let end = rest.iter().position(|&c| c == b'\n').unwrap_or(rest.len());
+    let tail = &rest[..end];
+    if !tail.is_empty() {
+        let t = tail.strip_suffix(b"\r").unwrap_or(tail);
+        let ok = t.is_empty() || (ws && blank(t[0])) || (!ws && t[0] == d);
+        if !ok || t.contains(&b'"') || t.contains(&b'#') {
+            return None;
+        }
+    }
+    let took = i + end + usize::from(end < rest.len());
+    (took > 0).then_some((row, took))
+}
+
+/// Parses the lines of `text` into `slot` (room for every line of it).
+pub(super) fn parse_range<'a>(
+    text: &[u8],
+    lay: &Layout,
+    quoted: bool,
+    slot: RowsMut<'a>,
+) -> Chunk<'a> {
+    let mut out = Chunk {
+        slot,
+        ..Chunk::default()
+    };
+    if quoted {
+        out.got.lines = parse_csv(text, lay, 1, &mut out);
+        return out;
+    }
+    let cols = columns(lay);
+    let mut pos = 0;
+    let mut line = 0u64;
+    while pos < text.len() {
+        line += 1;
+        let rest = &text[pos..];
+        if let Some((row, took)) = fast_row(rest, lay, &cols) {
+            out.take(line, Ok(row));
+            pos += took;
+            continue;
+        }
+        let end = rest
+            .iter()
+            .position(|&c| c == b'\n')
+            .map_or(rest.len(), |p| p + 1);
+        out.got.quoted |= rest[..end].contains(&b'"');
+        parse_csv(&rest[..end], lay, line, &mut out);
+        pos += end;
+    }
+    out.got.lines = line;
+    out
+}
+
+/// Rows a range of text can hold: one per line, as [`parse_range`] counts them.
+pub(super) fn room(text: &[u8]) -> usize {
+    memchr::memchr_iter(b'\n', text).count() + usize::from(text.last().is_some_and(|&c| c != b'\n'))
+}
+
+/// The lines of the body that start in `a..b` (file offsets): the range of `bytes` they
+/// take. Ranges that partition the body partition its lines.
+pub(super) fn line_range(bytes: &[u8], body: usize, (a, b): (usize, usize)) -> (usize, usize) {
+    // the first line start at or after offset x
+    let start_at = |x: usize| -> usize {
+        if x <= body {
+            return x;
+        }
+        if x >= bytes.len() {
+            return bytes.len();
+        }
+        bytes[x - 1..]
+            .iter()
+            .position(|&c| c == b'\n')
+            .map_or(bytes.len(), |p| x + p)
+    };
+    let e = start_at(b);
+    (start_at(a).min(e), e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::series::Rows;
+
+    /// The one-pass reader and the csv crate give the same rows, and the lines the one
+    /// pass does not take go to the csv crate.
+    #[test]
+    fn the_fast_path_reads_what_the_csv_crate_reads() {
+        let lay = |delim, time: Option<usize>| Layout {
+            delim,
+            time,
+            gyro: Some([1, 2, 3]),
+            acc: Some([5, 6, 7]),
+            time_unit: TimeUnit::Ns,
+            gyro_si: 0.5,
+            acc_si: 2.0,
+            gyro_stated: true,
+            acc_stated: true,
+            body: 0,
+            body_line: 1,
+            what: String::new(),
+            euroc: false,
+        };
+        let csv = "1,0.5,-1e-3,3,temp,1.25e2,-0,7,extra\r\n2, 0.25 ,2,3,x,4,5,6\n# comment\n\n3,1,2,3,\"q\",4,5,6\n4,1,2\n5,1,2,3,x,4,5,nan";
+        let ws = "  1   0.5 -1e-3\t3 t 1.25e2 -0 7\n2 1 2 3 x 4 5 6 9 9\n";
+        for (text, d) in [(csv, Delim::Byte(b',')), (ws, Delim::Whitespace(b' '))] {
+            let l = lay(d, Some(0));
+            let n = room(text.as_bytes());
+            let (mut fast_rows, mut slow_rows) = (Rows::zeroed(n), Rows::zeroed(n));
+            let fast = parse_range(text.as_bytes(), &l, false, fast_rows.split(&[n]).remove(0));
+            let mut slow = Chunk {
+                slot: slow_rows.split(&[n]).remove(0),
+                ..Chunk::default()
+            };
+            slow.got.lines = parse_csv(text.as_bytes(), &l, 1, &mut slow);
+            assert!(
+                fast.got.filled > 0 && fast.got.filled == slow.got.filled,
+                "{text:?}"
+            );
+            let (fo, so) = (fast.got.order, slow.got.order);
+            assert_eq!(
+                (fo.first, fo.last, fo.back, fo.dup),
+                (so.first, so.last, so.back, so.dup)
+            );
+            assert_eq!(
+                (fast.got.bad, fast.got.lines),
+                (slow.got.bad, slow.got.lines)
+            );
+            assert_eq!(fast.got.first_bad, slow.got.first_bad);
+            let filled = fast.got.filled;
+            drop((fast, slow));
+            for i in 0..filled {
+                let (a, b) = (fast_rows.row(i), slow_rows.row(i));
+                assert_eq!(format!("{a:?}"), format!("{b:?}"), "{text:?}");
+                assert_eq!(fast_rows.record_time[i], slow_rows.record_time[i]);
+            }
+        }
+    }
+
+    #[test]
+    fn times_keep_every_digit() {
+        assert_eq!(
+            parse_time_ns(b"1403636579758555392", TimeUnit::Ns),
+            Some(1403636579758555392)
+        );
+        assert_eq!(
+            parse_time_ns(b"1403636579.758555392", TimeUnit::S),
+            Some(1403636579758555392)
+        );
+        assert_eq!(parse_time_ns(b"12.5", TimeUnit::Ms), Some(12_500_000));
+        assert_eq!(parse_time_ns(b"0.0000000016", TimeUnit::S), Some(2));
+        assert_eq!(parse_time_ns(b"1e-3", TimeUnit::S), Some(1_000_000));
+        assert_eq!(parse_time_ns(b"-1", TimeUnit::S), None);
+        assert_eq!(parse_time_ns(b"abc", TimeUnit::S), None);
+    }
+}

@@ -1,0 +1,349 @@
+//! Delimited text logs: CSV, TSV, `;` or whitespace separated, with or without a header,
+//! with `#` comment lines — what microcontroller and phone loggers, `rostopic echo -p` and
+//! the EuRoC/ASL datasets (`#timestamp [ns],w_RS_S_x [rad s^-1],…`) write.
+//!
+//! Columns are found from the header by common names ([`role_of`]: `t`/`time`/`timestamp`,
+//! `gx`/`gyro_x`/`wx`/`w_RS_S_x`/…, `ax`/`acc_x`/`a_RS_S_x`/…) or given with `--columns`.
+//! Units come from the header (`[ns]`, `[rad s^-1]`, `(deg/s)`), bag2mat's own CSV layout
+//! (`t,ax,ay,az,wx,wy,wz`: s, m/s², rad/s), or the flags. Nothing is guessed: two columns
+//! for one role, a time column without a unit, or values that cannot be SI without a unit
+//! are errors that say what to add. A line that does not parse is skipped with a warning
+//! naming its line number and the count of such lines; past [`MAX_BAD_FRACTION`] of the
+//! lines the file is refused. Stamps that go backwards or repeat are reported.
+//!
+//! The body is read with the `csv` crate (one reader per byte range, in parallel) and the
+//! numbers with `fast-float2`; times are parsed as decimals straight to nanoseconds, so
+//! `1403636579.758555` s keeps every digit.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+mod body;
+mod layout;
+mod units;
+
+use super::InputOptions;
+use crate::RosTime;
+use crate::decoded::{DecodedSource, Row, Stream};
+use crate::error::Error;
+use crate::series::Rows;
+use crate::source::InputKind;
+pub(crate) use body::parse_time_ns;
+use body::{Summary, line_range, parse_range, room};
+use layout::{Delim, Layout, bad, layout};
+pub use units::{AccUnit, GyroUnit, TimeUnit};
+
+/// Bytes looked at to decide whether a file is text, and to find its header.
+pub const SNIFF_BYTES: usize = 64 * 1024;
+/// Lines that fail to parse beyond this fraction of the data lines (and beyond
+/// [`MIN_BAD_LIMIT`]) make the file an error rather than a log with a few damaged lines.
+pub const MAX_BAD_FRACTION: f64 = 0.01;
+/// Malformed lines always tolerated (with warnings), whatever the file's length.
+pub const MIN_BAD_LIMIT: u64 = 10;
+/// Standard gravity, m/s² (the `g` unit; CGPM 1901).
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+/// Bytes per parallel parse range.
+const RANGE_BYTES: usize = 4 << 20;
+/// Rows sampled for the unit plausibility checks.
+const PLAUSIBILITY_ROWS: usize = 4096;
+/// A gyroscope stated in no unit whose largest |value| exceeds this cannot be rad/s: 40
+/// rad/s is 2300 deg/s, beyond the range of common MEMS gyros (±2000 deg/s).
+pub const MAX_PLAUSIBLE_RAD_S: f64 = 40.0;
+/// An accelerometer stated in no unit whose median |a| lies in this band reads ≈1 at rest:
+/// it is in g, not m/s² (≈9.8 at rest).
+pub const G_LIKE_BAND: (f64, f64) = (0.3, 3.0);
+/// An accelerometer stated in no unit whose median |a| exceeds this (m/s², 20 g) is in mg
+/// or raw counts.
+pub const MAX_PLAUSIBLE_M_S2: f64 = 200.0;
+
+/// True when the first bytes of `path` are text (UTF-8, no control bytes but tab, CR, LF).
+pub(crate) fn looks_like_text(path: &Path) -> bool {
+    let Ok(head) = read_head(path) else {
+        return false;
+    };
+    if head.is_empty() {
+        return false;
+    }
+    let valid = match std::str::from_utf8(&head) {
+        Ok(_) => true,
+        // a multi-byte character cut by the sniff window
+        Err(e) => e.error_len().is_none() && head.len() == SNIFF_BYTES,
+    };
+    valid
+        && !head
+            .iter()
+            .any(|&b| b < 0x20 && b != b'\t' && b != b'\n' && b != b'\r')
+}
+
+fn read_head(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut v = Vec::with_capacity(SNIFF_BYTES);
+    std::fs::File::open(path)?
+        .take(SNIFF_BYTES as u64)
+        .read_to_end(&mut v)?;
+    Ok(v)
+}
+
+/// A parsed text log: one stream, and what reading it found.
+pub struct Parsed {
+    /// The samples: the topic's stream.
+    pub streams: Vec<Stream>,
+    /// Notes (units assumed, stamps out of order, malformed lines).
+    pub notes: Vec<String>,
+    /// True when the header is EuRoC/ASL's.
+    pub euroc: bool,
+}
+
+/// Parses the text log at `path` into a stream named `topic`.
+pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
+    let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    let map = crate::mapped::Mapped::of(&file, path)?;
+    let bytes = map.bytes();
+    let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
+    let lay = layout(path, head, bytes.len() as u64, opts)?;
+    let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
+    let (mut rows, chunks) = read_body(bytes, &lay);
+    // the 1-based line number of each range's first line
+    let line_starts: Vec<u64> = chunks
+        .iter()
+        .scan(lay.body_line, |l, c| {
+            let first = *l;
+            *l += c.lines;
+            Some(first)
+        })
+        .collect();
+    let mut notes = Vec::new();
+    notes.extend(malformed_lines(path, &chunks, &line_starts)?);
+    if lay.time.is_none() {
+        // no time column: the rows are numbered at the given rate
+        let rate = opts.rate.unwrap_or(1.0);
+        for (k, (r, s)) in rows.record_time.iter_mut().zip(&mut rows.stamp).enumerate() {
+            let t = RosTime::from_nanos((k as f64 * 1e9 / rate).round() as u64);
+            (*r, *s) = (t, t);
+        }
+    } else {
+        notes.extend(stamp_order(&chunks, &line_starts));
+    }
+    check_plausible(path, &lay, &rows)?;
+    let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
+    if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
+        notes.push(format!("{}: {}", path.display(), lay.what));
+    }
+    if lay.gyro.is_none() {
+        notes.push(format!(
+            "'{topic}' has no gyroscope columns: its gyro values are NaN"
+        ));
+    }
+    if lay.acc.is_none() {
+        notes.push(format!(
+            "'{topic}' has no accelerometer columns: its acc values are NaN"
+        ));
+    }
+    Ok(Parsed {
+        streams: vec![Stream::of_rows(topic, msg_type, rows)],
+        notes,
+        euroc: lay.euroc,
+    })
+}
+
+/// The body of a file (`bytes`, laid out as `lay` says) in ranges parsed in parallel, each
+/// straight into its slot of the topic's columns (room for one row per line: no copy of
+/// the file nor of the rows), and what each range found. A quoted field may hold a line
+/// break: a file whose lines hold quotes is read by the csv crate whole instead.
+fn read_body(bytes: &[u8], lay: &Layout) -> (Rows, Vec<Summary>) {
+    let ranges: Vec<&[u8]> = (lay.body..bytes.len())
+        .step_by(RANGE_BYTES)
+        .map(|a| {
+            let (s, e) = line_range(bytes, lay.body, (a, (a + RANGE_BYTES).min(bytes.len())));
+            &bytes[s..e]
+        })
+        .collect();
+    let parse_into = |ranges: &[&[u8]], quoted: bool| {
+        let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
+        let mut rows = Rows::zeroed(room.iter().sum());
+        let got: Vec<Summary> = ranges
+            .par_iter()
+            .zip(rows.split(&room))
+            .map(|(r, slot)| parse_range(r, lay, quoted, slot).got)
+            .collect();
+        // the rows of each range follow those of the ranges before it
+        let mut n = 0;
+        for (g, at) in got.iter().zip(room.iter().scan(0, |a, r| {
+            *a += r;
+            Some(*a - r)
+        })) {
+            if at != n {
+                rows.move_down(at, g.filled, n);
+            }
+            n += g.filled;
+        }
+        rows.truncate(n);
+        (rows, got)
+    };
+    let (rows, chunks) = parse_into(&ranges, false);
+    if chunks.iter().any(|c| c.quoted) && !matches!(lay.delim, Delim::Whitespace(_)) {
+        return parse_into(&[&bytes[lay.body..]], true);
+    }
+    (rows, chunks)
+}
+
+/// The note on malformed lines (their count and the first, by its line number), or the
+/// error when more than [`MAX_BAD_FRACTION`] of the lines are malformed.
+fn malformed_lines(
+    path: &Path,
+    chunks: &[Summary],
+    line_starts: &[u64],
+) -> Result<Option<String>, Error> {
+    let total_bad: u64 = chunks.iter().map(|c| c.bad).sum();
+    if total_bad == 0 {
+        return Ok(None);
+    }
+    let total_lines: u64 = chunks.iter().map(|c| c.lines).sum();
+    let (l, why) = chunks
+        .iter()
+        .zip(line_starts)
+        .find_map(|(c, l0)| {
+            c.first_bad
+                .as_ref()
+                .map(|(l, why)| (l0 + l - 1, why.clone()))
+        })
+        .unwrap_or((0, String::new()));
+    let limit = MIN_BAD_LIMIT.max((MAX_BAD_FRACTION * total_lines as f64) as u64);
+    let msg = format!(
+        "{total_bad} malformed line{} skipped (first: line {l}: {why})",
+        if total_bad == 1 { "" } else { "s" }
+    );
+    if total_bad > limit {
+        return Err(Error::Log {
+            path: path.to_path_buf(),
+            what: format!(
+                "{msg}: more than {limit} of its {total_lines} lines ({}%) do not parse; check the delimiter and --columns",
+                MAX_BAD_FRACTION * 100.0
+            ),
+        });
+    }
+    Ok(Some(msg))
+}
+
+/// The notes on stamps that go backwards or repeat, with the line of the first of each,
+/// within the ranges and across their borders.
+fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<String> {
+    let (mut back, mut dup) = (0u64, 0u64);
+    let (mut first_back, mut first_dup) = (None, None);
+    let mut prev: Option<u64> = None;
+    for (c, l0) in chunks.iter().zip(line_starts) {
+        let o = &c.order;
+        let at = |l: u64| l0 + l - 1;
+        if let (Some(p), Some((t, l))) = (prev, o.first) {
+            if t < p {
+                back += 1;
+                first_back.get_or_insert(at(l));
+            } else if t == p {
+                dup += 1;
+                first_dup.get_or_insert(at(l));
+            }
+        }
+        back += o.back;
+        dup += o.dup;
+        if let Some(l) = o.first_back {
+            first_back.get_or_insert(at(l));
+        }
+        if let Some(l) = o.first_dup {
+            first_dup.get_or_insert(at(l));
+        }
+        prev = o.last.or(prev);
+    }
+    let mut notes = Vec::new();
+    if back > 0 {
+        notes.push(format!(
+            "{back} time stamp{} backwards (first at line {})",
+            if back == 1 { " goes" } else { "s go" },
+            first_back.unwrap_or(0)
+        ));
+    }
+    if dup > 0 {
+        notes.push(format!(
+            "{dup} time stamp{} the one before (first at line {}); the rows are kept",
+            if dup == 1 { " repeats" } else { "s repeat" },
+            first_dup.unwrap_or(0)
+        ));
+    }
+    notes
+}
+
+/// Values stated in no unit must be plausible in SI: else the error says which unit to add.
+fn check_plausible(path: &Path, lay: &Layout, rows: &Rows) -> Result<(), Error> {
+    let n = rows.len();
+    let step = (n / PLAUSIBILITY_ROWS).max(1);
+    let sample: Vec<Row> = (0..n).step_by(step).map(|i| rows.row(i)).collect();
+    if sample.is_empty() {
+        return Ok(());
+    }
+    if lay.gyro.is_some() && !lay.gyro_stated {
+        let m = sample
+            .iter()
+            .flat_map(|r| r.gyro)
+            .map(f64::abs)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        if m > MAX_PLAUSIBLE_RAD_S {
+            return Err(bad(
+                path,
+                format!(
+                    "the gyroscope columns state no unit and reach {m}, which is not rad/s (beyond {MAX_PLAUSIBLE_RAD_S}): give --gyro-unit deg/s, or --gyro-scale LSB with --gyro-unit for raw counts"
+                ),
+            ));
+        }
+    }
+    if lay.acc.is_some() && !lay.acc_stated {
+        let mut mags: Vec<f64> = sample
+            .iter()
+            .map(|r| (r.acc[0] * r.acc[0] + r.acc[1] * r.acc[1] + r.acc[2] * r.acc[2]).sqrt())
+            .filter(|v| v.is_finite())
+            .collect();
+        if !mags.is_empty() {
+            let k = mags.len() / 2;
+            let m = *mags.select_nth_unstable_by(k, f64::total_cmp).1;
+            if m > G_LIKE_BAND.0 && m < G_LIKE_BAND.1 {
+                return Err(bad(
+                    path,
+                    format!(
+                        "the accelerometer columns state no unit and their median magnitude is {m:.4}, about 1 g, not m/s^2 (9.8 at rest): give --acc-unit g (or --acc-unit m/s^2 if that is right)"
+                    ),
+                ));
+            }
+            if m > MAX_PLAUSIBLE_M_S2 {
+                return Err(bad(
+                    path,
+                    format!(
+                        "the accelerometer columns state no unit and their median magnitude is {m:.1}, not m/s^2: give --acc-unit mg, or --acc-scale LSB with --acc-unit for raw counts"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Opens a text log: one topic, `imu`.
+pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
+    // a data.csv in an EuRoC imuN folder is that folder's topic, with its sensor.yaml
+    if let Some(dir) = path.parent()
+        && path.file_name().is_some_and(|n| n == "data.csv")
+        && super::euroc::is_imu_folder(dir)
+    {
+        return super::euroc::open_files(
+            vec![(super::euroc::folder_topic(dir), PathBuf::from(path))],
+            opts,
+        );
+    }
+    let p = parse(path, "imu", opts)?;
+    Ok(DecodedSource::new(
+        InputKind::Text,
+        p.streams,
+        p.notes,
+        Vec::new(),
+    ))
+}
