@@ -484,12 +484,48 @@ impl BagReader {
         &mut self,
         walk: Walk,
         index_conns: Vec<Connection>,
-        mut infos: Vec<ChunkInfo>,
+        infos: Vec<ChunkInfo>,
         chunk_count: Option<u32>,
     ) {
         let had_index = !infos.is_empty() || !index_conns.is_empty();
         let mut chunks: BTreeMap<u64, ChunkLoc> =
             walk.chunks.into_iter().map(|c| (c.pos, c)).collect();
+        let unlisted = self.join_chunk_infos(&mut chunks, infos);
+        if had_index && !unlisted.is_empty() {
+            self.contents.notes.push(format!(
+                "{} chunk(s) are not listed in the bag's index (first at byte {}); they were read",
+                unlisted.len(),
+                unlisted.iter().next().copied().unwrap_or(0)
+            ));
+        }
+        if let Some(n) = chunk_count
+            && had_index
+            && n as usize != chunks.len()
+        {
+            self.contents.notes.push(format!(
+                "the bag header announces {n} chunks; {} were found",
+                chunks.len()
+            ));
+        }
+        self.chunks = chunks.into_values().collect();
+        let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
+        for c in index_conns.into_iter().chain(walk.connections) {
+            connections.entry(c.id).or_insert(c);
+        }
+        self.scan_chunks(&mut connections, had_index);
+        self.index.connections = connections.into_values().collect();
+        self.index.chunk_count = self.chunks.len();
+        self.index.indexed = had_index;
+    }
+
+    /// Gives the walk's chunks the counts and times of their chunk infos (sorted by chunk
+    /// position), reads the chunks only the index knows, and returns the positions of the
+    /// chunks no info lists.
+    fn join_chunk_infos(
+        &mut self,
+        chunks: &mut BTreeMap<u64, ChunkLoc>,
+        mut infos: Vec<ChunkInfo>,
+    ) -> BTreeSet<u64> {
         infos.sort_by_key(|i| i.chunk_pos);
         let mut unlisted: BTreeSet<u64> = chunks.keys().copied().collect();
         for info in infos {
@@ -516,65 +552,52 @@ impl BagReader {
                     "two chunk infos name the chunk at byte {}; the chunk is read once",
                     info.chunk_pos
                 )),
-                None => {
-                    // Not seen by the walk (it stopped early): read it if it is a chunk.
-                    let ok = self
-                        .record_at(info.chunk_pos, self.len)
-                        .and_then(|(hb, _, dlen)| {
-                            let h = Header::parse(&hb).ok()?;
-                            (h.op().ok()? == Op::Chunk).then_some(dlen)
-                        });
-                    match ok {
-                        Some(dlen) => {
-                            chunks.insert(
-                                info.chunk_pos,
-                                ChunkLoc {
-                                    pos: info.chunk_pos,
-                                    stored: Some(dlen as u64),
-                                    size: None,
-                                    index_data: BTreeMap::new(),
-                                    info_counts: Some(info.counts),
-                                    span: Some((info.start_time, info.end_time)),
-                                },
-                            );
-                        }
-                        None => self.contents.losses.push(Loss {
-                            what: format!(
-                                "the index lists a chunk at byte {} that holds no chunk record",
-                                info.chunk_pos
-                            ),
-                            messages: Some(info.counts.iter().map(|&(_, n)| n as u64).sum()),
-                            span: Some((info.start_time.as_nanos(), info.end_time.as_nanos())),
-                            channel: None,
-                            ..Loss::default()
-                        }),
-                    }
-                }
+                None => self.unwalked_chunk(chunks, info),
             }
         }
-        if had_index && !unlisted.is_empty() {
-            self.contents.notes.push(format!(
-                "{} chunk(s) are not listed in the bag's index (first at byte {}); they were read",
-                unlisted.len(),
-                unlisted.iter().next().copied().unwrap_or(0)
-            ));
+        unlisted
+    }
+
+    /// A chunk the index lists and the walk did not reach (it stopped early): read if it is
+    /// a chunk, else a loss of the messages its info counts.
+    fn unwalked_chunk(&mut self, chunks: &mut BTreeMap<u64, ChunkLoc>, info: ChunkInfo) {
+        let ok = self
+            .record_at(info.chunk_pos, self.len)
+            .and_then(|(hb, _, dlen)| {
+                let h = Header::parse(&hb).ok()?;
+                (h.op().ok()? == Op::Chunk).then_some(dlen)
+            });
+        match ok {
+            Some(dlen) => {
+                chunks.insert(
+                    info.chunk_pos,
+                    ChunkLoc {
+                        pos: info.chunk_pos,
+                        stored: Some(dlen as u64),
+                        size: None,
+                        index_data: BTreeMap::new(),
+                        info_counts: Some(info.counts),
+                        span: Some((info.start_time, info.end_time)),
+                    },
+                );
+            }
+            None => self.contents.losses.push(Loss {
+                what: format!(
+                    "the index lists a chunk at byte {} that holds no chunk record",
+                    info.chunk_pos
+                ),
+                messages: Some(info.counts.iter().map(|&(_, n)| n as u64).sum()),
+                span: Some((info.start_time.as_nanos(), info.end_time.as_nanos())),
+                channel: None,
+                ..Loss::default()
+            }),
         }
-        if let Some(n) = chunk_count
-            && had_index
-            && n as usize != chunks.len()
-        {
-            self.contents.notes.push(format!(
-                "the bag header announces {n} chunks; {} were found",
-                chunks.len()
-            ));
-        }
-        self.chunks = chunks.into_values().collect();
-        let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
-        for c in index_conns.into_iter().chain(walk.connections) {
-            connections.entry(c.id).or_insert(c);
-        }
-        // Connections the chunks use but no readable record outside them describes: rosbag
-        // also writes each connection record inside the first chunk that uses it.
+    }
+
+    /// Reads the chunks whose connections or counts nothing outside them gives: the
+    /// connection records inside them (rosbag also writes each connection record inside
+    /// the first chunk that uses it) and, for a chunk without any index, its message count.
+    fn scan_chunks(&mut self, connections: &mut BTreeMap<u32, Connection>, had_index: bool) {
         let referenced: BTreeSet<u32> = self
             .chunks
             .iter()
@@ -587,49 +610,46 @@ impl BagReader {
             })
             .collect();
         let unknown = |m: &BTreeMap<u32, Connection>| referenced.iter().any(|k| !m.contains_key(k));
-        if !had_index || unknown(&connections) || self.chunks.iter().any(|c| c.promised().is_none())
+        if had_index && !unknown(connections) && self.chunks.iter().all(|c| c.promised().is_some())
         {
-            for i in 0..self.chunks.len() {
-                let needs_count = self.chunks[i].promised().is_none();
-                if !needs_count && !unknown(&connections) && had_index {
-                    continue;
-                }
-                let pos = self.chunks[i].pos;
-                let mut found = Vec::new();
-                let mut counts: BTreeMap<u32, u64> = BTreeMap::new();
-                let r = self.with_chunk_body(pos, |body| {
-                    walk_body(body, &Vec::new, &mut |rec| match rec {
-                        BodyRecord::Connection(hb, data) => {
-                            if let Ok(c) =
-                                Header::parse(hb).and_then(|h| Connection::decode(&h, data))
-                            {
-                                found.push(c);
-                            }
+            return;
+        }
+        for i in 0..self.chunks.len() {
+            let needs_count = self.chunks[i].promised().is_none();
+            if !needs_count && !unknown(connections) && had_index {
+                continue;
+            }
+            let pos = self.chunks[i].pos;
+            let mut found = Vec::new();
+            let mut counts: BTreeMap<u32, u64> = BTreeMap::new();
+            let r = self.with_chunk_body(pos, |body| {
+                walk_body(body, &Vec::new, &mut |rec| match rec {
+                    BodyRecord::Connection(hb, data) => {
+                        if let Ok(c) = Header::parse(hb).and_then(|h| Connection::decode(&h, data))
+                        {
+                            found.push(c);
                         }
-                        BodyRecord::Message(c, ..) => *counts.entry(c).or_default() += 1,
-                    });
-                    Ok(())
+                    }
+                    BodyRecord::Message(c, ..) => *counts.entry(c).or_default() += 1,
                 });
-                if r.is_err() {
-                    continue;
-                }
-                for c in found {
-                    connections.entry(c.id).or_insert(c);
-                }
-                if needs_count {
-                    // Counted by reading: the scan's count stands in for the missing index.
-                    self.chunks[i].info_counts = Some(
-                        counts
-                            .into_iter()
-                            .map(|(k, n)| (k, n.min(u32::MAX as u64) as u32))
-                            .collect(),
-                    );
-                }
+                Ok(())
+            });
+            if r.is_err() {
+                continue;
+            }
+            for c in found {
+                connections.entry(c.id).or_insert(c);
+            }
+            if needs_count {
+                // Counted by reading: the scan's count stands in for the missing index.
+                self.chunks[i].info_counts = Some(
+                    counts
+                        .into_iter()
+                        .map(|(k, n)| (k, n.min(u32::MAX as u64) as u32))
+                        .collect(),
+                );
             }
         }
-        self.index.connections = connections.into_values().collect();
-        self.index.chunk_count = self.chunks.len();
-        self.index.indexed = had_index;
     }
 
     fn bytes_at(&self, pos: u64, len: u32) -> Result<Vec<u8>, Error> {

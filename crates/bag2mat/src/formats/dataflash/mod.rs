@@ -143,11 +143,61 @@ pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
 
 /// Reads a DataFlash log held in memory.
 pub(crate) fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
-    let mut defs: HashMap<u8, Def> = HashMap::new();
-    let mut streams: Vec<Stream> = Vec::new();
-    let mut by_key: HashMap<(String, u32), usize> = HashMap::new();
-    let mut stream_of = |streams: &mut Vec<Stream>, name: &str, k: u32, imu: bool| -> usize {
-        *by_key.entry((name.to_string(), k)).or_insert_with(|| {
+    let mut r = Reader::default();
+    let mut i = 0usize;
+    let mut in_skip = false;
+    while i + 3 <= bytes.len() {
+        let ty = bytes[i + 2];
+        let len = match (bytes[i..i + 2] == HEAD, ty == FMT_TYPE, r.defs.get(&ty)) {
+            (true, true, _) => Some(FMT_LEN),
+            (true, false, Some(d)) => Some(d.len),
+            _ => None,
+        };
+        let Some(len) = len else {
+            // no message here: skip a byte, counting the stretch once
+            if !in_skip {
+                r.skip_runs += 1;
+                r.first_skip.get_or_insert(i);
+                in_skip = true;
+            }
+            r.skipped += 1;
+            i += 1;
+            continue;
+        };
+        if i + len > bytes.len() {
+            r.truncated = Some(i);
+            break;
+        }
+        in_skip = false;
+        r.message(ty, &bytes[i + 3..i + len]);
+        i += len;
+    }
+    r.finish(path)
+}
+
+/// What reading a log has gathered: the definitions, the topics, open batches and what was
+/// lost.
+#[derive(Default)]
+struct Reader {
+    defs: HashMap<u8, Def>,
+    streams: Vec<Stream>,
+    by_key: HashMap<(String, u32), usize>,
+    batches: HashMap<u16, Batch>,
+    /// Bytes skipped, the stretches they form, and the first one's offset.
+    skipped: u64,
+    skip_runs: u64,
+    first_skip: Option<usize>,
+    orphan_isbd: u64,
+    short_batches: u64,
+    short_samples: u64,
+    truncated: Option<usize>,
+}
+
+impl Reader {
+    /// The stream of topic `name` instance `k`, made at its first message.
+    fn stream(&mut self, name: &str, k: u32, imu: bool) -> usize {
+        let streams = &mut self.streams;
+        *self.by_key.entry((name.to_string(), k)).or_insert_with(|| {
             let topic = format!("{name}:{k}");
             let ty = format!("ardupilot/{name}");
             streams.push(if imu {
@@ -157,228 +207,216 @@ pub(crate) fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
             });
             streams.len() - 1
         })
-    };
-    let mut batches: HashMap<u16, Batch> = HashMap::new();
-    let (mut skipped, mut skip_runs, mut first_skip) = (0u64, 0u64, None);
-    let (mut orphan_isbd, mut short_batches, mut short_samples) = (0u64, 0u64, 0u64);
-    let mut truncated: Option<usize> = None;
-    let mut i = 0usize;
-    let mut in_skip = false;
-    let finish = |b: &Batch, short: &mut u64, samples: &mut u64| {
+    }
+
+    /// A batch that is complete or replaced: counted when it holds fewer samples than its
+    /// header promised.
+    fn close(&mut self, b: &Batch) {
         if b.got < b.count {
-            *short += 1;
-            *samples += (b.count - b.got) as u64;
+            self.short_batches += 1;
+            self.short_samples += (b.count - b.got) as u64;
         }
-    };
-    while i + 3 <= bytes.len() {
-        let ty = bytes[i + 2];
-        let len = match (bytes[i..i + 2] == HEAD, ty == FMT_TYPE, defs.get(&ty)) {
-            (true, true, _) => Some(FMT_LEN),
-            (true, false, Some(d)) => Some(d.len),
-            _ => None,
-        };
-        let Some(len) = len else {
-            // no message here: skip a byte, counting the stretch once
-            if !in_skip {
-                skip_runs += 1;
-                first_skip.get_or_insert(i);
-                in_skip = true;
-            }
-            skipped += 1;
-            i += 1;
-            continue;
-        };
-        if i + len > bytes.len() {
-            truncated = Some(i);
-            break;
-        }
-        in_skip = false;
-        let p = &bytes[i + 3..i + len];
-        i += len;
+    }
+
+    /// One message of type `ty`, payload `p`.
+    fn message(&mut self, ty: u8, p: &[u8]) {
         if ty == FMT_TYPE {
-            let mut c = Cursor::new(p);
-            let parsed = (|| -> Option<(u8, usize, String, String, String)> {
-                let t = c.le::<u8>("type").ok()?;
-                let l = c.le::<u8>("length").ok()? as usize;
-                let text = |c: &mut Cursor, n| -> Option<String> {
-                    let b = c.take(n, "text").ok()?;
-                    let b = &b[..b.iter().position(|&x| x == 0).unwrap_or(b.len())];
-                    Some(String::from_utf8_lossy(b).into_owned())
-                };
-                Some((t, l, text(&mut c, 4)?, text(&mut c, 16)?, text(&mut c, 64)?))
-            })();
-            if let Some((t, l, name, fmt, cols)) = parsed
-                && t != FMT_TYPE
-                && let Some(d) = Def::parse(&name, &fmt, &cols, l)
-            {
-                defs.insert(t, d);
-            }
-            continue;
+            self.format(p);
+            return;
         }
-        let Some(d) = defs.get(&ty) else { continue };
-        let t_us = if d.time { d.get_u64(p, "TimeUS") } else { None };
-        match d.name.as_str() {
-            name @ ("IMU" | "IMU2" | "IMU3") => {
-                let k = match d.get(p, "I") {
-                    Some(k) => k as u32,
-                    None => match name {
-                        "IMU2" => 1,
-                        "IMU3" => 2,
-                        _ => 0,
-                    },
-                };
-                let (Some(t), Some(row)) = (
-                    t_us,
-                    (|| {
-                        Some(Row {
-                            stamp: 0,
-                            gyro: [d.get(p, "GyrX")?, d.get(p, "GyrY")?, d.get(p, "GyrZ")?],
-                            acc: [d.get(p, "AccX")?, d.get(p, "AccY")?, d.get(p, "AccZ")?],
-                        })
-                    })(),
-                ) else {
-                    continue;
-                };
-                let s = stream_of(&mut streams, "IMU", k, true);
-                let t = t.saturating_mul(1000);
-                streams[s].push(t, &Row { stamp: t, ..row });
-            }
-            "ISBH" => {
-                let h = (|| {
-                    Some((
-                        d.get(p, "N")? as u16,
-                        d.get(p, "type")? as u8,
-                        d.get(p, "instance")? as u32,
-                        d.get(p, "mul")?,
-                        d.get(p, "smp_cnt")? as usize,
-                        d.get_u64(p, "SampleUS")?,
-                        d.get(p, "smp_rate")?,
-                    ))
-                })();
-                let Some((n, kind, inst, mul, count, start_us, rate)) = h else {
-                    continue;
-                };
-                let gyro = kind == 1;
-                let s = stream_of(
-                    &mut streams,
-                    if gyro { "ISB_GYR" } else { "ISB_ACC" },
-                    inst,
-                    true,
-                );
-                if let Some(old) = batches.insert(
-                    n,
-                    Batch {
-                        stream: s,
-                        mul,
-                        count,
-                        start_us,
-                        rate,
-                        gyro,
-                        got: 0,
-                    },
-                ) {
-                    finish(&old, &mut short_batches, &mut short_samples);
-                }
-            }
-            "ISBD" => {
-                let (Some(n), Some(seq)) = (d.get(p, "N"), d.get(p, "seqno")) else {
-                    continue;
-                };
-                let Some(b) = batches.get_mut(&(n as u16)) else {
-                    orphan_isbd += 1;
-                    continue;
-                };
-                let (Some(x), Some(y), Some(z)) =
-                    (d.array(p, "x"), d.array(p, "y"), d.array(p, "z"))
-                else {
-                    continue;
-                };
-                if !(b.mul > 0.0 && b.rate > 0.0) {
-                    continue;
-                }
-                for k in 0..ISBD_SAMPLES {
-                    let j = seq as usize * ISBD_SAMPLES + k;
-                    if j >= b.count {
-                        break;
+        // the definitions are only read here: out of `self` for the call (no copy)
+        let defs = std::mem::take(&mut self.defs);
+        if let Some(d) = defs.get(&ty) {
+            let t_us = if d.time { d.get_u64(p, "TimeUS") } else { None };
+            match d.name.as_str() {
+                name @ ("IMU" | "IMU2" | "IMU3") => self.imu(d, p, name, t_us),
+                "ISBH" => self.batch_header(d, p),
+                "ISBD" => self.batch_data(d, p),
+                name => {
+                    if let Some(t) = t_us {
+                        let s = self.stream(name, 0, false);
+                        self.streams[s].push_time(t.saturating_mul(1000));
                     }
-                    let t = b
-                        .start_us
-                        .saturating_mul(1000)
-                        .saturating_add((j as f64 * 1e9 / b.rate).round() as u64);
-                    let v = [
-                        x[k] as f64 / b.mul,
-                        y[k] as f64 / b.mul,
-                        z[k] as f64 / b.mul,
-                    ];
-                    let nan = [f64::NAN; 3];
-                    let row = if b.gyro {
-                        Row {
-                            stamp: t,
-                            gyro: v,
-                            acc: nan,
-                        }
-                    } else {
-                        Row {
-                            stamp: t,
-                            gyro: nan,
-                            acc: v,
-                        }
-                    };
-                    streams[b.stream].push(t, &row);
-                    b.got += 1;
-                }
-            }
-            name => {
-                if let Some(t) = t_us {
-                    let s = stream_of(&mut streams, name, 0, false);
-                    streams[s].push_time(t.saturating_mul(1000));
                 }
             }
         }
+        self.defs = defs;
     }
-    for b in batches.values() {
-        finish(b, &mut short_batches, &mut short_samples);
+
+    /// An `FMT` message: a definition (one that redefines `FMT` itself is ignored).
+    fn format(&mut self, p: &[u8]) {
+        let mut c = Cursor::new(p);
+        let parsed = (|| -> Option<(u8, usize, String, String, String)> {
+            let t = c.le::<u8>("type").ok()?;
+            let l = c.le::<u8>("length").ok()? as usize;
+            let text = |c: &mut Cursor, n| -> Option<String> {
+                let b = c.take(n, "text").ok()?;
+                let b = &b[..b.iter().position(|&x| x == 0).unwrap_or(b.len())];
+                Some(String::from_utf8_lossy(b).into_owned())
+            };
+            Some((t, l, text(&mut c, 4)?, text(&mut c, 16)?, text(&mut c, 64)?))
+        })();
+        if let Some((t, l, name, fmt, cols)) = parsed
+            && t != FMT_TYPE
+            && let Some(d) = Def::parse(&name, &fmt, &cols, l)
+        {
+            self.defs.insert(t, d);
+        }
     }
-    if defs.is_empty() {
-        return Err(Error::Corrupt {
-            path: path.to_path_buf(),
-            offset: 0,
-            what: "DataFlash: no FMT message could be read".into(),
-        });
+
+    /// An `IMU` (`IMU2`, `IMU3`) message: a row of its instance's topic.
+    fn imu(&mut self, d: &Def, p: &[u8], name: &str, t_us: Option<u64>) {
+        let k = match d.get(p, "I") {
+            Some(k) => k as u32,
+            None => match name {
+                "IMU2" => 1,
+                "IMU3" => 2,
+                _ => 0,
+            },
+        };
+        let row = || {
+            Some(Row {
+                stamp: 0,
+                gyro: [d.get(p, "GyrX")?, d.get(p, "GyrY")?, d.get(p, "GyrZ")?],
+                acc: [d.get(p, "AccX")?, d.get(p, "AccY")?, d.get(p, "AccZ")?],
+            })
+        };
+        let (Some(t), Some(row)) = (t_us, row()) else {
+            return;
+        };
+        let s = self.stream("IMU", k, true);
+        let t = t.saturating_mul(1000);
+        self.streams[s].push(t, &Row { stamp: t, ..row });
     }
-    super::instance_topics(streams.iter_mut().map(|s| &mut s.topic));
-    let mut losses = Vec::new();
-    let mut notes = Vec::new();
-    if skipped > 0 {
-        losses.push(Loss::new(format!(
-            "{skipped} bytes in {skip_runs} stretch{} are no DataFlash message and were skipped to the next header (first at byte {})",
-            if skip_runs == 1 { "" } else { "es" },
-            first_skip.unwrap_or(0)
-        )));
+
+    /// An `ISBH` batch header: opens its batch (closing one with the same number).
+    fn batch_header(&mut self, d: &Def, p: &[u8]) {
+        let h = (|| {
+            Some((
+                d.get(p, "N")? as u16,
+                d.get(p, "type")? as u8,
+                d.get(p, "instance")? as u32,
+                d.get(p, "mul")?,
+                d.get(p, "smp_cnt")? as usize,
+                d.get_u64(p, "SampleUS")?,
+                d.get(p, "smp_rate")?,
+            ))
+        })();
+        let Some((n, kind, inst, mul, count, start_us, rate)) = h else {
+            return;
+        };
+        let gyro = kind == 1;
+        let stream = self.stream(if gyro { "ISB_GYR" } else { "ISB_ACC" }, inst, true);
+        let batch = Batch {
+            stream,
+            mul,
+            count,
+            start_us,
+            rate,
+            gyro,
+            got: 0,
+        };
+        if let Some(old) = self.batches.insert(n, batch) {
+            self.close(&old);
+        }
     }
-    if orphan_isbd > 0 {
-        losses.push(Loss::new(format!(
-            "{orphan_isbd} ISBD batch data messages have no ISBH header and were skipped"
-        )));
+
+    /// An `ISBD` batch data message: its samples, as rows of its batch's topic.
+    fn batch_data(&mut self, d: &Def, p: &[u8]) {
+        let (Some(n), Some(seq)) = (d.get(p, "N"), d.get(p, "seqno")) else {
+            return;
+        };
+        let Some(b) = self.batches.get_mut(&(n as u16)) else {
+            self.orphan_isbd += 1;
+            return;
+        };
+        let (Some(x), Some(y), Some(z)) = (d.array(p, "x"), d.array(p, "y"), d.array(p, "z"))
+        else {
+            return;
+        };
+        if !(b.mul > 0.0 && b.rate > 0.0) {
+            return;
+        }
+        for k in 0..ISBD_SAMPLES {
+            let j = seq as usize * ISBD_SAMPLES + k;
+            if j >= b.count {
+                break;
+            }
+            let t = b
+                .start_us
+                .saturating_mul(1000)
+                .saturating_add((j as f64 * 1e9 / b.rate).round() as u64);
+            let v = [
+                x[k] as f64 / b.mul,
+                y[k] as f64 / b.mul,
+                z[k] as f64 / b.mul,
+            ];
+            let nan = [f64::NAN; 3];
+            let (gyro, acc) = if b.gyro { (v, nan) } else { (nan, v) };
+            self.streams[b.stream].push(
+                t,
+                &Row {
+                    stamp: t,
+                    gyro,
+                    acc,
+                },
+            );
+            b.got += 1;
+        }
     }
-    if short_batches > 0 {
-        losses.push(Loss {
-            what: format!("{short_batches} sensor batches (ISBH) hold fewer samples than their header promises"),
-            messages: Some(short_samples),
-            at_most: None,
-            span: None,
-            channel: None,
-        });
+
+    /// The source: the topics, and what was lost said as losses and notes.
+    fn finish(mut self, path: &Path) -> Result<DecodedSource, Error> {
+        for b in std::mem::take(&mut self.batches).values() {
+            self.close(b);
+        }
+        if self.defs.is_empty() {
+            return Err(Error::Corrupt {
+                path: path.to_path_buf(),
+                offset: 0,
+                what: "DataFlash: no FMT message could be read".into(),
+            });
+        }
+        super::instance_topics(self.streams.iter_mut().map(|s| &mut s.topic));
+        let mut losses = Vec::new();
+        let mut notes = Vec::new();
+        if self.skipped > 0 {
+            losses.push(Loss::new(format!(
+                "{} bytes in {} stretch{} are no DataFlash message and were skipped to the next header (first at byte {})",
+                self.skipped,
+                self.skip_runs,
+                if self.skip_runs == 1 { "" } else { "es" },
+                self.first_skip.unwrap_or(0)
+            )));
+        }
+        if self.orphan_isbd > 0 {
+            losses.push(Loss::new(format!(
+                "{} ISBD batch data messages have no ISBH header and were skipped",
+                self.orphan_isbd
+            )));
+        }
+        if self.short_batches > 0 {
+            losses.push(Loss {
+                what: format!(
+                    "{} sensor batches (ISBH) hold fewer samples than their header promises",
+                    self.short_batches
+                ),
+                messages: Some(self.short_samples),
+                at_most: None,
+                span: None,
+                channel: None,
+            });
+        }
+        if let Some(at) = self.truncated {
+            notes.push(format!(
+                "the log ends inside a message at byte {at} (cut short): read to there"
+            ));
+        }
+        Ok(DecodedSource::new(
+            InputKind::DataFlash,
+            self.streams,
+            notes,
+            losses,
+        ))
     }
-    if let Some(at) = truncated {
-        notes.push(format!(
-            "the log ends inside a message at byte {at} (cut short): read to there"
-        ));
-    }
-    Ok(DecodedSource::new(
-        InputKind::DataFlash,
-        streams,
-        notes,
-        losses,
-    ))
 }
