@@ -194,7 +194,8 @@ fn section_series(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
     [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]]
 }
 
-/// [`run`] on samples already in memory.
+/// [`run`] on samples already in memory: the record checked, the rate chosen, both
+/// analyses side by side, then every output rendered and written.
 pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
@@ -210,10 +211,88 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
     }
-    // One pass per column for the finiteness check and the value checks below; then the
-    // record check (bag2mat::record_check): duplicates, a clock that steps back and a record
-    // that is not one continuous stretch are cut, spikes dropped when asked, and what the
-    // record breaks of the analysis' assumptions is found.
+    let mut c = check_record(config, data, &mut notes)?;
+    let topic = c
+        .data
+        .topic
+        .clone()
+        .unwrap_or_else(|| config.common.named_topic().to_string());
+    let absent = c.data.absent;
+    // The IEEE 952 analysis reads the raw columns, so its curves are made before the compat
+    // path turns them into prefix sums; its fits then run beside the compat path. Data too
+    // short for it only cost the section, with a note.
+    let early = c.early.take();
+    let (curves, curves_s) = section_curves(config, &c, early, &mut notes);
+    let axes = compat_axes(c.data);
+    let ((ieee, fits_s), analysis) = rayon::join(
+        || {
+            let start = Instant::now();
+            let an = curves
+                .as_ref()
+                .map(|cv| cv.finish(c.findings.clone(), &crate::ieee952::Config::default()));
+            (an, start.elapsed().as_secs_f64())
+        },
+        || {
+            let start = Instant::now();
+            analyse(axes, c.rate.used, config.estimator, config.common.quiet)
+                .map(|a| (a, start.elapsed()))
+        },
+    );
+    let (mut analysis, analyse_t) = analysis?;
+    analysis.absent = absent;
+    let analyse_s = analyse_t.as_secs_f64();
+    // the section's share of the wall time: its curves, and its fits less what they overlapped
+    let ieee_s = curves_s + (fits_s - analyse_s).max(0.0);
+    let start = Instant::now();
+    let text = report::full_text_of(&analysis.accel, &analysis.gyro, absent);
+    let written = write_outputs(config, &analysis, ieee.as_ref(), c.rate.used, &topic)?;
+    let timings = Timings {
+        load: 0.0,
+        analyse: analyse_s,
+        ieee952: ieee_s,
+        output: start.elapsed().as_secs_f64(),
+        checks: c.checks_s,
+    };
+    Ok(RunOutput {
+        topic: data_topic,
+        analysis,
+        rate: c.rate,
+        text,
+        ieee952_text: ieee.as_ref().map(|a| {
+            crate::ieee952::imu::summary_text(a)
+                + &crate::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
+        }),
+        findings: c.findings,
+        notes,
+        written,
+        timings,
+    })
+}
+
+/// A record after its checks: the samples analysed, what the checks found, the rate, and
+/// the section's curves made beside the checks (see [`check_record`]).
+struct Checked {
+    data: ImuData,
+    findings: Vec<bag2mat::record_check::Finding>,
+    rate: RateChoice,
+    /// The check kept every sample.
+    whole: bool,
+    /// What makes the record unfit for the IEEE 952 section, if anything.
+    refusal: Option<bag2mat::record_check::Finding>,
+    /// The section's curves made beside the check (taken by [`section_curves`]).
+    early: Option<EarlyCurves>,
+    checks_s: f64,
+}
+
+/// The section's curves made beside the record check: the rate assumed, the curves, their
+/// notes and seconds.
+type EarlyCurves = (f64, Option<crate::ieee952::imu::ImuCurves>, Vec<Note>, f64);
+
+/// The finiteness and value checks of each column, then the record check
+/// (bag2mat::record_check): duplicates, a clock that steps back and a record that is not
+/// one continuous stretch are cut, spikes dropped when asked, and what the record breaks of
+/// the analysis' assumptions is found; then the rate.
+fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result<Checked, Error> {
     let scans = data.scan_checked()?;
     // The section's curves need only the columns and the rate. On a record the check keeps
     // whole (the usual case) they are made beside it, at the rate the run will most likely
@@ -284,40 +363,56 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let rate = input::choose_rate(config.common.rate, check.rate, data.len())?;
     notes.extend(rate.message.clone().map(Note::info));
     findings.extend(rate.finding.clone());
-    let topic = data
-        .topic
-        .clone()
-        .unwrap_or_else(|| config.common.named_topic().to_string());
-    // The IEEE 952 analysis reads the raw columns, so its curves are made before the compat
-    // path turns them into prefix sums; its fits then run beside the compat path. Data too
-    // short for it only cost the section, with a note.
+    Ok(Checked {
+        data,
+        findings,
+        rate,
+        whole,
+        refusal: check.refusal().cloned(),
+        early,
+        checks_s,
+    })
+}
+
+/// The IEEE 952 section's curves and the seconds they took: none when the section is off
+/// or the record breaks its assumptions (said in a note), those made beside the check when
+/// they fit what the check kept and the rate chosen, else made now.
+fn section_curves(
+    config: &Config,
+    c: &Checked,
+    early: Option<EarlyCurves>,
+    notes: &mut Vec<Note>,
+) -> (Option<crate::ieee952::imu::ImuCurves>, f64) {
     let start = Instant::now();
-    let refusal = check.refusal().cloned();
-    if let (true, Some(r)) = (config.common.ieee952, &refusal) {
+    if let (true, Some(r)) = (config.common.ieee952, &c.refusal) {
         notes.push(Note::warning(format!(
             "IEEE 952 section not computed: the record breaks its assumptions ({})",
             r.short()
         )));
     }
-    let (curves, curves_s) = match early {
-        _ if !config.common.ieee952 || refusal.is_some() => (None, 0.0),
-        Some((r, curves, early_notes, early_s)) if whole && r == rate.section => {
+    match early {
+        _ if !config.common.ieee952 || c.refusal.is_some() => (None, 0.0),
+        Some((r, curves, early_notes, early_s)) if c.whole && r == c.rate.section => {
             notes.extend(early_notes);
             (curves, early_s)
         }
         _ => {
-            let c = crate::ieee952::imu::section_curves_of(
-                section_series(&data.axes),
-                absent,
-                rate.section,
-                &mut notes,
+            let cv = crate::ieee952::imu::section_curves_of(
+                section_series(&c.data.axes),
+                c.data.absent,
+                c.rate.section,
+                notes,
             );
-            (c, start.elapsed().as_secs_f64())
+            (cv, start.elapsed().as_secs_f64())
         }
-    };
+    }
+}
+
+/// The six columns the compat path runs on: the absent sensor's get the present one's
+/// samples as a stand-in, whose results are dropped afterwards.
+fn compat_axes(data: ImuData) -> [Vec<f64>; 6] {
+    let absent = data.absent;
     let ImuData { mut axes, .. } = data;
-    // the compat path runs on six columns: the absent sensor's get the present one's
-    // samples as a stand-in, whose results are dropped below
     if let Some(s) = absent {
         let (to, from) = if s == bag2mat::Sensor::Acc {
             (0, 3)
@@ -328,29 +423,19 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
             axes[to + k] = axes[from + k].clone();
         }
     }
-    let ((ieee, fits_s), analysis) = rayon::join(
-        || {
-            let start = Instant::now();
-            let an = curves
-                .as_ref()
-                .map(|c| c.finish(findings.clone(), &crate::ieee952::Config::default()));
-            (an, start.elapsed().as_secs_f64())
-        },
-        || {
-            let start = Instant::now();
-            analyse(axes, rate.used, config.estimator, config.common.quiet)
-                .map(|a| (a, start.elapsed()))
-        },
-    );
-    let (mut analysis, analyse_t) = analysis?;
-    analysis.absent = absent;
-    let analyse_s = analyse_t.as_secs_f64();
-    // the section's share of the wall time: its curves, and its fits less what they overlapped
-    let ieee_s = curves_s + (fits_s - analyse_s).max(0.0);
-    let start = Instant::now();
-    let text = report::full_text_of(&analysis.accel, &analysis.gyro, absent);
+    axes
+}
 
-    // Render the text outputs before touching the output directory.
+/// Renders the yaml and the curves' CSV (before the output folder is touched), then writes
+/// them, the compat charts and the section's files and chart; returns the paths written.
+fn write_outputs(
+    config: &Config,
+    analysis: &Analysis,
+    ieee: Option<&crate::ieee952::imu::ImuAnalysis>,
+    update_rate: f64,
+    topic: &str,
+) -> Result<Vec<PathBuf>, Error> {
+    let absent = analysis.absent;
     let source = config
         .common
         .samples_path()
@@ -362,8 +447,8 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         accelerometer_random_walk: analysis.accel.bias,
         gyroscope_noise_density: analysis.gyro.white,
         gyroscope_random_walk: analysis.gyro.bias,
-        rostopic: topic.clone(),
-        update_rate: rate.used,
+        rostopic: topic.to_string(),
+        update_rate,
         absent,
     }
     .render(&source);
@@ -401,12 +486,12 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     };
     // The charts are rendered in parallel (each is one thread's work).
     let (compat_plots, section_files) = rayon::join(
-        || write_plots(&analysis, &title, dir),
+        || write_plots(analysis, &title, dir),
         || -> Result<Vec<PathBuf>, Error> {
-            let Some(an) = &ieee else {
+            let Some(an) = ieee else {
                 return Ok(Vec::new());
             };
-            let mut w = crate::ieee952::files::write_outputs(an, dir, "", &topic)?;
+            let mut w = crate::ieee952::files::write_outputs(an, dir, "", topic)?;
             let truth = crate::ieee952::plot::find_truth(config.common.samples_path(), an);
             w.extend(crate::ieee952::plot::write_chart(
                 an,
@@ -420,27 +505,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     );
     written.extend(compat_plots?);
     written.extend(section_files?);
-    let timings = Timings {
-        load: 0.0,
-        analyse: analyse_s,
-        ieee952: ieee_s,
-        output: start.elapsed().as_secs_f64(),
-        checks: checks_s,
-    };
-    Ok(RunOutput {
-        topic: data_topic,
-        analysis,
-        rate,
-        text,
-        ieee952_text: ieee.as_ref().map(|a| {
-            crate::ieee952::imu::summary_text(a)
-                + &crate::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
-        }),
-        findings,
-        notes,
-        written,
-        timings,
-    })
+    Ok(written)
 }
 
 /// Drops the samples of the first `seconds` of the record; returns how many, and a

@@ -235,82 +235,10 @@ pub fn analyse(t: &[i64]) -> Timing {
         return out;
     };
     out.median_period_ns = Some(p);
-    // Rate segments: blocks at another rate, the change placed exactly.
-    let mut changes: Vec<usize> = Vec::new();
-    let mut prev: Option<(bool, i64)> = None;
-    let mut buf: Vec<i64> = Vec::with_capacity(RATE_BLOCK);
-    for (b, block) in d.chunks(RATE_BLOCK).enumerate() {
-        if block.len() < RATE_BLOCK / 4 {
-            continue;
-        }
-        buf.clear();
-        buf.extend(block.iter().copied().filter(|&x| x > 0));
-        if buf.is_empty() {
-            continue;
-        }
-        let m = median(&mut buf);
-        let other = ((m - p) as f64 / p as f64).abs() > RATE_CHANGE_REL;
-        match prev {
-            Some((was, pm)) if was != other => {
-                changes.push(refine_change(&d, b * RATE_BLOCK, pm, m));
-            }
-            None if other => changes.push(0),
-            _ => {}
-        }
-        prev = Some((other, m));
-    }
-    changes.retain(|&c| c > 0 && c < n);
-    changes.dedup();
+    let changes = rate_changes(&d, p, n);
     out.rate_changes = changes.clone();
-    // Within each rate segment, the intervals in whole periods of its own median.
-    let bounds: Vec<usize> = std::iter::once(0)
-        .chain(changes.iter().copied())
-        .chain([n])
-        .collect();
-    let mut long_cuts: Vec<usize> = Vec::new();
-    let mut rate_segments: Vec<(usize, usize, u64)> = Vec::new();
-    let mut total_periods = 0u64;
-    for w in bounds.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        // the intervals inside [a, b): a .. b-1
-        let inner = &d[a..b.saturating_sub(1).max(a)];
-        // one rate throughout: the series' median (no second selection)
-        let ps = if changes.is_empty() {
-            p
-        } else {
-            median_positive(inner).unwrap_or(p)
-        };
-        let mut periods_in = 0u64;
-        for (j, &x) in inner.iter().enumerate() {
-            // most intervals are one period: no division for them
-            let k = if x.saturating_sub(ps).saturating_abs().saturating_mul(2) < ps {
-                1
-            } else {
-                periods(x, ps)
-            };
-            periods_in += k;
-            if k >= 2 {
-                let i = a + j;
-                out.gaps.push(Gap {
-                    after: i,
-                    at: (t[i] - t[0]) as f64 * NS,
-                    length: x as f64 * NS,
-                    missing: k - 1,
-                });
-                out.missing += k - 1;
-                if k > GAP_FACTOR {
-                    long_cuts.push(i + 1);
-                }
-            }
-        }
-        total_periods += periods_in;
-        rate_segments.push((a, b, periods_in));
-    }
-    if total_periods > 0 {
-        out.nominal_period = Some(out.span / total_periods as f64);
-    }
-    let continuous = out.is_continuous();
-    let mut cuts: Vec<usize> = if continuous {
+    let long_cuts = out.count_gaps(t, &d, p, &changes);
+    let mut cuts: Vec<usize> = if out.is_continuous() {
         Vec::new()
     } else {
         changes.iter().copied().chain(long_cuts).collect()
@@ -337,6 +265,90 @@ pub fn analyse(t: &[i64]) -> Timing {
         }
     }
     out
+}
+
+/// Where the rate changes in a series of `n` stamps with intervals `d` and median
+/// interval `p`: blocks of [`RATE_BLOCK`] intervals at another rate, each change placed
+/// exactly ([`refine_change`]).
+fn rate_changes(d: &[i64], p: i64, n: usize) -> Vec<usize> {
+    let mut changes: Vec<usize> = Vec::new();
+    let mut prev: Option<(bool, i64)> = None;
+    let mut buf: Vec<i64> = Vec::with_capacity(RATE_BLOCK);
+    for (b, block) in d.chunks(RATE_BLOCK).enumerate() {
+        if block.len() < RATE_BLOCK / 4 {
+            continue;
+        }
+        buf.clear();
+        buf.extend(block.iter().copied().filter(|&x| x > 0));
+        if buf.is_empty() {
+            continue;
+        }
+        let m = median(&mut buf);
+        let other = ((m - p) as f64 / p as f64).abs() > RATE_CHANGE_REL;
+        match prev {
+            Some((was, pm)) if was != other => {
+                changes.push(refine_change(d, b * RATE_BLOCK, pm, m));
+            }
+            None if other => changes.push(0),
+            _ => {}
+        }
+        prev = Some((other, m));
+    }
+    changes.retain(|&c| c > 0 && c < n);
+    changes.dedup();
+    changes
+}
+
+impl Timing {
+    /// Within each rate segment (cut at `changes`), the intervals `d` of `t` in whole
+    /// periods of the segment's own median (`p` with one rate throughout): the gaps, the
+    /// samples missing and the nominal period. Returns where gaps longer than
+    /// [`GAP_FACTOR`] periods cut the series.
+    fn count_gaps(&mut self, t: &[i64], d: &[i64], p: i64, changes: &[usize]) -> Vec<usize> {
+        let bounds: Vec<usize> = std::iter::once(0)
+            .chain(changes.iter().copied())
+            .chain([self.n])
+            .collect();
+        let mut long_cuts: Vec<usize> = Vec::new();
+        let mut total_periods = 0u64;
+        for w in bounds.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            // the intervals inside [a, b): a .. b-1
+            let inner = &d[a..b.saturating_sub(1).max(a)];
+            // one rate throughout: the series' median (no second selection)
+            let ps = if changes.is_empty() {
+                p
+            } else {
+                median_positive(inner).unwrap_or(p)
+            };
+            for (j, &x) in inner.iter().enumerate() {
+                // most intervals are one period: no division for them
+                let k = if x.saturating_sub(ps).saturating_abs().saturating_mul(2) < ps {
+                    1
+                } else {
+                    periods(x, ps)
+                };
+                total_periods += k;
+                if k >= 2 {
+                    let i = a + j;
+                    self.gaps.push(Gap {
+                        after: i,
+                        at: (t[i] - t[0]) as f64 * NS,
+                        length: x as f64 * NS,
+                        missing: k - 1,
+                    });
+                    self.missing += k - 1;
+                    if k > GAP_FACTOR {
+                        long_cuts.push(i + 1);
+                    }
+                }
+            }
+        }
+        if total_periods > 0 {
+            self.nominal_period = Some(self.span / total_periods as f64);
+        }
+        long_cuts
+    }
 }
 
 /// The nominal rate of `t` (ns, in order), Hz, without the rest of [`analyse`]: the span over
