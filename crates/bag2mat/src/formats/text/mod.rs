@@ -29,6 +29,8 @@ use crate::decoded::{DecodedSource, Row, Stream};
 use crate::error::Error;
 use crate::series::Rows;
 use crate::source::InputKind;
+/// The test tools read times as the body does.
+#[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
 use body::{Summary, line_range, parse_range, room};
 use layout::{Delim, Layout, bad, layout};
