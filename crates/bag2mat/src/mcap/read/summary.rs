@@ -1,0 +1,212 @@
+//! The summary section of an MCAP file: the footer, the summary records (schemas, channels,
+//! statistics, chunk indexes; their CRC checked when stored) and the chunks they locate.
+
+use super::*;
+
+impl McapReader {
+    /// The footer and its offset, when the file ends with a footer record and the magic.
+    pub(super) fn read_footer(&self) -> Option<(u64, Footer)> {
+        let tail = RECORD_PREFIX + FOOTER_CONTENT_LEN + MAGIC.len() as u64;
+        if self.len < MAGIC.len() as u64 + tail {
+            return None;
+        }
+        let pos = self.len - tail;
+        let mut b = vec![0u8; tail as usize];
+        self.file.read_exact_at(&mut b, pos).ok()?;
+        if &b[tail as usize - 8..] != MAGIC || b[0] != Op::Footer as u8 {
+            return None;
+        }
+        if u64::from_le_bytes(b[1..9].try_into().ok()?) != FOOTER_CONTENT_LEN {
+            return None;
+        }
+        Some((pos, Footer::decode(&b[9..29]).ok()?))
+    }
+
+    /// Reads the summary section: schemas, channels, statistics and chunk indexes. A CRC
+    /// that does not match leaves its counts untrusted; its chunk indexes still locate
+    /// chunks (each is checked against the data section).
+    pub(super) fn read_summary(&mut self, footer_pos: u64, f: &Footer) -> Result<Summary, String> {
+        let end = if f.summary_offset_start != 0 {
+            f.summary_offset_start
+        } else {
+            footer_pos
+        };
+        if f.summary_start < MAGIC.len() as u64 || f.summary_start > end || end > footer_pos {
+            return Err(format!(
+                "its offsets {}..{} are outside the file",
+                f.summary_start, end
+            ));
+        }
+        let mut trusted = true;
+        if f.summary_crc != 0 {
+            // The CRC covers the summary and summary-offset sections and the footer up to
+            // (not including) its CRC field.
+            let mut b = vec![0u8; (footer_pos + RECORD_PREFIX + 16 - f.summary_start) as usize];
+            self.file
+                .read_exact_at(&mut b, f.summary_start)
+                .map_err(|e| e.to_string())?;
+            let crc = crc32fast::hash(&b);
+            if crc != f.summary_crc {
+                trusted = false;
+                self.contents.notes.push(format!(
+                    "the summary section is damaged (CRC {crc:08x} differs from the footer's {:08x}): its counts are not used, its chunk indexes only locate chunks",
+                    f.summary_crc
+                ));
+            }
+        }
+        let mut b = vec![0u8; (end - f.summary_start) as usize];
+        self.file
+            .read_exact_at(&mut b, f.summary_start)
+            .map_err(|e| e.to_string())?;
+        let chunk_indexes = self.summary_records(&b, trusted)?;
+        Ok(Summary {
+            chunk_indexes,
+            trusted,
+        })
+    }
+
+    /// Parses summary records (schemas, channels, statistics, chunk indexes). Untrusted,
+    /// a record that does not parse ends the section instead of failing it.
+    pub(super) fn summary_records(
+        &mut self,
+        b: &[u8],
+        trusted: bool,
+    ) -> Result<Vec<ChunkIndex>, String> {
+        let mut c = Cursor::new(b);
+        let mut chunk_indexes = Vec::new();
+        while c.pos() < b.len() {
+            // Framing first: an untrusted summary skips a record whose content does not
+            // parse, and ends at framing that does not hold.
+            let framed = c.le::<u8>("opcode").and_then(|op| Ok((op, c.bytes64()?)));
+            let (op, content) = match framed {
+                Ok(x) => x,
+                Err(e) if trusted => return Err(e.to_string()),
+                Err(_) => break,
+            };
+            let rec = (|| -> Result<(), CursorError> {
+                match Op::from_byte(op) {
+                    Some(Op::Schema) => {
+                        let s = Schema::decode(content)?;
+                        offer(&mut self.schemas, s.id, s, schema_plausible);
+                    }
+                    Some(Op::Channel) => {
+                        let ch = record::Channel::decode(content)?;
+                        offer(&mut self.mcap_channels, ch.id, ch, channel_plausible);
+                    }
+                    Some(Op::Statistics) => self.statistics = Some(Statistics::decode(content)?),
+                    Some(Op::ChunkIndex) => {
+                        let ci = ChunkIndex::decode(content)?;
+                        if ci.chunk_start_offset < self.len {
+                            chunk_indexes.push(ci);
+                        }
+                    }
+                    _ => {}
+                }
+                Ok(())
+            })();
+            if let Err(e) = rec
+                && trusted
+            {
+                return Err(e.to_string());
+            }
+        }
+        Ok(chunk_indexes)
+    }
+
+    /// Chunks the summary locates that the walk did not find (their record framing is
+    /// damaged): read from the summary's fields when their bytes are in the file, counted
+    /// from their Message Index records otherwise.
+    pub(super) fn chunks_from_summary(&mut self, chunk_indexes: &[ChunkIndex]) {
+        let found: std::collections::BTreeSet<u64> = self
+            .locs
+            .iter()
+            .filter_map(|l| match l {
+                Loc::Chunk { pos, .. } => Some(*pos),
+                Loc::Loose { .. } => None,
+            })
+            .collect();
+        let Ok(file) = self.file.try_clone() else {
+            return;
+        };
+        let mut w = Window {
+            file: &file,
+            len: self.len,
+            buf: Vec::new(),
+            at: 0,
+        };
+        for ci in chunk_indexes {
+            let k = if found.contains(&ci.chunk_start_offset) {
+                self.locs.iter().position(
+                    |l| matches!(l, Loc::Chunk { pos, .. } if *pos == ci.chunk_start_offset),
+                )
+            } else {
+                let fits = ci
+                    .chunk_start_offset
+                    .checked_add(ci.chunk_length)
+                    .is_some_and(|e| e <= self.len)
+                    && ci.chunk_length > RECORD_PREFIX;
+                let added = fits
+                    .then(|| {
+                        self.add_chunk(
+                            &mut w,
+                            ci.chunk_start_offset,
+                            ci.chunk_length - RECORD_PREFIX,
+                            Some(ci),
+                        )
+                        .ok()
+                    })
+                    .flatten();
+                if added.is_some() {
+                    self.contents.notes.push(format!(
+                        "the chunk at byte {} has a damaged record header; it was read where the summary locates it",
+                        ci.chunk_start_offset
+                    ));
+                }
+                added
+            };
+            // The summary's message indexes count the chunk when the walk found none.
+            let indexes: Vec<IndexRef> = ci
+                .message_index_offsets
+                .iter()
+                .filter_map(|&(ch, off)| {
+                    let (op, clen) = w.prefix(off)?;
+                    let b = w.get(off + RECORD_PREFIX, 6).ok()?;
+                    (op == Op::MessageIndex as u8
+                        && b.len() == 6
+                        && u16::from_le_bytes([b[0], b[1]]) == ch)
+                        .then(|| IndexRef {
+                            channel: ch,
+                            entries_pos: off + RECORD_PREFIX + 6,
+                            count: (u32::from_le_bytes(b[2..6].try_into().expect("4 bytes"))
+                                as u64)
+                                .min(clen.saturating_sub(6))
+                                / INDEX_ENTRY,
+                        })
+                })
+                .collect();
+            match k {
+                Some(k) if self.indexes[k].is_empty() && !indexes.is_empty() => {
+                    self.contents.parts[k].counts = Some(
+                        indexes
+                            .iter()
+                            .map(|i| (i.channel as u32, i.count))
+                            .collect(),
+                    );
+                    self.indexes[k] = indexes;
+                }
+                Some(_) => {}
+                None => self.lost.push(Lost {
+                    what: format!(
+                        "the summary lists a chunk at byte {} that the data section does not hold",
+                        ci.chunk_start_offset
+                    ),
+                    span: Some((ci.message_start_time, ci.message_end_time)),
+                    bytes: ci
+                        .uncompressed_size
+                        .min(ci.compressed_size.saturating_mul(source::MAX_EXPANSION)),
+                    indexes,
+                }),
+            }
+        }
+    }
+}

@@ -1,0 +1,533 @@
+//! The walk over an MCAP file's top-level records: chunks and runs of loose messages become
+//! parts, damage is passed to the next whole record and counted, a cut end is read to its
+//! last complete record.
+
+use super::*;
+
+impl McapReader {
+    /// The end of the record at `pos` when it frames as a top-level record a walk may land
+    /// on (see [`Landing`]) and its content checks out for its opcode.
+    pub(super) fn frames(
+        &self,
+        w: &mut Window,
+        pos: u64,
+        end: u64,
+        landing: Landing,
+    ) -> Option<u64> {
+        let (op, clen) = w.prefix(pos)?;
+        let content_pos = pos + RECORD_PREFIX;
+        let rec_end = content_pos.checked_add(clen).filter(|&e| e <= end)?;
+        match Op::from_byte(op)? {
+            Op::Chunk => {
+                // Landing on bytes that only look like a chunk is ruled out by its times too.
+                let h = chunk_header(w, content_pos, clen)?;
+                (h.message_start_time <= h.message_end_time).then_some(rec_end)
+            }
+            Op::MessageIndex => {
+                let b = w.get(content_pos, 6.min(clen as usize)).ok()?;
+                (b.len() == 6
+                    && u32::from_le_bytes(b[2..6].try_into().expect("4 bytes")) as u64 == clen - 6
+                    && (clen - 6) % INDEX_ENTRY == 0)
+                    .then_some(rec_end)
+            }
+            Op::DataEnd => (clen == 4).then_some(rec_end),
+            Op::Footer => (clen == FOOTER_CONTENT_LEN).then_some(rec_end),
+            Op::Message if landing == Landing::Unchunked => {
+                (clen >= MESSAGE_FIXED_LEN as u64).then_some(rec_end)
+            }
+            Op::Schema | Op::Channel if landing == Landing::Unchunked => {
+                if clen > MAX_META_RECORD {
+                    return None;
+                }
+                let b = w.get(content_pos, clen as usize).ok()?;
+                let ok = if op == Op::Schema as u8 {
+                    Schema::decode(b).is_ok()
+                } else {
+                    record::Channel::decode(b).is_ok()
+                };
+                ok.then_some(rec_end)
+            }
+            _ => None,
+        }
+    }
+
+    /// The next position at or after `from` where a whole record starts that is followed
+    /// by another (or by the end): a chunk the summary locates, else the first such bytes.
+    pub(super) fn resync(
+        &self,
+        w: &mut Window,
+        from: u64,
+        end: u64,
+        hints: &[u64],
+        landing: Landing,
+    ) -> Option<u64> {
+        let followed = |w: &mut Window, p: u64| -> bool {
+            match self.frames(w, p, end, landing) {
+                Some(e) => e == end || self.frames(w, e, end, landing).is_some(),
+                None => false,
+            }
+        };
+        let k = hints.partition_point(|&h| h < from);
+        if let Some(&h) = hints[k..].iter().find(|&&h| h < end && followed(w, h)) {
+            return Some(h);
+        }
+        let mut p = from;
+        while p + RECORD_PREFIX <= end {
+            let b = w.get(p, 1).ok()?;
+            let op = *b.first()?;
+            let candidate = matches!(
+                Op::from_byte(op),
+                Some(Op::Chunk | Op::MessageIndex | Op::DataEnd | Op::Footer)
+            ) || (landing == Landing::Unchunked
+                && matches!(
+                    Op::from_byte(op),
+                    Some(Op::Message | Op::Schema | Op::Channel)
+                ));
+            if candidate && followed(w, p) {
+                return Some(p);
+            }
+            p += 1;
+        }
+        None
+    }
+
+    pub(super) fn walk(&mut self, end: u64, hints: &[u64]) -> Result<Option<Summary>, Error> {
+        let file = self
+            .file
+            .try_clone()
+            .map_err(|e| Error::io(&self.path, e))?;
+        let mut w = Window {
+            file: &file,
+            len: end,
+            buf: Vec::new(),
+            at: 0,
+        };
+        let path = self.path.clone();
+        let io = |e: std::io::Error| Error::io(&path, e);
+        let mut pos = MAGIC.len() as u64;
+        let mut first = true;
+        let mut any = false;
+        let mut seen_data_end = false;
+        let mut after = After::Other;
+        let mut found_summary = None;
+        while pos < end {
+            let landing = if self.locs.iter().any(|l| matches!(l, Loc::Chunk { .. })) {
+                Landing::Chunked
+            } else {
+                Landing::Unchunked
+            };
+            let Some((op, clen)) = w.prefix(pos) else {
+                self.tail_lost(&mut w, pos, end, None);
+                break;
+            };
+            let content_pos = pos + RECORD_PREFIX;
+            let rec_end = content_pos.checked_add(clen).filter(|&e| e <= end);
+            let Some(rec_end) = rec_end else {
+                // A length past the end: truncation, or a damaged length with records after.
+                // A chunk's own records are never landed on (they frame as loose ones).
+                let is_chunk = op == Op::Chunk as u8
+                    && w.get(content_pos, (end - content_pos).min(4096) as usize)
+                        .ok()
+                        .is_some_and(|b| ChunkHeader::decode(b).is_ok());
+                let landing = if is_chunk { Landing::Chunked } else { landing };
+                match self.resync(&mut w, pos + 1, end, hints, landing) {
+                    Some(next) => {
+                        after = self.damaged(
+                            &mut w,
+                            pos,
+                            next,
+                            op,
+                            "its length runs past the end of the file",
+                        );
+                        pos = next;
+                        continue;
+                    }
+                    None => {
+                        self.tail_lost(&mut w, pos, end, Some(op));
+                        break;
+                    }
+                }
+            };
+            if first && op != Op::Header as u8 {
+                // The Header only names the profile and library: its damage costs nothing.
+                self.contents.notes.push(format!(
+                    "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
+                ));
+            }
+            first = false;
+            let small = |w: &mut Window| -> Result<Option<Vec<u8>>, Error> {
+                if clen > MAX_META_RECORD {
+                    return Ok(None);
+                }
+                Ok(Some(
+                    w.get(content_pos, clen as usize).map_err(io)?.to_vec(),
+                ))
+            };
+            match Op::from_byte(op) {
+                Some(Op::Header) if pos == MAGIC.len() as u64 => {
+                    match small(&mut w)?.map(|b| Header::decode(&b)) {
+                        Some(Ok(h)) => self.header = h,
+                        _ => self.contents.notes.push(format!(
+                            "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
+                        )),
+                    }
+                    after = After::Other;
+                }
+                Some(Op::Schema) => {
+                    if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {
+                        offer(&mut self.schemas, s.id, s, schema_plausible);
+                    } else {
+                        self.contents
+                            .notes
+                            .push(format!("unreadable Schema record at byte {pos} skipped"));
+                    }
+                    after = After::Other;
+                }
+                Some(Op::Channel) => {
+                    if let Some(Ok(c)) = small(&mut w)?.map(|b| record::Channel::decode(&b)) {
+                        offer(&mut self.mcap_channels, c.id, c, channel_plausible);
+                    } else {
+                        self.contents
+                            .notes
+                            .push(format!("unreadable Channel record at byte {pos} skipped"));
+                    }
+                    after = After::Other;
+                }
+                Some(Op::Chunk) => {
+                    // Its stored length and compression frame it (its times may be damaged).
+                    if chunk_header(&mut w, content_pos, clen).is_some() {
+                        let k = self.add_chunk(&mut w, pos, clen, None)?;
+                        after = After::Chunk(k);
+                    } else {
+                        let next = self.resync(&mut w, pos + 1, end, hints, landing);
+                        let to = next.unwrap_or(end);
+                        after = self.damaged(&mut w, pos, to, op, "its header is damaged");
+                        pos = to;
+                        continue;
+                    }
+                }
+                Some(Op::MessageIndex) => {
+                    let b = w
+                        .get(content_pos, 6.min(clen as usize))
+                        .map_err(io)?
+                        .to_vec();
+                    if b.len() == 6 {
+                        let channel = u16::from_le_bytes([b[0], b[1]]);
+                        let stated =
+                            u32::from_le_bytes(b[2..6].try_into().expect("4 bytes")) as u64;
+                        // A damaged length counts no more entries than the record holds.
+                        let count = stated.min(clen.saturating_sub(6)) / INDEX_ENTRY;
+                        let ix = IndexRef {
+                            channel,
+                            entries_pos: content_pos + 6,
+                            count,
+                        };
+                        match after {
+                            After::Chunk(k) => {
+                                self.indexes[k].push(ix);
+                                self.contents.parts[k]
+                                    .counts
+                                    .get_or_insert_with(Vec::new)
+                                    .push((channel as u32, count));
+                            }
+                            After::Lost(k) => self.lost[k].indexes.push(ix),
+                            After::Other => {}
+                        }
+                    }
+                }
+                Some(Op::Message) => {
+                    let b = w
+                        .get(content_pos, MESSAGE_FIXED_LEN.min(clen as usize))
+                        .map_err(io)?;
+                    let t = (b.len() == MESSAGE_FIXED_LEN)
+                        .then(|| u64::from_le_bytes(b[6..14].try_into().expect("8 bytes")));
+                    self.add_loose(pos, rec_end, t);
+                    after = After::Other;
+                }
+                Some(Op::Attachment | Op::Metadata) => after = After::Other,
+                Some(op @ (Op::DataEnd | Op::Footer))
+                    if clen
+                        == if op == Op::DataEnd {
+                            4
+                        } else {
+                            FOOTER_CONTENT_LEN
+                        } =>
+                {
+                    let op = op as u8;
+                    // The end of the data section, unless data-section records follow it
+                    // (its opcode is damaged).
+                    let data_follows = rec_end < end
+                        && self.frames(&mut w, rec_end, end, landing).is_some_and(|_| {
+                            w.prefix(rec_end).is_some_and(|(o, _)| {
+                                matches!(
+                                    Op::from_byte(o),
+                                    Some(Op::Chunk | Op::MessageIndex | Op::Message)
+                                )
+                            })
+                        });
+                    if data_follows {
+                        self.contents.notes.push(format!(
+                            "a {} record at byte {pos} stands in the middle of the data section (a damaged opcode?); the records after it were read",
+                            op_name(op)
+                        ));
+                        after = After::Other;
+                    } else {
+                        seen_data_end = op == Op::DataEnd as u8;
+                        if !self.summary_used && rec_end < end {
+                            // A file cut in its summary section still holds summary records.
+                            let mut b = vec![0u8; (end - rec_end).min(MAX_META_RECORD) as usize];
+                            if self.file.read_exact_at(&mut b, rec_end).is_ok()
+                                && let Ok(ci) = self.summary_records(&b, false)
+                            {
+                                self.statistics = None;
+                                found_summary = Some(Summary {
+                                    chunk_indexes: ci,
+                                    trusted: false,
+                                });
+                            }
+                        }
+                        pos = end;
+                        any = true;
+                        break;
+                    }
+                }
+                Some(_) | None => {
+                    // An opcode the data section does not hold (or a Data End or Footer
+                    // opcode on a record of another length). A chunk whose opcode is
+                    // damaged is still read (its CRC checks it); private records (0x80 and
+                    // up) are skipped; anything else is damage, counted.
+                    let as_chunk = {
+                        let avail = clen.min(4096) as usize;
+                        let b = w.get(content_pos, avail).map_err(io)?;
+                        matches!(ChunkHeader::decode(b), Ok((h, off)) if h.compressed_size == clen - off as u64)
+                    };
+                    if as_chunk {
+                        self.contents.notes.push(format!(
+                            "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
+                        ));
+                        let k = self.add_chunk(&mut w, pos, clen, None)?;
+                        after = After::Chunk(k);
+                    } else {
+                        let next_ok =
+                            rec_end == end || self.frames(&mut w, rec_end, end, landing).is_some();
+                        if op >= 0x80 && next_ok {
+                            // A private record followed by a whole one.
+                            after = After::Other;
+                            any = true;
+                            pos = rec_end;
+                            continue;
+                        }
+                        let to = if next_ok {
+                            rec_end
+                        } else {
+                            self.resync(&mut w, pos + 1, end, hints, landing)
+                                .unwrap_or(end)
+                        };
+                        after = self.damaged(
+                            &mut w,
+                            pos,
+                            to,
+                            op,
+                            "its opcode is not one the data section holds",
+                        );
+                        pos = to;
+                        continue;
+                    }
+                }
+            }
+            any = true;
+            pos = rec_end;
+        }
+        if !any {
+            return Err(Error::Corrupt {
+                path: self.path.clone(),
+                offset: pos,
+                what: "the MCAP file holds no complete record after its magic (truncated)".into(),
+            });
+        }
+        if !seen_data_end && pos >= end && self.summary_used {
+            self.contents
+                .notes
+                .push("the data section has no Data End record".to_string());
+        }
+        Ok(found_summary)
+    }
+
+    /// Records the bytes `pos..to` the walk could not read as records.
+    pub(super) fn damaged(
+        &mut self,
+        w: &mut Window,
+        pos: u64,
+        to: u64,
+        op: u8,
+        why: &str,
+    ) -> After {
+        let header = (op == Op::Chunk as u8)
+            .then(|| {
+                let avail = (to.saturating_sub(pos + RECORD_PREFIX)).min(4096) as usize;
+                let b = w.get(pos + RECORD_PREFIX, avail).ok()?.to_vec();
+                ChunkHeader::decode(&b).ok().map(|(h, _)| h)
+            })
+            .flatten();
+        // What the stretch held: a chunk's stated records, bounded by what the rest of the
+        // file can hold; else what its own bytes can hold.
+        let stored = to.saturating_sub(pos);
+        let rest = self.len.saturating_sub(pos);
+        let bytes = match &header {
+            Some(h) if h.compression.is_empty() => h.uncompressed_size.min(rest).max(stored),
+            Some(h) => h
+                .uncompressed_size
+                .min(rest.saturating_mul(source::MAX_EXPANSION))
+                .max(stored),
+            None => stored.saturating_mul(source::MAX_EXPANSION),
+        };
+        self.lost.push(Lost {
+            what: format!(
+                "bytes {pos}..{to} could not be read as records (a {} record at byte {pos}: {why}); skipped",
+                op_name(op)
+            ),
+            span: header.map(|h| (h.message_start_time, h.message_end_time)),
+            bytes,
+            indexes: Vec::new(),
+        });
+        After::Lost(self.lost.len() - 1)
+    }
+
+    /// Adds the chunk record at `pos` (content length `clen`) as a part; `from_index` gives
+    /// the summary's fields when the record's own header is not to be trusted.
+    pub(super) fn add_chunk(
+        &mut self,
+        w: &mut Window,
+        pos: u64,
+        clen: u64,
+        from_index: Option<&ChunkIndex>,
+    ) -> Result<usize, Error> {
+        let content_pos = pos + RECORD_PREFIX;
+        let (h, off) = match from_index {
+            None => {
+                let avail = clen.min(4096) as usize;
+                let b = w
+                    .get(content_pos, avail)
+                    .map_err(|e| Error::io(&self.path, e))?;
+                ChunkHeader::decode(b).map_err(|e| Error::Corrupt {
+                    path: self.path.clone(),
+                    offset: pos,
+                    what: e.to_string(),
+                })?
+            }
+            Some(ci) => {
+                // The header's own fields at their places; the CRC as stored (a damaged one
+                // fails the chunk, it never passes damaged records).
+                let b = w
+                    .get(content_pos + 24, 4)
+                    .map_err(|e| Error::io(&self.path, e))?;
+                let crc = if b.len() == 4 {
+                    u32::from_le_bytes(b.try_into().expect("4 bytes"))
+                } else {
+                    0
+                };
+                (
+                    ChunkHeader {
+                        message_start_time: ci.message_start_time,
+                        message_end_time: ci.message_end_time,
+                        uncompressed_size: ci.uncompressed_size,
+                        uncompressed_crc: crc,
+                        compression: ci.compression.clone(),
+                        compressed_size: ci.compressed_size,
+                    },
+                    8 + 8 + 8 + 4 + 4 + ci.compression.len() + 8,
+                )
+            }
+        };
+        self.locs.push(Loc::Chunk {
+            pos,
+            records_pos: content_pos + off as u64,
+            compressed_size: h.compressed_size,
+            uncompressed_size: h.uncompressed_size,
+            crc: h.uncompressed_crc,
+            compression: h.compression.clone(),
+        });
+        self.indexes.push(Vec::new());
+        self.contents.parts.push(Part {
+            bytes: h
+                .uncompressed_size
+                .min(h.compressed_size.saturating_mul(source::MAX_EXPANSION)),
+            label: format!("chunk at byte {pos}"),
+            span: Some((h.message_start_time, h.message_end_time)),
+            counts: None,
+        });
+        Ok(self.locs.len() - 1)
+    }
+
+    /// Extends the current run of unchunked records, or starts a new one.
+    pub(super) fn add_loose(&mut self, pos: u64, end: u64, t: Option<u64>) {
+        if let (Some(Loc::Loose { start, end: e }), Some(p)) =
+            (self.locs.last_mut(), self.contents.parts.last_mut())
+            && *e == pos
+            && end - *start <= LOOSE_PART_BYTES
+        {
+            *e = end;
+            p.bytes = end - *start;
+            if let Some(t) = t {
+                p.span = Some(match p.span {
+                    Some((a, b)) => (a.min(t), b.max(t)),
+                    None => (t, t),
+                });
+            }
+            return;
+        }
+        self.locs.push(Loc::Loose { start: pos, end });
+        self.indexes.push(Vec::new());
+        self.contents.parts.push(Part {
+            bytes: end - pos,
+            label: format!("unchunked messages from byte {pos}"),
+            span: t.map(|t| (t, t)),
+            counts: None,
+        });
+    }
+
+    /// Notes what the incomplete record at the end of the walk held.
+    pub(super) fn tail_lost(&mut self, w: &mut Window, pos: u64, end: u64, op: Option<u8>) {
+        let what = match op {
+            Some(op) => format!(
+                "the last {} bytes of the file are an incomplete {} record (truncated file); skipped",
+                end - pos,
+                op_name(op)
+            ),
+            None => format!(
+                "the last {} bytes of the file are an incomplete record (truncated file); skipped",
+                end - pos
+            ),
+        };
+        let header = (op == Some(Op::Chunk as u8))
+            .then(|| {
+                let avail = (end.saturating_sub(pos + RECORD_PREFIX)).min(4096) as usize;
+                let b = w.get(pos + RECORD_PREFIX, avail).ok()?.to_vec();
+                ChunkHeader::decode(&b).ok().map(|(h, _)| h)
+            })
+            .flatten();
+        // What the incomplete record can have held: a chunk its stated records (bounded by
+        // what its stored bytes decompress to), a message one.
+        let (messages, at_most) = match (op, &header) {
+            (Some(o), _) if o == Op::Message as u8 => (Some(1), None),
+            (_, Some(h)) => {
+                let bytes = if h.compression.is_empty() {
+                    h.uncompressed_size.min(h.compressed_size)
+                } else {
+                    h.uncompressed_size
+                        .min(h.compressed_size.saturating_mul(source::MAX_EXPANSION))
+                };
+                (None, Some(bytes / MIN_IMU_RECORD))
+            }
+            // A header cut short says nothing of the records after it.
+            _ => (None, None),
+        };
+        self.contents.losses.push(Loss {
+            what,
+            messages,
+            at_most,
+            span: header.map(|h| (h.message_start_time, h.message_end_time)),
+            ..Loss::default()
+        });
+    }
+}
