@@ -246,25 +246,7 @@ fn run_series(
     }
     let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
-    let problems: Vec<_> = (0..collect::FIELDS.len())
-        .into_par_iter()
-        .filter(|&k| absent != Some(if k < 3 { Sensor::Gyro } else { Sensor::Acc }))
-        .map(|k| {
-            let col = if k < 3 {
-                collected.gyro_rad_s(k)
-            } else {
-                collected.acc_m_s2(k - 3)
-            };
-            allan_kalibr::input::value_problem(collect::FIELDS[k], col)
-        })
-        .collect();
-    for problem in problems {
-        match problem {
-            Some((true, what)) => return Err(Error::Config(what)),
-            Some((false, what)) => notes.push(Note::warning(what)),
-            None => {}
-        }
-    }
+    check_values(&collected, absent, &mut notes)?;
     let t1 = Instant::now();
     let (axes, gyro_mean) =
         analysis::allan_step(&collected, config.max_cluster, config.common.ieee952)?;
@@ -284,38 +266,13 @@ fn run_series(
         )));
     }
     let ieee = if config.common.ieee952 && check.refusal().is_none() {
-        // with the PSD and the lines of the samples (in SI units)
-        let curves: Vec<CurveData> = axes
-            .par_iter()
-            .enumerate()
-            .filter(|(i, _)| absent != Some(if *i < 3 { Sensor::Gyro } else { Sensor::Acc }))
-            .map(|(i, a)| {
-                let y = if i < 3 {
-                    collected.gyro_rad_s(i)
-                } else {
-                    collected.acc_m_s2(i - 3)
-                };
-                ieee952_curve(a, i < 3, 1.0 / section_rate).with_spectrum(y)
-            })
-            .collect();
-        let mut it = curves.into_iter();
-        let sensors: Vec<(Sensor, [CurveData; 3])> = [Sensor::Gyro, Sensor::Acc]
-            .into_iter()
-            .filter(|s| Some(*s) != absent)
-            .map(|s| {
-                (
-                    s,
-                    std::array::from_fn(|_| it.next().expect("three per sensor")),
-                )
-            })
-            .collect();
-        let mut an = imu::analyse_curves(
-            &sensors,
+        Some(section(
+            &axes,
+            &collected,
+            absent,
             section_rate,
-            &allan_kalibr::ieee952::Config::default(),
-        );
-        an.checks = check.findings.clone();
-        Some(an)
+            &check.findings,
+        ))
     } else {
         None
     };
@@ -333,23 +290,7 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
-    let mut files = report::write_curve_files(&analysis, &config.name, &config.common.out_dir)?;
-    for mode in [YamlMode::Compat, YamlMode::Continuous] {
-        let p = config.common.out_dir.join(mode.file_name(&config.name));
-        report::write_text(&p, &opencv_yaml::yaml_text(&analysis, &config.name, mode))?;
-        files.push(p);
-    }
-    if config.plots {
-        files.extend(plot::write_plots(
-            &analysis,
-            &config.name,
-            &config.common.out_dir,
-        )?);
-    }
-    if let Some(an) = &ieee {
-        files.extend(write_ieee952(an, config, &topic)?);
-    }
+    let files = write_outputs(&analysis, ieee.as_ref(), config, &topic)?;
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee.as_ref().map(|a| {
         imu::summary_text(a)
@@ -366,6 +307,104 @@ fn run_series(
         ieee952: ieee,
         timings,
     })
+}
+
+/// The value check of every analysed column (`allan_kalibr::input::value_problem`): a
+/// column no analysis can use is an error, an odd one a warning.
+fn check_values(
+    collected: &collect::Collected,
+    absent: Option<Sensor>,
+    notes: &mut Vec<Note>,
+) -> Result<(), Error> {
+    let problems: Vec<_> = (0..collect::FIELDS.len())
+        .into_par_iter()
+        .filter(|&k| absent != Some(if k < 3 { Sensor::Gyro } else { Sensor::Acc }))
+        .map(|k| {
+            let col = if k < 3 {
+                collected.gyro_rad_s(k)
+            } else {
+                collected.acc_m_s2(k - 3)
+            };
+            allan_kalibr::input::value_problem(collect::FIELDS[k], col)
+        })
+        .collect();
+    for problem in problems {
+        match problem {
+            Some((true, what)) => return Err(Error::Config(what)),
+            Some((false, what)) => notes.push(Note::warning(what)),
+            None => {}
+        }
+    }
+    Ok(())
+}
+
+/// The IEEE 952 section on imu_utils' overlapping curves (rad/s, m/s²), with the PSD and
+/// lines of the samples (SI units) and the record check's `findings`.
+fn section(
+    axes: &[AxisAllan],
+    collected: &collect::Collected,
+    absent: Option<Sensor>,
+    section_rate: f64,
+    findings: &[bag2mat::record_check::Finding],
+) -> ImuAnalysis {
+    let curves: Vec<CurveData> = axes
+        .par_iter()
+        .enumerate()
+        .filter(|(i, _)| absent != Some(if *i < 3 { Sensor::Gyro } else { Sensor::Acc }))
+        .map(|(i, a)| {
+            let y = if i < 3 {
+                collected.gyro_rad_s(i)
+            } else {
+                collected.acc_m_s2(i - 3)
+            };
+            ieee952_curve(a, i < 3, 1.0 / section_rate).with_spectrum(y)
+        })
+        .collect();
+    let mut it = curves.into_iter();
+    let sensors: Vec<(Sensor, [CurveData; 3])> = [Sensor::Gyro, Sensor::Acc]
+        .into_iter()
+        .filter(|s| Some(*s) != absent)
+        .map(|s| {
+            (
+                s,
+                std::array::from_fn(|_| it.next().expect("three per sensor")),
+            )
+        })
+        .collect();
+    let mut an = imu::analyse_curves(
+        &sensors,
+        section_rate,
+        &allan_kalibr::ieee952::Config::default(),
+    );
+    an.checks = findings.to_vec();
+    an
+}
+
+/// imu_utils' files (curves, both yaml modes, plots) and the section's.
+fn write_outputs(
+    analysis: &Analysis,
+    ieee: Option<&ImuAnalysis>,
+    config: &Config,
+    topic: &str,
+) -> Result<Vec<PathBuf>, Error> {
+    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
+    let mut files = report::write_curve_files(analysis, &config.name, &config.common.out_dir)?;
+    for mode in [YamlMode::Compat, YamlMode::Continuous] {
+        let p = config.common.out_dir.join(mode.file_name(&config.name));
+        report::write_text(&p, &opencv_yaml::yaml_text(analysis, &config.name, mode))?;
+        files.push(p);
+    }
+    if config.plots {
+        files.extend(plot::write_plots(
+            analysis,
+            &config.name,
+            &config.common.out_dir,
+        )?);
+    }
+    if let Some(an) = ieee {
+        files.extend(write_ieee952(an, config, topic)?);
+    }
+    Ok(files)
 }
 
 /// The section's files (prefixed `<name>_`) and chart.
