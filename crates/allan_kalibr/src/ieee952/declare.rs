@@ -104,6 +104,20 @@ fn declare_from(
                         _ => break,
                     }
                 }
+                // past the first point-wise miss: the longest extension the data accept
+                // jointly (fit::range_end)
+                let accepted_tau = fd.points[end - 1].tau * (1.0 + 1e-12);
+                for e in (end + 1..=np).rev() {
+                    if let Some((g, m, mm)) = fit_and_check(data, fd, valid, cfg, b.start, e)
+                        && m.iter().all(|x| x.tau > accepted_tau)
+                        && fit::extension_agrees(fd, &f, &g, &cfg.fit)
+                    {
+                        f = g;
+                        max_mis = mm;
+                        end = e;
+                        break;
+                    }
+                }
             }
             let (lo_t, hi_t) = (fd.points[b.start].tau, fd.points[end - 1].tau);
             if (hi_t / lo_t).log10() < MIN_RANGE_DECADES {

@@ -10,6 +10,8 @@
 //! The terms' basis functions and shapes are in `model`, the small dense linear algebra
 //! (whitening, active-set NNLS, normal equations, SPD solve) in `linalg`; this module is the
 //! fit itself: GLS with the discrepancy, the τ range, term selection and the intervals.
+//! How far a range may go on past the first point the model misses is `range_end`'s joint
+//! test of the extension.
 //!
 //! # Weighting: generalised least squares with a model-discrepancy component
 //! The statistical covariance Σ(c) of the overlapping AVAR points under the model
@@ -87,6 +89,7 @@ use super::avar_cov::CovBasis;
 
 mod linalg;
 mod model;
+mod range_end;
 pub(in crate::ieee952) use linalg::solve_spd;
 use linalg::{covariance, nnls_subsets, whiten};
 use model::effective_coef;
@@ -95,6 +98,7 @@ pub use model::{
     FLICKER_AVAR, GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA,
     TERM_COUNT, TERM_NAMES, alpha_index, basis, basis_at, flicker_band, gm_basis,
 };
+pub(in crate::ieee952) use range_end::extension_agrees;
 
 /// Fit settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
