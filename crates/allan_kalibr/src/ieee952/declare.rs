@@ -6,8 +6,8 @@
 use super::avar_cov;
 use super::{
     APPROX_CHI2, APPROX_DELTA, AxisVerdict, Config, CurveData, CurvePoint, FIT_TOL,
-    MIN_RANGE_DECADES, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN, SHORT_FEATURE_SPAN, ci, edf,
-    fit, short,
+    MIN_RANGE_DECADES, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN, SHORT_FEATURE_SPAN, Term,
+    Verdict, ci, edf, fit, pipeline, short, terms,
 };
 
 /// Chooses the fitted range and fits it: the start from [`fit::choose_start`], then the
@@ -112,9 +112,13 @@ fn declare_from(
                         && m.iter().all(|x| x.tau > accepted_tau)
                         && fit::extension_agrees(fd, &f, &g, &cfg.fit)
                     {
-                        f = g;
-                        max_mis = mm;
-                        end = e;
+                        // only the longest extension the test accepts is a candidate: a
+                        // shorter one would be a range chosen for the terms it gives
+                        if extension_is_honest(data, fd, cfg, &f, &g) {
+                            f = g;
+                            max_mis = mm;
+                            end = e;
+                        }
                         break;
                     }
                 }
@@ -277,4 +281,37 @@ fn check_level(kind: Overlap, points: usize) -> f64 {
         Overlap::Overlapping => 0.95,
         Overlap::Normal => 0.95f64.powf(1.0 / points.max(1) as f64),
     }
+}
+
+/// Whether the extended fit `ext` may replace the accepted fit `base` (issue 17.1b): the
+/// joint test ([`fit::extension_agrees`]) says the added points are described, and this
+/// says the extension does not buy its terms. It is refused when it makes the fit
+/// approximate ([`APPROX_DELTA`], [`APPROX_CHI2`]) where the accepted one was not, or when
+/// a term it newly resolves lies above the accepted fit's upper bound for that term: the
+/// long-τ points then carry a term the accepted range rules out (on a record with a
+/// mid-curve line, a random walk read off the last, noisiest points), not one it merely
+/// sharpens.
+fn extension_is_honest(
+    data: &CurveData,
+    fd: &fit::FitData,
+    cfg: &Config,
+    base: &fit::FitResult,
+    ext: &fit::FitResult,
+) -> bool {
+    let approximate = |x: &fit::FitResult| x.delta > APPROX_DELTA || x.chi2_per_dof > APPROX_CHI2;
+    if approximate(ext) && !approximate(base) {
+        return false;
+    }
+    let terms = |x: &fit::FitResult| {
+        let first = fd.points[x.used[0]].tau;
+        let last = fd.points[x.used[x.used.len() - 1]].tau;
+        let curve = pipeline::curve_points(data, cfg, Some(x), Some((first, last)));
+        let t = terms::make_terms(x, fd, &curve, cfg);
+        [t.q, t.n, t.b, t.k, t.r, t.g]
+    };
+    let resolved = |t: &Term| t.verdict == Verdict::Resolved;
+    let (was, now) = (terms(base), terms(ext));
+    was.iter()
+        .zip(&now)
+        .all(|(w, n)| !resolved(n) || resolved(w) || n.value <= w.hi)
 }

@@ -126,7 +126,7 @@ fn fit_data<'a>(
 /// The analysed curve: each valid point with its α (identified, else the fitted model's
 /// dominant term), its Greenhall EDF, its bounds at `cfg.curve_confidence` and at 95 %,
 /// whether it is in the declared `range`, and the model there.
-fn curve_points(
+pub(super) fn curve_points(
     data: &CurveData,
     cfg: &Config,
     fitted: Option<&fit::FitResult>,

@@ -22,6 +22,12 @@
 //! the model at long τ — many points off the same way, each correlated with the next —
 //! still fails: the covariance makes a bend cost its full weight, a fluctuation only its
 //! own.
+//!
+//! Only the longest extension the test accepts is a candidate, and the declared fit takes it
+//! only when it does not buy its terms (`declare::extension_is_honest`): not when it makes
+//! the fit approximate, nor when a term it newly resolves lies above the accepted range's
+//! upper bound for it (a profile's gyro K 2× the truth was resolved so by the last points
+//! alone). Trying shorter extensions after a refusal would choose the range by its terms.
 
 use super::{FitConfig, FitData, FitResult, fixed_ls, signed_terms};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
