@@ -90,39 +90,11 @@ fn declare_from(
             );
         };
         if misses.is_empty() {
-            let (mut f, mut max_mis, mut end) = (f, max_mis, b.end);
-            // after a cut at the long end, extend again while the check holds: the first miss
-            // is where the model stops following, not necessarily where the curve bends
-            if b.long_cut {
-                while end < np {
-                    match fit_and_check(data, fd, valid, cfg, b.start, end + 1) {
-                        Some((g, m, mm)) if m.is_empty() => {
-                            f = g;
-                            max_mis = mm;
-                            end += 1;
-                        }
-                        _ => break,
-                    }
-                }
-                // past the first point-wise miss: the longest extension the data accept
-                // jointly (fit::range_end)
-                let accepted_tau = fd.points[end - 1].tau * (1.0 + 1e-12);
-                for e in (end + 1..=np).rev() {
-                    if let Some((g, m, mm)) = fit_and_check(data, fd, valid, cfg, b.start, e)
-                        && m.iter().all(|x| x.tau > accepted_tau)
-                        && fit::extension_agrees(fd, &f, &g, &cfg.fit)
-                    {
-                        // only the longest extension the test accepts is a candidate: a
-                        // shorter one would be a range chosen for the terms it gives
-                        if extension_is_honest(data, fd, cfg, &f, &g) {
-                            f = g;
-                            max_mis = mm;
-                            end = e;
-                        }
-                        break;
-                    }
-                }
-            }
+            let (f, max_mis, end) = if b.long_cut {
+                extend_long_end(data, fd, valid, cfg, b.start, (f, max_mis, b.end))
+            } else {
+                (f, max_mis, b.end)
+            };
             let (lo_t, hi_t) = (fd.points[b.start].tau, fd.points[end - 1].tau);
             if (hi_t / lo_t).log10() < MIN_RANGE_DECADES {
                 let reason = match b.last_miss {
@@ -222,6 +194,51 @@ struct Miss {
 
 /// A fit with its check: the misses in ascending τ and the largest misfit.
 type Checked = (fit::FitResult, Vec<Miss>, f64);
+
+/// The fitted range `start..end` of `accepted` (its fit, its largest misfit), after a cut at
+/// the long end, grown again while the check holds — the first miss is where the model
+/// stops following, not necessarily where the curve bends — and then past the first
+/// point-wise miss to the longest extension the data accept jointly ([`fit::range_end`]).
+fn extend_long_end(
+    data: &CurveData,
+    fd: &fit::FitData,
+    valid: &[&CurvePoint],
+    cfg: &Config,
+    start: usize,
+    accepted: (fit::FitResult, f64, usize),
+) -> (fit::FitResult, f64, usize) {
+    let np = fd.points.len();
+    let (mut f, mut max_mis, mut end) = accepted;
+    while end < np {
+        match fit_and_check(data, fd, valid, cfg, start, end + 1) {
+            Some((g, m, mm)) if m.is_empty() => {
+                f = g;
+                max_mis = mm;
+                end += 1;
+            }
+            _ => break,
+        }
+    }
+    // past the first point-wise miss: the longest extension the data accept
+    // jointly (fit::range_end)
+    let accepted_tau = fd.points[end - 1].tau * (1.0 + 1e-12);
+    for e in (end + 1..=np).rev() {
+        if let Some((g, m, mm)) = fit_and_check(data, fd, valid, cfg, start, e)
+            && m.iter().all(|x| x.tau > accepted_tau)
+            && fit::extension_agrees(fd, &f, &g, &cfg.fit)
+        {
+            // only the longest extension the test accepts is a candidate: a
+            // shorter one would be a range chosen for the terms it gives
+            if extension_is_honest(data, fd, cfg, &f, &g) {
+                f = g;
+                max_mis = mm;
+                end = e;
+            }
+            break;
+        }
+    }
+    (f, max_mis, end)
+}
 
 /// Fits positions `start..end` of `fd` and checks every curve point of that τ range: returns
 /// the fit, the misses in ascending τ and the largest misfit.
