@@ -825,7 +825,84 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     let ieee = ieee_only(cfg.terms);
     let base = data.base_shapes();
     let full = gls(data, used, ieee, signed, est, cfg.max_iter, base);
-    let mut terms = ieee;
+    let (terms, mut shapes) = select_terms(data, used, cfg, &full, est)?;
+    let mut s = if terms == ieee && shapes == base {
+        full.clone()?
+    } else {
+        gls(data, used, terms, signed, est, cfg.max_iter, shapes)?
+    };
+    if !cfg.discrepancy && data.basis.is_some() {
+        // plain GLS: standard errors scaled against misfit
+        let scale = (s.chi2 / s.dof.max(1) as f64).max(1.0);
+        for row in s.cov.iter_mut() {
+            for v in row.iter_mut() {
+                *v *= scale;
+            }
+        }
+    }
+    let mut left_out = [false; TERM_COUNT];
+    let mut coef = s.coef;
+    let mut cov = s.cov;
+    let mut left_out_coef = [0.0; TERM_COUNT];
+    for j in 0..TERM_COUNT {
+        if cfg.terms[j] && !terms[j] && base.has(j) {
+            left_out[j] = true;
+            coef[j] = 0.0;
+            cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
+            left_out_coef[j] = full.as_ref().map_or(0.0, |f| f.coef[j].max(0.0));
+        }
+    }
+    // the fixed lines' coefficients are the PSD's
+    for (j, v) in shapes.fixed_coef().iter().enumerate() {
+        if *v != 0.0 {
+            coef[j] = *v;
+        }
+    }
+    if coef[GM] == 0.0 {
+        shapes.gm_t = f64::NAN;
+    }
+    if coef[2] == 0.0 {
+        shapes.b_lo = 0.0;
+    }
+    let ambiguous = ambiguous_terms(data, used, cfg, &s, terms, shapes, &coef);
+    let alternatives = floor_alternatives(data, used, cfg, &s, terms, shapes, &coef);
+    let max_share = max_shares(data, used, &coef, &shapes);
+    Some(FitResult {
+        coef,
+        cov,
+        free: std::array::from_fn(|j| coef[j] != 0.0),
+        left_out,
+        left_out_coef,
+        used: used.to_vec(),
+        iterations: s.iterations,
+        converged: s.converged,
+        chi2_per_dof: s.chi2_stat / s.dof.max(1) as f64,
+        delta: if data.basis.is_some() || cfg.discrepancy {
+            s.delta
+        } else {
+            f64::NAN
+        },
+        dof: s.dof,
+        shapes,
+        alternatives,
+        ambiguous,
+        max_share,
+    })
+}
+
+/// The forward selection of the nuisance terms, the Gauss–Markov bump and the flicker
+/// floor's corner (with `cfg.select`): each step adds the candidate whose χ² drop beyond its
+/// threshold is largest, while one is positive. Returns the terms and shapes chosen (the
+/// IEEE terms and the base shapes without a selection).
+fn select_terms(
+    data: &FitData,
+    used: &[usize],
+    cfg: &FitConfig,
+    full: &Option<Solve>,
+    est: Delta,
+) -> Option<([bool; TERM_COUNT], Shapes)> {
+    let signed = signed_terms(cfg);
+    let base = data.base_shapes();
     let mut shapes = base;
     if cfg.select {
         let mut t = [false; TERM_COUNT];
@@ -910,50 +987,25 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
                     _ => break,
                 }
             }
-            terms = t;
+            return Some((t, shapes));
         }
     }
-    let mut s = if terms == ieee && shapes == base {
-        full.clone()?
-    } else {
-        gls(data, used, terms, signed, est, cfg.max_iter, shapes)?
-    };
-    if !cfg.discrepancy && data.basis.is_some() {
-        // plain GLS: standard errors scaled against misfit
-        let scale = (s.chi2 / s.dof.max(1) as f64).max(1.0);
-        for row in s.cov.iter_mut() {
-            for v in row.iter_mut() {
-                *v *= scale;
-            }
-        }
-    }
-    let mut left_out = [false; TERM_COUNT];
-    let mut coef = s.coef;
-    let mut cov = s.cov;
-    let mut left_out_coef = [0.0; TERM_COUNT];
-    for j in 0..TERM_COUNT {
-        if cfg.terms[j] && !terms[j] && base.has(j) {
-            left_out[j] = true;
-            coef[j] = 0.0;
-            cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
-            left_out_coef[j] = full.as_ref().map_or(0.0, |f| f.coef[j].max(0.0));
-        }
-    }
-    // the fixed lines' coefficients are the PSD's
-    for (j, v) in shapes.fixed_coef().iter().enumerate() {
-        if *v != 0.0 {
-            coef[j] = *v;
-        }
-    }
-    if coef[GM] == 0.0 {
-        shapes.gm_t = f64::NAN;
-    }
-    if coef[2] == 0.0 {
-        shapes.b_lo = 0.0;
-    }
-    // B or K only where no Gauss–Markov bias explains the data as well: the model with the
-    // term swapped for a bump (its best correlation time) must fit worse, under the final
-    // model's covariance, by Akaike's measure (the bump has one more parameter).
+    Some((ieee_only(cfg.terms), base))
+}
+
+/// B or K only where no Gauss–Markov bias explains the data as well: the model with the
+/// term swapped for a bump (its best correlation time) must fit worse, under the final
+/// model's covariance (`s`), by Akaike's measure (the bump has one more parameter).
+fn ambiguous_terms(
+    data: &FitData,
+    used: &[usize],
+    cfg: &FitConfig,
+    s: &Solve,
+    terms: [bool; TERM_COUNT],
+    shapes: Shapes,
+    coef: &[f64; TERM_COUNT],
+) -> [bool; TERM_COUNT] {
+    let signed = signed_terms(cfg);
     let mut ambiguous = [false; TERM_COUNT];
     if cfg.select && cfg.terms[GM] {
         let d = if data.basis.is_none() { 1.0 } else { s.delta };
@@ -982,9 +1034,22 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
             }
         }
     }
-    // the flicker floor's shape as the data leave it: every corner (and the flat floor)
-    // whose fit is within the 95 % profile-likelihood bound of the best one, under the
-    // final model's covariance — the terms' intervals span theirs (see [`FitResult`])
+    ambiguous
+}
+
+/// The flicker floor's shape as the data leave it: every corner (and the flat floor) whose
+/// fit is within the 95 % profile-likelihood bound of the best one, under the final model's
+/// covariance (`s`) — the terms' intervals span theirs (see [`FitResult`]).
+fn floor_alternatives(
+    data: &FitData,
+    used: &[usize],
+    cfg: &FitConfig,
+    s: &Solve,
+    terms: [bool; TERM_COUNT],
+    shapes: Shapes,
+    coef: &[f64; TERM_COUNT],
+) -> Vec<ShapeAlternative> {
+    let signed = signed_terms(cfg);
     let mut alternatives = Vec::new();
     if terms[2] && coef[2] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
         let cands: Vec<f64> = std::iter::once(0.0)
@@ -1008,48 +1073,35 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
             }
         }
     }
-    // each term's largest share of the model's Allan variance at a used point (the model
-    // rather than the measured points: their scatter at long τ would make a term dominant,
-    // or not, by chance)
-    // (a noise term's share of the noise: a resonance's tail adds white-like variance at
-    // long τ, and must not make the white noise "never dominant")
-    let mut noise_coef = coef;
+    alternatives
+}
+
+/// Each term's largest share of the model's Allan variance at a used point (the model
+/// rather than the measured points: their scatter at long τ would make a term dominant, or
+/// not, by chance). A noise term's share is of the noise: a resonance's tail adds
+/// white-like variance at long τ, and must not make the white noise "never dominant".
+fn max_shares(
+    data: &FitData,
+    used: &[usize],
+    coef: &[f64; TERM_COUNT],
+    shapes: &Shapes,
+) -> [f64; TERM_COUNT] {
+    let mut noise_coef = *coef;
     for v in noise_coef.iter_mut().skip(LINE0) {
         *v = 0.0;
     }
-    let max_share = std::array::from_fn(|j| {
+    std::array::from_fn(|j| {
         used.iter()
             .map(|&i| {
                 let tau = data.points[i].tau;
-                let total = predict(if j < LINE0 { &noise_coef } else { &coef }, &shapes, tau);
+                let total = predict(if j < LINE0 { &noise_coef } else { coef }, shapes, tau);
                 if total > 0.0 {
-                    (coef[j] * basis_at(j, tau, &shapes) / total).max(0.0)
+                    (coef[j] * basis_at(j, tau, shapes) / total).max(0.0)
                 } else {
                     0.0
                 }
             })
             .fold(0.0, f64::max)
-    });
-    Some(FitResult {
-        coef,
-        cov,
-        free: std::array::from_fn(|j| coef[j] != 0.0),
-        left_out,
-        left_out_coef,
-        used: used.to_vec(),
-        iterations: s.iterations,
-        converged: s.converged,
-        chi2_per_dof: s.chi2_stat / s.dof.max(1) as f64,
-        delta: if data.basis.is_some() || cfg.discrepancy {
-            s.delta
-        } else {
-            f64::NAN
-        },
-        dof: s.dof,
-        shapes,
-        alternatives,
-        ambiguous,
-        max_share,
     })
 }
 
