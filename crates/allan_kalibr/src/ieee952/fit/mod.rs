@@ -864,8 +864,16 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     if coef[2] == 0.0 {
         shapes.b_lo = 0.0;
     }
-    let ambiguous = ambiguous_terms(data, used, cfg, &s, terms, shapes, &coef);
-    let alternatives = floor_alternatives(data, used, cfg, &s, terms, shapes, &coef);
+    let model = FinalModel {
+        data,
+        used,
+        cfg,
+        s: &s,
+        terms,
+        shapes,
+        coef: &coef,
+    };
+    let (ambiguous, alternatives) = (model.ambiguous_terms(), model.floor_alternatives());
     let max_share = max_shares(data, used, &coef, &shapes);
     Some(FitResult {
         coef,
@@ -993,87 +1001,104 @@ fn select_terms(
     Some((ieee_only(cfg.terms), base))
 }
 
-/// B or K only where no Gauss–Markov bias explains the data as well: the model with the
-/// term swapped for a bump (its best correlation time) must fit worse, under the final
-/// model's covariance (`s`), by Akaike's measure (the bump has one more parameter).
-fn ambiguous_terms(
-    data: &FitData,
-    used: &[usize],
-    cfg: &FitConfig,
-    s: &Solve,
+/// The final model of a fit, for the checks made under its covariance (`s`): the terms it
+/// holds, its shapes and its coefficients (left-out terms at 0, fixed lines at the PSD's).
+#[derive(Clone, Copy)]
+struct FinalModel<'a> {
+    data: &'a FitData<'a>,
+    used: &'a [usize],
+    cfg: &'a FitConfig,
+    s: &'a Solve,
     terms: [bool; TERM_COUNT],
     shapes: Shapes,
-    coef: &[f64; TERM_COUNT],
-) -> [bool; TERM_COUNT] {
-    let signed = signed_terms(cfg);
-    let mut ambiguous = [false; TERM_COUNT];
-    if cfg.select && cfg.terms[GM] {
-        let d = if data.basis.is_none() { 1.0 } else { s.delta };
-        let grid = shape_grid(data, used, GM_GRID);
-        let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
-            fixed_ls(data, used, tt, signed, &s.coef, d, sh).map(|x| x.1)
-        };
-        if let Some(cur) = chi(terms, shapes) {
-            for j in [2, 3] {
-                if !terms[j] || coef[j] == 0.0 {
-                    continue;
-                }
-                let mut tt = terms;
-                tt[j] = false;
-                tt[GM] = true;
-                let times: Vec<f64> = if terms[GM] {
-                    vec![shapes.gm_t]
-                } else {
-                    grid.clone()
-                };
-                let alt = times
-                    .iter()
-                    .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }))
-                    .fold(f64::INFINITY, f64::min);
-                ambiguous[j] = alt + SWAP_PENALTY <= cur;
-            }
-        }
-    }
-    ambiguous
+    coef: &'a [f64; TERM_COUNT],
 }
 
-/// The flicker floor's shape as the data leave it: every corner (and the flat floor) whose
-/// fit is within the 95 % profile-likelihood bound of the best one, under the final model's
-/// covariance (`s`) — the terms' intervals span theirs (see [`FitResult`]).
-fn floor_alternatives(
-    data: &FitData,
-    used: &[usize],
-    cfg: &FitConfig,
-    s: &Solve,
-    terms: [bool; TERM_COUNT],
-    shapes: Shapes,
-    coef: &[f64; TERM_COUNT],
-) -> Vec<ShapeAlternative> {
-    let signed = signed_terms(cfg);
-    let mut alternatives = Vec::new();
-    if terms[2] && coef[2] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
-        let cands: Vec<f64> = std::iter::once(0.0)
-            .chain(shape_grid(data, used, CORNER_GRID))
-            .collect();
-        let fits: Vec<(f64, FixedLs)> = cands
-            .iter()
-            .filter_map(|&lo| {
-                let sh = Shapes { b_lo: lo, ..shapes };
-                fixed_ls(data, used, terms, signed, &s.coef, s.delta, sh).map(|f| (lo, f))
-            })
-            .collect();
-        let best = fits.iter().map(|f| f.1.1).fold(f64::INFINITY, f64::min);
-        for (lo, (c, chi, _, cv)) in fits {
-            if lo != shapes.b_lo && chi - best <= PROFILE_CHI2_95 {
-                alternatives.push(ShapeAlternative {
-                    shapes: Shapes { b_lo: lo, ..shapes },
-                    coef: c,
-                    std_err: std::array::from_fn(|j| cv[j][j].max(0.0).sqrt()),
-                });
+impl FinalModel<'_> {
+    /// B or K only where no Gauss–Markov bias explains the data as well: the model with the
+    /// term swapped for a bump (its best correlation time) must fit worse, under the final
+    /// model's covariance (`s`), by Akaike's measure (the bump has one more parameter).
+    fn ambiguous_terms(&self) -> [bool; TERM_COUNT] {
+        let FinalModel {
+            data,
+            used,
+            cfg,
+            s,
+            terms,
+            shapes,
+            coef,
+        } = *self;
+        let signed = signed_terms(cfg);
+        let mut ambiguous = [false; TERM_COUNT];
+        if cfg.select && cfg.terms[GM] {
+            let d = if data.basis.is_none() { 1.0 } else { s.delta };
+            let grid = shape_grid(data, used, GM_GRID);
+            let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
+                fixed_ls(data, used, tt, signed, &s.coef, d, sh).map(|x| x.1)
+            };
+            if let Some(cur) = chi(terms, shapes) {
+                for j in [2, 3] {
+                    if !terms[j] || coef[j] == 0.0 {
+                        continue;
+                    }
+                    let mut tt = terms;
+                    tt[j] = false;
+                    tt[GM] = true;
+                    let times: Vec<f64> = if terms[GM] {
+                        vec![shapes.gm_t]
+                    } else {
+                        grid.clone()
+                    };
+                    let alt = times
+                        .iter()
+                        .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }))
+                        .fold(f64::INFINITY, f64::min);
+                    ambiguous[j] = alt + SWAP_PENALTY <= cur;
+                }
             }
         }
+        ambiguous
     }
-    alternatives
+
+    /// The flicker floor's shape as the data leave it: every corner (and the flat floor) whose
+    /// fit is within the 95 % profile-likelihood bound of the best one, under the final model's
+    /// covariance (`s`) — the terms' intervals span theirs (see [`FitResult`]).
+    fn floor_alternatives(&self) -> Vec<ShapeAlternative> {
+        let FinalModel {
+            data,
+            used,
+            cfg,
+            s,
+            terms,
+            shapes,
+            coef,
+        } = *self;
+        let signed = signed_terms(cfg);
+        let mut alternatives = Vec::new();
+        if terms[2] && coef[2] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
+            let cands: Vec<f64> = std::iter::once(0.0)
+                .chain(shape_grid(data, used, CORNER_GRID))
+                .collect();
+            let fits: Vec<(f64, FixedLs)> = cands
+                .iter()
+                .filter_map(|&lo| {
+                    let sh = Shapes { b_lo: lo, ..shapes };
+                    fixed_ls(data, used, terms, signed, &s.coef, s.delta, sh).map(|f| (lo, f))
+                })
+                .collect();
+            let best = fits.iter().map(|f| f.1.1).fold(f64::INFINITY, f64::min);
+            for (lo, (c, chi, _, cv)) in fits {
+                if lo != shapes.b_lo && chi - best <= PROFILE_CHI2_95 {
+                    alternatives.push(ShapeAlternative {
+                        shapes: Shapes { b_lo: lo, ..shapes },
+                        coef: c,
+                        std_err: std::array::from_fn(|j| cv[j][j].max(0.0).sqrt()),
+                    });
+                }
+            }
+        }
+        alternatives
+    }
 }
 
 /// Each term's largest share of the model's Allan variance at a used point (the model
