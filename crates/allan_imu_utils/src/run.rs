@@ -293,8 +293,7 @@ fn run_series(
     let files = write_outputs(&analysis, ieee.as_ref(), config, &topic)?;
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee.as_ref().map(|a| {
-        imu::summary_text(a)
-            + &allan_kalibr::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
+        allan_kalibr::ieee952::stated::section_text(a, config.common.samples_path(), &topic)
     });
     Ok(Outcome {
         topic,

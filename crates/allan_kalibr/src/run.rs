@@ -221,8 +221,7 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     // The IEEE 952 analysis reads the raw columns, so its curves are made before the compat
     // path turns them into prefix sums; its fits then run beside the compat path. Data too
     // short for it only cost the section, with a note.
-    let early = c.early.take();
-    let (curves, curves_s) = section_curves(config, &c, early, &mut notes);
+    let (curves, curves_s) = section_curves(config, &mut c, &mut notes);
     let axes = compat_axes(c.data);
     let ((ieee, fits_s), analysis) = rayon::join(
         || {
@@ -258,10 +257,9 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
         analysis,
         rate: c.rate,
         text,
-        ieee952_text: ieee.as_ref().map(|a| {
-            crate::ieee952::imu::summary_text(a)
-                + &crate::ieee952::stated::beside_ours(a, config.common.samples_path(), &topic)
-        }),
+        ieee952_text: ieee
+            .as_ref()
+            .map(|a| crate::ieee952::stated::section_text(a, config.common.samples_path(), &topic)),
         findings: c.findings,
         notes,
         written,
@@ -379,8 +377,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
 /// they fit what the check kept and the rate chosen, else made now.
 fn section_curves(
     config: &Config,
-    c: &Checked,
-    early: Option<EarlyCurves>,
+    c: &mut Checked,
     notes: &mut Vec<Note>,
 ) -> (Option<crate::ieee952::imu::ImuCurves>, f64) {
     let start = Instant::now();
@@ -390,7 +387,7 @@ fn section_curves(
             r.short()
         )));
     }
-    match early {
+    match c.early.take() {
         _ if !config.common.ieee952 || c.refusal.is_some() => (None, 0.0),
         Some((r, curves, early_notes, early_s)) if c.whole && r == c.rate.section => {
             notes.extend(early_notes);

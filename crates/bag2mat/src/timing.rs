@@ -235,13 +235,12 @@ pub fn analyse(t: &[i64]) -> Timing {
         return out;
     };
     out.median_period_ns = Some(p);
-    let changes = rate_changes(&d, p, n);
-    out.rate_changes = changes.clone();
-    let long_cuts = out.count_gaps(t, &d, p, &changes);
+    out.rate_changes = rate_changes(&d, p, n);
+    let long_cuts = out.count_gaps(t, &d, p);
     let mut cuts: Vec<usize> = if out.is_continuous() {
         Vec::new()
     } else {
-        changes.iter().copied().chain(long_cuts).collect()
+        out.rate_changes.iter().copied().chain(long_cuts).collect()
     };
     cuts.sort_unstable();
     cuts.dedup();
@@ -300,13 +299,14 @@ fn rate_changes(d: &[i64], p: i64, n: usize) -> Vec<usize> {
 }
 
 impl Timing {
-    /// Within each rate segment (cut at `changes`), the intervals `d` of `t` in whole
-    /// periods of the segment's own median (`p` with one rate throughout): the gaps, the
-    /// samples missing and the nominal period. Returns where gaps longer than
+    /// Within each rate segment (cut at `self.rate_changes`), the intervals `d` of `t` in
+    /// whole periods of the segment's own median (`p` with one rate throughout): the gaps,
+    /// the samples missing and the nominal period. Returns where gaps longer than
     /// [`GAP_FACTOR`] periods cut the series.
-    fn count_gaps(&mut self, t: &[i64], d: &[i64], p: i64, changes: &[usize]) -> Vec<usize> {
+    fn count_gaps(&mut self, t: &[i64], d: &[i64], p: i64) -> Vec<usize> {
+        let one_rate = self.rate_changes.is_empty();
         let bounds: Vec<usize> = std::iter::once(0)
-            .chain(changes.iter().copied())
+            .chain(self.rate_changes.iter().copied())
             .chain([self.n])
             .collect();
         let mut long_cuts: Vec<usize> = Vec::new();
@@ -316,7 +316,7 @@ impl Timing {
             // the intervals inside [a, b): a .. b-1
             let inner = &d[a..b.saturating_sub(1).max(a)];
             // one rate throughout: the series' median (no second selection)
-            let ps = if changes.is_empty() {
+            let ps = if one_rate {
                 p
             } else {
                 median_positive(inner).unwrap_or(p)

@@ -119,8 +119,7 @@ fn declare_from(
                 short_feature: b.feature,
                 band_limited: b.start > 0,
                 long_cut: end < np,
-                approximate: (f.delta > APPROX_DELTA || f.chi2_per_dof > APPROX_CHI2)
-                    .then_some(f.delta),
+                approximate: approximate(&f).then_some(f.delta),
             };
             return (Some(f), verdict, max_mis);
         }
@@ -315,7 +314,6 @@ fn extension_is_honest(
     base: &fit::FitResult,
     ext: &fit::FitResult,
 ) -> bool {
-    let approximate = |x: &fit::FitResult| x.delta > APPROX_DELTA || x.chi2_per_dof > APPROX_CHI2;
     if approximate(ext) && !approximate(base) {
         return false;
     }
@@ -324,11 +322,16 @@ fn extension_is_honest(
         let last = fd.points[x.used[x.used.len() - 1]].tau;
         let curve = pipeline::curve_points(data, cfg, Some(x), Some((first, last)));
         let t = terms::make_terms(x, fd, &curve, cfg);
-        [t.q, t.n, t.b, t.k, t.r, t.g]
+        t.as_array().into_iter().chain([t.g])
     };
     let resolved = |t: &Term| t.verdict == Verdict::Resolved;
-    let (was, now) = (terms(base), terms(ext));
-    was.iter()
-        .zip(&now)
-        .all(|(w, n)| !resolved(n) || resolved(w) || n.value <= w.hi)
+    terms(base)
+        .zip(terms(ext))
+        .all(|(w, n)| !resolved(&n) || resolved(&w) || n.value <= w.hi)
+}
+
+/// A fit whose model misses the curve beyond its statistics by more than [`APPROX_DELTA`],
+/// or whose χ²/dof exceeds [`APPROX_CHI2`]: its terms are declared approximate.
+fn approximate(f: &fit::FitResult) -> bool {
+    f.delta > APPROX_DELTA || f.chi2_per_dof > APPROX_CHI2
 }

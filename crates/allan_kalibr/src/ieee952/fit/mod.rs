@@ -825,7 +825,7 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     let ieee = ieee_only(cfg.terms);
     let base = data.base_shapes();
     let full = gls(data, used, ieee, signed, est, cfg.max_iter, base);
-    let (terms, mut shapes) = select_terms(data, used, cfg, &full, est)?;
+    let (terms, mut shapes) = select_terms(data, used, cfg, full.as_ref(), est)?;
     let mut s = if terms == ieee && shapes == base {
         full.clone()?
     } else {
@@ -906,7 +906,7 @@ fn select_terms(
     data: &FitData,
     used: &[usize],
     cfg: &FitConfig,
-    full: &Option<Solve>,
+    full: Option<&Solve>,
     est: Delta,
 ) -> Option<([bool; TERM_COUNT], Shapes)> {
     let signed = signed_terms(cfg);
@@ -922,7 +922,7 @@ fn select_terms(
         if t.iter().any(|x| *x) {
             // each step tests the candidates under the covariance of the current model (the
             // null hypothesis), with the full model's discrepancy (see [`fixed_ls`])
-            let d = match (&full, est) {
+            let d = match (full, est) {
                 (Some(f), Delta::Estimate) if data.basis.is_some() => f.delta,
                 _ if data.basis.is_none() => 1.0,
                 _ => 0.0,
