@@ -20,8 +20,9 @@ pub use write::BagWriter;
 
 use std::fmt;
 
-/// A ROS 1 time: seconds and nanoseconds since the UNIX epoch.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+/// A ROS 1 time: seconds and nanoseconds since the UNIX epoch. All-zero bytes are the
+/// default (`Zeroable`), so that columns of them are allocated zeroed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Hash, bytemuck::Zeroable)]
 pub struct RosTime {
     /// Whole seconds.
     pub sec: u32,

@@ -15,11 +15,12 @@ pub struct Rows {
 }
 
 impl Rows {
-    /// `n` rows of zeros (allocated zeroed: pages are touched only where written).
+    /// `n` rows of zeros (allocated zeroed: pages are touched only where written, by the
+    /// parallel readers; `vec![RosTime::default(); n]` would write the times serially).
     pub(crate) fn zeroed(n: usize) -> Rows {
         Rows {
-            record_time: vec![RosTime::default(); n],
-            stamp: vec![RosTime::default(); n],
+            record_time: bytemuck::zeroed_vec(n),
+            stamp: bytemuck::zeroed_vec(n),
             seq: vec![0; n],
             acc: std::array::from_fn(|_| vec![0.0; n]),
             gyro: std::array::from_fn(|_| vec![0.0; n]),
