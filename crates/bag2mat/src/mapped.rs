@@ -31,6 +31,17 @@ impl Mapped {
         Ok(Mapped { map: Some(map) })
     }
 
+    /// Fills the mapping's page tables from the page cache, in file order (Linux
+    /// `MADV_POPULATE_READ`; elsewhere, or on a kernel without it, nothing). Run beside a
+    /// one-threaded first pass over the file (the ULog hop), it takes the page faults off that
+    /// pass: about a tenth of the hop's time. Advice only: a failure changes nothing.
+    pub(crate) fn fill_pages(&self) {
+        #[cfg(target_os = "linux")]
+        if let Some(m) = &self.map {
+            let _ = m.advise(memmap2::Advice::PopulateRead);
+        }
+    }
+
     /// The bytes.
     pub(crate) fn bytes(&self) -> &[u8] {
         self.map.as_deref().unwrap_or(&[])

@@ -601,6 +601,14 @@ fn read_source(
         .collect();
     let (columns, outs) = read_columns(src, &selected, &mut lookup, &promised, opts, take);
     let after = src.losses_after_read();
+    // each topic in record-time order, the topics in parallel (a pass over every row each)
+    let columns: Vec<(Rows, Option<Vec<u32>>)> = columns
+        .into_par_iter()
+        .map(|mut rows| {
+            let order = rows.sort_by_record_time();
+            (rows, order)
+        })
+        .collect();
 
     let n_sel = selected.len();
     let mut series = Vec::with_capacity(n_sel);
@@ -712,18 +720,18 @@ fn read_columns(
     (columns, outs)
 }
 
-/// Topic `k`'s series from its rows: its report (promised, delivered, undecodable, the
-/// losses of its parts and of the container) and its notes.
+/// Topic `k`'s series from its rows in record-time order (and where each was stored, when
+/// sorting moved them): its report (promised, delivered, undecodable, the losses of its
+/// parts and of the container) and its notes.
 fn topic_series(
     src: &dyn Source,
     s: &Selected,
     k: usize,
-    mut rows: Rows,
+    (rows, storage_order): (Rows, Option<Vec<u32>>),
     promised: Option<u64>,
     outs: &[PartOut],
     after: &[Loss],
 ) -> ImuSeries {
-    let storage_order = rows.sort_by_record_time();
     let sorted = storage_order.is_some();
     let Rows {
         record_time,

@@ -116,7 +116,7 @@ impl Decoder {
         &self,
         t_ns: u64,
         data: &[u8],
-        out: &mut dyn FnMut(u64, Row),
+        mut out: impl FnMut(u64, Row),
     ) -> Result<(), &'static str> {
         let Decoder::Fifo {
             acc,

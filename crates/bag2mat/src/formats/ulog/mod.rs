@@ -120,6 +120,7 @@ const IS_TYPE: [bool; 256] = {
 };
 
 /// The step at `at`: the hop and every part walk the messages the same way.
+#[inline]
 fn step(win: &Window, at: u64, appended_at: Option<u64>) -> Step {
     let Some(h) = win.get(at, 3) else {
         return Step::Cut(at);
@@ -158,8 +159,26 @@ fn subscription(body: &[u8]) -> Option<(u8, u16, &str)> {
     Some((multi, id, m.str(n, "message name").ok()?))
 }
 
-/// Subscriptions: message id → channel ([`NO_CHANNEL`] when none), a table for the hot loop.
-type Subs = Vec<u32>;
+/// Subscriptions: message id → channel ([`NO_CHANNEL`] when none), a table for the hot loop
+/// as long as the largest id subscribed (ids count up from 0), so that each part's copy
+/// is small.
+#[derive(Debug, Clone, Default)]
+struct Subs(Vec<u32>);
+
+impl Subs {
+    #[inline]
+    fn get(&self, id: u16) -> u32 {
+        self.0.get(id as usize).copied().unwrap_or(NO_CHANNEL)
+    }
+
+    fn set(&mut self, id: u16, ch: u32) {
+        let i = id as usize;
+        if self.0.len() <= i {
+            self.0.resize(i + 1, NO_CHANNEL);
+        }
+        self.0[i] = ch;
+    }
+}
 /// A message id without a subscription.
 const NO_CHANNEL: u32 = u32::MAX;
 
@@ -182,14 +201,15 @@ pub struct UlogReader {
     appended_at: Option<u64>,
 }
 
-/// Opens a ULog file: one serial hop over the message headers (definitions, subscriptions,
-/// the parts), then each part counted in parallel ([`count_part`]).
+/// Opens a ULog file: one serial hop over the messages (definitions, subscriptions, the
+/// parts and what each part's data messages hold, [`hop`]).
 pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
     check_header(path, map.bytes())?;
-    let hop = hop(map.bytes());
+    // the page tables filled on the other core while the serial hop runs
+    let (hop, ()) = rayon::join(|| hop(map.bytes()), || map.fill_pages());
     if hop.formats.defs.is_empty() && hop.channels.is_empty() {
         return Err(Error::Corrupt {
             path: path.to_path_buf(),
@@ -205,14 +225,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
         parts: hop.parts,
         appended_at: hop.appended_at,
     };
-    let counted: Vec<PartCount> = {
-        use rayon::prelude::*;
-        let r = &reader;
-        (0..r.parts.len())
-            .into_par_iter()
-            .map(|k| r.count_part(k))
-            .collect()
-    };
+    let counted = hop.counted;
     let mut found = hop.found;
     found.dropouts = dropout_times(&hop.dropouts, &counted);
     for c in &counted {
@@ -291,13 +304,17 @@ struct Hop {
     found: Found,
     /// Each dropout in file order: the part it lies in (`None` before the data) and its ms.
     dropouts: Vec<(Option<usize>, u16)>,
+    /// What each part's data messages hold.
+    counted: Vec<PartCount>,
     appended_at: Option<u64>,
 }
 
-/// The hop: every message's header, the body only of definitions, subscriptions and
-/// dropouts, so that the data messages (nearly all of a log) cost a step each here and are
-/// counted in parallel. Parts start at data messages, every [`PART_BYTES`], each with the
-/// subscriptions then.
+/// The hop: every message in file order, the definitions, subscriptions and dropouts read,
+/// each data message counted to its part ([`PartCount::data`]: its id, time stamp and, for
+/// a FIFO message, its sample count; bytes in the cache line the header brought in, so the
+/// count costs little beside the step, where a second walk per part cost a tenth of the
+/// read). Parts start at data messages, every [`PART_BYTES`], each with the subscriptions
+/// then; they are decoded in parallel.
 fn hop(bytes: &[u8]) -> Hop {
     let len = bytes.len() as u64;
     let win = Window { data: bytes, len };
@@ -311,9 +328,10 @@ fn hop(bytes: &[u8]) -> Hop {
         parts: Vec::new(),
         found: Found::default(),
         dropouts: Vec::new(),
+        counted: Vec::new(),
         appended_at: None,
     };
-    let mut subs: Subs = vec![NO_CHANNEL; 1 << 16];
+    let mut subs = Subs::default();
     let mut at = HEADER_LEN as u64;
     while at < len {
         let (m_at, ty, size) = match step(&win, at, h.appended_at) {
@@ -339,6 +357,12 @@ fn hop(bytes: &[u8]) -> Hop {
                     end: len,
                     subs: subs.clone(),
                 });
+                h.counted.push(PartCount::default());
+            }
+            // step said the body is there
+            let body = win.get(m_at + 3, size as usize).unwrap_or(&[]);
+            if let Some(c) = h.counted.last_mut() {
+                c.data(m_at, body, &subs, &h.chans);
             }
             continue;
         }
@@ -378,17 +402,20 @@ impl Hop {
                 }
             }
             b'A' => match subscription(body) {
-                Some((multi, id, name)) => subs[id as usize] = self.channel(name, multi),
+                Some((multi, id, name)) => subs.set(id, self.channel(name, multi)),
                 None => self.found.skipped.push((m_at, body.len() as u64 + 3)),
             },
             b'R' => {
                 if let Ok(id) = m.le::<u16>("msg_id") {
-                    subs[id as usize] = NO_CHANNEL;
+                    subs.set(id, NO_CHANNEL);
                 }
             }
             b'O' => {
                 if let Ok(ms) = m.le::<u16>("dropout duration") {
                     self.dropouts.push((self.parts.len().checked_sub(1), ms));
+                    if let Some(c) = self.counted.last_mut() {
+                        c.dropout_latest.push(c.latest);
+                    }
                 }
             }
             _ => {} // info, parameters, log text, sync
@@ -439,6 +466,48 @@ struct PartCount {
     latest: u64,
 }
 
+impl PartCount {
+    /// Counts a data message (body `body`, at `m_at`) of the part: its rows (a FIFO message
+    /// is several, the oldest (n−1)·dt before its time), the times spanned, or an orphan.
+    fn data(&mut self, m_at: u64, body: &[u8], subs: &Subs, chans: &[Chan]) {
+        if body.len() < 2 {
+            self.skipped.push((m_at, body.len() as u64 + 3));
+            return;
+        }
+        let ch = subs.get(u16::from_le_bytes([body[0], body[1]]));
+        let data = &body[2..];
+        let Some(chan) = chans.get(ch as usize) else {
+            self.orphans += 1;
+            return;
+        };
+        let Some(t_us) = chan.ts.and_then(|s| s.get_u64(data)) else {
+            self.orphans += 1;
+            return;
+        };
+        let t = t_us.saturating_mul(1000);
+        self.latest = self.latest.max(t);
+        let (rows, first) = match &chan.decoder {
+            Some(d @ Decoder::Fifo { dt, .. }) => {
+                let n = d.rows_in(data);
+                let dt = dt.get(data).unwrap_or(0.0).max(0.0);
+                (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
+            }
+            _ => (1, t),
+        };
+        if rows == 0 {
+            return;
+        }
+        if self.counts.len() <= ch as usize {
+            self.counts.resize(ch as usize + 1, 0);
+        }
+        self.counts[ch as usize] += rows;
+        self.span = Some(
+            self.span
+                .map_or((first, t), |(a, b)| (a.min(first), b.max(t))),
+        );
+    }
+}
+
 /// Each dropout's time: the latest record time logged before it (0 before any), as the
 /// logger's `O` message has no time of its own.
 fn dropout_times(dropouts: &[(Option<usize>, u16)], counted: &[PartCount]) -> Vec<(u64, u16)> {
@@ -466,7 +535,8 @@ fn dropout_times(dropouts: &[(Option<usize>, u16)], counted: &[PartCount]) -> Ve
 
 /// The messages from `start` to the window's end, each given to `on` with its offset, type
 /// and body: the hop and every part walk the messages the same way ([`step`]).
-fn walk(win: &Window, start: u64, appended_at: Option<u64>, on: &mut dyn FnMut(u64, u8, &[u8])) {
+// generic, not `dyn`: the walk is the hot loop of every part, and `on` is inlined into it
+fn walk(win: &Window, start: u64, appended_at: Option<u64>, mut on: impl FnMut(u64, u8, &[u8])) {
     let mut at = start;
     while at < win.len {
         let (m_at, ty, size) = match step(win, at, appended_at) {
@@ -557,7 +627,7 @@ impl crate::source::Source for UlogReader {
         want: &(dyn Fn(u32) -> bool + Sync),
         sink: &mut crate::source::MessageSink<'_>,
     ) -> crate::source::PartRead {
-        self.walk_part(part, want, &mut |ch, t, row| match row {
+        self.walk_part(part, want, |ch, t, row| match row {
             Some(row) => sink(ch, t, &row.encode()),
             None => sink(ch, t, &[]),
         })
@@ -569,7 +639,7 @@ impl crate::source::Source for UlogReader {
         sink: &mut crate::source::RowSink<'_>,
     ) -> Option<crate::source::PartRead> {
         let imu = |ch: u32| want(ch) && self.chans[ch as usize].decoder.is_some();
-        Some(self.walk_part(part, &imu, &mut |ch, t, row| {
+        Some(self.walk_part(part, imu, |ch, t, row| {
             if let Some(row) = row {
                 sink(ch, t, row);
             }
@@ -586,11 +656,11 @@ impl UlogReader {
                 if let Some((multi, id, name)) = subscription(body)
                     && let Some(&ch) = self.by_key.get(&(name.to_string(), multi))
                 {
-                    subs[id as usize] = ch;
+                    subs.set(id, ch);
                 }
             }
             b'R' if body.len() >= 2 => {
-                subs[u16::from_le_bytes([body[0], body[1]]) as usize] = NO_CHANNEL;
+                subs.set(u16::from_le_bytes([body[0], body[1]]), NO_CHANNEL);
             }
             _ => {}
         }
@@ -606,77 +676,27 @@ impl UlogReader {
         Some((win, p.start, p.subs.clone()))
     }
 
-    /// Counts part `part`'s data messages: rows per channel, the times spanned, orphans and
-    /// the latest time before each dropout.
-    fn count_part(&self, part: usize) -> PartCount {
-        let mut c = PartCount::default();
-        let Some((win, start, mut subs)) = self.part_walk(part) else {
-            return c;
-        };
-        walk(
-            &win,
-            start,
-            self.appended_at,
-            &mut |m_at, ty, body| match ty {
-                b'A' | b'R' => self.follow(ty, body, &mut subs),
-                b'O' if body.len() >= 2 => c.dropout_latest.push(c.latest),
-                b'D' if body.len() < 2 => c.skipped.push((m_at, body.len() as u64 + 3)),
-                b'D' => {
-                    let ch = subs[u16::from_le_bytes([body[0], body[1]]) as usize];
-                    let data = &body[2..];
-                    let Some(chan) = self.chans.get(ch as usize) else {
-                        c.orphans += 1;
-                        return;
-                    };
-                    let Some(t_us) = chan.ts.and_then(|s| s.get_u64(data)) else {
-                        c.orphans += 1;
-                        return;
-                    };
-                    let t = t_us.saturating_mul(1000);
-                    c.latest = c.latest.max(t);
-                    // a FIFO message is several rows, the oldest (n−1)·dt before its time
-                    let (rows, first) = match &chan.decoder {
-                        Some(d @ Decoder::Fifo { dt, .. }) => {
-                            let n = d.rows_in(data);
-                            let dt = dt.get(data).unwrap_or(0.0).max(0.0);
-                            (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
-                        }
-                        _ => (1, t),
-                    };
-                    if rows == 0 {
-                        return;
-                    }
-                    if c.counts.len() <= ch as usize {
-                        c.counts.resize(ch as usize + 1, 0);
-                    }
-                    c.counts[ch as usize] += rows;
-                    c.span = Some(c.span.map_or((first, t), |(a, b)| (a.min(first), b.max(t))));
-                }
-                _ => {}
-            },
-        );
-        c
-    }
-
     /// Walks part `part`, handing each message of a channel `want` accepts to `deliver`:
     /// its row for an IMU channel (a FIFO message gives several), `None` for another topic.
+    /// Generic, not `dyn`, and `want` asked once per channel: this is the hot loop.
     fn walk_part(
         &self,
         part: usize,
-        want: &(dyn Fn(u32) -> bool + Sync),
-        deliver: &mut dyn FnMut(u32, u64, Option<&Row>),
+        want: impl Fn(u32) -> bool,
+        mut deliver: impl FnMut(u32, u64, Option<&Row>),
     ) -> crate::source::PartRead {
         let mut r = crate::source::PartRead::default();
+        let wanted: Vec<bool> = (0..self.chans.len() as u32).map(want).collect();
         let Some((win, start, mut subs)) = self.part_walk(part) else {
             r.error = Some(format!("no part {part}"));
             return r;
         };
-        walk(&win, start, self.appended_at, &mut |_, ty, body| match ty {
+        walk(&win, start, self.appended_at, |_, ty, body| match ty {
             b'A' | b'R' => self.follow(ty, body, &mut subs),
             b'D' if body.len() >= 2 => {
-                let ch = subs[u16::from_le_bytes([body[0], body[1]]) as usize];
-                if ch == NO_CHANNEL || !want(ch) {
-                    return;
+                let ch = subs.get(u16::from_le_bytes([body[0], body[1]]));
+                if !wanted.get(ch as usize).is_some_and(|&w| w) {
+                    return; // NO_CHANNEL is past the table
                 }
                 let data = &body[2..];
                 let c = &self.chans[ch as usize];
@@ -689,7 +709,7 @@ impl UlogReader {
                     r.delivered += 1;
                     return;
                 };
-                let rows = d.rows(t, data, &mut |rt, row| {
+                let rows = d.rows(t, data, |rt, row| {
                     deliver(ch, rt, Some(&row));
                     r.delivered += 1;
                 });
