@@ -304,7 +304,7 @@ impl CommonArgs {
 pub fn rate_for_text(input: Option<&Path>, rate: Option<f64>) -> Option<f64> {
     let text = input.is_some_and(|p| {
         matches!(
-            bag2mat::source::detect(p),
+            bag2mat::detect::input_kind(p),
             Ok(bag2mat::source::InputKind::Text)
         )
     });

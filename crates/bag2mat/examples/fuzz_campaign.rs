@@ -388,7 +388,7 @@ fn db3_regions(path: &Path, b: &[u8]) -> Vec<Region> {
 /// start (read with our reader from the clean file: only where rows are, never their
 /// values).
 fn source_units(path: &Path) -> Vec<(usize, Vec<u32>)> {
-    let src = bag2mat::source::open(path).expect("open clean file");
+    let src = bag2mat::input::open(path).expect("open clean file");
     let bytes = std::fs::read(path).expect("read clean file");
     let imu_ids: Vec<u32> = src
         .channels()

@@ -7,9 +7,9 @@
 //! and the 37 doubles of the body in the ROS 1 order. The decoder reads straight into the
 //! same [`ImuSample`] the ROS 1 codec fills, so both feed the same columns.
 
-use crate::bag::RosTime;
 use crate::error::Error;
 use crate::imu_msg::{BODY_DOUBLES, Imu, ImuSample};
+use crate::time::RosTime;
 
 /// The ROS 2 type name.
 pub const TYPE: &str = "sensor_msgs/msg/Imu";

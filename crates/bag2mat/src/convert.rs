@@ -11,13 +11,13 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::bag::RosTime;
 use crate::error::Error;
 use crate::mat::{self, COLS, DataImu};
 use crate::series::{
     ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, topic_folder_names,
 };
 use crate::shared::output::write_atomic;
+use crate::time::RosTime;
 
 /// Output file formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

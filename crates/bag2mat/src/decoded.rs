@@ -9,72 +9,11 @@
 //! at most [`PART_ROWS`] messages with exact counts. Topics the tools do not read as Imu keep
 //! only their log times (for `bag2mat info`) and deliver empty payloads.
 
-use crate::RosTime;
-use crate::error::Error;
-use crate::imu_msg::ImuSample;
-use crate::series::Rows;
+use crate::rows::{ROW_LEN, Row, Rows};
 use crate::source::{self, Channel, Contents, Encoding, InputKind, Loss, MessageSink, Part};
-
-/// Bytes of one [`Row`] payload: the sample time (u64 ns), then acc x y z and gyro x y z
-/// (f64), little-endian.
-pub const ROW_LEN: usize = 56;
 
 /// Messages per part (a part is the unit of parallel decoding and of the progress bar).
 pub const PART_ROWS: usize = 1 << 16;
-
-/// One decoded sample. A sensor a topic does not carry (a gyro-only topic's accelerometer)
-/// is NaN.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Row {
-    /// The sensor's sample time, ns (`header.stamp` of the series).
-    pub stamp: u64,
-    /// Linear acceleration, m/s².
-    pub acc: [f64; 3],
-    /// Angular velocity, rad/s.
-    pub gyro: [f64; 3],
-}
-
-impl Row {
-    /// The payload.
-    pub(crate) fn encode(&self) -> [u8; ROW_LEN] {
-        let mut b = [0u8; ROW_LEN];
-        b[..8].copy_from_slice(&self.stamp.to_le_bytes());
-        for (i, v) in self.acc.iter().chain(&self.gyro).enumerate() {
-            b[8 + 8 * i..16 + 8 * i].copy_from_slice(&v.to_le_bytes());
-        }
-        b
-    }
-
-    /// The sample of a payload.
-    pub(crate) fn decode(b: &[u8]) -> Result<ImuSample, Error> {
-        let Some(b) = b.first_chunk::<ROW_LEN>().filter(|_| b.len() == ROW_LEN) else {
-            return Err(Error::BadMessage {
-                what: format!("a decoded row is {ROW_LEN} bytes, this one {}", b.len()),
-            });
-        };
-        let (stamp, values) = b.split_first_chunk::<8>().unwrap_or((&[0; 8], &[]));
-        let mut v = [0f64; 6];
-        for (x, c) in v.iter_mut().zip(values.chunks_exact(8)) {
-            *x = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
-        }
-        Ok(ImuSample::from(&Row {
-            stamp: u64::from_le_bytes(*stamp),
-            acc: [v[0], v[1], v[2]],
-            gyro: [v[3], v[4], v[5]],
-        }))
-    }
-}
-
-impl From<&Row> for ImuSample {
-    fn from(r: &Row) -> ImuSample {
-        ImuSample {
-            seq: 0,
-            stamp: RosTime::from_nanos(r.stamp),
-            acc: r.acc,
-            gyro: r.gyro,
-        }
-    }
-}
 
 /// One topic's messages (or a piece of them): their log (record) times and, for an Imu
 /// topic, their rows, kept as the columns the read path delivers ([`crate::series`]), so a
@@ -347,6 +286,7 @@ impl source::Source for DecodedSource {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
     use crate::series::{ReadOptions, TopicSelector, read_from};
     use crate::source::Source;
 

@@ -56,7 +56,7 @@ pub enum Error {
     /// an analysis that needs both.
     #[error(
         "topic '{}' carries no {} (a topic of one sensor: PX4 sensor_gyro/sensor_accel, ArduPilot ISB batches, a text log without those columns); the analysers fit both sensors together: analyse a topic with both (sensor_combined, vehicle_imu, IMU), or convert this one with bag2mat",
-        crate::shared::cli::escape(.topic),
+        crate::printable::escape(.topic),
         .missing.name()
     )]
     OneSensor {
@@ -106,9 +106,9 @@ pub enum Error {
     /// The topic exists but does not carry `sensor_msgs/Imu` (with the right md5 for ROS 1).
     #[error(
         "topic '{}' carries {} [{}], not sensor_msgs/Imu [{}] or sensor_msgs/msg/Imu [cdr]",
-        crate::shared::cli::escape(.topic),
-        crate::shared::cli::escape(.msg_type),
-        crate::shared::cli::escape(.md5sum),
+        crate::printable::escape(.topic),
+        crate::printable::escape(.msg_type),
+        crate::printable::escape(.md5sum),
         crate::imu_msg::MD5
     )]
     WrongType {
@@ -174,12 +174,12 @@ fn nothing_read(topic: &str, why: &[String]) -> String {
     if why.is_empty() {
         return format!(
             "topic '{}' holds no message",
-            crate::shared::cli::escape(topic)
+            crate::printable::escape(topic)
         );
     }
     let mut s = format!(
         "no message of topic '{}' could be read:",
-        crate::shared::cli::escape(topic)
+        crate::printable::escape(topic)
     );
     for w in why {
         s.push_str("\n  ");
@@ -203,7 +203,7 @@ fn several_imu_topics(available: &[TopicSummary]) -> String {
 fn topic_not_found(topic: &str, available: &[TopicSummary]) -> String {
     let mut s = format!(
         "no sensor_msgs/Imu topic '{}' in the bag",
-        crate::shared::cli::escape(topic)
+        crate::printable::escape(topic)
     );
     list_topics(&mut s, available);
     s
@@ -218,9 +218,9 @@ fn list_topics(s: &mut String, available: &[TopicSummary]) {
             // Names come from the file: control bytes are escaped.
             s.push_str(&format!(
                 "\n  {:<30} {:>10} msgs : {}",
-                crate::shared::cli::escape(&t.topic),
+                crate::printable::escape(&t.topic),
                 t.count,
-                crate::shared::cli::escape(&t.msg_type)
+                crate::printable::escape(&t.msg_type)
             ));
         }
     }

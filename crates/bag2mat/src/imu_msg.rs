@@ -8,8 +8,14 @@
 
 use std::sync::LazyLock;
 
-use crate::bag::RosTime;
 use crate::cursor::Cursor;
+use crate::time::RosTime;
+
+/// The smallest payload a decodable `sensor_msgs/Imu` has (ROS 1: 16 header bytes and 37
+/// doubles; CDR: 4 encapsulation bytes, the stamp, an empty frame_id and 37 aligned doubles):
+/// a part of `bytes` bytes holds at most `bytes / MIN_IMU_PAYLOAD` rows, whatever its index
+/// says.
+pub const MIN_IMU_PAYLOAD: u64 = 16 + 37 * 8;
 
 /// The ROS type name.
 pub const TYPE: &str = "sensor_msgs/Imu";

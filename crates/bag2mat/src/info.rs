@@ -9,11 +9,11 @@ use std::path::Path;
 
 use rayon::prelude::*;
 
-use crate::bag::RosTime;
 use crate::error::Error;
 use crate::record_check::{self, Finding, Record};
 use crate::series::is_imu;
 use crate::source::{self, InputKind, Loss};
+use crate::time::RosTime;
 
 /// One topic (and type) of an input.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,7 +97,7 @@ pub fn info_with(
     quiet: bool,
     opts: &crate::formats::InputOptions,
 ) -> Result<InfoReport, Error> {
-    let src = source::open_with(path, opts)?;
+    let src = crate::input::open_with(path, opts)?;
     let parts = src.parts();
     let pb = crate::shared::progress::bar(parts.len().max(1) as u64, quiet, "parts");
     pb.set_message("reading");
@@ -250,8 +250,8 @@ impl InfoReport {
             s.push_str(&format!(
                 "{} {:<28} {:<22} {:>5} {:>9} {:>11} {:>8} {:>11} {:>5} {:>8} {:>10}\n",
                 if t.imu { "*" } else { " " },
-                crate::shared::cli::escape(&t.topic),
-                crate::shared::cli::escape(&t.msg_type),
+                crate::printable::escape(&t.topic),
+                crate::printable::escape(&t.msg_type),
                 t.encoding,
                 t.count,
                 opt(t.rate, 3),

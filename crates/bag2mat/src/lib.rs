@@ -38,28 +38,35 @@ pub mod cli;
 pub mod convert;
 pub mod cursor;
 pub mod decoded;
+pub mod detect;
 mod error;
 pub mod formats;
 pub mod imu_msg;
 pub mod info;
+pub mod input;
 pub mod mapped;
 pub mod mat;
 pub mod mcap;
+pub mod printable;
 pub mod record_check;
 pub mod rosbag2;
+pub mod rows;
 pub mod sensor;
 pub mod series;
 pub mod shared;
 pub mod source;
 #[cfg(any(test, feature = "test-support"))]
 pub mod test_tools;
+pub mod time;
 pub mod timing;
 pub mod zstd;
 
-pub use bag::{Compression, RosTime};
+pub use bag::Compression;
 pub use error::{Error, TopicSummary};
+pub use rows::permute;
 pub use sensor::Sensor;
 pub use series::{
-    ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, permute,
-    read_imu_series, read_imu_topics,
+    ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, read_imu_series,
+    read_imu_topics,
 };
+pub use time::RosTime;

@@ -1,19 +1,13 @@
 //! One interface over every container the workspace reads: ROS 1 bags, MCAP files, rosbag2
 //! sqlite3 files and rosbag2 bag directories (split files, zstd file or message compression).
 //!
-//! [`open`] recognises the input from its content (never its extension) and returns a
-//! [`Source`]: the channels with their type, encoding and the message count the container
+//! [`crate::input::open`] recognises the input from its content (never its extension,
+//! [`crate::detect`]) and returns a [`Source`]: the channels with their type, encoding and the message count the container
 //! promises, the independently readable parts (chunks, row ranges), and what opening found
 //! (notes, and [`Loss`]es: data the container held or promised that cannot be delivered).
 //! Reading a part hands out `(channel, record time, payload)` for the channels asked for and
 //! says how many it delivered and why it stopped early. Decoding, the topic rules, progress
 //! and sorting are written once on top of this, in [`crate::series`].
-
-use std::fs::File;
-use std::io::Read;
-use std::path::{Path, PathBuf};
-
-use crate::error::Error;
 
 /// What an input is, recognised from its first bytes (or `metadata.yaml` for a directory).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,7 +69,7 @@ pub enum Encoding {
     Ros1,
     /// CDR (ROS 2).
     Cdr,
-    /// Samples a log reader already decoded ([`crate::decoded::Row`]).
+    /// Samples a log reader already decoded ([`crate::rows::Row`]).
     Row,
     /// Anything else, named as the container names it.
     Other(String),
@@ -209,7 +203,7 @@ pub struct PartRead {
 pub type MessageSink<'a> = dyn FnMut(u32, u64, &[u8]) + 'a;
 
 /// The callback of [`Source::read_part_rows`]: `(channel id, record time in ns, row)`.
-pub type RowSink<'a> = dyn FnMut(u32, u64, &crate::decoded::Row) + 'a;
+pub type RowSink<'a> = dyn FnMut(u32, u64, &crate::rows::Row) + 'a;
 
 /// A container opened for reading.
 pub trait Source: Sync {
@@ -257,7 +251,7 @@ pub trait Source: Sync {
     /// opening, for a read that owns the source and reads it once
     /// ([`crate::series::read_owned`]): no part of the channel delivers rows afterwards.
     /// `None`: the reader keeps no such columns (read the parts).
-    fn take_rows(&self, _channel: u32) -> Option<crate::series::Rows> {
+    fn take_rows(&self, _channel: u32) -> Option<crate::rows::Rows> {
         None
     }
     /// What only a complete read can tell was lost (the rows past the last one a damaged
@@ -278,138 +272,4 @@ pub struct Contents {
     pub notes: Vec<String>,
     /// What opening found lost.
     pub losses: Vec<Loss>,
-}
-
-/// Recognises `path` from its content.
-pub fn detect(path: &Path) -> Result<InputKind, Error> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
-    if meta.is_dir() {
-        if path.join("metadata.yaml").is_file() {
-            return Ok(InputKind::Rosbag2Dir);
-        }
-        if let Some(kind) = crate::formats::detect_dir(path) {
-            return Ok(kind);
-        }
-        return Err(Error::NotABag {
-            path: path.to_path_buf(),
-            what: format!(
-                "a directory without metadata.yaml or an EuRoC/ASL imuN/data.csv. Accepted: {ACCEPTED}"
-            ),
-        });
-    }
-    let mut head = [0u8; 16];
-    let mut f = File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut got = 0;
-    while got < head.len() {
-        match f.read(&mut head[got..]) {
-            Ok(0) => break,
-            Ok(n) => got += n,
-            Err(e) => return Err(Error::io(path, e)),
-        }
-    }
-    let head = &head[..got];
-    if head.starts_with(ROS1_MAGIC) {
-        return Ok(InputKind::Ros1Bag);
-    }
-    if head.starts_with(crate::mcap::MAGIC) {
-        return Ok(InputKind::Mcap);
-    }
-    if head.starts_with(SQLITE_MAGIC) {
-        return Ok(InputKind::Sqlite3);
-    }
-    if head.starts_with(ZSTD_MAGIC) {
-        return Ok(InputKind::Zstd);
-    }
-    if let Some(kind) = crate::formats::detect_file(path, head) {
-        return Ok(kind);
-    }
-    let what = if head.is_empty() {
-        "the file is empty".to_string()
-    } else if head.starts_with(b"#ROSBAG V") {
-        let line = head.split(|&b| b == b'\n').next().unwrap_or(head);
-        format!(
-            "unsupported ROS bag version line {:?} (only 2.0 is read)",
-            String::from_utf8_lossy(line)
-        )
-    } else if head.starts_with(b"\x89MCAP") {
-        format!(
-            "MCAP major version {:?} is not supported (only 0)",
-            head.get(5).map(|&b| b as char)
-        )
-    } else if head.starts_with(b"rosbag2_bagfile_information") {
-        "a metadata.yaml file: pass its directory".to_string()
-    } else {
-        format!(
-            "it starts with {:?}",
-            String::from_utf8_lossy(&head[..head.len().min(12)])
-        )
-    };
-    Err(Error::NotABag {
-        path: path.to_path_buf(),
-        what: format!("{what}. Accepted: {ACCEPTED}"),
-    })
-}
-
-/// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
-pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
-    open_with(path, &crate::formats::InputOptions::default())
-}
-
-/// [`open`], with what the user said about a log whose content does not say it all.
-pub(crate) fn open_with(
-    path: &Path,
-    opts: &crate::formats::InputOptions,
-) -> Result<Box<dyn Source>, Error> {
-    if path.file_name().is_some_and(|n| n == "metadata.yaml")
-        && path.is_file()
-        && let Some(dir) = path.parent()
-    {
-        let dir = if dir.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            dir
-        };
-        return Ok(Box::new(crate::rosbag2::BagDir::open(dir)?));
-    }
-    Ok(match detect(path)? {
-        InputKind::Ros1Bag => Box::new(crate::bag::BagReader::open(path)?),
-        InputKind::Mcap => Box::new(crate::mcap::McapReader::open(path)?),
-        InputKind::Sqlite3 => Box::new(crate::rosbag2::Sqlite3Reader::open(path)?),
-        InputKind::Rosbag2Dir => Box::new(crate::rosbag2::BagDir::open(path)?),
-        InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
-        kind => crate::formats::open(kind, path, opts)?,
-    })
-}
-
-/// A file decompressed from a zstd FILE-mode input into a private temporary file, removed
-/// when dropped.
-pub struct Decompressed {
-    /// Where the decompressed bytes are.
-    pub path: PathBuf,
-    _dir: tempfile::TempDir,
-}
-
-/// Decompresses every zstd frame of `src` into a temporary file (FILE-mode rosbag2
-/// compression stores each storage file as one `.zstd` file).
-pub(crate) fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
-    let dir = tempfile::Builder::new()
-        .prefix("bag2mat-zstd.")
-        .tempdir()
-        .map_err(|e| Error::io(std::env::temp_dir(), e))?;
-    let name = src
-        .file_stem()
-        .map(|s| s.to_os_string())
-        .unwrap_or_else(|| "decompressed".into());
-    let path = dir.path().join(name);
-    let input = File::open(src).map_err(|e| Error::io(src, e))?;
-    let mut out = std::io::BufWriter::new(File::create(&path).map_err(|e| Error::io(&path, e))?);
-    crate::zstd::decompress_stream(std::io::BufReader::new(input), &mut out).map_err(|e| {
-        Error::Corrupt {
-            path: src.to_path_buf(),
-            offset: 0,
-            what: format!("zstd: {e}"),
-        }
-    })?;
-    std::io::Write::flush(&mut out).map_err(|e| Error::io(&path, e))?;
-    Ok(Decompressed { path, _dir: dir })
 }

@@ -1,6 +1,10 @@
 //! zstd in pure Rust (`ruzstd`): MCAP chunk and rosbag2 message/file compression.
 
+use std::fs::File;
 use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use crate::error::Error;
 
 /// Decompresses one or more concatenated zstd frames from `input` into `out`.
 pub(crate) fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std::io::Result<u64> {
@@ -69,4 +73,35 @@ mod tests {
         assert!(super::decompress_into(&z, &mut back, 1000).is_err());
         assert!(super::decompress_into(&z[..z.len() / 2], &mut back, u64::MAX).is_err());
     }
+}
+
+/// A file decompressed from a zstd FILE-mode input into a private temporary file, removed
+/// when dropped.
+pub struct Decompressed {
+    /// Where the decompressed bytes are.
+    pub path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+/// Decompresses every zstd frame of `src` into a temporary file (FILE-mode rosbag2
+/// compression stores each storage file as one `.zstd` file).
+pub(crate) fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
+    let dir = tempfile::Builder::new()
+        .prefix("bag2mat-zstd.")
+        .tempdir()
+        .map_err(|e| Error::io(std::env::temp_dir(), e))?;
+    let name = src
+        .file_stem()
+        .map(|s| s.to_os_string())
+        .unwrap_or_else(|| "decompressed".into());
+    let path = dir.path().join(name);
+    let input = File::open(src).map_err(|e| Error::io(src, e))?;
+    let mut out = std::io::BufWriter::new(File::create(&path).map_err(|e| Error::io(&path, e))?);
+    decompress_stream(std::io::BufReader::new(input), &mut out).map_err(|e| Error::Corrupt {
+        path: src.to_path_buf(),
+        offset: 0,
+        what: format!("zstd: {e}"),
+    })?;
+    std::io::Write::flush(&mut out).map_err(|e| Error::io(&path, e))?;
+    Ok(Decompressed { path, _dir: dir })
 }

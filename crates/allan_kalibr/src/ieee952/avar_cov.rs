@@ -45,7 +45,7 @@
 //! noise): on allan_variance_ros' dense curves that gave χ²/dof 8–37 and cut fits. Commensurate
 //! pairs (m, 2m) have aligned lattices and the density is only an approximation there.
 
-use super::fit::TERM_COUNT;
+use super::model::TERM_COUNT;
 use super::oadev::Overlap;
 use rayon::prelude::*;
 
@@ -403,7 +403,7 @@ pub fn avar_cov_pair_exact(
 #[cfg(test)]
 mod tests {
     use super::super::edf::greenhall_edf;
-    use super::super::fit::basis;
+    use super::super::model::basis;
     use super::super::oadev::{Overlap, Phase};
     use super::*;
     use rand::SeedableRng;

@@ -90,6 +90,7 @@ pub mod fit;
 pub mod imu;
 pub mod input_error;
 pub mod lines;
+pub(crate) mod model;
 pub mod noise_id;
 pub mod oadev;
 pub mod plot;

@@ -9,8 +9,9 @@
 //! Records as types, parsed from the header fields (as rosbag-rs does): [`BagHeader`],
 //! [`ChunkHeader`], [`Connection`], [`MessageData`], [`IndexData`], [`ChunkInfo`].
 
-use super::{Compression, RosTime};
+use super::Compression;
 use crate::cursor::Cursor;
+use crate::time::RosTime;
 
 /// What is wrong with a record's header or data.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -13,11 +13,12 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
+use super::Compression;
 use super::record::{self, ChunkInfo, Connection, MAGIC};
-use super::{Compression, RosTime};
 use crate::error::Error;
 use crate::imu_msg::{self, Imu};
 use crate::shared::output::AtomicFile;
+use crate::time::RosTime;
 
 /// rosbag's default chunk threshold: a chunk is closed once its body reaches 768 KiB.
 pub const DEFAULT_CHUNK_THRESHOLD: usize = 768 * 1024;

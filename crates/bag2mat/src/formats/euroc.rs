@@ -76,10 +76,7 @@ pub fn stated_for(path: &Path, topic: &str) -> Option<Stated> {
         imu_files(path)
     } else {
         // only a data.csv in an EuRoC imuN folder has a sensor.yaml of its own
-        let dir = path.parent()?;
-        if path.file_name()? != "data.csv" || !is_imu_folder(dir) {
-            return None;
-        }
+        let dir = data_csv_folder(path)?;
         vec![(folder_topic(dir), path.to_path_buf())]
     };
     let (_, f) = files.into_iter().find(|(t, _)| t == topic)?;
@@ -91,6 +88,12 @@ pub(crate) fn folder_topic(dir: &Path) -> String {
     dir.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "imu0".into())
+}
+
+/// The EuRoC `imuN` folder `path` is the `data.csv` of, if it is one.
+pub(crate) fn data_csv_folder(path: &Path) -> Option<&Path> {
+    let dir = path.parent()?;
+    (path.file_name().is_some_and(|n| n == "data.csv") && is_imu_folder(dir)).then_some(dir)
 }
 
 /// True when `dir` holds a `data.csv` with the EuRoC/ASL IMU header.

@@ -159,7 +159,14 @@ pub(crate) fn open(
     opts: &InputOptions,
 ) -> Result<Box<dyn Source>, Error> {
     Ok(match kind {
-        InputKind::Text => Box::new(text::open(path, opts)?),
+        // a data.csv in an EuRoC imuN folder is that folder's topic, with its sensor.yaml
+        InputKind::Text => match euroc::data_csv_folder(path) {
+            Some(dir) => Box::new(euroc::open_files(
+                vec![(euroc::folder_topic(dir), path.to_path_buf())],
+                opts,
+            )?),
+            None => Box::new(text::open(path, opts)?),
+        },
         InputKind::EurocDir => Box::new(euroc::open(path, opts)?),
         InputKind::Npy => Box::new(npy::open(path)?),
         InputKind::Ulog => Box::new(ulog::open(path)?),

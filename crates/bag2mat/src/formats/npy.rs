@@ -6,9 +6,10 @@
 use std::path::Path;
 
 use crate::cursor::Cursor;
-use crate::decoded::{DecodedSource, Row, Stream};
+use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
 use crate::mat::COLS;
+use crate::rows::Row;
 use crate::source::InputKind;
 
 /// The header's fields that matter: element type, order and shape.

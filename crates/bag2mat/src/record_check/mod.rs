@@ -235,7 +235,7 @@ impl Finding {
             s.push_str(a.label());
         }
         if let Some(t) = topic {
-            s.push_str(&format!(" of topic '{}'", crate::shared::cli::escape(t)));
+            s.push_str(&format!(" of topic '{}'", crate::printable::escape(t)));
         }
         s.push_str(": ");
         s.push_str(&self.text);

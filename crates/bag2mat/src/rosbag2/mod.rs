@@ -22,7 +22,8 @@ use crate::error::Error;
 use crate::imu_msg::Imu;
 use crate::mcap::{ChunkCompression, McapReader, McapWriter};
 use crate::shared::output::AtomicDir;
-use crate::source::{self, Channel, Decompressed, InputKind, Loss, MessageSink, PartRead, Source};
+use crate::source::{self, Channel, InputKind, Loss, MessageSink, PartRead, Source};
+use crate::zstd::Decompressed;
 use metadata::{BagInfo, OFFERED_QOS_PROFILES, WrittenBag, WrittenTopic};
 
 thread_local! {
@@ -59,14 +60,14 @@ pub struct BagDir {
 }
 
 fn open_storage(path: &Path) -> Result<(Box<dyn Source>, Option<Decompressed>), Error> {
-    let (inner, tmp) = match source::detect(path)? {
+    let (inner, tmp) = match crate::detect::input_kind(path)? {
         InputKind::Zstd => {
-            let d = source::decompress_zstd_file(path)?;
+            let d = crate::zstd::decompress_zstd_file(path)?;
             (d.path.clone(), Some(d))
         }
         _ => (path.to_path_buf(), None),
     };
-    let src: Box<dyn Source> = match source::detect(&inner)? {
+    let src: Box<dyn Source> = match crate::detect::input_kind(&inner)? {
         InputKind::Mcap => Box::new(McapReader::open(&inner)?),
         InputKind::Sqlite3 => Box::new(Sqlite3Reader::open(&inner)?),
         other => {
@@ -175,7 +176,7 @@ impl BagDir {
             .iter()
             .filter_map(|p| {
                 let len = std::fs::metadata(p).ok()?.len();
-                let raw = source::detect(p).ok()? == InputKind::Sqlite3
+                let raw = crate::detect::input_kind(p).ok()? == InputKind::Sqlite3
                     && info.compression_mode().is_empty();
                 Some(if raw {
                     len
@@ -194,7 +195,7 @@ impl BagDir {
     fn bound_promises(&mut self, bytes: u64) {
         for c in self.contents.channels.iter_mut() {
             let least = if crate::series::is_imu(c) {
-                crate::series::MIN_IMU_PAYLOAD
+                crate::imu_msg::MIN_IMU_PAYLOAD
             } else {
                 MIN_STORED_MESSAGE
             };
@@ -204,7 +205,7 @@ impl BagDir {
             {
                 self.contents.notes.push(format!(
                     "metadata.yaml promises {n} messages on '{}', more than its storage files can hold (at most {most}): the count is damaged and not used",
-                    crate::shared::cli::escape(&c.topic)
+                    crate::printable::escape(&c.topic)
                 ));
                 c.count = self.file_counts.get(&c.id).copied().flatten();
             }

@@ -186,7 +186,7 @@ impl Sqlite3Reader {
                     pages - kept
                 ),
                 at_most: Some(
-                    ((pages - kept) as u64).saturating_mul(page) / crate::series::MIN_IMU_PAYLOAD,
+                    ((pages - kept) as u64).saturating_mul(page) / crate::imu_msg::MIN_IMU_PAYLOAD,
                 ),
                 ..Loss::default()
             });

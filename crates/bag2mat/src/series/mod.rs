@@ -12,18 +12,17 @@ use std::path::Path;
 
 use rayon::prelude::*;
 
-use crate::bag::RosTime;
 use crate::error::{Error, TopicSummary};
 use crate::imu_msg::{self, ImuSample};
 use crate::source::{self, Channel, Encoding, InputKind, Loss, Source};
+use crate::time::RosTime;
 
 mod losses;
-mod rows;
 mod selection;
 
+use crate::imu_msg::MIN_IMU_PAYLOAD;
+use crate::rows::{Rows, RowsMut};
 use losses::{LossTally, loss_notes, part_losses, skipped_topics};
-pub use rows::Rows;
-pub(crate) use rows::RowsMut;
 use selection::{Selected, select};
 
 /// How to read.
@@ -232,7 +231,7 @@ pub struct ImuRead {
 enum Codec {
     Ros1,
     Cdr,
-    /// Rows a log reader decoded ([`crate::decoded::Row`]), whatever the topic's type.
+    /// Rows a log reader decoded ([`crate::rows::Row`]), whatever the topic's type.
     Row,
 }
 
@@ -241,7 +240,7 @@ impl Codec {
     fn min_payload(self) -> u64 {
         match self {
             Codec::Ros1 | Codec::Cdr => MIN_IMU_PAYLOAD,
-            Codec::Row => crate::decoded::ROW_LEN as u64,
+            Codec::Row => crate::rows::ROW_LEN as u64,
         }
     }
 }
@@ -271,7 +270,7 @@ fn decode(codec: Codec, data: &[u8]) -> Result<ImuSample, Error> {
     match codec {
         Codec::Ros1 => ImuSample::decode(data).map_err(Error::from),
         Codec::Cdr => crate::cdr::decode_sample(data),
-        Codec::Row => crate::decoded::Row::decode(data),
+        Codec::Row => crate::rows::Row::decode(data),
     }
 }
 
@@ -319,12 +318,6 @@ pub(crate) fn channel_counts(src: &dyn Source) -> std::collections::BTreeMap<u32
     total
 }
 
-/// The smallest payload a decodable `sensor_msgs/Imu` has (ROS 1: 16 header bytes and 37
-/// doubles; CDR: 4 encapsulation bytes, the stamp, an empty frame_id and 37 aligned doubles):
-/// a part of `bytes` bytes holds at most `bytes / MIN_IMU_PAYLOAD` rows, whatever its index
-/// says.
-pub const MIN_IMU_PAYLOAD: u64 = 16 + 37 * 8;
-
 /// Parts decoded at once when the container does not say how many rows each holds: their
 /// rows are buffered, then appended in order, so memory stays near the size of the result.
 const WINDOW_PARTS_PER_THREAD: usize = 4;
@@ -348,7 +341,7 @@ impl Target<'_> {
     }
 
     /// [`Target::put`] for a decoded row (its seq stays 0: the column is left untouched).
-    fn put_row(&mut self, t: u64, r: &crate::decoded::Row) {
+    fn put_row(&mut self, t: u64, r: &crate::rows::Row) {
         if self.filled < self.slot.cap() {
             self.slot.set_row(self.filled, t, r);
             self.filled += 1;
@@ -392,7 +385,7 @@ pub fn read_imu_topics_with(
     opts: &ReadOptions,
     input: &crate::formats::InputOptions,
 ) -> Result<ImuRead, Error> {
-    read_owned(source::open_with(path, input)?, sel, opts)
+    read_owned(crate::input::open_with(path, input)?, sel, opts)
 }
 
 /// How part `i` routes a selected channel's messages: channel id → (topic, codec).
@@ -835,11 +828,6 @@ pub fn topic_folder_names(topics: &[&str]) -> Vec<String> {
 pub fn read_imu_series(path: &Path, topic: &str, opts: &ReadOptions) -> Result<ImuSeries, Error> {
     let mut r = read_imu_topics(path, &TopicSelector::one(topic), opts)?;
     Ok(r.series.remove(0))
-}
-
-/// `v` reordered so that element `i` is `v[order[i]]`.
-pub fn permute<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
-    order.iter().map(|&i| v[i]).collect()
 }
 
 #[cfg(test)]

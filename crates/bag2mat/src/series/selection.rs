@@ -59,8 +59,8 @@ pub(super) fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Select
         }
         let note = format!(
             "topic '{}' is not in the bag; using '{}'",
-            crate::shared::cli::escape(t),
-            crate::shared::cli::escape(&other)
+            crate::printable::escape(t),
+            crate::printable::escape(&other)
         );
         push_selected(&mut out, other, cs, Some(note), true)?;
     }
@@ -108,12 +108,12 @@ pub(super) fn select_default(
         }),
         [t] => {
             let missing = match &sel.preferred {
-                Some(p) => format!(" and no '{}'", crate::shared::cli::escape(p)),
+                Some(p) => format!(" and no '{}'", crate::printable::escape(p)),
                 None => String::new(),
             };
             let note = format!(
                 "no topic named{missing}: reading '{}', the only sensor_msgs/Imu topic",
-                crate::shared::cli::escape(t)
+                crate::printable::escape(t)
             );
             push_selected(out, t.to_string(), on(t), Some(note), true)
         }
@@ -170,14 +170,14 @@ pub(super) fn push_selected(
         .map(|c| {
             format!(
                 "{} ({} messages)",
-                crate::shared::cli::escape(&c.msg_type),
+                crate::printable::escape(&c.msg_type),
                 c.count.map_or("?".to_string(), |n| n.to_string())
             )
         })
         .collect();
     let mixed = format!(
         "topic '{}' also carries {}; only its sensor_msgs/Imu connection is converted, as bagconvert does",
-        crate::shared::cli::escape(&topic),
+        crate::printable::escape(&topic),
         other_types.join(", ")
     );
     let note = Some(match note {

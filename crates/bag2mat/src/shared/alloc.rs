@@ -43,7 +43,7 @@ impl ExitOnOom {
             unsafe {
                 libc::write(2, buf.bytes().as_ptr().cast(), buf.bytes().len());
             }
-            super::output::remove_live_paths();
+            super::live::remove_live_paths();
         }
         // SAFETY: ends the process without running anything else (no unwinding out of the
         // allocator, which must not).

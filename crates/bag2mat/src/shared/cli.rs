@@ -78,29 +78,12 @@ pub fn only_with(needed: &str, present: bool, flags: &[(&str, bool)]) -> Result<
     ))
 }
 
-/// Text from a file (a topic name, a type) made safe to print: control characters are
-/// escaped, so a damaged or hostile name cannot move the cursor or clear the terminal.
-pub fn escape(s: &str) -> String {
-    if !s.chars().any(|c| c.is_control()) {
-        return s.to_string();
-    }
-    s.chars()
-        .map(|c| {
-            if c.is_control() {
-                c.escape_default().to_string()
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn positive_and_escape() {
+    fn positive_numbers() {
         assert_eq!(positive_f64("200"), Ok(200.0));
         assert!(positive_f64("-1").unwrap_err().contains("must be positive"));
         assert!(positive_f64("0").unwrap_err().contains("must be positive"));
@@ -110,7 +93,5 @@ mod tests {
                 .contains("must be positive")
         );
         assert!(positive_f64("abc").unwrap_err().contains("not a number"));
-        assert_eq!(escape("/imu"), "/imu");
-        assert_eq!(escape("/i\x1b[2Jmu\n"), "/i\\u{1b}[2Jmu\\n");
     }
 }

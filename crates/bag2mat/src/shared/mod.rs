@@ -6,6 +6,7 @@
 pub mod alloc;
 pub mod cfmt;
 pub mod cli;
+mod live;
 pub mod note;
 pub mod output;
 pub mod plot;

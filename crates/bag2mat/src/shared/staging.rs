@@ -26,7 +26,7 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use super::output::{lock, register, remove, unique, unregister};
+use super::live::{lock, register, remove, unique, unregister};
 use crate::error::Error;
 
 /// The name of the journal a stage holds while its files are moved in one by one.

@@ -7,7 +7,7 @@
 //! linear in the coefficients c = (Q², N², B², K², R²), fitted to the curve points on a
 //! 2-per-octave sub-grid ([`FitConfig::per_octave`]).
 //!
-//! The terms' basis functions and shapes are in `model`, the small dense linear algebra
+//! The terms' basis functions and shapes are in [`super::model`], the small dense linear algebra
 //! (whitening, active-set NNLS, normal equations, SPD solve) in `linalg`; this module is the
 //! fit itself: GLS with the discrepancy, the τ range, term selection and the intervals.
 //! How far a range may go on past the first point the model misses is `range_end`'s joint
@@ -88,16 +88,15 @@
 use super::avar_cov::CovBasis;
 
 mod linalg;
-mod model;
 mod range_end;
-pub(in crate::ieee952) use linalg::solve_spd;
-use linalg::{covariance, nnls_subsets, whiten};
-use model::effective_coef;
-pub(in crate::ieee952) use model::is_positive;
-pub use model::{
+use super::model::effective_coef;
+pub(in crate::ieee952) use super::model::is_positive;
+pub use super::model::{
     FLICKER_AVAR, GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA,
     TERM_COUNT, TERM_NAMES, alpha_index, basis, basis_at, flicker_band, gm_basis,
 };
+pub(in crate::ieee952) use linalg::solve_spd;
+use linalg::{covariance, nnls_subsets, whiten};
 pub(in crate::ieee952) use range_end::extension_agrees;
 
 /// Fit settings.

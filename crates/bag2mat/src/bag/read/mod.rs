@@ -24,13 +24,14 @@ use std::io::Read;
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
+use super::Compression;
 use super::record::{
     self, BagHeader, ChunkHeader, ChunkInfo, Connection, Header, INDEX_ENTRY_LEN, IndexData, MAGIC,
     Op, RecordError,
 };
-use super::{Compression, RosTime};
 use crate::error::{Error, TopicSummary};
 use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
+use crate::time::RosTime;
 use chunk::{BodyRecord, find, walk_body};
 
 thread_local! {
@@ -339,7 +340,7 @@ impl BagReader {
             });
         let bound = stored.saturating_mul(source::MAX_EXPANSION);
         // A header cut short says nothing of the records after it.
-        size.map(|s| s.min(bound) / crate::series::MIN_IMU_PAYLOAD)
+        size.map(|s| s.min(bound) / crate::imu_msg::MIN_IMU_PAYLOAD)
     }
 
     fn record_at(&self, pos: u64, end: u64) -> Option<RecordAt> {

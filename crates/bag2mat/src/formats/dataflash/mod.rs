@@ -19,8 +19,9 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::cursor::Cursor;
-use crate::decoded::{DecodedSource, Row, Stream};
+use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
+use crate::rows::Row;
 use crate::source::{InputKind, Loss};
 
 /// The two bytes every message starts with.

@@ -3,8 +3,8 @@
 
 use super::layout::{Delim, Layout};
 use super::units::TimeUnit;
-use crate::decoded::Row;
-use crate::series::RowsMut;
+use crate::rows::Row;
+use crate::rows::RowsMut;
 
 /// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
 pub(crate) fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {
@@ -434,7 +434,7 @@ pub(super) fn line_range(bytes: &[u8], body: usize, (a, b): (usize, usize)) -> (
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::series::Rows;
+    use crate::rows::Rows;
 
     /// The one-pass reader and the csv crate give the same rows, and the lines the one
     /// pass does not take go to the csv crate.

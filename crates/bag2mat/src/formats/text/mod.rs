@@ -15,7 +15,7 @@
 //! numbers with `fast-float2`; times are parsed as decimals straight to nanoseconds, so
 //! `1403636579.758555` s keeps every digit.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 
@@ -25,9 +25,10 @@ mod units;
 
 use super::InputOptions;
 use crate::RosTime;
-use crate::decoded::{DecodedSource, Row, Stream};
+use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
-use crate::series::Rows;
+use crate::rows::Row;
+use crate::rows::Rows;
 use crate::source::InputKind;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
@@ -329,18 +330,9 @@ fn check_plausible(path: &Path, lay: &Layout, rows: &Rows) -> Result<(), Error> 
     Ok(())
 }
 
-/// Opens a text log: one topic, `imu`.
+/// Opens a text log: one topic, `imu` (a `data.csv` in an EuRoC `imuN` folder is opened
+/// as that folder's by [`super::open`]).
 pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
-    // a data.csv in an EuRoC imuN folder is that folder's topic, with its sensor.yaml
-    if let Some(dir) = path.parent()
-        && path.file_name().is_some_and(|n| n == "data.csv")
-        && super::euroc::is_imu_folder(dir)
-    {
-        return super::euroc::open_files(
-            vec![(super::euroc::folder_topic(dir), PathBuf::from(path))],
-            opts,
-        );
-    }
     let p = parse(path, "imu", opts)?;
     Ok(DecodedSource::new(
         InputKind::Text,

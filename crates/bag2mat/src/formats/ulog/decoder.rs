@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::format::Slot;
-use crate::decoded::Row;
+use crate::rows::Row;
 
 /// How the messages of one IMU topic become rows.
 #[derive(Debug, Clone)]

@@ -37,8 +37,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::cursor::{Cursor, CursorError};
-use crate::decoded::Row;
 use crate::error::Error;
+use crate::rows::Row;
 use crate::source::{InputKind, Loss};
 
 use decoder::{Decoder, fifo_offset_ns};
@@ -270,7 +270,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
             label: format!("bytes {}..{}", p.start, p.end),
             span: c.span,
             counts: Some(counts),
-            bytes: rows * crate::decoded::ROW_LEN as u64,
+            bytes: rows * crate::rows::ROW_LEN as u64,
         });
     }
     contents.channels = channels;

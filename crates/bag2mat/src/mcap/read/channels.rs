@@ -162,7 +162,7 @@ impl McapReader {
                 {
                     notes.push(format!(
                         "the Channel record of '{}' names the encoding {:?} (damaged); read as cdr, the encoding of ROS 2 files",
-                        crate::shared::cli::escape(&c.topic),
+                        crate::printable::escape(&c.topic),
                         c.message_encoding
                     ));
                     Encoding::Cdr

@@ -46,7 +46,7 @@ const MAX_META_RECORD: u64 = 64 << 20;
 /// Bytes a Message record of a `sensor_msgs/Imu` takes at least (record prefix, fixed
 /// fields, the smallest Imu payload): bounds the Imu messages lost bytes can hold.
 pub const MIN_IMU_RECORD: u64 =
-    RECORD_PREFIX + MESSAGE_FIXED_LEN as u64 + crate::series::MIN_IMU_PAYLOAD;
+    RECORD_PREFIX + MESSAGE_FIXED_LEN as u64 + crate::imu_msg::MIN_IMU_PAYLOAD;
 /// Bytes a Message record takes at least: bounds any count a file states.
 const MIN_MESSAGE_RECORD: u64 = RECORD_PREFIX + MESSAGE_FIXED_LEN as u64;
 /// Bytes of a Message Index entry (log time, offset).

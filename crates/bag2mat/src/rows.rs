@@ -1,10 +1,72 @@
-//! The columns of a read ([`Rows`]): one row per message, in record-time order, and the
-//! mutable views the parallel decode writes each part into ([`RowsMut`]).
+//! The rows of a read: one decoded sample ([`Row`], also the fixed payload of the log
+//! readers' channels), the columns of a topic ([`Rows`]: one row per message, in
+//! record-time order) and the mutable views the parallel decode writes each part into
+//! ([`RowsMut`]). Below the readers and the read path, which all write them.
 
-use super::*;
+use crate::error::Error;
+use crate::imu_msg::ImuSample;
+use crate::time::RosTime;
 
-/// The columns of one topic's rows, as [`ImuSeries`] holds them (what a log reader that
-/// decoded a topic on opening hands over whole: [`Source::take_rows`]).
+/// Bytes of one [`Row`] payload: the sample time (u64 ns), then acc x y z and gyro x y z
+/// (f64), little-endian.
+pub const ROW_LEN: usize = 56;
+
+/// One decoded sample. A sensor a topic does not carry (a gyro-only topic's accelerometer)
+/// is NaN.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Row {
+    /// The sensor's sample time, ns (`header.stamp` of the series).
+    pub stamp: u64,
+    /// Linear acceleration, m/s².
+    pub acc: [f64; 3],
+    /// Angular velocity, rad/s.
+    pub gyro: [f64; 3],
+}
+
+impl Row {
+    /// The payload.
+    pub(crate) fn encode(&self) -> [u8; ROW_LEN] {
+        let mut b = [0u8; ROW_LEN];
+        b[..8].copy_from_slice(&self.stamp.to_le_bytes());
+        for (i, v) in self.acc.iter().chain(&self.gyro).enumerate() {
+            b[8 + 8 * i..16 + 8 * i].copy_from_slice(&v.to_le_bytes());
+        }
+        b
+    }
+
+    /// The sample of a payload.
+    pub(crate) fn decode(b: &[u8]) -> Result<ImuSample, Error> {
+        let Some(b) = b.first_chunk::<ROW_LEN>().filter(|_| b.len() == ROW_LEN) else {
+            return Err(Error::BadMessage {
+                what: format!("a decoded row is {ROW_LEN} bytes, this one {}", b.len()),
+            });
+        };
+        let (stamp, values) = b.split_first_chunk::<8>().unwrap_or((&[0; 8], &[]));
+        let mut v = [0f64; 6];
+        for (x, c) in v.iter_mut().zip(values.chunks_exact(8)) {
+            *x = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+        }
+        Ok(ImuSample::from(&Row {
+            stamp: u64::from_le_bytes(*stamp),
+            acc: [v[0], v[1], v[2]],
+            gyro: [v[3], v[4], v[5]],
+        }))
+    }
+}
+
+impl From<&Row> for ImuSample {
+    fn from(r: &Row) -> ImuSample {
+        ImuSample {
+            seq: 0,
+            stamp: RosTime::from_nanos(r.stamp),
+            acc: r.acc,
+            gyro: r.gyro,
+        }
+    }
+}
+
+/// The columns of one topic's rows, as [`crate::ImuSeries`] holds them (what a log reader that
+/// decoded a topic on opening hands over whole: [`crate::source::Source::take_rows`]).
 #[derive(Debug, Clone, Default)]
 pub struct Rows {
     pub(crate) record_time: Vec<RosTime>,
@@ -43,13 +105,13 @@ impl Rows {
     }
 
     /// Appends a decoded row logged at `t` ns.
-    pub(crate) fn push_row(&mut self, t: u64, r: &crate::decoded::Row) {
+    pub(crate) fn push_row(&mut self, t: u64, r: &Row) {
         self.push(t, &ImuSample::from(r));
     }
 
     /// Row `i` as a decoded row.
-    pub(crate) fn row(&self, i: usize) -> crate::decoded::Row {
-        crate::decoded::Row {
+    pub(crate) fn row(&self, i: usize) -> Row {
+        Row {
             stamp: self.stamp[i].as_nanos(),
             acc: std::array::from_fn(|c| self.acc[c][i]),
             gyro: std::array::from_fn(|c| self.gyro[c][i]),
@@ -79,7 +141,7 @@ impl Rows {
         }
     }
 
-    pub(super) fn push(&mut self, t: u64, s: &ImuSample) {
+    pub(crate) fn push(&mut self, t: u64, s: &ImuSample) {
         self.record_time.push(RosTime::from_nanos(t));
         self.stamp.push(s.stamp);
         self.seq.push(s.seq);
@@ -90,7 +152,7 @@ impl Rows {
     }
 
     /// Appends rows `..n` of `slot`.
-    pub(super) fn extend_from(&mut self, slot: &RowsMut<'_>, n: usize) {
+    pub(crate) fn extend_from(&mut self, slot: &RowsMut<'_>, n: usize) {
         self.record_time.extend_from_slice(&slot.record_time[..n]);
         self.stamp.extend_from_slice(&slot.stamp[..n]);
         self.seq.extend_from_slice(&slot.seq[..n]);
@@ -100,7 +162,7 @@ impl Rows {
         }
     }
 
-    pub(super) fn append(&mut self, other: &Rows) {
+    pub(crate) fn append(&mut self, other: &Rows) {
         self.record_time.extend_from_slice(&other.record_time);
         self.stamp.extend_from_slice(&other.stamp);
         self.seq.extend_from_slice(&other.seq);
@@ -141,7 +203,7 @@ impl Rows {
 
     /// Sorts by record time (stable) when the storage order differs from it; returns the
     /// storage position of each row if it did.
-    pub(super) fn sort_by_record_time(&mut self) -> Option<Vec<u32>> {
+    pub(crate) fn sort_by_record_time(&mut self) -> Option<Vec<u32>> {
         if !self.record_time.windows(2).any(|w| w[1] < w[0]) {
             return None;
         }
@@ -161,11 +223,11 @@ impl Rows {
 /// One part's rows of every column of one topic.
 #[derive(Default)]
 pub(crate) struct RowsMut<'a> {
-    pub(super) record_time: &'a mut [RosTime],
-    pub(super) stamp: &'a mut [RosTime],
-    pub(super) seq: &'a mut [u32],
-    pub(super) acc: [&'a mut [f64]; 3],
-    pub(super) gyro: [&'a mut [f64]; 3],
+    pub(crate) record_time: &'a mut [RosTime],
+    pub(crate) stamp: &'a mut [RosTime],
+    pub(crate) seq: &'a mut [u32],
+    pub(crate) acc: [&'a mut [f64]; 3],
+    pub(crate) gyro: [&'a mut [f64]; 3],
 }
 
 impl RowsMut<'_> {
@@ -174,7 +236,7 @@ impl RowsMut<'_> {
     }
 
     /// Sets row `i` to a decoded row logged at `t` ns (its seq stays 0).
-    pub(crate) fn set_row(&mut self, i: usize, t: u64, r: &crate::decoded::Row) {
+    pub(crate) fn set_row(&mut self, i: usize, t: u64, r: &Row) {
         self.record_time[i] = RosTime::from_nanos(t);
         self.stamp[i] = RosTime::from_nanos(r.stamp);
         for c in 0..3 {
@@ -183,7 +245,7 @@ impl RowsMut<'_> {
         }
     }
 
-    pub(super) fn set(&mut self, i: usize, t: u64, s: &ImuSample) {
+    pub(crate) fn set(&mut self, i: usize, t: u64, s: &ImuSample) {
         self.record_time[i] = RosTime::from_nanos(t);
         self.stamp[i] = s.stamp;
         self.seq[i] = s.seq;
@@ -195,7 +257,7 @@ impl RowsMut<'_> {
 }
 
 /// Splits a column into one slice per part, of the given lengths.
-pub(super) fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
+pub(crate) fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
     let mut rest = column;
     sizes
         .iter()
@@ -205,4 +267,9 @@ pub(super) fn split_rows<'a, T>(column: &'a mut [T], sizes: &[usize]) -> Vec<&'a
             head
         })
         .collect()
+}
+
+/// `v` reordered so that element `i` is `v[order[i]]`.
+pub fn permute<T: Copy>(v: &[T], order: &[usize]) -> Vec<T> {
+    order.iter().map(|&i| v[i]).collect()
 }

@@ -232,7 +232,11 @@ pub fn basis_at(j: usize, tau: f64, s: &Shapes) -> f64 {
 /// local slope there (a random walk where it rises like one, white noise where it falls,
 /// flicker in between). [`crate::ieee952::avar_cov`] has covariances of power laws only; the EDF of
 /// a bump's shoulder is that of the power law it resembles.
-pub(super) fn effective_coef(c: &[f64; TERM_COUNT], s: &Shapes, tau: f64) -> [f64; TERM_COUNT] {
+pub(in crate::ieee952) fn effective_coef(
+    c: &[f64; TERM_COUNT],
+    s: &Shapes,
+    tau: f64,
+) -> [f64; TERM_COUNT] {
     let mut e = *c;
     e[GM] = 0.0;
     let spread = |e: &mut [f64; TERM_COUNT], a: f64, shape: &dyn Fn(f64) -> f64| {

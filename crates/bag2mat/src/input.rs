@@ -1,0 +1,38 @@
+//! Opens any accepted input: [`crate::detect`] says what it is, and its reader opens it as
+//! a [`Source`].
+
+use std::path::Path;
+
+use crate::error::Error;
+use crate::source::{InputKind, Source};
+
+/// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
+pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
+    open_with(path, &crate::formats::InputOptions::default())
+}
+
+/// [`open`], with what the user said about a log whose content does not say it all.
+pub(crate) fn open_with(
+    path: &Path,
+    opts: &crate::formats::InputOptions,
+) -> Result<Box<dyn Source>, Error> {
+    if path.file_name().is_some_and(|n| n == "metadata.yaml")
+        && path.is_file()
+        && let Some(dir) = path.parent()
+    {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        return Ok(Box::new(crate::rosbag2::BagDir::open(dir)?));
+    }
+    Ok(match crate::detect::input_kind(path)? {
+        InputKind::Ros1Bag => Box::new(crate::bag::BagReader::open(path)?),
+        InputKind::Mcap => Box::new(crate::mcap::McapReader::open(path)?),
+        InputKind::Sqlite3 => Box::new(crate::rosbag2::Sqlite3Reader::open(path)?),
+        InputKind::Rosbag2Dir => Box::new(crate::rosbag2::BagDir::open(path)?),
+        InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
+        kind => crate::formats::open(kind, path, opts)?,
+    })
+}
