@@ -101,6 +101,8 @@ pub mod stated;
 pub mod tau_grid;
 pub mod vio_files;
 
+mod chart_panels;
+mod config_values;
 mod curve_data;
 mod declare;
 mod pipeline;

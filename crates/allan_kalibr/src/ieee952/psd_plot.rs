@@ -65,7 +65,7 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let panels = super::plot::titled_panels(
+        let panels = super::chart_panels::titled_panels(
             root,
             &format!(
                 "{} — Welch PSD, one-sided (white noise N: level 2N²); lines found marked",
@@ -189,7 +189,7 @@ where
     }
     let (x0, x1) = (x0 / 1.2, x1 * 1.2);
     let (y0, y1) = (y0 / 3.0, y1 * 3.0);
-    let mut ctx = super::plot::log_log_panel(
+    let mut ctx = super::chart_panels::log_log_panel(
         area,
         format!("{label} — {} segments of {}", p.segments, p.segment),
         (x0, x1),
@@ -253,7 +253,7 @@ where
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red));
         }
     }
-    super::plot::draw_legend(&mut ctx, scale)
+    super::chart_panels::draw_legend(&mut ctx, scale)
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@
 
 use std::fmt::Write as _;
 
-use super::files::{FileValues, file_values, inline_note};
+use super::config_values::{FileValues, file_values, inline_note};
 use super::imu::{ImuAnalysis, Sensor, SensorValue};
 use crate::yaml::yaml_float;
 

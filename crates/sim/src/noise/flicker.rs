@@ -31,9 +31,6 @@ pub const PER_DECADE: f64 = 1.5;
 pub const LO_MARGIN: f64 = 40.0;
 /// T_max = τ_hi · HI_MARGIN.
 pub const HI_MARGIN: f64 = 16.0;
-/// The shortest floor corner τ_lo must span at least this many output samples (below it the
-/// discrete sampling of the fastest component shapes the floor).
-pub const MIN_TAU_SAMPLES: f64 = 10.0;
 /// √(2 ln 2 / π): the flicker Allan-deviation floor per unit B.
 pub const FLOOR_PER_B: f64 = 0.664_282_470_267_960_1;
 

@@ -47,6 +47,11 @@ pub struct BiasInstability {
     pub tau_hi: f64,
 }
 
+/// The shortest floor corner τ_lo ([`BiasInstability::tau_lo`]) must span at least this many
+/// output samples (below it the discrete sampling of the fastest component of
+/// [`super::flicker::components`] shapes the floor).
+pub const MIN_TAU_SAMPLES: f64 = 10.0;
+
 /// First-order Gauss–Markov bias: stationary, standard deviation σ, correlation time T.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GaussMarkov {
@@ -344,7 +349,7 @@ impl ImuModel {
                     ));
                 }
                 if let Some(bi) = a.bias_instability {
-                    let min_tau = super::flicker::MIN_TAU_SAMPLES / output_rate;
+                    let min_tau = MIN_TAU_SAMPLES / output_rate;
                     if !(bi.b.is_finite() && bi.b >= 0.0) {
                         return Err(at(
                             "bias_instability",
@@ -360,9 +365,7 @@ impl ImuModel {
                             "bias_instability",
                             format!(
                                 "corner times must satisfy {min_tau} s ({} output samples) <= tau_lo < tau_hi, got {} .. {}",
-                                super::flicker::MIN_TAU_SAMPLES,
-                                bi.tau_lo,
-                                bi.tau_hi
+                                MIN_TAU_SAMPLES, bi.tau_lo, bi.tau_hi
                             ),
                         ));
                     }
