@@ -57,24 +57,6 @@ pub fn compress(data: &[u8], out: &mut Vec<u8>) {
     ruzstd::encoding::compress(data, &mut *out, ruzstd::encoding::CompressionLevel::Fastest);
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn round_trip_and_limit() {
-        let data: Vec<u8> = (0..200_000u32)
-            .flat_map(|i| (i % 251).to_le_bytes())
-            .collect();
-        let mut z = Vec::new();
-        super::compress(&data, &mut z);
-        assert!(z.len() < data.len() / 2);
-        let mut back = Vec::new();
-        super::decompress_into(&z, &mut back, data.len() as u64).unwrap();
-        assert_eq!(back, data);
-        assert!(super::decompress_into(&z, &mut back, 1000).is_err());
-        assert!(super::decompress_into(&z[..z.len() / 2], &mut back, u64::MAX).is_err());
-    }
-}
-
 /// A file decompressed from a zstd FILE-mode input into a private temporary file, removed
 /// when dropped.
 pub struct Decompressed {
@@ -104,4 +86,22 @@ pub(crate) fn decompress_zstd_file(src: &Path) -> Result<Decompressed, Error> {
     })?;
     std::io::Write::flush(&mut out).map_err(|e| Error::io(&path, e))?;
     Ok(Decompressed { path, _dir: dir })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn round_trip_and_limit() {
+        let data: Vec<u8> = (0..200_000u32)
+            .flat_map(|i| (i % 251).to_le_bytes())
+            .collect();
+        let mut z = Vec::new();
+        super::compress(&data, &mut z);
+        assert!(z.len() < data.len() / 2);
+        let mut back = Vec::new();
+        super::decompress_into(&z, &mut back, data.len() as u64).unwrap();
+        assert_eq!(back, data);
+        assert!(super::decompress_into(&z, &mut back, 1000).is_err());
+        assert!(super::decompress_into(&z[..z.len() / 2], &mut back, u64::MAX).is_err());
+    }
 }
