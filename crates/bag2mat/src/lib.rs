@@ -50,20 +50,20 @@ pub mod mcap;
 pub mod printable;
 pub mod record_check;
 pub mod rosbag2;
-pub mod rows;
+mod rows;
 pub mod sensor;
 pub mod series;
 pub mod shared;
 pub mod source;
 #[cfg(any(test, feature = "test-support"))]
 pub mod test_tools;
-pub mod time;
+mod time;
 pub mod timing;
 pub mod zstd;
 
 pub use bag::Compression;
 pub use error::{Error, TopicSummary};
-pub use rows::permute;
+pub use rows::{ROW_LEN, Row, Rows, permute};
 pub use sensor::Sensor;
 pub use series::{
     ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, read_imu_series,

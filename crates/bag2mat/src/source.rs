@@ -69,7 +69,7 @@ pub enum Encoding {
     Ros1,
     /// CDR (ROS 2).
     Cdr,
-    /// Samples a log reader already decoded ([`crate::rows::Row`]).
+    /// Samples a log reader already decoded ([`crate::Row`]).
     Row,
     /// Anything else, named as the container names it.
     Other(String),

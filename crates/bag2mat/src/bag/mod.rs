@@ -9,7 +9,7 @@
 //!   was lost is reported.
 //! * [`write`] writes bags that Debian's `rosbag info/check` and the python API accept.
 //!
-//! Times are [`RosTime`] ([`crate::time`]): unsigned seconds and nanoseconds since the UNIX
+//! Times are [`RosTime`] (module `time`): unsigned seconds and nanoseconds since the UNIX
 //! epoch.
 
 pub mod read;

@@ -231,7 +231,7 @@ pub struct ImuRead {
 enum Codec {
     Ros1,
     Cdr,
-    /// Rows a log reader decoded ([`crate::rows::Row`]), whatever the topic's type.
+    /// Rows a log reader decoded ([`crate::Row`]), whatever the topic's type.
     Row,
 }
 
