@@ -454,89 +454,104 @@ pub fn summary_text(a: &ImuAnalysis) -> String {
     }
     s.push_str(&lines_text(a));
     for ax in &a.axes {
-        let an = &ax.analysis;
-        let sensor = ax.sensor;
-        let lab = sensor.axis_label(ax.axis);
-        let _ = writeln!(s, "{lab:<7} fit: {}", verdict_line(an));
-        let _ = writeln!(
-            s,
-            "{:<7} white noise N  = {}",
-            "",
-            term_text(&an.terms.n, sensor.n_unit())
-        );
-        let _ = writeln!(
-            s,
-            "{:<7} random walk K  = {}",
-            "",
-            term_text(&an.terms.k, sensor.k_unit())
-        );
-        let b = &an.terms.b;
-        if b.verdict != Verdict::NotFitted {
-            let _ = writeln!(
-                s,
-                "{:<7} bias instab. B = {}",
-                "",
-                term_text(b, sensor.unit())
-            );
-        }
-        if an.terms.b_corner > 0.0 && an.terms.b.verdict != Verdict::NotFitted {
-            let _ = writeln!(
-                s,
-                "{:<7} B's floor has a lower corner: within 2 % of 0.664*B from tau = {} s on (1/f spectrum down to a correlation time of {} s)",
-                "",
-                short(BAND_FLOOR_X * an.terms.b_corner),
-                short(an.terms.b_corner)
-            );
-        }
-        for (name, t, unit) in [
-            ("quantiz. Q", &an.terms.q, sensor.q_unit()),
-            ("rate ramp R", &an.terms.r, sensor.r_unit()),
-        ] {
-            if t.verdict == Verdict::Resolved {
-                let _ = writeln!(s, "{:<7} {name:<15}= {}", "", term_text(t, unit));
-            }
-        }
-        if an.terms.g.verdict != Verdict::NotFitted {
-            let _ = writeln!(
-                s,
-                "{:<7} Gauss–Markov bias σ = {}, correlation time {} s (a bump: exponentially correlated noise, not B or K)",
-                "",
-                term_text(&an.terms.g, sensor.unit()),
-                short(an.terms.g_time)
-            );
-        }
-        if an.verdict.fits() {
-            let r = &an.region;
-            let rd = |x: Option<super::region::Reading>| match x {
-                Some(x) if x.kind == super::region::ReadingKind::Line => format!("{:.3e}", x.value),
-                Some(x) => format!("< {:.2e}", x.hi),
-                None => "-".into(),
-            };
-            let psd_n = an
-                .psd
-                .as_ref()
-                .and_then(super::psd::white_density)
-                .map_or("-".into(), |v| format!("{v:.3e}"));
-            let _ = writeln!(
-                s,
-                "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
-                "",
-                rd(r.n),
-                rd(r.b),
-                rd(r.k)
-            );
-        }
-        for f in a.axis_checks(sensor, ax.axis) {
-            let _ = writeln!(
-                s,
-                "{:<7} caveat: {} (see the warning on stderr)",
-                "",
-                f.short()
-            );
-        }
+        s.push_str(&axis_text(a, ax));
     }
     s.push_str(&advice_text(a));
     s.push_str(&checks_text(a));
+    s.push_str(&values_text(a));
+    s
+}
+
+/// One axis' lines of [`summary_text`]: the fit verdict, the terms, the cross-checks and
+/// the caveats.
+fn axis_text(a: &ImuAnalysis, ax: &AxisResult) -> String {
+    let mut s = String::new();
+    let an = &ax.analysis;
+    let sensor = ax.sensor;
+    let lab = sensor.axis_label(ax.axis);
+    let _ = writeln!(s, "{lab:<7} fit: {}", verdict_line(an));
+    let _ = writeln!(
+        s,
+        "{:<7} white noise N  = {}",
+        "",
+        term_text(&an.terms.n, sensor.n_unit())
+    );
+    let _ = writeln!(
+        s,
+        "{:<7} random walk K  = {}",
+        "",
+        term_text(&an.terms.k, sensor.k_unit())
+    );
+    let b = &an.terms.b;
+    if b.verdict != Verdict::NotFitted {
+        let _ = writeln!(
+            s,
+            "{:<7} bias instab. B = {}",
+            "",
+            term_text(b, sensor.unit())
+        );
+    }
+    if an.terms.b_corner > 0.0 && an.terms.b.verdict != Verdict::NotFitted {
+        let _ = writeln!(
+            s,
+            "{:<7} B's floor has a lower corner: within 2 % of 0.664*B from tau = {} s on (1/f spectrum down to a correlation time of {} s)",
+            "",
+            short(BAND_FLOOR_X * an.terms.b_corner),
+            short(an.terms.b_corner)
+        );
+    }
+    for (name, t, unit) in [
+        ("quantiz. Q", &an.terms.q, sensor.q_unit()),
+        ("rate ramp R", &an.terms.r, sensor.r_unit()),
+    ] {
+        if t.verdict == Verdict::Resolved {
+            let _ = writeln!(s, "{:<7} {name:<15}= {}", "", term_text(t, unit));
+        }
+    }
+    if an.terms.g.verdict != Verdict::NotFitted {
+        let _ = writeln!(
+            s,
+            "{:<7} Gauss–Markov bias σ = {}, correlation time {} s (a bump: exponentially correlated noise, not B or K)",
+            "",
+            term_text(&an.terms.g, sensor.unit()),
+            short(an.terms.g_time)
+        );
+    }
+    if an.verdict.fits() {
+        let r = &an.region;
+        let rd = |x: Option<super::region::Reading>| match x {
+            Some(x) if x.kind == super::region::ReadingKind::Line => format!("{:.3e}", x.value),
+            Some(x) => format!("< {:.2e}", x.hi),
+            None => "-".into(),
+        };
+        let psd_n = an
+            .psd
+            .as_ref()
+            .and_then(super::psd::white_density)
+            .map_or("-".into(), |v| format!("{v:.3e}"));
+        let _ = writeln!(
+            s,
+            "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
+            "",
+            rd(r.n),
+            rd(r.b),
+            rd(r.k)
+        );
+    }
+    for f in a.axis_checks(sensor, ax.axis) {
+        let _ = writeln!(
+            s,
+            "{:<7} caveat: {} (see the warning on stderr)",
+            "",
+            f.short()
+        );
+    }
+    s
+}
+
+/// The continuous-time values per sensor that go to Kalibr, and which file holds them.
+fn values_text(a: &ImuAnalysis) -> String {
+    let mut s = String::new();
     for sensor in a.sensors() {
         let fmt = |v: Option<SensorValue>, unit: &str| match v {
             Some(v) => format!(

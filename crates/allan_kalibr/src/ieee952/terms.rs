@@ -71,24 +71,79 @@ fn line_shape_variance(
 }
 
 /// The terms of a fit the axis verdict declares: each term's value, its interval at
-/// `cfg.term_confidence` and its verdict, then bounded by the whole record.
+/// `cfg.term_confidence` and its verdict ([`TermsOfFit::fitted`]), then bounded by the whole
+/// record ([`TermsOfFit::bounded`]).
 pub(super) fn make_terms(
     f: &fit::FitResult,
     fd: &fit::FitData,
     curve: &[Point],
     cfg: &Config,
 ) -> Terms {
-    let z = z_of(cfg.term_confidence);
-    let have_stats = fd.basis.is_some();
-    // the measured floor of the fitted range, for B's verdict (see [`B_FLOOR_TOL`])
-    let floor = curve
-        .iter()
-        .filter(|p| p.in_range)
-        .map(|p| p.adev)
-        .fold(f64::INFINITY, f64::min);
-    let floor_shown = |b: f64| (region::B_FLOOR_FACTOR * b / floor - 1.0).abs() <= B_FLOOR_TOL;
-    let shape_var = line_shape_variance(f, fd, cfg);
-    let one = |j: usize| -> Term {
+    let t = TermsOfFit {
+        f,
+        fd,
+        curve,
+        cfg,
+        z: z_of(cfg.term_confidence),
+        have_stats: fd.basis.is_some(),
+        // the measured floor of the fitted range, for B's verdict (see [`B_FLOOR_TOL`])
+        floor: curve
+            .iter()
+            .filter(|p| p.in_range)
+            .map(|p| p.adev)
+            .fold(f64::INFINITY, f64::min),
+        shape_var: line_shape_variance(f, fd, cfg),
+    };
+    let one = |j: usize| t.fitted(j);
+    let bounded = |j: usize, term: Term| t.bounded(j, term);
+    Terms {
+        q: one(0),
+        n: bounded(1, one(1)),
+        b: bounded(2, one(2)),
+        k: bounded(3, one(3)),
+        r: bounded(4, one(4)),
+        g: bounded(fit::GM, one(fit::GM)),
+        g_time: f.shapes.gm_t,
+        b_corner: f.shapes.b_lo,
+        lines: std::array::from_fn(|k| {
+            f.shapes.lines[k].map(|l| LineTerm {
+                frequency: l.frequency,
+                bandwidth: l.bandwidth,
+                amplitude: f.coef[fit::LINE0 + k].max(0.0).sqrt(),
+                psd_amplitude: l.psd_amp2.sqrt(),
+            })
+        }),
+    }
+}
+
+/// What the terms of one fit are made from.
+struct TermsOfFit<'a> {
+    f: &'a fit::FitResult,
+    fd: &'a fit::FitData<'a>,
+    curve: &'a [Point],
+    cfg: &'a Config,
+    /// The normal quantile of the terms' confidence.
+    z: f64,
+    /// The fit has a sample count (a statistical covariance): intervals and verdicts.
+    have_stats: bool,
+    floor: f64,
+    shape_var: [f64; fit::TERM_COUNT],
+}
+
+impl TermsOfFit<'_> {
+    /// Term `j` from the fit alone: its value, interval and verdict.
+    fn fitted(&self, j: usize) -> Term {
+        let TermsOfFit {
+            f,
+            fd,
+            curve,
+            cfg,
+            z,
+            have_stats,
+            floor,
+            ref shape_var,
+        } = *self;
+        let floor_shown = |b: f64| (region::B_FLOOR_FACTOR * b / floor - 1.0).abs() <= B_FLOOR_TOL;
         if !cfg.fit.terms[j] {
             return Term::not_fitted();
         }
@@ -161,28 +216,38 @@ pub(super) fn make_terms(
             hi: nan_if(hi_c.sqrt()),
             verdict,
         }
-    };
-    // The whole record's say (issue 17): every curve point bounds every term (its Allan
-    // deviation is at most the point's upper 95 % band), the points the range left out too;
-    // and a term that pushes the model up at long τ (B, K, R, a Gauss–Markov bias) is not
-    // resolved where the model then rises above the upper band of a point beyond the range
-    // and the term's own share is what lifts it there (a K fitted to the shoulder of a line,
-    // or to a bend the range cut, whose +½ line the long-τ curve does not follow).
-    let range_end = f.used.last().map_or(f64::INFINITY, |&i| fd.points[i].tau);
-    let long_cut = f.used.last().is_some_and(|&i| i + 1 < fd.points.len());
-    let record_bound =
-        |j: usize| region::upper_bound(curve.iter(), |tau| fit::basis_at(j, tau, &f.shapes).sqrt());
-    let contradicted = |j: usize| {
-        curve
-            .iter()
-            .filter(|p| p.tau > range_end * (1.0 + 1e-12) && p.hi95.is_finite())
-            .any(|p| {
-                let model = f.predict(p.tau);
-                let over = model - p.hi95 * p.hi95;
-                over > 0.0 && f.coef[j] * fit::basis_at(j, p.tau, &f.shapes) >= over
-            })
-    };
-    let bounded = |j: usize, mut t: Term| -> Term {
+    }
+
+    /// Term `j` bounded by the whole record's say (issue 17): every curve point bounds every
+    /// term (its Allan deviation is at most the point's upper 95 % band), the points the
+    /// range left out too;
+    /// and a term that pushes the model up at long τ (B, K, R, a Gauss–Markov bias) is not
+    /// resolved where the model then rises above the upper band of a point beyond the range
+    /// and the term's own share is what lifts it there (a K fitted to the shoulder of a line,
+    /// or to a bend the range cut, whose +½ line the long-τ curve does not follow).
+    fn bounded(&self, j: usize, mut t: Term) -> Term {
+        let TermsOfFit {
+            f,
+            fd,
+            curve,
+            have_stats,
+            ..
+        } = *self;
+        let range_end = f.used.last().map_or(f64::INFINITY, |&i| fd.points[i].tau);
+        let long_cut = f.used.last().is_some_and(|&i| i + 1 < fd.points.len());
+        let record_bound = |j: usize| {
+            region::upper_bound(curve.iter(), |tau| fit::basis_at(j, tau, &f.shapes).sqrt())
+        };
+        let contradicted = |j: usize| {
+            curve
+                .iter()
+                .filter(|p| p.tau > range_end * (1.0 + 1e-12) && p.hi95.is_finite())
+                .any(|p| {
+                    let model = f.predict(p.tau);
+                    let over = model - p.hi95 * p.hi95;
+                    over > 0.0 && f.coef[j] * fit::basis_at(j, p.tau, &f.shapes) >= over
+                })
+        };
         if !have_stats || matches!(t.verdict, Verdict::NotFitted) || j == 0 {
             return t;
         }
@@ -204,24 +269,6 @@ pub(super) fn make_terms(
             t.lo = t.lo.min(t.hi);
         }
         t
-    };
-    Terms {
-        q: one(0),
-        n: bounded(1, one(1)),
-        b: bounded(2, one(2)),
-        k: bounded(3, one(3)),
-        r: bounded(4, one(4)),
-        g: bounded(fit::GM, one(fit::GM)),
-        g_time: f.shapes.gm_t,
-        b_corner: f.shapes.b_lo,
-        lines: std::array::from_fn(|k| {
-            f.shapes.lines[k].map(|l| LineTerm {
-                frequency: l.frequency,
-                bandwidth: l.bandwidth,
-                amplitude: f.coef[fit::LINE0 + k].max(0.0).sqrt(),
-                psd_amplitude: l.psd_amp2.sqrt(),
-            })
-        }),
     }
 }
 
