@@ -518,25 +518,7 @@ fn axis_text(a: &ImuAnalysis, ax: &AxisResult) -> String {
         );
     }
     if an.verdict.fits() {
-        let r = &an.region;
-        let rd = |x: Option<super::region::Reading>| match x {
-            Some(x) if x.kind == super::region::ReadingKind::Line => format!("{:.3e}", x.value),
-            Some(x) => format!("< {:.2e}", x.hi),
-            None => "-".into(),
-        };
-        let psd_n = an
-            .psd
-            .as_ref()
-            .and_then(super::psd::white_density)
-            .map_or("-".into(), |v| format!("{v:.3e}"));
-        let _ = writeln!(
-            s,
-            "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
-            "",
-            rd(r.n),
-            rd(r.b),
-            rd(r.k)
-        );
+        s.push_str(&readings_text(an));
     }
     for f in a.axis_checks(sensor, ax.axis) {
         let _ = writeln!(
@@ -546,6 +528,31 @@ fn axis_text(a: &ImuAnalysis, ax: &AxisResult) -> String {
             f.short()
         );
     }
+    s
+}
+
+/// An axis' region readings and PSD level, the cross-check beside its fit.
+fn readings_text(an: &Analysis) -> String {
+    let mut s = String::new();
+    let r = &an.region;
+    let rd = |x: Option<super::region::Reading>| match x {
+        Some(x) if x.kind == super::region::ReadingKind::Line => format!("{:.3e}", x.value),
+        Some(x) => format!("< {:.2e}", x.hi),
+        None => "-".into(),
+    };
+    let psd_n = an
+        .psd
+        .as_ref()
+        .and_then(super::psd::white_density)
+        .map_or("-".into(), |v| format!("{v:.3e}"));
+    let _ = writeln!(
+        s,
+        "{:<7} region readings (cross-check): N {}  B {}  K {}; N from the PSD level {psd_n}",
+        "",
+        rd(r.n),
+        rd(r.b),
+        rd(r.k)
+    );
     s
 }
 

@@ -136,12 +136,12 @@ impl TermsOfFit<'_> {
         let TermsOfFit {
             f,
             fd,
-            curve,
             cfg,
             z,
             have_stats,
             floor,
             ref shape_var,
+            ..
         } = *self;
         let floor_shown = |b: f64| (region::B_FLOOR_FACTOR * b / floor - 1.0).abs() <= B_FLOOR_TOL;
         if !cfg.fit.terms[j] {
@@ -155,29 +155,7 @@ impl TermsOfFit<'_> {
             return Term::not_fitted();
         }
         if f.left_out[j] || c <= 0.0 {
-            // left out by the selection, at its bound, or the 1/τ² coefficient negative
-            // (the low-pass correction, not a quantization): 0 with the upper bound
-            let mut hi = if f.left_out[j] {
-                (f.left_out_coef[j] + z * se_c).sqrt()
-            } else {
-                fit::inverted_interval(fd, f, &cfg.fit, j, z)
-                    .1
-                    .max(0.0)
-                    .sqrt()
-            };
-            if !(hi > 0.0 && hi.is_finite()) {
-                // The fit's own error says nothing here (a term left out where the full fit
-                // had it at its bound has no standard error; an interval the data do not
-                // close is ∞): bound the term by the curve itself, never "< 0".
-                hi = data_bound(j, f, fd, curve);
-            }
-            return Term {
-                value: 0.0,
-                std_err: f64::NAN,
-                lo: nan_if(0.0),
-                hi: nan_if(hi),
-                verdict: Verdict::NotSignificant,
-            };
+            return self.absent(j, se_c);
         }
         let value = c.sqrt();
         let std_err = nan_if((se_c * se_c + shape_var[j]).sqrt() / (2.0 * value));
@@ -215,6 +193,44 @@ impl TermsOfFit<'_> {
             lo: nan_if(lo_c.sqrt()),
             hi: nan_if(hi_c.sqrt()),
             verdict,
+        }
+    }
+
+    /// Term `j` the selection left out or the fit put at its bound (standard error `se_c`
+    /// of its coefficient): 0 with its upper bound.
+    fn absent(&self, j: usize, se_c: f64) -> Term {
+        let TermsOfFit {
+            f,
+            fd,
+            curve,
+            cfg,
+            z,
+            have_stats,
+            ..
+        } = *self;
+        let nan_if = |v: f64| if have_stats { v } else { f64::NAN };
+        // left out by the selection, at its bound, or the 1/τ² coefficient negative
+        // (the low-pass correction, not a quantization): 0 with the upper bound
+        let mut hi = if f.left_out[j] {
+            (f.left_out_coef[j] + z * se_c).sqrt()
+        } else {
+            fit::inverted_interval(fd, f, &cfg.fit, j, z)
+                .1
+                .max(0.0)
+                .sqrt()
+        };
+        if !(hi > 0.0 && hi.is_finite()) {
+            // The fit's own error says nothing here (a term left out where the full fit
+            // had it at its bound has no standard error; an interval the data do not
+            // close is ∞): bound the term by the curve itself, never "< 0".
+            hi = data_bound(j, f, fd, curve);
+        }
+        Term {
+            value: 0.0,
+            std_err: f64::NAN,
+            lo: nan_if(0.0),
+            hi: nan_if(hi),
+            verdict: Verdict::NotSignificant,
         }
     }
 
