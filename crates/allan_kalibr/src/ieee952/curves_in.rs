@@ -594,7 +594,53 @@ fn read_avr(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesErr
     let mut notes = vec![
         "allan_variance_ros: non-overlapping deviations on 0.1 s bins (analysed as such)".into(),
     ];
-    let n = match (opts.samples, opts.rate, opts.duration) {
+    let n = avr_bins(opts, tau0, &ms, &acc_rows, &mut notes)?;
+    let keep = on_log_grid(&ms);
+    let dropped = keep.iter().filter(|k| !**k).count();
+    let (ms, acc_rows, gyr_rows) = (
+        kept(ms, &keep),
+        kept(acc_rows, &keep),
+        kept(gyr_rows, &keep),
+    );
+    if dropped > 0 {
+        notes.push(format!(
+            "allan_variance_ros' dense 0.1 s grid thinned to the section's {} points per octave ({dropped} periods left out: the fit uses that grid, and neighbouring periods share most of their bins)",
+            super::tau_grid::GridSpec::default().per_octave
+        ));
+    }
+    let (ma, ca) = dedup_rows(ms.clone(), acc_rows);
+    let (mg, cg) = dedup_rows(ms, gyr_rows);
+    Ok(Curves {
+        format: Format::AllanVarianceRos,
+        sensors: vec![
+            sensor_curves(
+                Sensor::Gyro,
+                &mg,
+                tau0,
+                n,
+                Overlap::Normal,
+                &cg,
+                std::f64::consts::PI / 180.0,
+            ),
+            sensor_curves(Sensor::Acc, &ma, tau0, n, Overlap::Normal, &ca, 1.0),
+        ],
+        rate: 1.0 / tau0,
+        notes,
+        imu_utils: None,
+    })
+}
+
+/// The record's length in 0.1 s bins of an allan_variance.csv (periods `ms`, acc rows
+/// `acc_rows`): from the options, else from where the curve stops (a period has a value only
+/// while it fits twice in the record), else unknown; each way said in `notes`.
+fn avr_bins(
+    opts: &Options,
+    tau0: f64,
+    ms: &[usize],
+    acc_rows: &[[f64; 3]],
+    notes: &mut Vec<String>,
+) -> Result<Option<usize>, CurvesError> {
+    Ok(match (opts.samples, opts.rate, opts.duration) {
         (Some(_), None, None) => {
             return Err(CurvesError::Options(
                 "--samples with an allan_variance.csv needs the IMU rate (--rate); or give --duration".into(),
@@ -635,39 +681,6 @@ fn read_avr(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesErr
                 }
             }
         }
-    };
-    let keep = on_log_grid(&ms);
-    let dropped = keep.iter().filter(|k| !**k).count();
-    let (ms, acc_rows, gyr_rows) = (
-        kept(ms, &keep),
-        kept(acc_rows, &keep),
-        kept(gyr_rows, &keep),
-    );
-    if dropped > 0 {
-        notes.push(format!(
-            "allan_variance_ros' dense 0.1 s grid thinned to the section's {} points per octave ({dropped} periods left out: the fit uses that grid, and neighbouring periods share most of their bins)",
-            super::tau_grid::GridSpec::default().per_octave
-        ));
-    }
-    let (ma, ca) = dedup_rows(ms.clone(), acc_rows);
-    let (mg, cg) = dedup_rows(ms, gyr_rows);
-    Ok(Curves {
-        format: Format::AllanVarianceRos,
-        sensors: vec![
-            sensor_curves(
-                Sensor::Gyro,
-                &mg,
-                tau0,
-                n,
-                Overlap::Normal,
-                &cg,
-                std::f64::consts::PI / 180.0,
-            ),
-            sensor_curves(Sensor::Acc, &ma, tau0, n, Overlap::Normal, &ca, 1.0),
-        ],
-        rate: 1.0 / tau0,
-        notes,
-        imu_utils: None,
     })
 }
 
@@ -768,38 +781,7 @@ fn read_kalibr(path: &Path, text: &str, opts: &Options) -> Result<Curves, Curves
 
 fn read_ieee952(path: &Path, text: &str, opts: &Options) -> Result<Curves, CurvesError> {
     let stated_n = files::stated_samples(text);
-    // (axis label, rows of (m, τ, deviation))
-    type AxisRows = Vec<(String, Vec<(usize, f64, f64)>)>;
-    let mut per_axis: AxisRows = Vec::new();
-    let mut header_seen = false;
-    for (i, l) in text.lines().enumerate() {
-        let t = l.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        if !header_seen {
-            header_seen = true;
-            continue;
-        }
-        let f: Vec<&str> = t.split(',').collect();
-        if f.len() < 4 {
-            return Err(CurvesError::Parse {
-                path: path.to_path_buf(),
-                line: i + 1,
-                what: "need axis,m,tau,adev".into(),
-            });
-        }
-        let v = parse_fields(path, i + 1, &f[1..4])?;
-        let axis = f[0].trim().to_string();
-        let entry = match per_axis.iter_mut().find(|(a, _)| *a == axis) {
-            Some(e) => e,
-            None => {
-                per_axis.push((axis, Vec::new()));
-                per_axis.last_mut().expect("just pushed")
-            }
-        };
-        entry.1.push((v[0] as usize, v[1], v[2]));
-    }
+    let per_axis = ieee952_rows(path, text)?;
     let tau0 = per_axis
         .iter()
         .flat_map(|(_, r)| r.iter())
@@ -810,30 +792,7 @@ fn read_ieee952(path: &Path, text: &str, opts: &Options) -> Result<Curves, Curve
             why: "ieee952_curves.csv without a point".into(),
         })?;
     let mut notes = Vec::new();
-    let n = match given_n(opts, tau0, 1.0 / tau0) {
-        Some((n, why)) => {
-            notes.push(format!("{why}: N = {n}"));
-            Some(n)
-        }
-        None => match stated_n {
-            Some(n) => {
-                notes.push(format!("sample count N = {n} (stated in the file)"));
-                Some(n)
-            }
-            None => {
-                let last = per_axis
-                    .iter()
-                    .flat_map(|(_, r)| r.iter().map(|x| x.0))
-                    .max()
-                    .unwrap_or(0);
-                let n = 4 * last;
-                notes.push(format!(
-                    "sample count not given: the grid ends at m = {last} ≤ N/4, using N = {n} (intervals wide); give --duration"
-                ));
-                Some(n)
-            }
-        },
-    };
+    let n = ieee952_samples(opts, tau0, stated_n, &per_axis, &mut notes);
     let mut sensors = Vec::new();
     for (sensor, names) in [
         (Sensor::Gyro, ["gx", "gy", "gz"]),
@@ -882,6 +841,79 @@ fn read_ieee952(path: &Path, text: &str, opts: &Options) -> Result<Curves, Curve
         notes,
         imu_utils: None,
     })
+}
+
+/// The rows of an ieee952_curves.csv per axis label: (label, rows of (m, τ, deviation)).
+type AxisRows = Vec<(String, Vec<(usize, f64, f64)>)>;
+
+/// The rows of an ieee952_curves.csv (`axis,m,tau,adev` after its header), per axis.
+fn ieee952_rows(path: &Path, text: &str) -> Result<AxisRows, CurvesError> {
+    let mut per_axis: AxisRows = Vec::new();
+    let mut header_seen = false;
+    for (i, l) in text.lines().enumerate() {
+        let t = l.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        if !header_seen {
+            header_seen = true;
+            continue;
+        }
+        let f: Vec<&str> = t.split(',').collect();
+        if f.len() < 4 {
+            return Err(CurvesError::Parse {
+                path: path.to_path_buf(),
+                line: i + 1,
+                what: "need axis,m,tau,adev".into(),
+            });
+        }
+        let v = parse_fields(path, i + 1, &f[1..4])?;
+        let axis = f[0].trim().to_string();
+        let entry = match per_axis.iter_mut().find(|(a, _)| *a == axis) {
+            Some(e) => e,
+            None => {
+                per_axis.push((axis, Vec::new()));
+                per_axis.last_mut().expect("just pushed")
+            }
+        };
+        entry.1.push((v[0] as usize, v[1], v[2]));
+    }
+    Ok(per_axis)
+}
+
+/// The sample count of an ieee952_curves.csv's record: given, stated in the file, or four
+/// times the grid's last m (the grid ends at m ≤ N/4); which, said in `notes`.
+fn ieee952_samples(
+    opts: &Options,
+    tau0: f64,
+    stated_n: Option<usize>,
+    per_axis: &AxisRows,
+    notes: &mut Vec<String>,
+) -> Option<usize> {
+    match given_n(opts, tau0, 1.0 / tau0) {
+        Some((n, why)) => {
+            notes.push(format!("{why}: N = {n}"));
+            Some(n)
+        }
+        None => match stated_n {
+            Some(n) => {
+                notes.push(format!("sample count N = {n} (stated in the file)"));
+                Some(n)
+            }
+            None => {
+                let last = per_axis
+                    .iter()
+                    .flat_map(|(_, r)| r.iter().map(|x| x.0))
+                    .max()
+                    .unwrap_or(0);
+                let n = 4 * last;
+                notes.push(format!(
+                    "sample count not given: the grid ends at m = {last} ≤ N/4, using N = {n} (intervals wide); give --duration"
+                ));
+                Some(n)
+            }
+        },
+    }
 }
 
 /// A unit of a plain CSV: (sensor, factor to rad/s or m/s²).
