@@ -684,20 +684,21 @@ fn avr_bins(
     })
 }
 
+/// The data lines of a CSV with one header line (blank and `#` lines skipped): each line's
+/// number (1-based) and its comma-separated fields.
+fn csv_data_lines(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, t)| !(t.is_empty() || t.starts_with('#')))
+        .skip(1)
+        .map(|(n, t)| (n, t.split(',').collect()))
+}
+
 fn csv_rows(path: &Path, text: &str) -> Result<Vec<Vec<f64>>, CurvesError> {
     let mut rows = Vec::new();
-    let mut header_seen = false;
-    for (i, l) in text.lines().enumerate() {
-        let t = l.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        if !header_seen {
-            header_seen = true;
-            continue;
-        }
-        let f: Vec<&str> = t.split(',').collect();
-        rows.push(parse_fields(path, i + 1, &f)?);
+    for (line, f) in csv_data_lines(text) {
+        rows.push(parse_fields(path, line, &f)?);
     }
     Ok(rows)
 }
@@ -849,25 +850,15 @@ type AxisRows = Vec<(String, Vec<(usize, f64, f64)>)>;
 /// The rows of an ieee952_curves.csv (`axis,m,tau,adev` after its header), per axis.
 fn ieee952_rows(path: &Path, text: &str) -> Result<AxisRows, CurvesError> {
     let mut per_axis: AxisRows = Vec::new();
-    let mut header_seen = false;
-    for (i, l) in text.lines().enumerate() {
-        let t = l.trim();
-        if t.is_empty() || t.starts_with('#') {
-            continue;
-        }
-        if !header_seen {
-            header_seen = true;
-            continue;
-        }
-        let f: Vec<&str> = t.split(',').collect();
+    for (line, f) in csv_data_lines(text) {
         if f.len() < 4 {
             return Err(CurvesError::Parse {
                 path: path.to_path_buf(),
-                line: i + 1,
+                line,
                 what: "need axis,m,tau,adev".into(),
             });
         }
-        let v = parse_fields(path, i + 1, &f[1..4])?;
+        let v = parse_fields(path, line, &f[1..4])?;
         let axis = f[0].trim().to_string();
         let entry = match per_axis.iter_mut().find(|(a, _)| *a == axis) {
             Some(e) => e,
