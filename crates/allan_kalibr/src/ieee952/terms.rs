@@ -94,15 +94,14 @@ pub(super) fn make_terms(
             .fold(f64::INFINITY, f64::min),
         shape_var: line_shape_variance(f, fd, cfg),
     };
-    let one = |j: usize| t.fitted(j);
-    let bounded = |j: usize, term: Term| t.bounded(j, term);
+    let term = |j: usize| t.bounded(j, t.fitted(j));
     Terms {
-        q: one(0),
-        n: bounded(1, one(1)),
-        b: bounded(2, one(2)),
-        k: bounded(3, one(3)),
-        r: bounded(4, one(4)),
-        g: bounded(fit::GM, one(fit::GM)),
+        q: t.fitted(0),
+        n: term(1),
+        b: term(2),
+        k: term(3),
+        r: term(4),
+        g: term(fit::GM),
         g_time: f.shapes.gm_t,
         b_corner: f.shapes.b_lo,
         lines: std::array::from_fn(|k| {

@@ -3,8 +3,7 @@
 
 use super::layout::{Delim, Layout};
 use super::units::TimeUnit;
-use crate::rows::Row;
-use crate::rows::RowsMut;
+use crate::rows::{Row, RowsMut};
 
 /// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
 pub(crate) fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {

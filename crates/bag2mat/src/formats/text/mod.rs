@@ -27,8 +27,7 @@ use super::InputOptions;
 use crate::RosTime;
 use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
-use crate::rows::Row;
-use crate::rows::Rows;
+use crate::rows::{Row, Rows};
 use crate::source::InputKind;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]

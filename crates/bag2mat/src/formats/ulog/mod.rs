@@ -179,6 +179,7 @@ impl Subs {
         self.0[i] = ch;
     }
 }
+
 /// A message id without a subscription.
 const NO_CHANNEL: u32 = u32::MAX;
 
@@ -226,14 +227,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
         appended_at: hop.appended_at,
     };
     let counted = hop.counted;
-    let mut found = hop.found;
-    found.dropouts = dropout_times(&hop.dropouts, &counted);
-    for c in &counted {
-        found.skipped.extend_from_slice(&c.skipped);
-        found.orphans += c.orphans;
-    }
-    // in file order, as one walk over the file would have met them
-    found.skipped.sort_by_key(|s| s.0);
+    let found = hop.found;
     let mut channels = hop.channels;
     for c in &counted {
         for (ch, n) in c.counts.iter().enumerate() {
@@ -300,12 +294,12 @@ struct Hop {
     chans: Vec<Chan>,
     by_key: HashMap<(String, u8), u32>,
     parts: Vec<PartMap>,
-    /// Skipped stretches and a cut end (the data messages are counted per part).
+    /// Dropouts, skipped stretches, orphans and a cut end, in file order.
     found: Found,
-    /// Each dropout in file order: the part it lies in (`None` before the data) and its ms.
-    dropouts: Vec<(Option<usize>, u16)>,
     /// What each part's data messages hold.
     counted: Vec<PartCount>,
+    /// The latest record time logged so far (a dropout's time: its `O` message has none).
+    latest: u64,
     appended_at: Option<u64>,
 }
 
@@ -327,8 +321,8 @@ fn hop(bytes: &[u8]) -> Hop {
         by_key: HashMap::new(),
         parts: Vec::new(),
         found: Found::default(),
-        dropouts: Vec::new(),
         counted: Vec::new(),
+        latest: 0,
         appended_at: None,
     };
     let mut subs = Subs::default();
@@ -361,8 +355,13 @@ fn hop(bytes: &[u8]) -> Hop {
             }
             // step said the body is there
             let body = win.get(m_at + 3, size as usize).unwrap_or(&[]);
-            if let Some(c) = h.counted.last_mut() {
-                c.data(m_at, body, &subs, &h.chans);
+            let Some(c) = h.counted.last_mut() else {
+                continue;
+            };
+            match c.data(body, &subs, &h.chans) {
+                Data::Counted(t) => h.latest = h.latest.max(t),
+                Data::Orphan => h.found.orphans += 1,
+                Data::Short => h.found.skipped.push((m_at, size as u64 + 3)),
             }
             continue;
         }
@@ -412,10 +411,7 @@ impl Hop {
             }
             b'O' => {
                 if let Ok(ms) = m.le::<u16>("dropout duration") {
-                    self.dropouts.push((self.parts.len().checked_sub(1), ms));
-                    if let Some(c) = self.counted.last_mut() {
-                        c.dropout_latest.push(c.latest);
-                    }
+                    self.found.dropouts.push((self.latest, ms));
                 }
             }
             _ => {} // info, parameters, log text, sync
@@ -457,35 +453,34 @@ struct PartCount {
     counts: Vec<u64>,
     /// The record times the part spans (a FIFO message from its oldest sample).
     span: Option<(u64, u64)>,
-    /// Data messages too short for their id: offset and length.
-    skipped: Vec<(u64, u64)>,
-    orphans: u64,
-    /// The latest record time before each of the part's dropouts, in order (0 for none).
-    dropout_latest: Vec<u64>,
-    /// The latest record time of the part (0 for none).
-    latest: u64,
+}
+
+/// What a data message was to the count.
+enum Data {
+    /// Counted, logged at this record time (ns).
+    Counted(u64),
+    /// Of no subscription, or without its time stamp.
+    Orphan,
+    /// Too short for its message id.
+    Short,
 }
 
 impl PartCount {
-    /// Counts a data message (body `body`, at `m_at`) of the part: its rows (a FIFO message
-    /// is several, the oldest (n−1)·dt before its time), the times spanned, or an orphan.
-    fn data(&mut self, m_at: u64, body: &[u8], subs: &Subs, chans: &[Chan]) {
+    /// Counts a data message (body `body`) of the part: its rows (a FIFO message is
+    /// several, the oldest (n−1)·dt before its time) and the times spanned.
+    fn data(&mut self, body: &[u8], subs: &Subs, chans: &[Chan]) -> Data {
         if body.len() < 2 {
-            self.skipped.push((m_at, body.len() as u64 + 3));
-            return;
+            return Data::Short;
         }
         let ch = subs.get(u16::from_le_bytes([body[0], body[1]]));
         let data = &body[2..];
         let Some(chan) = chans.get(ch as usize) else {
-            self.orphans += 1;
-            return;
+            return Data::Orphan;
         };
         let Some(t_us) = chan.ts.and_then(|s| s.get_u64(data)) else {
-            self.orphans += 1;
-            return;
+            return Data::Orphan;
         };
         let t = t_us.saturating_mul(1000);
-        self.latest = self.latest.max(t);
         let (rows, first) = match &chan.decoder {
             Some(d @ Decoder::Fifo { dt, .. }) => {
                 let n = d.rows_in(data);
@@ -495,7 +490,7 @@ impl PartCount {
             _ => (1, t),
         };
         if rows == 0 {
-            return;
+            return Data::Counted(t);
         }
         if self.counts.len() <= ch as usize {
             self.counts.resize(ch as usize + 1, 0);
@@ -505,32 +500,8 @@ impl PartCount {
             self.span
                 .map_or((first, t), |(a, b)| (a.min(first), b.max(t))),
         );
+        Data::Counted(t)
     }
-}
-
-/// Each dropout's time: the latest record time logged before it (0 before any), as the
-/// logger's `O` message has no time of its own.
-fn dropout_times(dropouts: &[(Option<usize>, u16)], counted: &[PartCount]) -> Vec<(u64, u16)> {
-    let before: Vec<u64> = counted
-        .iter()
-        .scan(0u64, |m, c| {
-            let b = *m;
-            *m = (*m).max(c.latest);
-            Some(b)
-        })
-        .collect();
-    let mut next = vec![0usize; counted.len()];
-    dropouts
-        .iter()
-        .map(|&(part, ms)| {
-            let t = part.map_or(0, |k| {
-                let i = next[k];
-                next[k] += 1;
-                before[k].max(counted[k].dropout_latest.get(i).copied().unwrap_or(0))
-            });
-            (t, ms)
-        })
-        .collect()
 }
 
 /// The messages from `start` to the window's end, each given to `on` with its offset, type
