@@ -159,43 +159,14 @@ fn seek_past(conn: &Connection, after: i64, stop: Option<i64>, capacity: u64) ->
 impl Sqlite3Reader {
     /// Opens a rosbag2 `.db3` read-only, lists its topics and plans its parts.
     pub(crate) fn open(path: &Path) -> Result<Sqlite3Reader, Error> {
-        let tables_of = |conn: &Connection| -> Result<Vec<String>, rusqlite::Error> {
-            conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
-                .and_then(|mut s| {
-                    s.query_map([], |r| r.get::<_, String>(0))?
-                        .collect::<Result<_, _>>()
-                })
-        };
-        let mut notes = Vec::new();
-        let mut losses = Vec::new();
-        let mut read_path = path.to_path_buf();
-        let mut copy = None;
-        let mut conn = connect(path).map_err(|e| sql_err(path, e))?;
-        let mut tables = tables_of(&conn);
-        if tables.is_err()
-            && let Some((tmp, kept, pages, page)) = truncated_copy(path)?
-        {
-            // SQLite refuses a file shorter than its header says; its whole pages are read
-            // from a private copy that says what it holds.
-            notes.push(format!(
-                "the file is truncated: it holds {kept} of the {pages} pages its header announces; they were read from a private copy"
-            ));
-            losses.push(Loss {
-                what: format!(
-                    "the last {} page(s) of the file are missing (truncated)",
-                    pages - kept
-                ),
-                at_most: Some(
-                    ((pages - kept) as u64).saturating_mul(page) / crate::imu_msg::MIN_IMU_PAYLOAD,
-                ),
-                ..Loss::default()
-            });
-            read_path = tmp.path().join("truncated.db3");
-            conn = connect(&read_path).map_err(|e| sql_err(path, e))?;
-            tables = tables_of(&conn);
-            copy = Some(tmp);
-        }
-        let tables = tables.map_err(|e| sql_err(path, e))?;
+        let Connected {
+            conn,
+            read_path,
+            copy,
+            tables,
+            mut notes,
+            mut losses,
+        } = Connected::to(path)?;
         for t in ["topics", "messages"] {
             if !tables.iter().any(|x| x == t) {
                 return Err(Error::NotABag {
@@ -225,41 +196,13 @@ impl Sqlite3Reader {
             .optional()
             .ok()
             .flatten();
-        let channels = conn
-            .prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
-            .and_then(|mut s| {
-                s.query_map([], |r| {
-                    Ok(source::Channel {
-                        id: r.get::<_, i64>(0)? as u32,
-                        topic: r.get(1)?,
-                        msg_type: r.get(2)?,
-                        encoding: Encoding::from_name(&r.get::<_, String>(3)?),
-                        md5sum: None,
-                        count: None,
-                    })
-                })?
-                .collect::<Result<Vec<_>, _>>()
-            })
-            .map_err(|e| sql_err(path, e))?;
+        let channels = topics(&conn).map_err(|e| sql_err(path, e))?;
         let len = std::fs::metadata(path)
             .map_err(|e| Error::io(path, e))?
             .len();
         let capacity = (len / MIN_ROW_BYTES).max(1);
         let starts = plan_parts(&conn, capacity, &mut notes, &mut losses);
-        let parts = starts
-            .iter()
-            .enumerate()
-            .map(|(k, a)| Part {
-                // Rows hold no count; the bound is never used to size memory.
-                bytes: u64::MAX,
-                label: match starts.get(k + 1) {
-                    Some(b) => format!("message rows {a}..{}", b - 1),
-                    None => format!("message rows {a}.."),
-                },
-                span: None,
-                counts: None,
-            })
-            .collect();
+        let parts = row_parts(&starts);
         Ok(Sqlite3Reader {
             path: read_path,
             _copy: copy,
@@ -289,6 +232,47 @@ impl Sqlite3Reader {
     fn give(&self, c: Connection) {
         if let Ok(mut p) = self.pool.lock() {
             p.push(c);
+        }
+    }
+
+    /// What the plan of a part's table walk found: rows missing or unreadable (losses) and
+    /// rows read where their ids belong or read once of two (notes).
+    fn plan_losses(&self, plan: &table_walk::Plan, start: i64, out: &mut PartRead) {
+        for h in &plan.holes {
+            let (a, b) = h.ids;
+            let what = match &h.error {
+                Some(e) => {
+                    format!("message rows {a}..{b} could not be read ({e}) and were skipped")
+                }
+                None => format!(
+                    "message rows {a}..{b} are missing from the table (a damaged page; rosbag2 numbers its rows without gaps)"
+                ),
+            };
+            let span = match h.around {
+                (Some(x), Some(y)) => Some((x.max(0) as u64, y.max(0) as u64)),
+                (Some(x), None) | (None, Some(x)) => Some((x.max(0) as u64, x.max(0) as u64)),
+                (None, None) => None,
+            };
+            out.lost.push(Loss {
+                what,
+                messages: Some(h.lost.min(self.capacity)),
+                span,
+                channel: None,
+                ..Loss::default()
+            });
+        }
+        if plan.moved.0 > 0 {
+            out.notes.push(format!(
+                "message rows {start}..: {} row(s) stored out of place (a damaged row id such as {}) were read where their ids belong",
+                plan.moved.0,
+                plan.moved.1.unwrap_or_default()
+            ));
+        }
+        if plan.doubles > 0 {
+            out.notes.push(format!(
+                "message rows {start}..: {} row(s) that damaged pages of the table show twice were read once",
+                plan.doubles
+            ));
         }
     }
 
@@ -391,6 +375,150 @@ impl Sqlite3Reader {
         }
         w
     }
+}
+
+/// The rows of a part's walk that were kept but do not read, as losses: rows whose fields
+/// do not read (on their topic when it reads) and rows that name no topic the table holds.
+fn row_losses(
+    w: &Walked2,
+    start: i64,
+    kept: &dyn Fn(u64) -> bool,
+    want: &(dyn Fn(u32) -> bool + Sync),
+) -> Vec<Loss> {
+    let mut lost = Vec::new();
+    // Rows whose fields do not read are lost, on their topic when it reads.
+    let mut bad: std::collections::BTreeMap<Option<u32>, (u64, &str)> = Default::default();
+    for (pos, topic, why) in &w.bad_fields {
+        if kept(*pos) && topic.is_none_or(want) {
+            let e = bad.entry(*topic).or_insert((0, why.as_str()));
+            e.0 += 1;
+        }
+    }
+    for (topic, (n, why)) in bad {
+        lost.push(Loss {
+            what: format!(
+                "message rows {start}..: {n} row(s) whose fields do not read (first: {why})"
+            ),
+            messages: Some(n),
+            channel: topic,
+            ..Loss::default()
+        });
+    }
+    let strays: Vec<u32> = w
+        .stray_topic
+        .iter()
+        .filter(|(p, _)| kept(*p))
+        .map(|x| x.1)
+        .collect();
+    if let Some(id) = strays.first() {
+        let n = strays.len();
+        lost.push(Loss {
+            what: format!(
+                "message rows {start}..: {n} row(s) name topic id {id}{}, which the topics table does not hold (damaged rows)",
+                if n > 1 { " or another" } else { "" }
+            ),
+            messages: Some(n as u64),
+            ..Loss::default()
+        });
+    }
+    lost
+}
+
+/// A database opened for reading, with its table names: the file itself, or the whole
+/// pages of a truncated one from a private copy (with the note and loss that says so).
+struct Connected {
+    conn: Connection,
+    read_path: std::path::PathBuf,
+    copy: Option<tempfile::TempDir>,
+    tables: Vec<String>,
+    notes: Vec<String>,
+    losses: Vec<Loss>,
+}
+
+impl Connected {
+    fn to(path: &Path) -> Result<Connected, Error> {
+        let tables_of = |conn: &Connection| -> Result<Vec<String>, rusqlite::Error> {
+            conn.prepare("SELECT name FROM sqlite_master WHERE type = 'table'")
+                .and_then(|mut s| {
+                    s.query_map([], |r| r.get::<_, String>(0))?
+                        .collect::<Result<_, _>>()
+                })
+        };
+        let mut notes = Vec::new();
+        let mut losses = Vec::new();
+        let mut read_path = path.to_path_buf();
+        let mut copy = None;
+        let mut conn = connect(path).map_err(|e| sql_err(path, e))?;
+        let mut tables = tables_of(&conn);
+        if tables.is_err()
+            && let Some((tmp, kept, pages, page)) = truncated_copy(path)?
+        {
+            // SQLite refuses a file shorter than its header says; its whole pages are read
+            // from a private copy that says what it holds.
+            notes.push(format!(
+                "the file is truncated: it holds {kept} of the {pages} pages its header announces; they were read from a private copy"
+            ));
+            losses.push(Loss {
+                what: format!(
+                    "the last {} page(s) of the file are missing (truncated)",
+                    pages - kept
+                ),
+                at_most: Some(
+                    ((pages - kept) as u64).saturating_mul(page) / crate::imu_msg::MIN_IMU_PAYLOAD,
+                ),
+                ..Loss::default()
+            });
+            read_path = tmp.path().join("truncated.db3");
+            conn = connect(&read_path).map_err(|e| sql_err(path, e))?;
+            tables = tables_of(&conn);
+            copy = Some(tmp);
+        }
+        let tables = tables.map_err(|e| sql_err(path, e))?;
+        Ok(Connected {
+            conn,
+            read_path,
+            copy,
+            tables,
+            notes,
+            losses,
+        })
+    }
+}
+
+/// The topics table, as channels.
+fn topics(conn: &Connection) -> Result<Vec<source::Channel>, rusqlite::Error> {
+    conn.prepare("SELECT id, name, type, serialization_format FROM topics ORDER BY id")
+        .and_then(|mut s| {
+            s.query_map([], |r| {
+                Ok(source::Channel {
+                    id: r.get::<_, i64>(0)? as u32,
+                    topic: r.get(1)?,
+                    msg_type: r.get(2)?,
+                    encoding: Encoding::from_name(&r.get::<_, String>(3)?),
+                    md5sum: None,
+                    count: None,
+                })
+            })?
+            .collect::<Result<Vec<_>, _>>()
+        })
+}
+
+/// The parts of the message rows that start at `starts`.
+fn row_parts(starts: &[i64]) -> Vec<Part> {
+    starts
+        .iter()
+        .enumerate()
+        .map(|(k, a)| Part {
+            // Rows hold no count; the bound is never used to size memory.
+            bytes: u64::MAX,
+            label: match starts.get(k + 1) {
+                Some(b) => format!("message rows {a}..{}", b - 1),
+                None => format!("message rows {a}.."),
+            },
+            span: None,
+            counts: None,
+        })
+        .collect()
 }
 
 /// One part's walk with the payloads it keeps.
@@ -514,77 +642,8 @@ impl Source for Sqlite3Reader {
                 out.delivered += 1;
             }
         }
-        // Rows whose fields do not read are lost, on their topic when it reads.
-        let mut bad: std::collections::BTreeMap<Option<u32>, (u64, &str)> = Default::default();
-        for (pos, topic, why) in &w.bad_fields {
-            if kept(*pos) && topic.is_none_or(want) {
-                let e = bad.entry(*topic).or_insert((0, why.as_str()));
-                e.0 += 1;
-            }
-        }
-        for (topic, (n, why)) in bad {
-            out.lost.push(Loss {
-                what: format!(
-                    "message rows {start}..: {n} row(s) whose fields do not read (first: {why})"
-                ),
-                messages: Some(n),
-                channel: topic,
-                ..Loss::default()
-            });
-        }
-        let strays: Vec<u32> = w
-            .stray_topic
-            .iter()
-            .filter(|(p, _)| kept(*p))
-            .map(|x| x.1)
-            .collect();
-        if let Some(id) = strays.first() {
-            let n = strays.len();
-            out.lost.push(Loss {
-                what: format!(
-                    "message rows {start}..: {n} row(s) name topic id {id}{}, which the topics table does not hold (damaged rows)",
-                    if n > 1 { " or another" } else { "" }
-                ),
-                messages: Some(n as u64),
-                ..Loss::default()
-            });
-        }
-        for h in &plan.holes {
-            let (a, b) = h.ids;
-            let what = match &h.error {
-                Some(e) => {
-                    format!("message rows {a}..{b} could not be read ({e}) and were skipped")
-                }
-                None => format!(
-                    "message rows {a}..{b} are missing from the table (a damaged page; rosbag2 numbers its rows without gaps)"
-                ),
-            };
-            let span = match h.around {
-                (Some(x), Some(y)) => Some((x.max(0) as u64, y.max(0) as u64)),
-                (Some(x), None) | (None, Some(x)) => Some((x.max(0) as u64, x.max(0) as u64)),
-                (None, None) => None,
-            };
-            out.lost.push(Loss {
-                what,
-                messages: Some(h.lost.min(self.capacity)),
-                span,
-                channel: None,
-                ..Loss::default()
-            });
-        }
-        if plan.moved.0 > 0 {
-            out.notes.push(format!(
-                "message rows {start}..: {} row(s) stored out of place (a damaged row id such as {}) were read where their ids belong",
-                plan.moved.0,
-                plan.moved.1.unwrap_or_default()
-            ));
-        }
-        if plan.doubles > 0 {
-            out.notes.push(format!(
-                "message rows {start}..: {} row(s) that damaged pages of the table show twice were read once",
-                plan.doubles
-            ));
-        }
+        out.lost.extend(row_losses(&w, start, &kept, want));
+        self.plan_losses(&plan, start, &mut out);
         let walk_rows = w.walk.rows();
         if let Ok(mut w) = self.walked.lock() {
             w.rows += walk_rows;

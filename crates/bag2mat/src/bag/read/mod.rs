@@ -127,20 +127,7 @@ impl BagReader {
         let mut head = vec![0u8; 13 + 8 + record::BAG_HEADER_PADDED_LEN];
         let got = read_up_to(&mut file, &mut head).map_err(|e| Error::io(path, e))?;
         head.truncate(got);
-        if head.len() < MAGIC.len() || &head[..MAGIC.len()] != MAGIC {
-            let what = if head.starts_with(b"#ROSBAG V") {
-                format!(
-                    "unsupported version line {:?}",
-                    String::from_utf8_lossy(&head[..head.len().min(13)])
-                )
-            } else {
-                "missing the '#ROSBAG V2.0' magic line".to_string()
-            };
-            return Err(Error::NotABag {
-                path: path.to_path_buf(),
-                what,
-            });
-        }
+        magic_line(path, &head)?;
         let corrupt = |offset: u64, what: String| Error::Corrupt {
             path: path.to_path_buf(),
             offset,
@@ -148,16 +135,7 @@ impl BagReader {
         };
         // The bag header names the index; when it is damaged, the chunks after its usual
         // 4104 bytes are walked as for a bag without an index.
-        let header = record::raw_record(&head, MAGIC.len())
-            .ok_or_else(|| "the bag header record is incomplete".to_string())
-            .and_then(|rec| {
-                let h = Header::parse(rec.header).map_err(|e| e.to_string())?;
-                let b = BagHeader::decode(&h).map_err(|e| match e {
-                    RecordError::Unexpected(_) => "the first record is not the bag header".into(),
-                    e => e.to_string(),
-                })?;
-                Ok((b.index_pos.unwrap_or(0), b.chunk_count, rec.end as u64))
-            });
+        let header = bag_header(&head);
         let mut header_damage = None;
         let (index_pos, chunk_count, first) = match header {
             Ok(h) => h,
@@ -196,18 +174,8 @@ impl BagReader {
         let (index_conns, infos) = if index_ok {
             reader.read_index(index_pos)
         } else {
-            if header_damage.is_some() {
-            } else if index_pos == 0 {
-                reader.contents.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
-            } else if index_pos >= len {
-                reader.contents.losses.push(Loss::new(format!(
-                    "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
-                    index_pos - len
-                )));
-            } else {
-                reader.contents.notes.push(format!(
-                    "the bag's index_pos {index_pos} points into its header; its chunks were walked"
-                ));
+            if header_damage.is_none() {
+                reader.no_index(index_pos);
             }
             (Vec::new(), Vec::new())
         };
@@ -225,6 +193,24 @@ impl BagReader {
         }
         reader.build_interface();
         Ok(reader)
+    }
+
+    /// Why the chunks are walked without the index, when the bag header is intact: no
+    /// index, one past the end of the file (a loss), or one that points into the header.
+    fn no_index(&mut self, index_pos: u64) {
+        let len = self.len;
+        if index_pos == 0 {
+            self.contents.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
+        } else if index_pos >= len {
+            self.contents.losses.push(Loss::new(format!(
+                "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
+                index_pos - len
+            )));
+        } else {
+            self.contents.notes.push(format!(
+                "the bag's index_pos {index_pos} points into its header; its chunks were walked"
+            ));
+        }
     }
 
     /// The channels and parts of the [`Source`] interface.
@@ -405,4 +391,36 @@ fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
         got += n;
     }
     Ok(got)
+}
+
+/// The version line: an error naming what is there when it is not ROS 1's `#ROSBAG V2.0`.
+fn magic_line(path: &Path, head: &[u8]) -> Result<(), Error> {
+    if head.len() < MAGIC.len() || &head[..MAGIC.len()] != MAGIC {
+        let what = if head.starts_with(b"#ROSBAG V") {
+            format!(
+                "unsupported version line {:?}",
+                String::from_utf8_lossy(&head[..head.len().min(13)])
+            )
+        } else {
+            "missing the '#ROSBAG V2.0' magic line".to_string()
+        };
+        return Err(Error::NotABag {
+            path: path.to_path_buf(),
+            what,
+        });
+    }
+    Ok(())
+}
+
+/// The bag header after the version line: the index position (0: none), the chunk count
+/// it states and where the first record after it starts; or what is wrong with it.
+fn bag_header(head: &[u8]) -> Result<(u64, Option<u32>, u64), String> {
+    let rec = record::raw_record(head, MAGIC.len())
+        .ok_or_else(|| "the bag header record is incomplete".to_string())?;
+    let h = Header::parse(rec.header).map_err(|e| e.to_string())?;
+    let b = BagHeader::decode(&h).map_err(|e| match e {
+        RecordError::Unexpected(_) => "the first record is not the bag header".into(),
+        e => e.to_string(),
+    })?;
+    Ok((b.index_pos.unwrap_or(0), b.chunk_count, rec.end as u64))
 }

@@ -4,6 +4,44 @@
 
 use super::*;
 
+/// A top-level record the walk met: where, its opcode, and the content length it states.
+#[derive(Clone, Copy)]
+struct Rec {
+    pos: u64,
+    op: u8,
+    clen: u64,
+    content_pos: u64,
+}
+
+/// Where the walk goes after a record.
+enum Flow {
+    /// On to this position, the record read.
+    Read(u64),
+    /// On to this position past bytes that were not read as records.
+    Skip(u64),
+    /// No further record can be read.
+    Stop,
+    /// The end of the data section: the rest is the summary.
+    DataEnd,
+}
+
+/// What the walk carries from record to record.
+struct Walk<'h> {
+    /// The end of what is walked.
+    end: u64,
+    /// Chunk positions the summary gives, for resynchronising.
+    hints: &'h [u64],
+    /// What a resynchronisation may land on (loose records only in an unchunked file).
+    landing: Landing,
+    /// What the last record was (a Message Index belongs to the chunk before it).
+    after: After,
+    /// A record was read.
+    any: bool,
+    seen_data_end: bool,
+    /// Summary records found past a Data End when the summary was not used.
+    found_summary: Option<Summary>,
+}
+
 impl McapReader {
     /// The end of the record at `pos` when it frames as a top-level record a walk may land
     /// on (see [`Landing`]) and its content checks out for its opcode.
@@ -102,16 +140,19 @@ impl McapReader {
             buf: Vec::new(),
             at: 0,
         };
-        let path = self.path.clone();
-        let io = |e: std::io::Error| Error::io(&path, e);
+        let mut st = Walk {
+            end,
+            hints,
+            landing: Landing::Unchunked,
+            after: After::Other,
+            any: false,
+            seen_data_end: false,
+            found_summary: None,
+        };
         let mut pos = MAGIC.len() as u64;
         let mut first = true;
-        let mut any = false;
-        let mut seen_data_end = false;
-        let mut after = After::Other;
-        let mut found_summary = None;
         while pos < end {
-            let landing = if self.locs.iter().any(|l| matches!(l, Loc::Chunk { .. })) {
+            st.landing = if self.locs.iter().any(|l| matches!(l, Loc::Chunk { .. })) {
                 Landing::Chunked
             } else {
                 Landing::Unchunked
@@ -120,237 +161,306 @@ impl McapReader {
                 self.tail_lost(&mut w, pos, end, None);
                 break;
             };
-            let content_pos = pos + RECORD_PREFIX;
-            let rec_end = content_pos.checked_add(clen).filter(|&e| e <= end);
-            let Some(rec_end) = rec_end else {
-                // A length past the end: truncation, or a damaged length with records after.
-                // A chunk's own records are never landed on (they frame as loose ones).
-                let is_chunk = op == Op::Chunk as u8
-                    && w.get(content_pos, (end - content_pos).min(4096) as usize)
-                        .ok()
-                        .is_some_and(|b| ChunkHeader::decode(b).is_ok());
-                let landing = if is_chunk { Landing::Chunked } else { landing };
-                match self.resync(&mut w, pos + 1, end, hints, landing) {
-                    Some(next) => {
-                        after = self.damaged(
-                            &mut w,
-                            pos,
-                            next,
-                            op,
-                            "its length runs past the end of the file",
-                        );
-                        pos = next;
-                        continue;
+            let rec = Rec {
+                pos,
+                op,
+                clen,
+                content_pos: pos + RECORD_PREFIX,
+            };
+            let flow = match rec.content_pos.checked_add(clen).filter(|&e| e <= end) {
+                None => self.overlong(&mut w, rec, &mut st)?,
+                Some(rec_end) => {
+                    if first && op != Op::Header as u8 {
+                        // The Header only names the profile and library: its damage costs
+                        // nothing.
+                        self.contents.notes.push(format!(
+                            "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
+                        ));
                     }
-                    None => {
-                        self.tail_lost(&mut w, pos, end, Some(op));
-                        break;
-                    }
+                    first = false;
+                    self.record(&mut w, rec, rec_end, &mut st)?
                 }
             };
-            if first && op != Op::Header as u8 {
-                // The Header only names the profile and library: its damage costs nothing.
-                self.contents.notes.push(format!(
-                    "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
-                ));
-            }
-            first = false;
-            let small = |w: &mut Window| -> Result<Option<Vec<u8>>, Error> {
-                if clen > MAX_META_RECORD {
-                    return Ok(None);
+            match flow {
+                Flow::Read(next) => {
+                    st.any = true;
+                    pos = next;
                 }
-                Ok(Some(
-                    w.get(content_pos, clen as usize).map_err(io)?.to_vec(),
-                ))
-            };
-            match Op::from_byte(op) {
-                Some(Op::Header) if pos == MAGIC.len() as u64 => {
-                    match small(&mut w)?.map(|b| Header::decode(&b)) {
-                        Some(Ok(h)) => self.header = h,
-                        _ => self.contents.notes.push(format!(
-                            "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
-                        )),
-                    }
-                    after = After::Other;
-                }
-                Some(Op::Schema) => {
-                    if let Some(Ok(s)) = small(&mut w)?.map(|b| Schema::decode(&b)) {
-                        offer(&mut self.schemas, s.id, s, schema_plausible);
-                    } else {
-                        self.contents
-                            .notes
-                            .push(format!("unreadable Schema record at byte {pos} skipped"));
-                    }
-                    after = After::Other;
-                }
-                Some(Op::Channel) => {
-                    if let Some(Ok(c)) = small(&mut w)?.map(|b| record::Channel::decode(&b)) {
-                        offer(&mut self.mcap_channels, c.id, c, channel_plausible);
-                    } else {
-                        self.contents
-                            .notes
-                            .push(format!("unreadable Channel record at byte {pos} skipped"));
-                    }
-                    after = After::Other;
-                }
-                Some(Op::Chunk) => {
-                    // Its stored length and compression frame it (its times may be damaged).
-                    if chunk_header(&mut w, content_pos, clen).is_some() {
-                        let k = self.add_chunk(&mut w, pos, clen, None)?;
-                        after = After::Chunk(k);
-                    } else {
-                        let next = self.resync(&mut w, pos + 1, end, hints, landing);
-                        let to = next.unwrap_or(end);
-                        after = self.damaged(&mut w, pos, to, op, "its header is damaged");
-                        pos = to;
-                        continue;
-                    }
-                }
-                Some(Op::MessageIndex) => {
-                    let b = w
-                        .get(content_pos, 6.min(clen as usize))
-                        .map_err(io)?
-                        .to_vec();
-                    if b.len() == 6 {
-                        let channel = u16::from_le_bytes([b[0], b[1]]);
-                        let stated =
-                            u32::from_le_bytes(b[2..6].try_into().expect("4 bytes")) as u64;
-                        // A damaged length counts no more entries than the record holds.
-                        let count = stated.min(clen.saturating_sub(6)) / INDEX_ENTRY;
-                        let ix = IndexRef {
-                            channel,
-                            entries_pos: content_pos + 6,
-                            count,
-                        };
-                        match after {
-                            After::Chunk(k) => {
-                                self.indexes[k].push(ix);
-                                self.contents.parts[k]
-                                    .counts
-                                    .get_or_insert_with(Vec::new)
-                                    .push((channel as u32, count));
-                            }
-                            After::Lost(k) => self.lost[k].indexes.push(ix),
-                            After::Other => {}
-                        }
-                    }
-                }
-                Some(Op::Message) => {
-                    let b = w
-                        .get(content_pos, MESSAGE_FIXED_LEN.min(clen as usize))
-                        .map_err(io)?;
-                    let t = (b.len() == MESSAGE_FIXED_LEN)
-                        .then(|| u64::from_le_bytes(b[6..14].try_into().expect("8 bytes")));
-                    self.add_loose(pos, rec_end, t);
-                    after = After::Other;
-                }
-                Some(Op::Attachment | Op::Metadata) => after = After::Other,
-                Some(op @ (Op::DataEnd | Op::Footer))
-                    if clen
-                        == if op == Op::DataEnd {
-                            4
-                        } else {
-                            FOOTER_CONTENT_LEN
-                        } =>
-                {
-                    let op = op as u8;
-                    // The end of the data section, unless data-section records follow it
-                    // (its opcode is damaged).
-                    let data_follows = rec_end < end
-                        && self.frames(&mut w, rec_end, end, landing).is_some_and(|_| {
-                            w.prefix(rec_end).is_some_and(|(o, _)| {
-                                matches!(
-                                    Op::from_byte(o),
-                                    Some(Op::Chunk | Op::MessageIndex | Op::Message)
-                                )
-                            })
-                        });
-                    if data_follows {
-                        self.contents.notes.push(format!(
-                            "a {} record at byte {pos} stands in the middle of the data section (a damaged opcode?); the records after it were read",
-                            op_name(op)
-                        ));
-                        after = After::Other;
-                    } else {
-                        seen_data_end = op == Op::DataEnd as u8;
-                        if !self.summary_used && rec_end < end {
-                            // A file cut in its summary section still holds summary records.
-                            let mut b = vec![0u8; (end - rec_end).min(MAX_META_RECORD) as usize];
-                            if self.file.read_exact_at(&mut b, rec_end).is_ok()
-                                && let Ok(ci) = self.summary_records(&b, false)
-                            {
-                                self.statistics = None;
-                                found_summary = Some(Summary {
-                                    chunk_indexes: ci,
-                                    trusted: false,
-                                });
-                            }
-                        }
-                        pos = end;
-                        any = true;
-                        break;
-                    }
-                }
-                Some(_) | None => {
-                    // An opcode the data section does not hold (or a Data End or Footer
-                    // opcode on a record of another length). A chunk whose opcode is
-                    // damaged is still read (its CRC checks it); private records (0x80 and
-                    // up) are skipped; anything else is damage, counted.
-                    let as_chunk = {
-                        let avail = clen.min(4096) as usize;
-                        let b = w.get(content_pos, avail).map_err(io)?;
-                        matches!(ChunkHeader::decode(b), Ok((h, off)) if h.compressed_size == clen - off as u64)
-                    };
-                    if as_chunk {
-                        self.contents.notes.push(format!(
-                            "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
-                        ));
-                        let k = self.add_chunk(&mut w, pos, clen, None)?;
-                        after = After::Chunk(k);
-                    } else {
-                        let next_ok =
-                            rec_end == end || self.frames(&mut w, rec_end, end, landing).is_some();
-                        if op >= 0x80 && next_ok {
-                            // A private record followed by a whole one.
-                            after = After::Other;
-                            any = true;
-                            pos = rec_end;
-                            continue;
-                        }
-                        let to = if next_ok {
-                            rec_end
-                        } else {
-                            self.resync(&mut w, pos + 1, end, hints, landing)
-                                .unwrap_or(end)
-                        };
-                        after = self.damaged(
-                            &mut w,
-                            pos,
-                            to,
-                            op,
-                            "its opcode is not one the data section holds",
-                        );
-                        pos = to;
-                        continue;
-                    }
+                Flow::Skip(next) => pos = next,
+                Flow::Stop => break,
+                Flow::DataEnd => {
+                    st.any = true;
+                    pos = end;
+                    break;
                 }
             }
-            any = true;
-            pos = rec_end;
         }
-        if !any {
+        if !st.any {
             return Err(Error::Corrupt {
                 path: self.path.clone(),
                 offset: pos,
                 what: "the MCAP file holds no complete record after its magic (truncated)".into(),
             });
         }
-        if !seen_data_end && pos >= end && self.summary_used {
+        if !st.seen_data_end && pos >= end && self.summary_used {
             self.contents
                 .notes
                 .push("the data section has no Data End record".to_string());
         }
-        Ok(found_summary)
+        Ok(st.found_summary)
+    }
+
+    /// A record whose length runs past the end: truncation, or a damaged length with
+    /// records after. A chunk's own records are never landed on (they frame as loose ones).
+    fn overlong(&mut self, w: &mut Window, rec: Rec, st: &mut Walk) -> Result<Flow, Error> {
+        let Rec {
+            pos,
+            op,
+            content_pos,
+            ..
+        } = rec;
+        let end = st.end;
+        let is_chunk = op == Op::Chunk as u8
+            && w.get(content_pos, (end - content_pos).min(4096) as usize)
+                .ok()
+                .is_some_and(|b| ChunkHeader::decode(b).is_ok());
+        let landing = if is_chunk {
+            Landing::Chunked
+        } else {
+            st.landing
+        };
+        Ok(match self.resync(w, pos + 1, end, st.hints, landing) {
+            Some(next) => {
+                st.after =
+                    self.damaged(w, pos, next, op, "its length runs past the end of the file");
+                Flow::Skip(next)
+            }
+            None => {
+                self.tail_lost(w, pos, end, Some(op));
+                Flow::Stop
+            }
+        })
+    }
+
+    /// A whole record (content up to `rec_end`): what it adds, and where the walk goes on.
+    fn record(
+        &mut self,
+        w: &mut Window,
+        rec: Rec,
+        rec_end: u64,
+        st: &mut Walk,
+    ) -> Result<Flow, Error> {
+        let Rec {
+            pos,
+            op,
+            clen,
+            content_pos,
+        } = rec;
+        match Op::from_byte(op) {
+            Some(Op::Header) if pos == MAGIC.len() as u64 => {
+                match self.small(w, rec)?.map(|b| Header::decode(&b)) {
+                    Some(Ok(h)) => self.header = h,
+                    _ => self.contents.notes.push(format!(
+                        "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
+                    )),
+                }
+                st.after = After::Other;
+            }
+            Some(Op::Schema) => {
+                if let Some(Ok(s)) = self.small(w, rec)?.map(|b| Schema::decode(&b)) {
+                    offer(&mut self.schemas, s.id, s, schema_plausible);
+                } else {
+                    self.contents
+                        .notes
+                        .push(format!("unreadable Schema record at byte {pos} skipped"));
+                }
+                st.after = After::Other;
+            }
+            Some(Op::Channel) => {
+                if let Some(Ok(c)) = self.small(w, rec)?.map(|b| record::Channel::decode(&b)) {
+                    offer(&mut self.mcap_channels, c.id, c, channel_plausible);
+                } else {
+                    self.contents
+                        .notes
+                        .push(format!("unreadable Channel record at byte {pos} skipped"));
+                }
+                st.after = After::Other;
+            }
+            Some(Op::Chunk) => {
+                // Its stored length and compression frame it (its times may be damaged).
+                if chunk_header(w, content_pos, clen).is_some() {
+                    let k = self.add_chunk(w, pos, clen, None)?;
+                    st.after = After::Chunk(k);
+                } else {
+                    let next = self.resync(w, pos + 1, st.end, st.hints, st.landing);
+                    let to = next.unwrap_or(st.end);
+                    st.after = self.damaged(w, pos, to, op, "its header is damaged");
+                    return Ok(Flow::Skip(to));
+                }
+            }
+            Some(Op::MessageIndex) => self.message_index(w, rec, st.after)?,
+            Some(Op::Message) => {
+                let b = w
+                    .get(content_pos, MESSAGE_FIXED_LEN.min(clen as usize))
+                    .map_err(|e| Error::io(&self.path, e))?;
+                let t = (b.len() == MESSAGE_FIXED_LEN)
+                    .then(|| u64::from_le_bytes(b[6..14].try_into().expect("8 bytes")));
+                self.add_loose(pos, rec_end, t);
+                st.after = After::Other;
+            }
+            Some(Op::Attachment | Op::Metadata) => st.after = After::Other,
+            Some(end_op @ (Op::DataEnd | Op::Footer))
+                if clen
+                    == if end_op == Op::DataEnd {
+                        4
+                    } else {
+                        FOOTER_CONTENT_LEN
+                    } =>
+            {
+                return Ok(self.section_end(w, rec, rec_end, st));
+            }
+            Some(_) | None => return self.odd_record(w, rec, rec_end, st),
+        }
+        Ok(Flow::Read(rec_end))
+    }
+
+    /// The content of a metadata record (schema, channel, header) small enough to hold.
+    fn small(&self, w: &mut Window, rec: Rec) -> Result<Option<Vec<u8>>, Error> {
+        if rec.clen > MAX_META_RECORD {
+            return Ok(None);
+        }
+        Ok(Some(
+            w.get(rec.content_pos, rec.clen as usize)
+                .map_err(|e| Error::io(&self.path, e))?
+                .to_vec(),
+        ))
+    }
+
+    /// A Message Index record: its entries belong to the chunk (or lost stretch) before it.
+    fn message_index(&mut self, w: &mut Window, rec: Rec, after: After) -> Result<(), Error> {
+        let Rec {
+            clen, content_pos, ..
+        } = rec;
+        let b = w
+            .get(content_pos, 6.min(clen as usize))
+            .map_err(|e| Error::io(&self.path, e))?
+            .to_vec();
+        if b.len() == 6 {
+            let channel = u16::from_le_bytes([b[0], b[1]]);
+            let stated = u32::from_le_bytes(b[2..6].try_into().expect("4 bytes")) as u64;
+            // A damaged length counts no more entries than the record holds.
+            let count = stated.min(clen.saturating_sub(6)) / INDEX_ENTRY;
+            let ix = IndexRef {
+                channel,
+                entries_pos: content_pos + 6,
+                count,
+            };
+            match after {
+                After::Chunk(k) => {
+                    self.indexes[k].push(ix);
+                    self.contents.parts[k]
+                        .counts
+                        .get_or_insert_with(Vec::new)
+                        .push((channel as u32, count));
+                }
+                After::Lost(k) => self.lost[k].indexes.push(ix),
+                After::Other => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// A Data End or Footer record of its length: the end of the data section, unless
+    /// data-section records follow it (its opcode is damaged).
+    fn section_end(&mut self, w: &mut Window, rec: Rec, rec_end: u64, st: &mut Walk) -> Flow {
+        let Rec { pos, op, .. } = rec;
+        let end = st.end;
+        let data_follows = rec_end < end
+            && self.frames(w, rec_end, end, st.landing).is_some_and(|_| {
+                w.prefix(rec_end).is_some_and(|(o, _)| {
+                    matches!(
+                        Op::from_byte(o),
+                        Some(Op::Chunk | Op::MessageIndex | Op::Message)
+                    )
+                })
+            });
+        if data_follows {
+            self.contents.notes.push(format!(
+                "a {} record at byte {pos} stands in the middle of the data section (a damaged opcode?); the records after it were read",
+                op_name(op)
+            ));
+            st.after = After::Other;
+            return Flow::Read(rec_end);
+        }
+        st.seen_data_end = op == Op::DataEnd as u8;
+        if !self.summary_used && rec_end < end {
+            // A file cut in its summary section still holds summary records.
+            let mut b = vec![0u8; (end - rec_end).min(MAX_META_RECORD) as usize];
+            if self.file.read_exact_at(&mut b, rec_end).is_ok()
+                && let Ok(ci) = self.summary_records(&b, false)
+            {
+                self.statistics = None;
+                st.found_summary = Some(Summary {
+                    chunk_indexes: ci,
+                    trusted: false,
+                });
+            }
+        }
+        Flow::DataEnd
+    }
+
+    /// An opcode the data section does not hold (or a Data End or Footer opcode on a record
+    /// of another length). A chunk whose opcode is damaged is still read (its CRC checks
+    /// it); private records (0x80 and up) are skipped; anything else is damage, counted.
+    fn odd_record(
+        &mut self,
+        w: &mut Window,
+        rec: Rec,
+        rec_end: u64,
+        st: &mut Walk,
+    ) -> Result<Flow, Error> {
+        let Rec {
+            pos,
+            op,
+            clen,
+            content_pos,
+        } = rec;
+        let end = st.end;
+        let as_chunk = {
+            let avail = clen.min(4096) as usize;
+            let b = w
+                .get(content_pos, avail)
+                .map_err(|e| Error::io(&self.path, e))?;
+            matches!(ChunkHeader::decode(b), Ok((h, off)) if h.compressed_size == clen - off as u64)
+        };
+        if as_chunk {
+            self.contents.notes.push(format!(
+                "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
+            ));
+            let k = self.add_chunk(w, pos, clen, None)?;
+            st.after = After::Chunk(k);
+            return Ok(Flow::Read(rec_end));
+        }
+        let next_ok = rec_end == end || self.frames(w, rec_end, end, st.landing).is_some();
+        if op >= 0x80 && next_ok {
+            // A private record followed by a whole one.
+            st.after = After::Other;
+            return Ok(Flow::Read(rec_end));
+        }
+        let to = if next_ok {
+            rec_end
+        } else {
+            self.resync(w, pos + 1, end, st.hints, st.landing)
+                .unwrap_or(end)
+        };
+        st.after = self.damaged(
+            w,
+            pos,
+            to,
+            op,
+            "its opcode is not one the data section holds",
+        );
+        Ok(Flow::Skip(to))
     }
 
     /// Records the bytes `pos..to` the walk could not read as records.
