@@ -455,7 +455,20 @@ fn decode_all(
 ) -> (Vec<Rows>, Vec<PartOut>) {
     let parts = src.parts();
     let n_sel = selected.len();
-    let planned: Option<Vec<Vec<usize>>> = parts
+    match part_plan(parts, lookup, selected) {
+        Some(plan) => decode_planned(src, lookup, &plan, n_sel, pb, per_part_unit),
+        None => decode_windowed(src, lookup, n_sel, pb, per_part_unit),
+    }
+}
+
+/// The rows of each selected topic each part holds (`plan[i][k]`: topic `k` in part `i`),
+/// when every part counts its messages; bounded by what the part's bytes can hold.
+fn part_plan(
+    parts: &[source::Part],
+    lookup: &Lookup,
+    selected: &[Selected],
+) -> Option<Vec<Vec<usize>>> {
+    parts
         .iter()
         .map(|p| {
             let counts = p.counts.as_ref()?;
@@ -481,84 +494,102 @@ fn decode_all(
                     .collect(),
             )
         })
+        .collect()
+}
+
+/// The parts decoded in parallel straight into their slots of columns sized by `plan`;
+/// when a part disagrees with its count, the columns are rebuilt in order.
+fn decode_planned(
+    src: &dyn Source,
+    lookup: &Lookup,
+    plan: &[Vec<usize>],
+    n_sel: usize,
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> (Vec<Rows>, Vec<PartOut>) {
+    let parts = src.parts();
+    let mut columns: Vec<Rows> = (0..n_sel)
+        .map(|k| Rows::zeroed(plan.iter().map(|p| p[k]).sum()))
         .collect();
-    match planned {
-        Some(plan) => {
-            let mut columns: Vec<Rows> = (0..n_sel)
-                .map(|k| Rows::zeroed(plan.iter().map(|p| p[k]).sum()))
-                .collect();
-            let outs: Vec<PartOut>;
-            let mut rebuilt: Option<Vec<Rows>> = None;
-            {
-                // slots[k][i]: topic k's rows of part i.
-                let mut slots: Vec<std::vec::IntoIter<RowsMut>> = columns
+    let outs: Vec<PartOut>;
+    let mut rebuilt: Option<Vec<Rows>> = None;
+    {
+        // slots[k][i]: topic k's rows of part i.
+        let mut slots: Vec<std::vec::IntoIter<RowsMut>> = columns
+            .iter_mut()
+            .enumerate()
+            .map(|(k, c)| {
+                let sizes: Vec<usize> = plan.iter().map(|p| p[k]).collect();
+                c.split(&sizes).into_iter()
+            })
+            .collect();
+        let mut per_part: Vec<Vec<Target>> = (0..parts.len())
+            .map(|_| {
+                slots
                     .iter_mut()
-                    .enumerate()
-                    .map(|(k, c)| {
-                        let sizes: Vec<usize> = plan.iter().map(|p| p[k]).collect();
-                        c.split(&sizes).into_iter()
+                    .map(|it| Target {
+                        slot: it.next().unwrap_or_default(),
+                        ..Target::default()
                     })
-                    .collect();
-                let mut per_part: Vec<Vec<Target>> = (0..parts.len())
-                    .map(|_| {
-                        slots
-                            .iter_mut()
-                            .map(|it| Target {
-                                slot: it.next().unwrap_or_default(),
-                                ..Target::default()
-                            })
-                            .collect()
-                    })
-                    .collect();
-                outs = per_part
-                    .par_iter_mut()
-                    .enumerate()
-                    .map(|(i, targets)| decode_part(src, i, lookup, targets, pb, per_part_unit))
-                    .collect();
-                if per_part.iter().flatten().any(|t| !t.exact()) {
-                    // Some part disagreed with its count: gather the rows in order.
-                    let mut r: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
-                    for targets in &per_part {
-                        for (k, t) in targets.iter().enumerate() {
-                            r[k].extend_from(&t.slot, t.filled);
-                            r[k].append(&t.overflow);
-                        }
-                    }
-                    rebuilt = Some(r);
+                    .collect()
+            })
+            .collect();
+        outs = per_part
+            .par_iter_mut()
+            .enumerate()
+            .map(|(i, targets)| decode_part(src, i, lookup, targets, pb, per_part_unit))
+            .collect();
+        if per_part.iter().flatten().any(|t| !t.exact()) {
+            // Some part disagreed with its count: gather the rows in order.
+            let mut r: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+            for targets in &per_part {
+                for (k, t) in targets.iter().enumerate() {
+                    r[k].extend_from(&t.slot, t.filled);
+                    r[k].append(&t.overflow);
                 }
             }
-            if let Some(r) = rebuilt {
-                columns = r;
-            }
-            (columns, outs)
-        }
-        None => {
-            let mut columns: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
-            let mut outs = Vec::with_capacity(parts.len());
-            let window = (rayon::current_num_threads() * WINDOW_PARTS_PER_THREAD).max(1);
-            let mut start = 0;
-            while start < parts.len() {
-                let end = (start + window).min(parts.len());
-                let done: Vec<(Vec<Target>, PartOut)> = (start..end)
-                    .into_par_iter()
-                    .map(|i| {
-                        let mut targets: Vec<Target> =
-                            (0..n_sel).map(|_| Target::default()).collect();
-                        let o = decode_part(src, i, lookup, &mut targets, pb, per_part_unit);
-                        (targets, o)
-                    })
-                    .collect();
-                for (targets, o) in done {
-                    for (k, t) in targets.iter().enumerate() {
-                        columns[k].append(&t.overflow);
-                    }
-                    outs.push(o);
-                }
-                start = end;
-            }
-            (columns, outs)
+            rebuilt = Some(r);
         }
     }
+    if let Some(r) = rebuilt {
+        columns = r;
+    }
+    (columns, outs)
+}
+
+/// The parts decoded a window at a time and appended (no counts to size the columns):
+/// memory stays near the size of the result.
+fn decode_windowed(
+    src: &dyn Source,
+    lookup: &Lookup,
+    n_sel: usize,
+    pb: &indicatif::ProgressBar,
+    per_part_unit: bool,
+) -> (Vec<Rows>, Vec<PartOut>) {
+    let parts = src.parts();
+    let mut columns: Vec<Rows> = (0..n_sel).map(|_| Rows::default()).collect();
+    let mut outs = Vec::with_capacity(parts.len());
+    let window = (rayon::current_num_threads() * WINDOW_PARTS_PER_THREAD).max(1);
+    let mut start = 0;
+    while start < parts.len() {
+        let end = (start + window).min(parts.len());
+        let done: Vec<(Vec<Target>, PartOut)> = (start..end)
+            .into_par_iter()
+            .map(|i| {
+                let mut targets: Vec<Target> = (0..n_sel).map(|_| Target::default()).collect();
+                let o = decode_part(src, i, lookup, &mut targets, pb, per_part_unit);
+                (targets, o)
+            })
+            .collect();
+        for (targets, o) in done {
+            for (k, t) in targets.iter().enumerate() {
+                columns[k].append(&t.overflow);
+            }
+            outs.push(o);
+        }
+        start = end;
+    }
+    (columns, outs)
 }
 
 /// [`read_imu_topics`] on an open source.

@@ -316,123 +316,134 @@ impl McapReader {
         Ok(r)
     }
 
-    /// Walks the top-level records of the data section, up to `end`. Returns the summary
-    /// records found after a Data End when the file has no usable footer (a file cut in
-    /// its summary section).
-    // Long: one loop over the records whose state (position, the chunk the next index
-    // follows, Data End seen, resync) every opcode's arm reads and moves; split per opcode
-    // it would thread that state through each arm.
+    /// The messages the chunk's message index lists for a wanted channel that were not
+    /// delivered (`delivered_at`: channel and offset, sorted), as one loss per channel.
+    fn unread_listed(
+        &self,
+        part: usize,
+        indexes: &[IndexRef],
+        want: &(dyn Fn(u32) -> bool + Sync),
+        delivered_at: &[(u16, u64)],
+        why: &str,
+    ) -> Vec<Loss> {
+        let mut losses = Vec::new();
+        let mut lost: BTreeMap<u16, (u64, u64, u64)> = BTreeMap::new();
+        for ix in indexes.iter().filter(|ix| want(ix.channel as u32)) {
+            for (t, off) in self.entries(ix) {
+                if delivered_at.binary_search(&(ix.channel, off)).is_err() {
+                    let e = lost.entry(ix.channel).or_insert((0, t, t));
+                    e.0 += 1;
+                    e.1 = e.1.min(t);
+                    e.2 = e.2.max(t);
+                }
+            }
+        }
+        let label = &self.contents.parts[part].label;
+        for (ch, (n, a, b)) in lost {
+            losses.push(Loss {
+                what: format!(
+                    "{label}: {} that the chunk's message index lists could not be read ({why})",
+                    if n == 1 { "a message" } else { "messages" }
+                ),
+                messages: Some(n),
+                span: Some((a, b)),
+                channel: Some(ch as u32),
+                ..Loss::default()
+            });
+        }
+        losses
+    }
+
     /// Calls `f(offset, opcode, content)` for each record of part `loc`, in order. A record
     /// whose framing is damaged is skipped to the next offset `listed()` gives (the chunk's
     /// message indexes, sorted), else ends the part with an error.
     fn with_records(
         &self,
         loc: usize,
-        mut f: impl FnMut(u64, u8, &[u8]) -> Result<(), String>,
+        f: impl FnMut(u64, u8, &[u8]) -> Result<(), String>,
         listed: &dyn Fn() -> Vec<u64>,
     ) -> Result<Vec<(String, u64)>, String> {
         let loc = self.locs.get(loc).ok_or("no such part")?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
-            let records: &[u8] = match loc {
-                Loc::Loose { start, end } => {
-                    raw.resize((end - start) as usize, 0);
-                    self.file
-                        .read_exact_at(raw, *start)
-                        .map_err(|e| e.to_string())?;
-                    raw
-                }
-                Loc::Chunk {
-                    records_pos,
-                    compressed_size,
-                    uncompressed_size,
-                    crc,
-                    compression,
-                    ..
-                } => {
-                    if records_pos.saturating_add(*compressed_size) > self.len {
-                        return Err("the chunk's records run past the end of the file".into());
-                    }
-                    raw.resize(*compressed_size as usize, 0);
-                    self.file
-                        .read_exact_at(raw, *records_pos)
-                        .map_err(|e| e.to_string())?;
-                    // A damaged size field must not fail records the CRC vouches for: the
-                    // output is bounded by what the stored bytes decompress to (or the size
-                    // stated, if larger), never preallocated.
-                    let limit = (*uncompressed_size)
-                        .max(compressed_size.saturating_mul(source::MAX_EXPANSION));
-                    let records: &[u8] = match compression.as_str() {
-                        "" => raw,
-                        "lz4" => {
-                            body.clear();
-                            lz4_flex::frame::FrameDecoder::new(&raw[..])
-                                .take(limit.saturating_add(1))
-                                .read_to_end(body)
-                                .map_err(|e| format!("lz4: {e}"))?;
-                            body
-                        }
-                        "zstd" => {
-                            crate::zstd::decompress_into(raw, body, limit)?;
-                            body
-                        }
-                        other => return Err(format!("unsupported chunk compression '{other}'")),
-                    };
-                    let crc_ok = *crc != 0 && crc32fast::hash(records) == *crc;
-                    // Without a CRC, the stored records of an uncompressed chunk are what
-                    // its record length frames, whatever its size field says.
-                    let framed = *crc == 0 && compression.is_empty();
-                    if records.len() as u64 != *uncompressed_size && !crc_ok && !framed {
-                        return Err(format!(
-                            "chunk records are {} bytes, its header says {uncompressed_size}",
-                            records.len()
-                        ));
-                    }
-                    if *crc != 0 && !crc_ok {
-                        return Err(format!(
-                            "chunk CRC {:08x} differs from the stored {crc:08x}",
-                            crc32fast::hash(records)
-                        ));
-                    }
-                    records
-                }
-            };
-            let total = records.len();
-            let mut damage = Vec::new();
-            let mut offsets: Option<Vec<u64>> = None;
-            let mut at = 0usize;
-            while at < total {
-                let rec = (|| {
-                    let mut c = Cursor::new(&records[at..]);
-                    let op = c.le::<u8>("opcode").ok()?;
-                    let content = c.bytes64().ok()?;
-                    Some((op, content, c.pos()))
-                })();
-                match rec {
-                    Some((op, content, n)) if op != Op::Message as u8 || content.len() >= MESSAGE_FIXED_LEN => {
-                        f(at as u64, op, content)?;
-                        at += n;
-                    }
-                    _ => {
-                        let next = offsets
-                            .get_or_insert_with(listed)
-                            .iter()
-                            .copied()
-                            .find(|&o| o > at as u64 && o < total as u64);
-                        let to = next.map_or(total, |o| o as usize);
-                        damage.push((
-                            format!(
-                                "damaged record framing at offset {at} of the chunk's records: bytes {at}..{to} skipped"
-                            ),
-                            (to - at) as u64,
-                        ));
-                        at = to;
-                    }
-                }
-            }
-            Ok(damage)
+            let records = self.records_of(loc, raw, body)?;
+            frame_records(records, f, listed)
         })
+    }
+
+    /// The stored records of part `loc`: read into `raw` (a chunk's decompressed into
+    /// `body`), and checked against the chunk's CRC and stated size.
+    fn records_of<'b>(
+        &self,
+        loc: &Loc,
+        raw: &'b mut Vec<u8>,
+        body: &'b mut Vec<u8>,
+    ) -> Result<&'b [u8], String> {
+        match loc {
+            Loc::Loose { start, end } => {
+                raw.resize((end - start) as usize, 0);
+                self.file
+                    .read_exact_at(raw, *start)
+                    .map_err(|e| e.to_string())?;
+                Ok(raw)
+            }
+            Loc::Chunk {
+                records_pos,
+                compressed_size,
+                uncompressed_size,
+                crc,
+                compression,
+                ..
+            } => {
+                if records_pos.saturating_add(*compressed_size) > self.len {
+                    return Err("the chunk's records run past the end of the file".into());
+                }
+                raw.resize(*compressed_size as usize, 0);
+                self.file
+                    .read_exact_at(raw, *records_pos)
+                    .map_err(|e| e.to_string())?;
+                // A damaged size field must not fail records the CRC vouches for: the
+                // output is bounded by what the stored bytes decompress to (or the size
+                // stated, if larger), never preallocated.
+                let limit =
+                    (*uncompressed_size).max(compressed_size.saturating_mul(source::MAX_EXPANSION));
+                let raw: &'b [u8] = raw;
+                let records: &'b [u8] = match compression.as_str() {
+                    "" => raw,
+                    "lz4" => {
+                        body.clear();
+                        lz4_flex::frame::FrameDecoder::new(&raw[..])
+                            .take(limit.saturating_add(1))
+                            .read_to_end(body)
+                            .map_err(|e| format!("lz4: {e}"))?;
+                        body
+                    }
+                    "zstd" => {
+                        crate::zstd::decompress_into(raw, body, limit)?;
+                        body
+                    }
+                    other => return Err(format!("unsupported chunk compression '{other}'")),
+                };
+                let crc_ok = *crc != 0 && crc32fast::hash(records) == *crc;
+                // Without a CRC, the stored records of an uncompressed chunk are what
+                // its record length frames, whatever its size field says.
+                let framed = *crc == 0 && compression.is_empty();
+                if records.len() as u64 != *uncompressed_size && !crc_ok && !framed {
+                    return Err(format!(
+                        "chunk records are {} bytes, its header says {uncompressed_size}",
+                        records.len()
+                    ));
+                }
+                if *crc != 0 && !crc_ok {
+                    return Err(format!(
+                        "chunk CRC {:08x} differs from the stored {crc:08x}",
+                        crc32fast::hash(records)
+                    ));
+                }
+                Ok(records)
+            }
+        }
     }
 
     /// The file's length.
@@ -515,30 +526,8 @@ impl Source for McapReader {
                     .collect::<Vec<_>>()
                     .join("; ")
             };
-            let mut lost: BTreeMap<u16, (u64, u64, u64)> = BTreeMap::new();
-            for ix in indexes.iter().filter(|ix| want(ix.channel as u32)) {
-                for (t, off) in self.entries(ix) {
-                    if delivered_at.binary_search(&(ix.channel, off)).is_err() {
-                        let e = lost.entry(ix.channel).or_insert((0, t, t));
-                        e.0 += 1;
-                        e.1 = e.1.min(t);
-                        e.2 = e.2.max(t);
-                    }
-                }
-            }
-            let label = &self.contents.parts[part].label;
-            for (ch, (n, a, b)) in lost {
-                out.lost.push(Loss {
-                    what: format!(
-                        "{label}: {} that the chunk's message index lists could not be read ({why})",
-                        if n == 1 { "a message" } else { "messages" }
-                    ),
-                    messages: Some(n),
-                    span: Some((a, b)),
-                    channel: Some(ch as u32),
-                    ..Loss::default()
-                });
-            }
+            out.lost
+                .extend(self.unread_listed(part, indexes, want, &delivered_at, &why));
         } else if no_channel > 0 && indexes.is_empty() {
             out.lost.push(Loss {
                 what: format!(
@@ -574,4 +563,50 @@ impl Source for McapReader {
         }
         out
     }
+}
+
+/// Calls `f(offset, opcode, content)` for each record of `records`, in order; a record
+/// whose framing is damaged is skipped to the next offset `listed()` gives. Returns what
+/// was skipped: (why, bytes).
+fn frame_records(
+    records: &[u8],
+    mut f: impl FnMut(u64, u8, &[u8]) -> Result<(), String>,
+    listed: &dyn Fn() -> Vec<u64>,
+) -> Result<Vec<(String, u64)>, String> {
+    let total = records.len();
+    let mut damage = Vec::new();
+    let mut offsets: Option<Vec<u64>> = None;
+    let mut at = 0usize;
+    while at < total {
+        let rec = (|| {
+            let mut c = Cursor::new(&records[at..]);
+            let op = c.le::<u8>("opcode").ok()?;
+            let content = c.bytes64().ok()?;
+            Some((op, content, c.pos()))
+        })();
+        match rec {
+            Some((op, content, n))
+                if op != Op::Message as u8 || content.len() >= MESSAGE_FIXED_LEN =>
+            {
+                f(at as u64, op, content)?;
+                at += n;
+            }
+            _ => {
+                let next = offsets
+                    .get_or_insert_with(listed)
+                    .iter()
+                    .copied()
+                    .find(|&o| o > at as u64 && o < total as u64);
+                let to = next.map_or(total, |o| o as usize);
+                damage.push((
+                    format!(
+                        "damaged record framing at offset {at} of the chunk's records: bytes {at}..{to} skipped"
+                    ),
+                    (to - at) as u64,
+                ));
+                at = to;
+            }
+        }
+    }
+    Ok(damage)
 }

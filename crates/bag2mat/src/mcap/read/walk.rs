@@ -129,6 +129,9 @@ impl McapReader {
         None
     }
 
+    /// Walks the top-level records of the data section, up to `end`. Returns the summary
+    /// records found after a Data End when the file has no usable footer (a file cut in
+    /// its summary section).
     pub(super) fn walk(&mut self, end: u64, hints: &[u64]) -> Result<Option<Summary>, Error> {
         let file = self
             .file
