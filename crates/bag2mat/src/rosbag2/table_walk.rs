@@ -182,15 +182,13 @@ pub(crate) fn plan(
         let k = sorted.partition_point(|&(_, l)| l < r.first);
         k < sorted.len() && sorted[k].0 <= r.last()
     };
-    // Walk positions where each segment's error struck.
-    let mut breaks: Vec<(u64, &str)> = Vec::new();
-    let mut at = 0u64;
-    for s in &walk.segments {
-        at += s.rows;
-        if let Some(e) = &s.error {
-            breaks.push((at, e.as_str()));
-        }
-    }
+    let slots = Slots {
+        runs,
+        bb: &bb,
+        lo,
+        hi,
+        breaks: breaks(walk),
+    };
     let mut out = Plan {
         max_id: bb.last().map(|&i| (runs[i].last(), runs[i].ts_last)),
         min_id: bb.first().map(|&i| runs[i].first),
@@ -201,42 +199,93 @@ pub(crate) fn plan(
     let mut next_bb = 0usize;
     let mut slot_start_pos = 0u64;
     let mut filled = 0u64;
-    let skip = |out: &mut Plan, a: u64, b: u64| {
-        if a < b {
-            match out.skip.last_mut() {
-                Some(l) if l.1 == a => l.1 = b,
-                _ => out.skip.push((a, b)),
-            }
+    for (i, r) in runs.iter().enumerate() {
+        if next_bb < bb.len() && bb[next_bb] == i {
+            slots.close(&mut out, next_bb, filled, slot_start_pos, pos);
+            next_bb += 1;
+            filled = 0;
+            pos += r.len;
+            slot_start_pos = pos;
+            continue;
         }
-    };
-    let room = |k: usize| -> Option<u64> {
+        // An out-of-place run in slot `next_bb`.
+        let double = collides(r) && ts_of(r.first) == Some(r.ts_first);
+        let space = slots
+            .room(next_bb)
+            .map_or(u64::MAX, |x| x.saturating_sub(filled));
+        let take = if double { 0 } else { r.len.min(space) };
+        if take > 0 {
+            out.moved.0 += take;
+            out.moved.1.get_or_insert(r.first);
+        }
+        filled += take;
+        out.doubles += r.len - take;
+        out.skip_walked(pos + take, pos + r.len);
+        pos += r.len;
+    }
+    slots.close(&mut out, next_bb, filled, slot_start_pos, pos);
+    out
+}
+
+/// Walk positions where each segment's error struck.
+fn breaks(walk: &Walk) -> Vec<(u64, &str)> {
+    let mut breaks = Vec::new();
+    let mut at = 0u64;
+    for s in &walk.segments {
+        at += s.rows;
+        if let Some(e) = &s.error {
+            breaks.push((at, e.as_str()));
+        }
+    }
+    breaks
+}
+
+/// The id ranges between the backbone runs (slot `k` before backbone run `k`) that the
+/// out-of-place runs fill.
+struct Slots<'w> {
+    runs: &'w [Run],
+    bb: &'w [usize],
+    lo: i64,
+    hi: Option<i64>,
+    breaks: Vec<(u64, &'w str)>,
+}
+
+impl Slots<'_> {
+    /// The ids slot `k` has room for (`None`: unbounded, past the last part).
+    fn room(&self, k: usize) -> Option<u64> {
+        let (runs, bb) = (self.runs, self.bb);
         let before = if k == 0 {
-            lo.checked_sub(1)
+            self.lo.checked_sub(1)
         } else {
             Some(runs[bb[k - 1]].last())
         };
         let after = if k < bb.len() {
             Some(runs[bb[k]].first)
         } else {
-            hi
+            self.hi
         };
         match (before, after) {
             (Some(b), Some(a)) => Some(a.saturating_sub(b).saturating_sub(1).max(0) as u64),
             _ => None,
         }
-    };
-    let close_slot = |out: &mut Plan, k: usize, filled: u64, from: u64, to: u64| {
-        let Some(r) = room(k) else { return };
+    }
+
+    /// Slot `k`, `filled` of its room taken by rows walked at `from..to`: the rest is a hole
+    /// (with the error that struck there, if one did).
+    fn close(&self, out: &mut Plan, k: usize, filled: u64, from: u64, to: u64) {
+        let (runs, bb) = (self.runs, self.bb);
+        let Some(r) = self.room(k) else { return };
         if r <= filled {
             return;
         }
         let first = if k == 0 {
-            lo
+            self.lo
         } else {
             runs[bb[k - 1]].last() + 1
         };
         let last = first + r as i64 - 1;
-        let error = breaks
+        let error = self
+            .breaks
             .iter()
             .find(|(p, _)| *p >= from && *p <= to)
             .map(|(_, e)| e.to_string());
@@ -249,31 +298,19 @@ pub(crate) fn plan(
             ),
             error,
         });
-    };
-    for (i, r) in runs.iter().enumerate() {
-        if next_bb < bb.len() && bb[next_bb] == i {
-            close_slot(&mut out, next_bb, filled, slot_start_pos, pos);
-            next_bb += 1;
-            filled = 0;
-            pos += r.len;
-            slot_start_pos = pos;
-            continue;
-        }
-        // An out-of-place run in slot `next_bb`.
-        let double = collides(r) && ts_of(r.first) == Some(r.ts_first);
-        let space = room(next_bb).map_or(u64::MAX, |x| x.saturating_sub(filled));
-        let take = if double { 0 } else { r.len.min(space) };
-        if take > 0 {
-            out.moved.0 += take;
-            out.moved.1.get_or_insert(r.first);
-        }
-        filled += take;
-        out.doubles += r.len - take;
-        skip(&mut out, pos + take, pos + r.len);
-        pos += r.len;
     }
-    close_slot(&mut out, next_bb, filled, slot_start_pos, pos);
-    out
+}
+
+impl Plan {
+    /// Skips the walked rows `a..b` (joined to the skip before when they follow it).
+    fn skip_walked(&mut self, a: u64, b: u64) {
+        if a < b {
+            match self.skip.last_mut() {
+                Some(l) if l.1 == a => l.1 = b,
+                _ => self.skip.push((a, b)),
+            }
+        }
+    }
 }
 
 #[cfg(test)]
