@@ -26,12 +26,14 @@ struct Curves<'a> {
     fit: [Vec<f64>; 3],
 }
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let finite_pos = |v: &f64| v.is_finite() && *v > 0.0;
+/// A value a log axis can show.
+fn finite_pos(v: &f64) -> bool {
+    v.is_finite() && *v > 0.0
+}
+
+/// The deviation range of every data and fit point a log axis can show; (1e-3, 1) when
+/// there is none.
+fn value_range(c: &Curves<'_>) -> (f64, f64) {
     let all: Vec<f64> = c
         .data
         .iter()
@@ -46,15 +48,40 @@ where
     if all.is_empty() {
         (lo, hi) = (1e-3, 1.0);
     }
+    (lo, hi)
+}
+
+/// The τ axis range: the positive cluster times widened by 1.3 each way; (1e-3, 1) when
+/// there is none.
+fn tau_range(c: &Curves<'_>) -> (f64, f64) {
     let taus: Vec<f64> = c.taus.iter().copied().filter(finite_pos).collect();
     let (tlo, thi) = taus
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-    let (tlo, thi) = if taus.is_empty() {
+    if taus.is_empty() {
         (1e-3, 1.0)
     } else {
         (tlo / 1.3, thi * 1.3)
-    };
+    }
+}
+
+/// The (τ, value) points of one series that a log-log chart can show.
+fn log_points(taus: &[f64], values: &[f64]) -> Vec<(f64, f64)> {
+    taus.iter()
+        .zip(values)
+        .filter(|(t, v)| finite_pos(t) && finite_pos(v))
+        .map(|(t, v)| (*t, *v))
+        .collect()
+}
+
+/// One sensor's chart: each axis' data as circles and its fit as a line, legend top right.
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (lo, hi) = value_range(c);
+    let (tlo, thi) = tau_range(c);
     let mut chart = ChartBuilder::on(root)
         .caption(&c.title, ("sans-serif", 26))
         .margin(20)
@@ -75,25 +102,13 @@ where
         .map_err(|e| e.to_string())?;
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
         let col = COLORS[k];
-        let pts: Vec<(f64, f64)> = c
-            .taus
-            .iter()
-            .zip(&c.data[k])
-            .filter(|(t, v)| finite_pos(t) && finite_pos(v))
-            .map(|(t, v)| (*t, *v))
-            .collect();
+        let pts = log_points(c.taus, &c.data[k]);
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.stroke_width(1))))
             .map_err(|e| e.to_string())?
             .label(format!("{axis} data"))
             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
-        let line: Vec<(f64, f64)> = c
-            .taus
-            .iter()
-            .zip(&c.fit[k])
-            .filter(|(t, v)| finite_pos(t) && finite_pos(v))
-            .map(|(t, v)| (*t, *v))
-            .collect();
+        let line = log_points(c.taus, &c.fit[k]);
         chart
             .draw_series(LineSeries::new(line, col.stroke_width(2)))
             .map_err(|e| e.to_string())?

@@ -201,30 +201,9 @@ fn run_series(
     let mut timings = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
     let mut notes = bag2mat::shared::note::warnings(&series.notes);
-    // a one-sensor topic (PX4 sensor_gyro, …): zeros stand in for the absent sensor in the
-    // record check, its samples in the Allan step; nothing of it is printed nor written
-    let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
-    notes.extend(absent.map(bag2mat::series::absent_warning));
-    if let Some(s) = config.common.skip_start {
-        let (k, warning) = skip_start(&mut series, s)?;
-        notes.extend(warning.map(Note::warning));
-        notes.push(Note::info(format!(
-            "--skip-start {s}: dropped the first {k} messages ({} left)",
-            series.len()
-        )));
-    }
+    let absent = stand_in_and_skip(config, &mut series, &mut notes)?;
     let collected = collect::collect(&series, config.max_time_min, config.common.time);
-    if collected.stop == Stop::EndOfBag {
-        // imu_utils' own words on stderr (the reference runs' stderr.txt)
-        notes.push(Note::upstream_warning(
-            "WARNING: ",
-            format!(
-            "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
-            collected.len(),
-            config.max_time_min
-        ),
-        ));
-    }
+    notes.extend(end_of_bag_note(&collected, config));
     // The record check (bag2mat::record_check) on the collected messages: duplicates, a
     // clock that steps back and a record that is not one continuous stretch are cut, spikes
     // dropped when asked; what the record breaks of the analysis' assumptions is found.
@@ -234,16 +213,7 @@ fn run_series(
     let mut check = check_record(&series, n, config);
     bag2mat::record_check::drop_absent(&mut check.findings, absent);
     timings.push(("record_check", t1.elapsed()));
-    let mut series = if check.keep.is_all() && n == series.len() {
-        series
-    } else {
-        check.keep.select_series(&series, n)
-    };
-    match absent {
-        Some(bag2mat::Sensor::Acc) => series.acc = series.gyro.clone(),
-        Some(bag2mat::Sensor::Gyro) => series.gyro = series.acc.clone(),
-        None => {}
-    }
+    let series = kept_series(series, &check, n, absent);
     let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     check_values(&collected, absent, &mut notes)?;
@@ -251,31 +221,8 @@ fn run_series(
     let (axes, gyro_mean) =
         analysis::allan_step(&collected, config.max_cluster, config.common.ieee952)?;
     timings.push(("allan", t1.elapsed()));
-    // The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at the stamps'
-    // nominal rate (lost samples do not change it; imu_utils' mean period does), with the
-    // record check's findings; not on a record that breaks its assumptions.
     let t1 = Instant::now();
-    let section_rate = check
-        .rate
-        .map(allan_kalibr::input::snap_rate)
-        .unwrap_or(axes[0].freq);
-    if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
-        notes.push(Note::warning(format!(
-            "IEEE 952 section not computed: the record breaks its assumptions ({})",
-            r.short()
-        )));
-    }
-    let ieee = if config.common.ieee952 && check.refusal().is_none() {
-        Some(section(
-            &axes,
-            &collected,
-            absent,
-            section_rate,
-            &check.findings,
-        ))
-    } else {
-        None
-    };
+    let ieee = ieee952_section(config, &check, &axes, &collected, absent, &mut notes);
     timings.push(("ieee952", t1.elapsed()));
     drop(collected);
     drop(series);
@@ -306,6 +253,98 @@ fn run_series(
         ieee952: ieee,
         timings,
     })
+}
+
+/// A one-sensor topic (PX4 sensor_gyro, …): zeros stand in for the absent sensor in the
+/// record check (the present one's samples in the Allan step, [`kept_series`]); nothing of
+/// it is printed nor written. Then `--skip-start`. Returns the absent sensor; both are said
+/// in `notes`.
+fn stand_in_and_skip(
+    config: &Config,
+    series: &mut bag2mat::ImuSeries,
+    notes: &mut Vec<Note>,
+) -> Result<Option<bag2mat::Sensor>, Error> {
+    let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
+    notes.extend(absent.map(bag2mat::series::absent_warning));
+    if let Some(s) = config.common.skip_start {
+        let (k, warning) = skip_start(series, s)?;
+        notes.extend(warning.map(Note::warning));
+        notes.push(Note::info(format!(
+            "--skip-start {s}: dropped the first {k} messages ({} left)",
+            series.len()
+        )));
+    }
+    Ok(absent)
+}
+
+/// imu_utils' own words on stderr (the reference runs' stderr.txt) when the bag ended
+/// before `max_time_min`.
+fn end_of_bag_note(collected: &collect::Collected, config: &Config) -> Option<Note> {
+    (collected.stop == Stop::EndOfBag).then(|| {
+        Note::upstream_warning(
+            "WARNING: ",
+            format!(
+            "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
+            collected.len(),
+            config.max_time_min
+        ),
+        )
+    })
+}
+
+/// The messages of the first `n` that the record check keeps; for a one-sensor topic the
+/// present sensor's samples then stand in for the absent one's.
+fn kept_series(
+    series: bag2mat::ImuSeries,
+    check: &bag2mat::record_check::Check,
+    n: usize,
+    absent: Option<bag2mat::Sensor>,
+) -> bag2mat::ImuSeries {
+    let mut series = if check.keep.is_all() && n == series.len() {
+        series
+    } else {
+        check.keep.select_series(&series, n)
+    };
+    match absent {
+        Some(bag2mat::Sensor::Acc) => series.acc = series.gyro.clone(),
+        Some(bag2mat::Sensor::Gyro) => series.gyro = series.acc.clone(),
+        None => {}
+    }
+    series
+}
+
+/// The IEEE 952 section on imu_utils' own overlapping curve (rad/s, m/s²) at the stamps'
+/// nominal rate (lost samples do not change it; imu_utils' mean period does), with the
+/// record check's findings; not on a record that breaks its assumptions (said in `notes`).
+fn ieee952_section(
+    config: &Config,
+    check: &bag2mat::record_check::Check,
+    axes: &[AxisAllan],
+    collected: &collect::Collected,
+    absent: Option<Sensor>,
+    notes: &mut Vec<Note>,
+) -> Option<ImuAnalysis> {
+    let section_rate = check
+        .rate
+        .map(allan_kalibr::input::snap_rate)
+        .unwrap_or(axes[0].freq);
+    if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
+        notes.push(Note::warning(format!(
+            "IEEE 952 section not computed: the record breaks its assumptions ({})",
+            r.short()
+        )));
+    }
+    if config.common.ieee952 && check.refusal().is_none() {
+        Some(section(
+            axes,
+            collected,
+            absent,
+            section_rate,
+            &check.findings,
+        ))
+    } else {
+        None
+    }
 }
 
 /// The value check of every analysed column (`allan_kalibr::input::value_problem`): a

@@ -3,7 +3,7 @@
 
 use std::process::ExitCode;
 
-use crate::cli::{Cli, Command};
+use crate::cli::{BagArgs, Cli, Command, SplineArgs, TrajArgs};
 
 /// Standard output through the workspace's one writer: a closed pipe (`| head`) ends the
 /// printing quietly; a failed write is an error, not a panic.
@@ -16,43 +16,9 @@ fn out(text: &str) -> anyhow::Result<()> {
 /// Runs the command the user typed and says what it did (stderr) and found (stdout); the
 /// exit code is a failed `--check` or self-check's, errors come back once to the binary.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
-    // Long on purpose: one arm per subcommand, each parse → run → print.
     match cli.command {
-        Command::Bag(a) => {
-            let cfg = crate::bag_sim::BagConfig::try_from(*a)?;
-            // Refused before any work when it cannot fit; its size said up front.
-            crate::bag_sim::validate(&cfg)?;
-            crate::bag_sim::check_disk(&cfg)?;
-            if !cfg.quiet {
-                eprintln!(
-                    "writing about {} messages, about {:.1} MB",
-                    crate::bag_sim::estimated_messages(&cfg),
-                    crate::bag_sim::estimated_bytes(&cfg) as f64 * 1e-6
-                );
-                eprintln!("{}", crate::report::bag_header(&cfg));
-                let n = crate::bag_sim::message_count(cfg.rate, cfg.duration) as usize;
-                for w in crate::noise::truth_file::widrow_warnings(&cfg.model, cfg.rate, n)? {
-                    eprintln!("warning: {w}");
-                }
-            }
-            let s = crate::bag_sim::run(&cfg)?;
-            if !cfg.quiet {
-                eprintln!("{}", crate::report::bag_done(&cfg, &s));
-            }
-        }
-        Command::Traj(a) => {
-            let cfg = crate::traj::TrajConfig::try_from(a)?;
-            eprintln!("{}", cfg.noise.describe(cfg.rate));
-            let s = crate::traj::run(&cfg)?;
-            eprintln!(
-                "wrote {} files into {} ({} IMU samples, {} camera frames, {} landmarks)",
-                s.files,
-                cfg.out_dir.display(),
-                s.imu_samples,
-                s.cam_frames,
-                s.points
-            );
-        }
+        Command::Bag(a) => run_bag(*a)?,
+        Command::Traj(a) => run_traj(a)?,
         Command::Integrate(a) => {
             let cfg = crate::integrate::IntegrateConfig::try_from(a)?;
             let (table, files) = crate::integrate::run(&cfg)?;
@@ -77,23 +43,68 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 out(&crate::noise::profiles::listing(a.rate))?;
             }
         }
-        Command::Spline(a) => {
-            if a.self_check {
-                let (text, pass) = crate::report::spline_self_check(a.pose_rate)?;
-                out(&text)?;
-                return Ok(if pass {
-                    ExitCode::SUCCESS
-                } else {
-                    ExitCode::FAILURE
-                });
-            }
-            let cfg = crate::spline_sim::SplineConfig::try_from(a)?;
-            if let Some(n) = &cfg.noise {
-                eprintln!("{}", n.describe(cfg.rate));
-            }
-            let s = crate::spline_sim::run(&cfg)?;
-            out(&crate::report::spline_summary(&s))?;
+        Command::Spline(a) => return run_spline(a),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `sim bag`: refused before any work when it cannot fit, its size said up front, then the
+/// run and what it wrote (stderr, unless quiet).
+fn run_bag(a: BagArgs) -> anyhow::Result<()> {
+    let cfg = crate::bag_sim::BagConfig::try_from(a)?;
+    crate::bag_sim::validate(&cfg)?;
+    crate::bag_sim::check_disk(&cfg)?;
+    if !cfg.quiet {
+        eprintln!(
+            "writing about {} messages, about {:.1} MB",
+            crate::bag_sim::estimated_messages(&cfg),
+            crate::bag_sim::estimated_bytes(&cfg) as f64 * 1e-6
+        );
+        eprintln!("{}", crate::report::bag_header(&cfg));
+        let n = crate::bag_sim::message_count(cfg.rate, cfg.duration) as usize;
+        for w in crate::noise::truth_file::widrow_warnings(&cfg.model, cfg.rate, n)? {
+            eprintln!("warning: {w}");
         }
     }
+    let s = crate::bag_sim::run(&cfg)?;
+    if !cfg.quiet {
+        eprintln!("{}", crate::report::bag_done(&cfg, &s));
+    }
+    Ok(())
+}
+
+/// `sim traj`: the noise model, the run, and what it wrote (stderr).
+fn run_traj(a: TrajArgs) -> anyhow::Result<()> {
+    let cfg = crate::traj::TrajConfig::try_from(a)?;
+    eprintln!("{}", cfg.noise.describe(cfg.rate));
+    let s = crate::traj::run(&cfg)?;
+    eprintln!(
+        "wrote {} files into {} ({} IMU samples, {} camera frames, {} landmarks)",
+        s.files,
+        cfg.out_dir.display(),
+        s.imu_samples,
+        s.cam_frames,
+        s.points
+    );
+    Ok(())
+}
+
+/// `sim spline`: the self-check (its verdict is the exit code), or the run and its summary.
+fn run_spline(a: SplineArgs) -> anyhow::Result<ExitCode> {
+    if a.self_check {
+        let (text, pass) = crate::report::spline_self_check(a.pose_rate)?;
+        out(&text)?;
+        return Ok(if pass {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::FAILURE
+        });
+    }
+    let cfg = crate::spline_sim::SplineConfig::try_from(a)?;
+    if let Some(n) = &cfg.noise {
+        eprintln!("{}", n.describe(cfg.rate));
+    }
+    let s = crate::spline_sim::run(&cfg)?;
+    out(&crate::report::spline_summary(&s))?;
     Ok(ExitCode::SUCCESS)
 }

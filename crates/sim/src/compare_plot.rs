@@ -93,6 +93,46 @@ fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
         .collect())
 }
 
+/// The τ and deviation ranges `(t0, t1, y0, y1)` of the tools' curves; `None` when they
+/// span no area.
+fn tool_bounds(curves: &[Curves]) -> Option<(f64, f64, f64, f64)> {
+    let all = curves.iter().flat_map(|c| c.kalibr.iter().chain(&c.ieee));
+    let (mut t0, mut t1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
+    for &(t, v) in all {
+        (t0, t1, y0, y1) = (t0.min(t), t1.max(t), y0.min(v), y1.max(v));
+    }
+    (t0 < t1 && y0 < y1).then_some((t0, t1, y0, y1))
+}
+
+/// The truth curve of `c` on [t0, t1]: the exact curve when there is one, else the model
+/// √(N²/τ + K²τ/3) at 201 log-spaced τ.
+fn truth_points(c: &Curves, t0: f64, t1: f64) -> Vec<(f64, f64)> {
+    let (n, k) = c.truth;
+    match &c.truth_curve {
+        Some(tc) => tc
+            .iter()
+            .copied()
+            .filter(|&(t, v)| t >= t0 && t <= t1 && v > 0.0)
+            .collect(),
+        None => (0..=200)
+            .map(|j| {
+                let t = t0 * (t1 / t0).powf(j as f64 / 200.0);
+                (t, (n * n / t + k * k * t / 3.0).sqrt())
+            })
+            .collect(),
+    }
+}
+
+/// The legend entry of the truth, by whether `c` has the exact curve.
+fn truth_label(c: &Curves) -> &'static str {
+    if c.truth_curve.is_some() {
+        "truth: exact ADEV of the simulated sequence (sim truth.csv)"
+    } else {
+        "truth: sqrt(N²/τ + K²τ/3)"
+    }
+}
+
+/// One chart: axes, the truth, the tools' curves over it, the legend.
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -102,17 +142,11 @@ fn draw<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    // Long on purpose: one chart written top to bottom (axes, truth, tools' curves, legend).
     let e = |x: &dyn std::fmt::Display| x.to_string();
     root.fill(&WHITE).map_err(|x| e(&x))?;
-    let all = curves.iter().flat_map(|c| c.kalibr.iter().chain(&c.ieee));
-    let (mut t0, mut t1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for &(t, v) in all {
-        (t0, t1, y0, y1) = (t0.min(t), t1.max(t), y0.min(v), y1.max(v));
-    }
-    if !(t0 < t1 && y0 < y1) {
+    let Some((t0, t1, y0, y1)) = tool_bounds(curves) else {
         return Err("no curve points to draw".into());
-    }
+    };
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 30))
         .margin(20)
@@ -132,30 +166,14 @@ where
         .map_err(|x| e(&x))?;
     // The truth first, under the tools' curves.
     for (i, c) in curves.iter().enumerate() {
-        let (n, k) = c.truth;
-        let points: Vec<(f64, f64)> = match &c.truth_curve {
-            Some(tc) => tc
-                .iter()
-                .copied()
-                .filter(|&(t, v)| t >= t0 && t <= t1 && v > 0.0)
-                .collect(),
-            None => (0..=200)
-                .map(|j| {
-                    let t = t0 * (t1 / t0).powf(j as f64 / 200.0);
-                    (t, (n * n / t + k * k * t / 3.0).sqrt())
-                })
-                .collect(),
-        };
         let truth = chart
-            .draw_series(LineSeries::new(points, BLACK.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                truth_points(c, t0, t1),
+                BLACK.stroke_width(2),
+            ))
             .map_err(|x| e(&x))?;
         if i == 0 {
-            let label = if c.truth_curve.is_some() {
-                "truth: exact ADEV of the simulated sequence (sim truth.csv)"
-            } else {
-                "truth: sqrt(N²/τ + K²τ/3)"
-            };
-            truth.label(label).legend(|(x, y)| {
+            truth.label(truth_label(c)).legend(|(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
             });
         }

@@ -92,27 +92,15 @@ pub struct SplineSummary {
 /// ring for a few knots, decaying by 2 − √3 per knot; spec §7.3 item 7).
 pub const TRIM_KNOTS: i64 = 10;
 
-/// Run `sim spline`.
+/// Run `sim spline`: checks, fit, emission, text files, bag, truth.
 pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
-    // Long on purpose: the command top to bottom (checks, fit, emission, text files, bag,
-    // truth); the steps share the window, the paths and the rows, a split would pass them all.
     if !(cfg.rate.is_finite() && cfg.rate > 0.0) {
         return Err(SimError::InvalidArgument(format!(
             "--rate must be positive, got {}",
             cfg.rate
         )));
     }
-    let poses: Vec<Pose> = match &cfg.source {
-        PoseSource::Tum(p) => read_tum(p)?,
-        PoseSource::Model { duration, rate } => {
-            if !(*duration > 0.0 && *rate > 0.0) {
-                return Err(SimError::InvalidArgument(
-                    "--duration and --pose-rate must be positive".into(),
-                ));
-            }
-            model_poses(*duration, *rate)
-        }
-    };
+    let poses = read_poses(&cfg.source)?;
     let knots = knots_from_poses(&poses, cfg.knot_dt_ns)?;
     if !cfg.gravity.is_finite() {
         return Err(SimError::InvalidArgument(format!(
@@ -122,7 +110,47 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
     }
     let (spline, fit) = SplitSpline::fit(knots.t0_ns, knots.dt_ns, &knots.poses, cfg.fit)?;
     let spline = spline.with_gravity(nalgebra::Vector3::new(0.0, 0.0, -cfg.gravity));
-    let (a, b) = spline.range_ns();
+    let (t_start, t_end) = emission_window(cfg, spline.range_ns())?;
+    let (dir, bag_path) = output_paths(&cfg.out);
+    std::fs::create_dir_all(&dir).map_err(|e| SimError::io(&dir, e))?;
+    let emitted = emit(cfg, &spline, t_start, t_end);
+    let mut files = write_text_files(cfg, &dir, &emitted, &poses)?;
+    let bag = write_bag(cfg, &bag_path, &emitted.noisy, t_start)?;
+    let truth = write_truth(cfg, &bag_path, emitted.noisy.len())?;
+    files.push(bag_path);
+    files.extend(truth);
+    Ok(SplineSummary {
+        poses: poses.len(),
+        knots: knots.poses.len(),
+        knot_dt: knots.dt_ns as f64 * 1e-9,
+        resampled: knots.resampled,
+        fit,
+        samples: emitted.clean.len(),
+        files,
+        bag,
+        model_error: emitted.model_error,
+    })
+}
+
+/// The input poses: the TUM file, or the analytic model sampled (its duration and rate
+/// checked).
+fn read_poses(source: &PoseSource) -> Result<Vec<Pose>> {
+    Ok(match source {
+        PoseSource::Tum(p) => read_tum(p)?,
+        PoseSource::Model { duration, rate } => {
+            if !(*duration > 0.0 && *rate > 0.0) {
+                return Err(SimError::InvalidArgument(
+                    "--duration and --pose-rate must be positive".into(),
+                ));
+            }
+            model_poses(*duration, *rate)
+        }
+    })
+}
+
+/// The emission window (ns): the configured one, by default the spline's valid range
+/// `(a, b)`, which it must lie in.
+fn emission_window(cfg: &SplineConfig, (a, b): (i64, i64)) -> Result<(i64, i64)> {
     let t_start = cfg.t_start_ns.unwrap_or(a);
     let t_end = cfg.t_end_ns.unwrap_or(b);
     if t_start < a || t_end > b || t_start > t_end {
@@ -134,22 +162,36 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
             b as f64 * 1e-9
         )));
     }
+    Ok((t_start, t_end))
+}
 
-    // Output locations.
-    let (dir, bag_path) = if cfg.out.extension().is_some_and(|e| e == "bag") {
-        let d = cfg
-            .out
+/// The text files' directory and the bag's path: `out` is the bag when it ends in `.bag`
+/// (the text files beside it), else the directory of both (bag `imu.bag`).
+fn output_paths(out: &Path) -> (PathBuf, PathBuf) {
+    if out.extension().is_some_and(|e| e == "bag") {
+        let d = out
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
             .unwrap_or(Path::new("."))
             .to_path_buf();
-        (d, cfg.out.clone())
+        (d, out.to_path_buf())
     } else {
-        (cfg.out.clone(), cfg.out.join("imu.bag"))
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| SimError::io(&dir, e))?;
+        (out.to_path_buf(), out.join("imu.bag"))
+    }
+}
 
-    // Emit: t_k = t_start + round(k·1e9/rate) while ≤ t_end.
+/// The emitted samples, clean and with noise, and with `--from-model` the max gyro and acc
+/// error against the analytic model.
+struct Emitted {
+    clean: Vec<PoseRow>,
+    noisy: Vec<PoseRow>,
+    model_error: Option<(f64, f64)>,
+}
+
+/// Samples the spline at t_k = t_start + round(k·1e9/rate) while ≤ t_end; the model error
+/// ignores [`TRIM_KNOTS`] knots at each end of the valid range.
+fn emit(cfg: &SplineConfig, spline: &SplitSpline, t_start: i64, t_end: i64) -> Emitted {
+    let (a, b) = spline.range_ns();
     let mut clean = Vec::new();
     let mut noisy = Vec::new();
     let mut gen_noise = cfg
@@ -191,13 +233,26 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
         clean.push(row);
         noisy.push(nrow);
     }
+    Emitted {
+        clean,
+        noisy,
+        model_error: model_err,
+    }
+}
 
+/// `imu_pose.txt`, `imu_pose_noise.txt` and with `--from-model` `model_poses.tum` into `dir`.
+fn write_text_files(
+    cfg: &SplineConfig,
+    dir: &Path,
+    emitted: &Emitted,
+    poses: &[Pose],
+) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let p = dir.join("imu_pose.txt");
-    write_string(&p, &format_pose_rows(&clean, NumFormat::Full))?;
+    write_string(&p, &format_pose_rows(&emitted.clean, NumFormat::Full))?;
     files.push(p);
     let p = dir.join("imu_pose_noise.txt");
-    write_string(&p, &format_pose_rows(&noisy, NumFormat::Full))?;
+    write_string(&p, &format_pose_rows(&emitted.noisy, NumFormat::Full))?;
     files.push(p);
     if let PoseSource::Model { .. } = cfg.source {
         let p = dir.join("model_poses.tum");
@@ -208,15 +263,24 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
         write_string(&p, &format_tum(&rows, 9, 9))?;
         files.push(p);
     }
+    Ok(files)
+}
 
-    // Bag of the noisy IMU, record time = stamp.
+/// The bag of the noisy IMU, record time = stamp: sample i at t_start + round(i·1e9/rate),
+/// shifted to `--start-time`, kept if already absolute (≥ 1e9 s), else to now.
+fn write_bag(
+    cfg: &SplineConfig,
+    bag_path: &Path,
+    noisy: &[PoseRow],
+    t_start: i64,
+) -> Result<BagSummary> {
     let offset: i64 = match cfg.start_ns {
         Some(s) => s as i64 - t_start,
         None if t_start >= 1_000_000_000_000_000_000 => 0,
         None => now_ns() as i64 - t_start,
     };
     let pb = bag2mat::shared::progress::bar(noisy.len() as u64, cfg.quiet, "msgs");
-    let mut sink = ImuBagSink::create(&bag_path, cfg.compression, &cfg.topic, &cfg.frame_id)?;
+    let mut sink = ImuBagSink::create(bag_path, cfg.compression, &cfg.topic, &cfg.frame_id)?;
     for (i, r) in noisy.iter().enumerate() {
         let t_ns = t_start + (i as f64 * 1e9 / cfg.rate).round() as i64 + offset;
         if t_ns < 0 {
@@ -234,7 +298,11 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
     }
     let bag = sink.finish()?;
     pb.finish_and_clear();
-    // The truth beside the bag: the noise model (zero with --no-noise) and its Allan deviation.
+    Ok(bag)
+}
+
+/// The truth beside the bag: the noise model (zero with --no-noise) and its Allan deviation.
+fn write_truth(cfg: &SplineConfig, bag_path: &Path, samples: usize) -> Result<[PathBuf; 2]> {
     let model = crate::noise::model::ImuModel::from_continuous(
         if cfg.noise.is_some() {
             "spline"
@@ -243,26 +311,13 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
         },
         &cfg.noise.unwrap_or(ContinuousNoise::ZERO),
     );
-    let truth = crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {
-        bag: &bag_path,
+    crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {
+        bag: bag_path,
         model: &model,
         rate: cfg.rate,
-        samples: noisy.len(),
+        samples,
         seed: cfg.seed,
         motion: "spline",
-    })?;
-    files.push(bag_path);
-    files.extend(truth);
-    Ok(SplineSummary {
-        poses: poses.len(),
-        knots: knots.poses.len(),
-        knot_dt: knots.dt_ns as f64 * 1e-9,
-        resampled: knots.resampled,
-        fit,
-        samples: clean.len(),
-        files,
-        bag,
-        model_error: model_err,
     })
 }
 

@@ -161,9 +161,60 @@ fn g_line(out: &mut String, vals: &[f64], trailing_space: bool) {
     out.push('\n');
 }
 
-/// Write every file of `sim traj` into `cfg.out_dir`.
+/// `all_points.txt`: every landmark point as `x y z 1`.
+fn points_text(points: &[Vector3<f64>]) -> String {
+    let mut s = String::new();
+    for p in points {
+        g_line(&mut s, &[p.x, p.y, p.z, 1.0], false);
+    }
+    s
+}
+
+/// The camera frames as pose rows (the gyro/acc columns 0: uninitialised upstream).
+fn cam_pose_rows(frames: &[CamFrame]) -> Vec<PoseRow> {
+    frames
+        .iter()
+        .map(|f| PoseRow {
+            t: f.t,
+            q: quat_from_matrix(&f.r_wc),
+            p: f.t_wc,
+            gyro: Vector3::zeros(),
+            acc: Vector3::zeros(),
+        })
+        .collect()
+}
+
+/// `keyframe/all_points_<n>.txt`: each point in front of camera `f`, world coordinates and
+/// normalised image coordinates (x/z, y/z), no intrinsics or bounds (upstream).
+fn frame_points_text(f: &CamFrame, points: &[Vector3<f64>]) -> String {
+    let mut s = String::new();
+    for p in points {
+        if let Some(c) = to_cam(f, p) {
+            g_line(&mut s, &[p.x, p.y, p.z, 1.0, c.x / c.z, c.y / c.z], true);
+        }
+    }
+    s
+}
+
+/// `keyframe/all_lines_<n>.txt`: each line with both ends in front of camera `f`, its ends
+/// in normalised image coordinates.
+fn frame_lines_text(f: &CamFrame, lines: &[Segment]) -> String {
+    let mut s = String::new();
+    for (a, b) in lines {
+        if let (Some(c1), Some(c2)) = (to_cam(f, a), to_cam(f, b)) {
+            g_line(
+                &mut s,
+                &[c1.x / c1.z, c1.y / c1.z, c2.x / c2.z, c2.y / c2.z],
+                true,
+            );
+        }
+    }
+    s
+}
+
+/// Write every file of `sim traj` into `cfg.out_dir`: the upstream `master` file writer top
+/// to bottom, one block per file.
 pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
-    // Long on purpose: the upstream `master` file writer top to bottom, one block per file.
     if !(cfg.duration > 0.0 && cfg.rate > 0.0 && cfg.cam_rate > 0.0) {
         return Err(SimError::InvalidArgument(
             "duration, rate and cam-rate must be positive".into(),
@@ -180,11 +231,7 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
 
     // Landmarks.
     let (points, lines) = landmarks();
-    let mut s = String::new();
-    for p in &points {
-        g_line(&mut s, &[p.x, p.y, p.z, 1.0], false);
-    }
-    write(&dir.join("all_points.txt"), &s)?;
+    write(&dir.join("all_points.txt"), &points_text(&points))?;
 
     // IMU.
     let truth = model_rows(cfg.grid, cfg.mode, cfg.duration, cfg.rate, None);
@@ -209,16 +256,7 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
 
     // Cameras.
     let frames = cam_frames(cfg.grid, cfg.mode, cfg.duration, cfg.cam_rate);
-    let cam_rows: Vec<PoseRow> = frames
-        .iter()
-        .map(|f| PoseRow {
-            t: f.t,
-            q: quat_from_matrix(&f.r_wc),
-            p: f.t_wc,
-            gyro: Vector3::zeros(),
-            acc: Vector3::zeros(),
-        })
-        .collect();
+    let cam_rows = cam_pose_rows(&frames);
     write(
         &dir.join("cam_pose.txt"),
         &format_pose_rows(&cam_rows, NumFormat::CppG),
@@ -226,26 +264,16 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
     let tum: Vec<_> = cam_rows.iter().map(|r| (r.t, r.p, r.q)).collect();
     write(&dir.join("cam_pose_tum.txt"), &format_tum(&tum, 9, 5))?;
 
-    // Observations, normalised coordinates (x/z, y/z), no intrinsics or bounds (upstream).
+    // Observations.
     for (n, f) in frames.iter().enumerate() {
-        let mut s = String::new();
-        for p in &points {
-            if let Some(c) = to_cam(f, p) {
-                g_line(&mut s, &[p.x, p.y, p.z, 1.0, c.x / c.z, c.y / c.z], true);
-            }
-        }
-        write(&kf.join(format!("all_points_{n}.txt")), &s)?;
-        let mut s = String::new();
-        for (a, b) in &lines {
-            if let (Some(c1), Some(c2)) = (to_cam(f, a), to_cam(f, b)) {
-                g_line(
-                    &mut s,
-                    &[c1.x / c1.z, c1.y / c1.z, c2.x / c2.z, c2.y / c2.z],
-                    true,
-                );
-            }
-        }
-        write(&kf.join(format!("all_lines_{n}.txt")), &s)?;
+        write(
+            &kf.join(format!("all_points_{n}.txt")),
+            &frame_points_text(f, &points),
+        )?;
+        write(
+            &kf.join(format!("all_lines_{n}.txt")),
+            &frame_lines_text(f, &lines),
+        )?;
     }
     Ok(TrajSummary {
         imu_samples: truth.len(),

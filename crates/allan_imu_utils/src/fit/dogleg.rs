@@ -374,16 +374,126 @@ fn gradient_max_norm(x: &Params, g: &[f64; 5]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Item 1: the Jacobi scale 1/(1 + ‖column‖) of each parameter, computed once, at the start
+/// point.
+fn jacobi_scale(j: &[[f64; 5]]) -> [f64; 5] {
+    let cn = squared_column_norm(j);
+    let mut scale = [0.0; 5];
+    for k in 0..5 {
+        scale[k] = 1.0 / (1.0 + cn[k].sqrt());
+    }
+    scale
+}
+
+/// `FinalizeIterationAndCheckIfMinimizerCanContinue`: the termination before attempt
+/// `iteration + 1`, if any (the attempt cap, the gradient after a successful step, the
+/// trust region's collapse).
+fn stop_before_attempt(
+    opts: &Options,
+    iteration: usize,
+    successful: bool,
+    grad_max: f64,
+    radius: f64,
+) -> Option<Termination> {
+    if iteration >= opts.max_num_iterations {
+        return Some(Termination::NoConvergence);
+    }
+    if successful && grad_max <= opts.gradient_tolerance {
+        return Some(Termination::Convergence);
+    }
+    if radius <= opts.min_radius {
+        return Some(Termination::Convergence);
+    }
+    None
+}
+
+/// The cost decrease the linear model predicts for `step` (scaled space): −Σ m(r + m/2)
+/// with m = J_s·step; the step is valid when it is positive.
+fn predicted_decrease(js: &[[f64; 5]], r: &[f64], step: &[f64; 5]) -> f64 {
+    let mr = right_multiply(js, step);
+    let mut s = 0.0;
+    for (m, r) in mr.iter().zip(r) {
+        s += m * (r + m / 2.0);
+    }
+    -s
+}
+
+/// `ParameterToleranceReached`, then `FunctionToleranceReached`: the step from `x` (norm
+/// `x_norm`, cost `cost`) to `candidate` is too small to go on.
+fn tolerance_reached(
+    opts: &Options,
+    x: &Params,
+    x_norm: f64,
+    cost: f64,
+    candidate: &Params,
+    candidate_cost: f64,
+) -> bool {
+    let mut d2 = 0.0;
+    for k in 0..5 {
+        let d = x[k] - candidate[k];
+        d2 += d * d;
+    }
+    if d2.sqrt() <= opts.parameter_tolerance * (x_norm + opts.parameter_tolerance) {
+        return true;
+    }
+    (cost - candidate_cost).abs() <= opts.function_tolerance * cost
+}
+
+/// The point `x + step·scale`: the Jacobi-scaled step back in parameter space.
+fn candidate_point(x: &Params, step: &[f64; 5], scale: &[f64; 5]) -> Params {
+    let mut candidate = *x;
+    for k in 0..5 {
+        candidate[k] = x[k] + step[k] * scale[k];
+    }
+    candidate
+}
+
+/// ρ, the actual over the predicted cost decrease; `f64::MIN` when the candidate's cost
+/// could not be evaluated.
+fn relative_decrease(cost: f64, candidate_cost: f64, model_cost_change: f64) -> f64 {
+    if candidate_cost >= f64::MAX {
+        f64::MIN
+    } else {
+        (cost - candidate_cost) / model_cost_change
+    }
+}
+
+impl Summary {
+    /// Nothing done yet: a failure, costs unknown.
+    fn not_started() -> Self {
+        Summary {
+            termination: Termination::Failure,
+            attempts: 0,
+            accepted: 0,
+            initial_cost: f64::NAN,
+            final_cost: f64::NAN,
+        }
+    }
+}
+
+impl Dogleg {
+    /// The strategy's start state for `opts`.
+    fn new(opts: &Options) -> Self {
+        Dogleg {
+            radius: opts.initial_radius,
+            max_radius: opts.max_radius,
+            min_diagonal: opts.min_diagonal,
+            max_diagonal: opts.max_diagonal,
+            mu: MIN_MU,
+            reuse: false,
+            diagonal: [0.0; 5],
+            gradient: [0.0; 5],
+            alpha: 0.0,
+            gauss_newton: [0.0; 5],
+            dogleg_step_norm: 0.0,
+        }
+    }
+}
+
 /// Minimises ½Σr² from `x0`; returns the final parameters whatever the termination
 /// (upstream never checks the summary; on failure at the start point `x0` comes back).
 pub fn solve(problem: &Problem<'_>, x0: Params, opts: &Options) -> (Params, Summary) {
-    let mut summary = Summary {
-        termination: Termination::Failure,
-        attempts: 0,
-        accepted: 0,
-        initial_cost: f64::NAN,
-        final_cost: f64::NAN,
-    };
+    let mut summary = Summary::not_started();
     let mut x = x0;
     // Iteration 0.
     let Some(mut ev) = problem.evaluate_full(&x) else {
@@ -391,61 +501,27 @@ pub fn solve(problem: &Problem<'_>, x0: Params, opts: &Options) -> (Params, Summ
     };
     summary.initial_cost = ev.cost;
     let mut x_norm = norm(&x);
-    // Item 1: the Jacobi scale is computed once, at the start point.
-    let cn = squared_column_norm(&ev.j);
-    let mut scale = [0.0; 5];
-    for k in 0..5 {
-        scale[k] = 1.0 / (1.0 + cn[k].sqrt());
-    }
+    let scale = jacobi_scale(&ev.j);
     let mut js = scale_columns(&ev.j, &scale);
     let mut grad_max = gradient_max_norm(&x, &ev.gradient);
-    let mut strategy = Dogleg {
-        radius: opts.initial_radius,
-        max_radius: opts.max_radius,
-        min_diagonal: opts.min_diagonal,
-        max_diagonal: opts.max_diagonal,
-        mu: MIN_MU,
-        reuse: false,
-        diagonal: [0.0; 5],
-        gradient: [0.0; 5],
-        alpha: 0.0,
-        gauss_newton: [0.0; 5],
-        dogleg_step_norm: 0.0,
-    };
+    let mut strategy = Dogleg::new(opts);
     let mut iteration = 0usize;
     let mut successful = true;
     let mut invalid_in_a_row = 0usize;
     loop {
-        // FinalizeIterationAndCheckIfMinimizerCanContinue.
-        if iteration >= opts.max_num_iterations {
-            summary.termination = Termination::NoConvergence;
-            break;
-        }
-        if successful && grad_max <= opts.gradient_tolerance {
-            summary.termination = Termination::Convergence;
-            break;
-        }
-        if strategy.radius <= opts.min_radius {
-            summary.termination = Termination::Convergence;
+        if let Some(t) = stop_before_attempt(opts, iteration, successful, grad_max, strategy.radius)
+        {
+            summary.termination = t;
             break;
         }
         iteration += 1;
         summary.attempts = iteration;
         // ComputeTrustRegionStep.
-        let step = strategy.compute_step(&js, &ev.r);
-        let mut model_cost_change = 0.0;
-        let mut valid = false;
-        if let Some(step) = &step {
-            let mr = right_multiply(&js, step);
-            let mut s = 0.0;
-            for (m, r) in mr.iter().zip(&ev.r) {
-                s += m * (r + m / 2.0);
-            }
-            model_cost_change = -s;
-            valid = model_cost_change > 0.0;
-        }
-        let step = match step {
-            Some(s) if valid => s,
+        let step = strategy
+            .compute_step(&js, &ev.r)
+            .map(|step| (step, predicted_decrease(&js, &ev.r, &step)));
+        let (step, model_cost_change) = match step {
+            Some((s, change)) if change > 0.0 => (s, change),
             _ => {
                 // HandleInvalidStep.
                 invalid_in_a_row += 1;
@@ -459,30 +535,14 @@ pub fn solve(problem: &Problem<'_>, x0: Params, opts: &Options) -> (Params, Summ
             }
         };
         invalid_in_a_row = 0;
-        let mut candidate = x;
-        for k in 0..5 {
-            candidate[k] = x[k] + step[k] * scale[k];
-        }
+        let candidate = candidate_point(&x, &step, &scale);
         let candidate_cost = problem.evaluate_cost(&candidate);
-        // ParameterToleranceReached, then FunctionToleranceReached (candidate not applied).
-        let mut d2 = 0.0;
-        for k in 0..5 {
-            let d = x[k] - candidate[k];
-            d2 += d * d;
-        }
-        if d2.sqrt() <= opts.parameter_tolerance * (x_norm + opts.parameter_tolerance) {
+        // The candidate is not applied when a tolerance is reached.
+        if tolerance_reached(opts, &x, x_norm, ev.cost, &candidate, candidate_cost) {
             summary.termination = Termination::Convergence;
             break;
         }
-        if (ev.cost - candidate_cost).abs() <= opts.function_tolerance * ev.cost {
-            summary.termination = Termination::Convergence;
-            break;
-        }
-        let rho = if candidate_cost >= f64::MAX {
-            f64::MIN
-        } else {
-            (ev.cost - candidate_cost) / model_cost_change
-        };
+        let rho = relative_decrease(ev.cost, candidate_cost, model_cost_change);
         if rho > opts.min_relative_decrease {
             // HandleSuccessfulStep: re-evaluate with the Jacobian at the new point.
             x = candidate;

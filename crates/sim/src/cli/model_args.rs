@@ -7,7 +7,9 @@ use clap::{Args, ValueEnum};
 
 use super::noise_args::{NoiseArgs, PresetArg};
 use crate::error::{Result, SimError};
-use crate::noise::model::{BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup};
+use crate::noise::model::{
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup,
+};
 use crate::noise::profiles::Profile;
 
 /// Sensor profiles (`sim sensors` lists their figures and sources).
@@ -179,100 +181,136 @@ impl ModelArgs {
     }
 
     /// The per-sensor term flags (bias instability, Gauss–Markov, ramp, quantization,
-    /// resolution, warm-up), checked.
+    /// resolution, warm-up), checked; the gyro's first.
     fn apply_terms(&self, m: &mut ImuModel) -> Result<()> {
-        let per_sensor = [
-            (
-                Sensor::Gyro,
-                self.gyro_bias_instability,
-                &self.gyro_bi_taus,
-                &self.gyro_gm,
-                self.gyro_ramp,
-                self.gyro_quantization,
-                self.gyro_resolution,
-                &self.gyro_warmup,
-            ),
-            (
-                Sensor::Acc,
-                self.acc_bias_instability,
-                &self.acc_bi_taus,
-                &self.acc_gm,
-                self.acc_ramp,
-                self.acc_quantization,
-                self.acc_resolution,
-                &self.acc_warmup,
-            ),
-        ];
-        for (s, b, taus, gm, ramp, q, lsb, warm) in per_sensor {
-            let flag = |name: &str| format!("--{}-{name}", s.short());
-            for (name, v) in [("bi-taus", taus), ("gm", gm), ("warmup", warm)] {
-                if let Some(v) = v
-                    && v.len() != 2
-                {
-                    return Err(SimError::InvalidArgument(format!(
-                        "{} takes two comma-separated numbers, got {}",
-                        flag(name),
-                        v.len()
-                    )));
-                }
-            }
-            for (name, v) in [
-                ("quantization", q),
-                ("resolution", lsb),
-                ("bias-instability", b),
-            ] {
-                if let Some(v) = v
-                    && !(v.is_finite() && v >= 0.0)
-                {
-                    return Err(SimError::InvalidArgument(format!(
-                        "{} must be a non-negative number, got {v}",
-                        flag(name)
-                    )));
-                }
-            }
-            for a in m.sensor_mut(s).axes.iter_mut() {
-                if b.is_some() || taus.is_some() {
-                    let old = a.bias_instability;
-                    let (lo, hi) = match (taus, old) {
-                        (Some(t), _) => (t[0], t[1]),
-                        (None, Some(o)) => (o.tau_lo, o.tau_hi),
-                        (None, None) => DEFAULT_BI_TAUS,
-                    };
-                    let bv = b.or(old.map(|o| o.b)).unwrap_or(0.0);
-                    a.bias_instability = (bv != 0.0).then_some(BiasInstability {
-                        b: bv,
-                        tau_lo: lo,
-                        tau_hi: hi,
-                    });
-                }
-                if let Some(g) = gm {
-                    a.gauss_markov = if g[0] == 0.0 {
-                        Vec::new()
-                    } else {
-                        vec![GaussMarkov {
-                            sigma: g[0],
-                            tau: g[1],
-                        }]
-                    };
-                }
-                if let Some(r) = ramp {
-                    a.rate_ramp = r;
-                }
-                if let Some(q) = q {
-                    a.quantization = q;
-                }
-                if let Some(l) = lsb {
-                    a.resolution = l;
-                }
-                if let Some(w) = warm {
-                    a.warmup = (w[0] != 0.0).then_some(Warmup::Exponential {
-                        amplitude: w[0],
-                        tau: w[1],
-                    });
-                }
+        for flags in self.term_flags() {
+            flags.check()?;
+            for a in m.sensor_mut(flags.sensor).axes.iter_mut() {
+                flags.apply(a);
             }
         }
         Ok(())
+    }
+
+    /// The term flags of each sensor, gyro then accelerometer.
+    fn term_flags(&self) -> [TermFlags<'_>; 2] {
+        [
+            TermFlags {
+                sensor: Sensor::Gyro,
+                bias_instability: self.gyro_bias_instability,
+                bi_taus: &self.gyro_bi_taus,
+                gm: &self.gyro_gm,
+                ramp: self.gyro_ramp,
+                quantization: self.gyro_quantization,
+                resolution: self.gyro_resolution,
+                warmup: &self.gyro_warmup,
+            },
+            TermFlags {
+                sensor: Sensor::Acc,
+                bias_instability: self.acc_bias_instability,
+                bi_taus: &self.acc_bi_taus,
+                gm: &self.acc_gm,
+                ramp: self.acc_ramp,
+                quantization: self.acc_quantization,
+                resolution: self.acc_resolution,
+                warmup: &self.acc_warmup,
+            },
+        ]
+    }
+}
+
+/// One sensor's term flags (`--gyro-…` or `--acc-…`), as given.
+struct TermFlags<'a> {
+    sensor: Sensor,
+    bias_instability: Option<f64>,
+    bi_taus: &'a Option<Vec<f64>>,
+    gm: &'a Option<Vec<f64>>,
+    ramp: Option<f64>,
+    quantization: Option<f64>,
+    resolution: Option<f64>,
+    warmup: &'a Option<Vec<f64>>,
+}
+
+impl TermFlags<'_> {
+    /// The pairs have two numbers, Q, LSB and B are non-negative; the error names the flag.
+    fn check(&self) -> Result<()> {
+        let flag = |name: &str| format!("--{}-{name}", self.sensor.short());
+        for (name, v) in [
+            ("bi-taus", self.bi_taus),
+            ("gm", self.gm),
+            ("warmup", self.warmup),
+        ] {
+            if let Some(v) = v
+                && v.len() != 2
+            {
+                return Err(SimError::InvalidArgument(format!(
+                    "{} takes two comma-separated numbers, got {}",
+                    flag(name),
+                    v.len()
+                )));
+            }
+        }
+        for (name, v) in [
+            ("quantization", self.quantization),
+            ("resolution", self.resolution),
+            ("bias-instability", self.bias_instability),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v >= 0.0)
+            {
+                return Err(SimError::InvalidArgument(format!(
+                    "{} must be a non-negative number, got {v}",
+                    flag(name)
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The given flags on axis `a` (checked first by [`TermFlags::check`]): B and its corner
+    /// times merge with the axis' own (defaults [`DEFAULT_BI_TAUS`]); B, σ or A of 0 turn the
+    /// term off.
+    fn apply(&self, a: &mut AxisModel) {
+        let b = self.bias_instability;
+        if b.is_some() || self.bi_taus.is_some() {
+            let old = a.bias_instability;
+            let (lo, hi) = match (self.bi_taus, old) {
+                (Some(t), _) => (t[0], t[1]),
+                (None, Some(o)) => (o.tau_lo, o.tau_hi),
+                (None, None) => DEFAULT_BI_TAUS,
+            };
+            let bv = b.or(old.map(|o| o.b)).unwrap_or(0.0);
+            a.bias_instability = (bv != 0.0).then_some(BiasInstability {
+                b: bv,
+                tau_lo: lo,
+                tau_hi: hi,
+            });
+        }
+        if let Some(g) = self.gm {
+            a.gauss_markov = if g[0] == 0.0 {
+                Vec::new()
+            } else {
+                vec![GaussMarkov {
+                    sigma: g[0],
+                    tau: g[1],
+                }]
+            };
+        }
+        if let Some(r) = self.ramp {
+            a.rate_ramp = r;
+        }
+        if let Some(q) = self.quantization {
+            a.quantization = q;
+        }
+        if let Some(l) = self.resolution {
+            a.resolution = l;
+        }
+        if let Some(w) = self.warmup {
+            a.warmup = (w[0] != 0.0).then_some(Warmup::Exponential {
+                amplitude: w[0],
+                tau: w[1],
+            });
+        }
     }
 }
 

@@ -324,7 +324,6 @@ impl ImuModel {
     /// Checks every parameter (finite, non-negative where it must be, corner times ordered,
     /// chain compatible with the output rate). Messages name sensor, axis and field.
     pub(crate) fn validate(&self, output_rate: f64) -> Result<()> {
-        // Long on purpose: a flat list of independent checks, one per rule, in the model's order.
         for s in Sensor::BOTH {
             let sm = self.sensor(s);
             sm.chain.resolve(s, output_rate)?;
@@ -332,93 +331,7 @@ impl ImuModel {
                 let at = |field: &str, msg: String| {
                     SimError::InvalidArgument(format!("{} {axis} {field}: {msg}", s.name()))
                 };
-                for (field, v) in [
-                    ("white_noise", a.white_noise),
-                    ("random_walk", a.random_walk),
-                    ("quantization", a.quantization),
-                    ("resolution", a.resolution),
-                ] {
-                    if !(v.is_finite() && v >= 0.0) {
-                        return Err(at(field, format!("must be a non-negative number, got {v}")));
-                    }
-                }
-                if !a.rate_ramp.is_finite() {
-                    return Err(at(
-                        "rate_ramp",
-                        format!("must be finite, got {}", a.rate_ramp),
-                    ));
-                }
-                if let Some(bi) = a.bias_instability {
-                    let min_tau = MIN_TAU_SAMPLES / output_rate;
-                    if !(bi.b.is_finite() && bi.b >= 0.0) {
-                        return Err(at(
-                            "bias_instability",
-                            format!("B must be a non-negative number, got {}", bi.b),
-                        ));
-                    }
-                    if !(bi.tau_lo.is_finite()
-                        && bi.tau_hi.is_finite()
-                        && bi.tau_lo >= min_tau
-                        && bi.tau_hi > bi.tau_lo)
-                    {
-                        return Err(at(
-                            "bias_instability",
-                            format!(
-                                "corner times must satisfy {min_tau} s ({} output samples) <= tau_lo < tau_hi, got {} .. {}",
-                                MIN_TAU_SAMPLES, bi.tau_lo, bi.tau_hi
-                            ),
-                        ));
-                    }
-                }
-                for gm in &a.gauss_markov {
-                    if !(gm.sigma.is_finite()
-                        && gm.sigma >= 0.0
-                        && gm.tau.is_finite()
-                        && gm.tau > 0.0)
-                    {
-                        return Err(at(
-                            "gauss_markov",
-                            format!(
-                                "sigma must be >= 0 and tau > 0 s, got sigma {} tau {}",
-                                gm.sigma, gm.tau
-                            ),
-                        ));
-                    }
-                }
-                for l in &a.lines {
-                    if !(l.frequency.is_finite()
-                        && l.frequency > 0.0
-                        && l.frequency < 0.5 * output_rate
-                        && l.amplitude.is_finite()
-                        && l.amplitude >= 0.0
-                        && l.bandwidth.is_finite()
-                        && l.bandwidth >= 0.0
-                        && l.bandwidth < l.frequency)
-                    {
-                        return Err(at(
-                            "lines",
-                            format!(
-                                "a line needs 0 < frequency < {} Hz (half the output rate), amplitude >= 0 and 0 <= bandwidth < frequency (lightly damped), got frequency {} Hz, amplitude {}, bandwidth {} Hz",
-                                0.5 * output_rate,
-                                l.frequency,
-                                l.amplitude,
-                                l.bandwidth
-                            ),
-                        ));
-                    }
-                }
-                if let Some(w) = a.warmup {
-                    let ok = w.amplitude().is_finite() && w.tau().is_finite() && w.tau() > 0.0;
-                    if !ok {
-                        return Err(at(
-                            "warmup",
-                            format!(
-                                "needs a finite amplitude and a time constant > 0 s, got {:?}",
-                                w
-                            ),
-                        ));
-                    }
-                }
+                a.validate(output_rate, &at)?;
             }
         }
         Ok(())
@@ -427,7 +340,6 @@ impl ImuModel {
     /// Human-readable table of every term, continuous and discrete at `rate` Hz (printed by
     /// `sim bag` and `sim sensors`).
     pub fn describe(&self, rate: f64) -> String {
-        // Long on purpose: a report template written top to bottom, one line per term.
         if let Some(c) = self.legacy(rate) {
             return c.describe(rate);
         }
@@ -446,74 +358,190 @@ impl ImuModel {
             };
             let _ = writeln!(o, "  {} [{}]: {chain}", s.name(), s.unit());
             for (axis, a) in AXES.iter().zip(&sm.axes) {
-                let _ = write!(
-                    o,
-                    "    {axis}: N {:.4e} {}, K {:.4e} {}",
-                    a.white_noise,
-                    s.term_unit("white_noise"),
-                    a.random_walk,
-                    s.term_unit("random_walk")
-                );
-                if let Some(bi) = a.bias_instability {
-                    let _ = write!(
-                        o,
-                        ", B {:.4e} {} ({} .. {} s)",
-                        bi.b,
-                        s.unit(),
-                        bi.tau_lo,
-                        bi.tau_hi
-                    );
-                }
-                for gm in &a.gauss_markov {
-                    let _ = write!(o, ", GM {:.4e} {} / {} s", gm.sigma, s.unit(), gm.tau);
-                }
-                if a.rate_ramp != 0.0 {
-                    let _ = write!(o, ", R {:.4e} {}", a.rate_ramp, s.term_unit("rate_ramp"));
-                }
-                if a.quantization != 0.0 {
-                    let _ = write!(
-                        o,
-                        ", Q {:.4e} {} (step {:.4e})",
-                        a.quantization,
-                        s.term_unit("quantization"),
-                        super::quantization_step(a.quantization)
-                    );
-                }
-                if a.resolution != 0.0 {
-                    let _ = write!(o, ", LSB {:.4e} {}", a.resolution, s.unit());
-                }
-                if let Some(w) = a.warmup {
-                    let _ = write!(
-                        o,
-                        ", warm-up {:.4e} {} / {} s",
-                        w.amplitude(),
-                        s.unit(),
-                        w.tau()
-                    );
-                }
-                for l in &a.lines {
-                    let _ = write!(
-                        o,
-                        ", line {} Hz amplitude {:.4e} {}",
-                        l.frequency,
-                        l.amplitude,
-                        s.unit()
-                    );
-                    if l.bandwidth > 0.0 {
-                        let _ = write!(o, " (resonance, bandwidth {} Hz)", l.bandwidth);
-                    }
-                }
-                let _ = writeln!(
-                    o,
-                    "; per sample: white {:.4e}, bias step {:.4e} {}",
-                    super::white_to_discrete(a.white_noise, dt),
-                    super::random_walk_to_discrete(a.random_walk, dt),
-                    s.unit()
-                );
+                a.describe_into(&mut o, s, axis, dt);
             }
         }
         o.pop();
         o
+    }
+}
+
+/// Builds the error of one field of one axis: `at(field, message)`.
+type FieldError<'a> = &'a dyn Fn(&str, String) -> SimError;
+
+impl AxisModel {
+    /// Checks this axis' terms in the model's order, one rule each (output rate
+    /// `output_rate` Hz); `at` names sensor, axis and field in the error.
+    fn validate(&self, output_rate: f64, at: FieldError<'_>) -> Result<()> {
+        for (field, v) in [
+            ("white_noise", self.white_noise),
+            ("random_walk", self.random_walk),
+            ("quantization", self.quantization),
+            ("resolution", self.resolution),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(at(field, format!("must be a non-negative number, got {v}")));
+            }
+        }
+        if !self.rate_ramp.is_finite() {
+            return Err(at(
+                "rate_ramp",
+                format!("must be finite, got {}", self.rate_ramp),
+            ));
+        }
+        if let Some(bi) = self.bias_instability {
+            bi.validate(output_rate, at)?;
+        }
+        for gm in &self.gauss_markov {
+            if !(gm.sigma.is_finite() && gm.sigma >= 0.0 && gm.tau.is_finite() && gm.tau > 0.0) {
+                return Err(at(
+                    "gauss_markov",
+                    format!(
+                        "sigma must be >= 0 and tau > 0 s, got sigma {} tau {}",
+                        gm.sigma, gm.tau
+                    ),
+                ));
+            }
+        }
+        for l in &self.lines {
+            l.validate(output_rate, at)?;
+        }
+        if let Some(w) = self.warmup {
+            let ok = w.amplitude().is_finite() && w.tau().is_finite() && w.tau() > 0.0;
+            if !ok {
+                return Err(at(
+                    "warmup",
+                    format!(
+                        "needs a finite amplitude and a time constant > 0 s, got {:?}",
+                        w
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Appends this axis' line of [`ImuModel::describe`]: N and K, every other term that is
+    /// on, then the discrete white noise and bias step per sample of `dt` s.
+    fn describe_into(&self, o: &mut String, s: Sensor, axis: &str, dt: f64) {
+        let _ = write!(
+            o,
+            "    {axis}: N {:.4e} {}, K {:.4e} {}",
+            self.white_noise,
+            s.term_unit("white_noise"),
+            self.random_walk,
+            s.term_unit("random_walk")
+        );
+        if let Some(bi) = self.bias_instability {
+            let _ = write!(
+                o,
+                ", B {:.4e} {} ({} .. {} s)",
+                bi.b,
+                s.unit(),
+                bi.tau_lo,
+                bi.tau_hi
+            );
+        }
+        for gm in &self.gauss_markov {
+            let _ = write!(o, ", GM {:.4e} {} / {} s", gm.sigma, s.unit(), gm.tau);
+        }
+        if self.rate_ramp != 0.0 {
+            let _ = write!(o, ", R {:.4e} {}", self.rate_ramp, s.term_unit("rate_ramp"));
+        }
+        if self.quantization != 0.0 {
+            let _ = write!(
+                o,
+                ", Q {:.4e} {} (step {:.4e})",
+                self.quantization,
+                s.term_unit("quantization"),
+                super::quantization_step(self.quantization)
+            );
+        }
+        if self.resolution != 0.0 {
+            let _ = write!(o, ", LSB {:.4e} {}", self.resolution, s.unit());
+        }
+        if let Some(w) = self.warmup {
+            let _ = write!(
+                o,
+                ", warm-up {:.4e} {} / {} s",
+                w.amplitude(),
+                s.unit(),
+                w.tau()
+            );
+        }
+        for l in &self.lines {
+            let _ = write!(
+                o,
+                ", line {} Hz amplitude {:.4e} {}",
+                l.frequency,
+                l.amplitude,
+                s.unit()
+            );
+            if l.bandwidth > 0.0 {
+                let _ = write!(o, " (resonance, bandwidth {} Hz)", l.bandwidth);
+            }
+        }
+        let _ = writeln!(
+            o,
+            "; per sample: white {:.4e}, bias step {:.4e} {}",
+            super::white_to_discrete(self.white_noise, dt),
+            super::random_walk_to_discrete(self.random_walk, dt),
+            s.unit()
+        );
+    }
+}
+
+impl BiasInstability {
+    /// B non-negative, corner times ordered, τ_lo at least [`MIN_TAU_SAMPLES`] output samples.
+    fn validate(&self, output_rate: f64, at: FieldError<'_>) -> Result<()> {
+        let min_tau = MIN_TAU_SAMPLES / output_rate;
+        if !(self.b.is_finite() && self.b >= 0.0) {
+            return Err(at(
+                "bias_instability",
+                format!("B must be a non-negative number, got {}", self.b),
+            ));
+        }
+        if !(self.tau_lo.is_finite()
+            && self.tau_hi.is_finite()
+            && self.tau_lo >= min_tau
+            && self.tau_hi > self.tau_lo)
+        {
+            return Err(at(
+                "bias_instability",
+                format!(
+                    "corner times must satisfy {min_tau} s ({} output samples) <= tau_lo < tau_hi, got {} .. {}",
+                    MIN_TAU_SAMPLES, self.tau_lo, self.tau_hi
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Line {
+    /// Below half the output rate, amplitude non-negative, lightly damped (bandwidth < f₀).
+    fn validate(&self, output_rate: f64, at: FieldError<'_>) -> Result<()> {
+        if !(self.frequency.is_finite()
+            && self.frequency > 0.0
+            && self.frequency < 0.5 * output_rate
+            && self.amplitude.is_finite()
+            && self.amplitude >= 0.0
+            && self.bandwidth.is_finite()
+            && self.bandwidth >= 0.0
+            && self.bandwidth < self.frequency)
+        {
+            return Err(at(
+                "lines",
+                format!(
+                    "a line needs 0 < frequency < {} Hz (half the output rate), amplitude >= 0 and 0 <= bandwidth < frequency (lightly damped), got frequency {} Hz, amplitude {}, bandwidth {} Hz",
+                    0.5 * output_rate,
+                    self.frequency,
+                    self.amplitude,
+                    self.bandwidth
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 

@@ -114,8 +114,39 @@ fn legacy(p: Profile, c: ContinuousNoise) -> ImuModel {
     ImuModel::from_continuous(p.name(), &c)
 }
 
+/// The Bosch BMI088: its two axis models and their signal chains.
 fn bmi088() -> ImuModel {
-    // Long on purpose: a datasheet transcribed figure by figure with its sources.
+    let gyro_axis = bmi088_gyro_axis();
+    ImuModel {
+        label: "bmi088".into(),
+        gyro: SensorModel {
+            // Gyro data path at 2000 Hz (its highest ODR, 532 Hz "unfiltered" in the register
+            // table, 523 Hz in Table 5); the 200 Hz ODR with 23 Hz bandwidth setting
+            // (GYRO_BANDWIDTH = 0x04).
+            chain: Chain {
+                internal_rate_hz: Some(2000.0),
+                filter: Filter::Butterworth2 { cutoff_hz: 23.0 },
+            },
+            axes: [gyro_axis.clone(), gyro_axis.clone(), gyro_axis],
+        },
+        acc: SensorModel {
+            // Accelerometer at its highest ODR 1600 Hz internally; ODR 200 Hz, normal mode:
+            // 80 Hz bandwidth (ACC_CONF table).
+            chain: Chain {
+                internal_rate_hz: Some(1600.0),
+                filter: Filter::Butterworth2 { cutoff_hz: 80.0 },
+            },
+            axes: [
+                bmi088_acc_axis(160.0),
+                bmi088_acc_axis(160.0),
+                bmi088_acc_axis(190.0),
+            ],
+        },
+    }
+}
+
+/// The BMI088 gyroscope axis, transcribed figure by figure with its sources.
+fn bmi088_gyro_axis() -> AxisModel {
     // Gyroscope. Datasheet rev. 1.4, Table 5: output noise "BW = 47 Hz (@ 0.014 °/s/√Hz)
     // 0.1 °/s"; the product flyer gives the same 0.014 °/s/√Hz.
     let gyro_n = 0.014 * DEG;
@@ -140,7 +171,7 @@ fn bmi088() -> ImuModel {
     };
     // A Gauss–Markov bump (σ 3e-5 rad/s, T 20 s): assumed, for the bumps real consumer
     // curves show (../shared/reference/real_curves README); not a datasheet figure.
-    let gyro_axis = AxisModel {
+    AxisModel {
         white_noise: gyro_n,
         random_walk: gyro_k,
         bias_instability: Some(BiasInstability {
@@ -155,10 +186,14 @@ fn bmi088() -> ImuModel {
         resolution: gyro_lsb,
         warmup: Some(gyro_warm),
         ..Default::default()
-    };
-    // Accelerometer. Datasheet Table 4: output noise density 160 µg/√Hz on x and y,
-    // 190 µg/√Hz on z (normal mode, ±3 g; the flyer's 230 µg/√Hz is at ±24 g).
-    let acc_axis = |ug: f64| AxisModel {
+    }
+}
+
+/// The BMI088 accelerometer axis of white noise density `ug` µg/√Hz. Datasheet Table 4:
+/// output noise density 160 µg/√Hz on x and y, 190 µg/√Hz on z (normal mode, ±3 g; the
+/// flyer's 230 µg/√Hz is at ±24 g).
+fn bmi088_acc_axis(ug: f64) -> AxisModel {
+    AxisModel {
         white_noise: ug * 1e-6 * G0,
         // Not in the datasheet; assumed 1e-5 m/s³/√Hz (+½ slope from ≈ 1000 s).
         random_walk: 1e-5,
@@ -178,28 +213,6 @@ fn bmi088() -> ImuModel {
             sensitivity: 0.2e-3 * G0,
         }),
         ..Default::default()
-    };
-    ImuModel {
-        label: "bmi088".into(),
-        gyro: SensorModel {
-            // Gyro data path at 2000 Hz (its highest ODR, 532 Hz "unfiltered" in the register
-            // table, 523 Hz in Table 5); the 200 Hz ODR with 23 Hz bandwidth setting
-            // (GYRO_BANDWIDTH = 0x04).
-            chain: Chain {
-                internal_rate_hz: Some(2000.0),
-                filter: Filter::Butterworth2 { cutoff_hz: 23.0 },
-            },
-            axes: [gyro_axis.clone(), gyro_axis.clone(), gyro_axis],
-        },
-        acc: SensorModel {
-            // Accelerometer at its highest ODR 1600 Hz internally; ODR 200 Hz, normal mode:
-            // 80 Hz bandwidth (ACC_CONF table).
-            chain: Chain {
-                internal_rate_hz: Some(1600.0),
-                filter: Filter::Butterworth2 { cutoff_hz: 80.0 },
-            },
-            axes: [acc_axis(160.0), acc_axis(160.0), acc_axis(190.0)],
-        },
     }
 }
 
