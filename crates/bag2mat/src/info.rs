@@ -98,6 +98,20 @@ pub fn info_with(
     opts: &crate::formats::InputOptions,
 ) -> Result<InfoReport, Error> {
     let src = crate::input::open_with(path, opts)?;
+    let (times, losses) = read_times(src.as_ref(), quiet);
+    let mut by = topic_infos(src.as_ref(), times);
+    check_imu_topics(src.as_ref(), &mut by);
+    Ok(InfoReport {
+        kind: src.kind(),
+        topics: by.into_values().collect(),
+        notes: src.notes().to_vec(),
+        losses,
+    })
+}
+
+/// Every message's record time per channel, read part by part in parallel, and every loss
+/// the container and its parts report.
+fn read_times(src: &dyn source::Source, quiet: bool) -> (BTreeMap<u32, Vec<u64>>, Vec<Loss>) {
     let parts = src.parts();
     let pb = crate::shared::progress::bar(parts.len().max(1) as u64, quiet, "parts");
     pb.set_message("reading");
@@ -129,26 +143,20 @@ pub fn info_with(
         }
     }
     losses.extend(src.losses_after_read());
+    (times, losses)
+}
+
+/// One entry per topic and type: its channels' promised counts, and its record times'
+/// count, span, rate and gaps.
+fn topic_infos(
+    src: &dyn source::Source,
+    mut times: BTreeMap<u32, Vec<u64>>,
+) -> BTreeMap<(String, String), TopicInfo> {
     let mut by: BTreeMap<(String, String), TopicInfo> = BTreeMap::new();
     let mut topic_times: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
     for c in src.channels() {
         let key = (c.topic.clone(), c.msg_type.clone());
-        let e = by.entry(key.clone()).or_insert_with(|| TopicInfo {
-            topic: c.topic.clone(),
-            msg_type: c.msg_type.clone(),
-            encoding: c.encoding.name().to_string(),
-            imu: true,
-            count: 0,
-            promised: Some(0),
-            span: None,
-            rate: None,
-            median_period: None,
-            jitter: None,
-            gaps: 0,
-            missing: 0,
-            longest_gap: None,
-            findings: Vec::new(),
-        });
+        let e = by.entry(key.clone()).or_insert_with(|| TopicInfo::empty(c));
         e.imu &= is_imu(c);
         e.promised = e.promised.zip(c.count).map(|(a, b)| a + b);
         topic_times
@@ -170,13 +178,29 @@ pub fn info_with(
         e.missing = missing;
         e.longest_gap = longest;
     }
-    check_imu_topics(src.as_ref(), &mut by);
-    Ok(InfoReport {
-        kind: src.kind(),
-        topics: by.into_values().collect(),
-        notes: src.notes().to_vec(),
-        losses,
-    })
+    by
+}
+
+impl TopicInfo {
+    /// The entry of channel `c`'s topic before any of its messages is counted.
+    fn empty(c: &source::Channel) -> TopicInfo {
+        TopicInfo {
+            topic: c.topic.clone(),
+            msg_type: c.msg_type.clone(),
+            encoding: c.encoding.name().to_string(),
+            imu: true,
+            count: 0,
+            promised: Some(0),
+            span: None,
+            rate: None,
+            median_period: None,
+            jitter: None,
+            gaps: 0,
+            missing: 0,
+            longest_gap: None,
+            findings: Vec::new(),
+        }
+    }
 }
 
 /// The record check of every Imu topic on its record time, as `allan_kalibr` runs it: its

@@ -139,23 +139,7 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
     };
     let mut header = [0u8; 128];
     let got = read_full(&mut r, &mut header).map_err(|e| Error::io(path, e))?;
-    if got >= 8 && &header[..8] == b"\x89HDF\r\n\x1a\n" || header.starts_with(b"MATLAB 7.3") {
-        return Err(err(
-            "MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')".into(),
-        ));
-    }
-    if got < 128 || header[..4].contains(&0) {
-        return Err(err("not a MATLAB Level-5 MAT file (header missing)".into()));
-    }
-    match &header[126..128] {
-        b"IM" => {}
-        b"MI" => return Err(err("big-endian MAT files are not supported".into())),
-        _ => {
-            return Err(err(
-                "not a MATLAB Level-5 MAT file (no endian indicator)".into()
-            ));
-        }
-    }
+    level5_header(&header[..got]).map_err(err)?;
     let mut pos = 128u64;
     let mut names = Vec::new();
     while pos < len {
@@ -214,6 +198,29 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
             names.join(", ")
         )
     }))
+}
+
+/// The 128-byte header of a MATLAB Level-5 MAT file (`header`: what the file holds of it),
+/// little-endian; else what it is instead (v7.3/HDF5, big-endian, no MAT file).
+fn level5_header(header: &[u8]) -> Result<(), String> {
+    if header.len() >= 8 && &header[..8] == b"\x89HDF\r\n\x1a\n"
+        || header.starts_with(b"MATLAB 7.3")
+    {
+        return Err(
+            "MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')".into(),
+        );
+    }
+    if header.len() < 128 || header[..4].contains(&0) {
+        return Err("not a MATLAB Level-5 MAT file (header missing)".into());
+    }
+    match &header[126..128] {
+        b"IM" => {}
+        b"MI" => return Err("big-endian MAT files are not supported".into()),
+        _ => {
+            return Err("not a MATLAB Level-5 MAT file (no endian indicator)".into());
+        }
+    }
+    Ok(())
 }
 
 /// Reads until `buf` is full or the input ends; returns the bytes read.

@@ -208,75 +208,82 @@ pub fn gaps(tm: &Timing, t: &[i64], cut: Option<Segment>) -> Vec<Finding> {
         )
     });
     if tm.missing > 0 {
-        let longest = tm.longest_gap().expect("a gap");
-        let long: Vec<_> = tm.gaps.iter().filter(|g| g.missing >= GAP_FACTOR).collect();
-        let long_text = if long.is_empty() {
-            String::new()
-        } else {
-            format!(
-                "; {} long gap(s) of {GAP_FACTOR} or more samples in a row, totalling {:.3} s ({:.2} % of the span)",
-                long.len(),
-                tm.long_gap_time(),
-                100.0 * tm.long_gap_time() / tm.span.max(f64::MIN_POSITIVE)
-            )
-        };
-        let what = match (&cut_text, tm.rate_changes.is_empty()) {
-            (Some(c), true) => c.clone(),
-            (Some(_), false) => "cut with the rate change below".to_string(),
-            (None, _) => format!(
-                "bridged: analysed as one record at the nominal {rate:.4} Hz (lost samples do not change the rate of those that arrived)"
-            ),
-        };
-        out.push(
-            Finding::new(
-                Level::Warning,
-                Kind::Gaps,
-                format!(
-                    "{} samples missing ({:.2} % of the {} the span holds at the nominal {rate:.4} Hz) in {} gap(s); the longest {:.4} s ({} missing) at t = {:.3} s, after sample {} (stamp {}){long_text}; {what}",
-                    tm.missing,
-                    100.0 * tm.missing_fraction(),
-                    tm.n as u64 + tm.missing,
-                    tm.gaps.len(),
-                    longest.length,
-                    longest.missing,
-                    longest.at,
-                    longest.after,
-                    stamp_text(t[longest.after])
-                ),
-            )
-            .at(longest.at, longest.after)
-            .counted(tm.missing as f64, "samples missing"),
-        );
+        out.push(missing_samples(tm, t, cut_text.as_deref(), rate));
     }
     if let Some(&first) = tm.rate_changes.first() {
-        let list: Vec<String> = tm
-            .rate_changes
-            .iter()
-            .take(MAX_LISTED)
-            .map(|&i| format!("sample {i} (t = {:.3} s)", secs(t[i] - t[0])))
-            .collect();
-        out.push(
-            Finding::new(
-                Level::Warning,
-                Kind::RateChange,
-                format!(
-                    "the sampling rate changes {} time(s) (off the median {:.4} Hz by more than {:.0} %, at {}{}); {}",
-                    tm.rate_changes.len(),
-                    1e9 / tm.median_period_ns.unwrap_or(1) as f64,
-                    100.0 * timing::RATE_CHANGE_REL,
-                    list.join(", "),
-                    if tm.rate_changes.len() > MAX_LISTED {
-                        ", …"
-                    } else {
-                        ""
-                    },
-                    cut_text.clone().unwrap_or_default()
-                ),
-            )
-            .at(secs(t[first] - t[0]), first),
-        );
+        out.push(rate_changes(tm, t, first, cut_text.as_deref()));
     }
     out
+}
+
+/// The finding on samples missing from the record: how many, the longest gap, the long
+/// ones, and whether the record is bridged or cut.
+fn missing_samples(tm: &Timing, t: &[i64], cut_text: Option<&str>, rate: f64) -> Finding {
+    let longest = tm.longest_gap().expect("a gap");
+    let long: Vec<_> = tm.gaps.iter().filter(|g| g.missing >= GAP_FACTOR).collect();
+    let long_text = if long.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; {} long gap(s) of {GAP_FACTOR} or more samples in a row, totalling {:.3} s ({:.2} % of the span)",
+            long.len(),
+            tm.long_gap_time(),
+            100.0 * tm.long_gap_time() / tm.span.max(f64::MIN_POSITIVE)
+        )
+    };
+    let what = match (cut_text, tm.rate_changes.is_empty()) {
+        (Some(c), true) => c.to_string(),
+        (Some(_), false) => "cut with the rate change below".to_string(),
+        (None, _) => format!(
+            "bridged: analysed as one record at the nominal {rate:.4} Hz (lost samples do not change the rate of those that arrived)"
+        ),
+    };
+    Finding::new(
+        Level::Warning,
+        Kind::Gaps,
+        format!(
+            "{} samples missing ({:.2} % of the {} the span holds at the nominal {rate:.4} Hz) in {} gap(s); the longest {:.4} s ({} missing) at t = {:.3} s, after sample {} (stamp {}){long_text}; {what}",
+            tm.missing,
+            100.0 * tm.missing_fraction(),
+            tm.n as u64 + tm.missing,
+            tm.gaps.len(),
+            longest.length,
+            longest.missing,
+            longest.at,
+            longest.after,
+            stamp_text(t[longest.after])
+        ),
+    )
+    .at(longest.at, longest.after)
+    .counted(tm.missing as f64, "samples missing")
+}
+
+/// The finding on the sampling rate changing (the first ones listed), at the first change.
+fn rate_changes(tm: &Timing, t: &[i64], first: usize, cut_text: Option<&str>) -> Finding {
+    let list: Vec<String> = tm
+        .rate_changes
+        .iter()
+        .take(MAX_LISTED)
+        .map(|&i| format!("sample {i} (t = {:.3} s)", secs(t[i] - t[0])))
+        .collect();
+    Finding::new(
+        Level::Warning,
+        Kind::RateChange,
+        format!(
+            "the sampling rate changes {} time(s) (off the median {:.4} Hz by more than {:.0} %, at {}{}); {}",
+            tm.rate_changes.len(),
+            1e9 / tm.median_period_ns.unwrap_or(1) as f64,
+            100.0 * timing::RATE_CHANGE_REL,
+            list.join(", "),
+            if tm.rate_changes.len() > MAX_LISTED {
+                ", …"
+            } else {
+                ""
+            },
+            cut_text.unwrap_or_default()
+        ),
+    )
+    .at(secs(t[first] - t[0]), first)
 }
 
 /// The other clock over the same samples: both must tick at the sensor's rate.

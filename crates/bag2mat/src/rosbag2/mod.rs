@@ -100,45 +100,7 @@ impl BagDir {
             ));
             BagInfo::default()
         });
-        let mut paths: Vec<PathBuf> = info
-            .relative_file_paths
-            .iter()
-            .map(|r| dir.join(r))
-            .collect();
-        let listed = paths.len();
-        if !paths.iter().any(|p| p.exists()) {
-            // Some tools leave the list empty; take the storage files in name order (also
-            // when none of those listed is there).
-            let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
-                .map_err(|e| Error::io(dir, e))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| {
-                    let n = p.to_string_lossy();
-                    [".db3", ".mcap", ".db3.zstd", ".mcap.zstd"]
-                        .iter()
-                        .any(|x| n.ends_with(x))
-                })
-                .collect();
-            found.sort();
-            if listed == 0 && !damaged {
-                notes.push(format!(
-                    "metadata.yaml lists no storage files; reading the {} found in the directory",
-                    found.len()
-                ));
-            } else if listed > 0 && !found.is_empty() {
-                notes.push(format!(
-                    "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
-                    found.len()
-                ));
-            }
-            for p in &paths {
-                losses.push(Loss::new(format!(
-                    "{} is listed in metadata.yaml but missing",
-                    p.display()
-                )));
-            }
-            paths = found;
-        }
+        let paths = storage_paths(dir, &info, damaged, &mut notes, &mut losses)?;
         let mut files = Vec::new();
         for p in &paths {
             if !p.exists() {
@@ -170,21 +132,7 @@ impl BagDir {
                 ),
             });
         }
-        // What the storage files can hold bounds the counts metadata.yaml states.
-        // (compressed data, MCAP chunks included, expands by at most MAX_EXPANSION).
-        let held: u64 = paths
-            .iter()
-            .filter_map(|p| {
-                let len = std::fs::metadata(p).ok()?.len();
-                let raw = crate::detect::input_kind(p).ok()? == InputKind::Sqlite3
-                    && info.compression_mode().is_empty();
-                Some(if raw {
-                    len
-                } else {
-                    len.saturating_mul(source::MAX_EXPANSION)
-                })
-            })
-            .fold(0u64, |a, b| a.saturating_add(b));
+        let held = held_bytes(&paths, &info);
         let mut d = Self::assemble(files, Some(info), message_zstd, notes, losses);
         d.bound_promises(held);
         Ok(d)
@@ -237,24 +185,7 @@ impl BagDir {
         let mut parts = Vec::new();
         let multi = files.len() > 1;
         for (fi, (src, tmp)) in files.into_iter().enumerate() {
-            let mut ids = BTreeMap::new();
-            for c in src.channels() {
-                let found = channels.iter_mut().find(|g| {
-                    g.topic == c.topic && g.msg_type == c.msg_type && g.encoding == c.encoding
-                });
-                let gid = match found {
-                    Some(g) => {
-                        g.count = g.count.zip(c.count).map(|(a, b)| a + b);
-                        g.id
-                    }
-                    None => {
-                        let id = channels.len() as u32 + 1;
-                        channels.push(Channel { id, ..c.clone() });
-                        id
-                    }
-                };
-                ids.insert(c.id, gid);
-            }
+            let ids = merge_channels(&mut channels, src.as_ref());
             for (pi, p) in src.parts().iter().enumerate() {
                 part_map.push((fi, pi));
                 let mut p = p.clone();
@@ -281,15 +212,8 @@ impl BagDir {
         }
         let file_counts: BTreeMap<u32, Option<u64>> =
             channels.iter().map(|c| (c.id, c.count)).collect();
-        // metadata.yaml's counts are what the recorder promised for the whole bag.
         if let Some(info) = &info {
-            for c in channels.iter_mut() {
-                if let Some(t) = info.topics_with_message_count.iter().find(|t| {
-                    t.topic_metadata.name == c.topic && t.topic_metadata.msg_type == c.msg_type
-                }) {
-                    c.count = Some(t.message_count);
-                }
-            }
+            promised_counts(&mut channels, info);
         }
         BagDir {
             files: out_files,
@@ -540,4 +464,112 @@ impl Ros2BagWriter {
         })?;
         self.dir.commit()
     }
+}
+
+/// Adds the channels of one storage file to the bag's (one per topic, type and encoding,
+/// their counts summed); returns the file's channel ids → the bag's.
+fn merge_channels(channels: &mut Vec<Channel>, src: &dyn Source) -> BTreeMap<u32, u32> {
+    let mut ids = BTreeMap::new();
+    for c in src.channels() {
+        let found = channels
+            .iter_mut()
+            .find(|g| g.topic == c.topic && g.msg_type == c.msg_type && g.encoding == c.encoding);
+        let gid = match found {
+            Some(g) => {
+                g.count = g.count.zip(c.count).map(|(a, b)| a + b);
+                g.id
+            }
+            None => {
+                let id = channels.len() as u32 + 1;
+                channels.push(Channel { id, ..c.clone() });
+                id
+            }
+        };
+        ids.insert(c.id, gid);
+    }
+    ids
+}
+
+/// Sets each channel's count to what metadata.yaml states for its topic and type.
+fn promised_counts(channels: &mut [Channel], info: &BagInfo) {
+    // metadata.yaml's counts are what the recorder promised for the whole bag.
+    for c in channels.iter_mut() {
+        if let Some(t) = info
+            .topics_with_message_count
+            .iter()
+            .find(|t| t.topic_metadata.name == c.topic && t.topic_metadata.msg_type == c.msg_type)
+        {
+            c.count = Some(t.message_count);
+        }
+    }
+}
+
+/// The storage files to read: those `metadata.yaml` lists, or, when none of them is there
+/// (some tools leave the list empty), the storage files in the directory in name order,
+/// with a note and a loss per listed file that is missing.
+fn storage_paths(
+    dir: &Path,
+    info: &BagInfo,
+    damaged: bool,
+    notes: &mut Vec<String>,
+    losses: &mut Vec<Loss>,
+) -> Result<Vec<PathBuf>, Error> {
+    let mut paths: Vec<PathBuf> = info
+        .relative_file_paths
+        .iter()
+        .map(|r| dir.join(r))
+        .collect();
+    let listed = paths.len();
+    if !paths.iter().any(|p| p.exists()) {
+        // Some tools leave the list empty; take the storage files in name order (also
+        // when none of those listed is there).
+        let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| Error::io(dir, e))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                let n = p.to_string_lossy();
+                [".db3", ".mcap", ".db3.zstd", ".mcap.zstd"]
+                    .iter()
+                    .any(|x| n.ends_with(x))
+            })
+            .collect();
+        found.sort();
+        if listed == 0 && !damaged {
+            notes.push(format!(
+                "metadata.yaml lists no storage files; reading the {} found in the directory",
+                found.len()
+            ));
+        } else if listed > 0 && !found.is_empty() {
+            notes.push(format!(
+                "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
+                found.len()
+            ));
+        }
+        for p in &paths {
+            losses.push(Loss::new(format!(
+                "{} is listed in metadata.yaml but missing",
+                p.display()
+            )));
+        }
+        paths = found;
+    }
+    Ok(paths)
+}
+
+/// What the storage files can hold, in bytes: it bounds the counts metadata.yaml states
+/// (compressed data, MCAP chunks included, expands by at most MAX_EXPANSION).
+fn held_bytes(paths: &[PathBuf], info: &BagInfo) -> u64 {
+    paths
+        .iter()
+        .filter_map(|p| {
+            let len = std::fs::metadata(p).ok()?.len();
+            let raw = crate::detect::input_kind(p).ok()? == InputKind::Sqlite3
+                && info.compression_mode().is_empty();
+            Some(if raw {
+                len
+            } else {
+                len.saturating_mul(source::MAX_EXPANSION)
+            })
+        })
+        .fold(0u64, |a, b| a.saturating_add(b))
 }

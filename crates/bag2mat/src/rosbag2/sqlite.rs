@@ -716,18 +716,7 @@ impl Sqlite3Reader {
         let hi = max_id.map_or(0, |m| m.0);
         let lo = min_id.unwrap_or(1);
         let index = format!("\"{}\"", index.replace('"', "\"\""));
-        let scan = |sql: &str, p: &[i64]| -> Result<Vec<(i64, i64)>, rusqlite::Error> {
-            let mut st = conn.prepare(sql)?;
-            let mut q = st.query(rusqlite::params_from_iter(p))?;
-            let mut found = Vec::new();
-            while let Some(row) = q.next()? {
-                found.push((row.get(0)?, row.get::<_, Option<i64>>(1)?.unwrap_or(0)));
-                if found.len() as u64 > self.capacity {
-                    break;
-                }
-            }
-            Ok(found)
-        };
+        let scan = |sql: &str, p: &[i64]| index_rows(conn, sql, p, self.capacity);
         let whole = format!(
             "SELECT id, timestamp FROM messages INDEXED BY {index} WHERE id > ?1 OR id < ?2"
         );
@@ -751,32 +740,7 @@ impl Sqlite3Reader {
         found.dedup_by_key(|x| x.0);
         let mut out = Vec::new();
         let take_run = |ids: &mut dyn Iterator<Item = &(i64, i64)>, from: i64, up: bool| {
-            let mut expect = from;
-            let (mut n, mut t0, mut t1) = (0u64, i64::MAX, i64::MIN);
-            let mut ends = (from, from);
-            for &(id, ts) in ids {
-                if id != expect {
-                    break;
-                }
-                n += 1;
-                t0 = t0.min(ts);
-                t1 = t1.max(ts);
-                ends = if up { (from, id) } else { (id, from) };
-                expect = if up {
-                    id.saturating_add(1)
-                } else {
-                    id.saturating_sub(1)
-                };
-            }
-            (n > 0).then(|| Loss {
-                what: format!(
-                    "message rows {}..{} that the table's timestamp index lists are missing from the table (a damaged page)",
-                    ends.0, ends.1
-                ),
-                messages: Some(n.min(self.capacity)),
-                span: Some((t0.max(0) as u64, t1.max(0) as u64)),
-                ..Loss::default()
-            })
+            listed_run(ids, from, up, self.capacity)
         };
         out.extend(take_run(
             &mut found.iter().filter(|x| x.0 > hi),
@@ -792,6 +756,62 @@ impl Sqlite3Reader {
         }
         out
     }
+}
+
+/// The (id, record time) rows a query over the timestamp index gives, at most one past
+/// `capacity` (what the file can hold).
+fn index_rows(
+    conn: &Connection,
+    sql: &str,
+    p: &[i64],
+    capacity: u64,
+) -> Result<Vec<(i64, i64)>, rusqlite::Error> {
+    let mut st = conn.prepare(sql)?;
+    let mut q = st.query(rusqlite::params_from_iter(p))?;
+    let mut found = Vec::new();
+    while let Some(row) = q.next()? {
+        found.push((row.get(0)?, row.get::<_, Option<i64>>(1)?.unwrap_or(0)));
+        if found.len() as u64 > capacity {
+            break;
+        }
+    }
+    Ok(found)
+}
+
+/// The run of consecutive ids from `from` (upwards or downwards) that the index lists and
+/// the table lacks, as a loss.
+fn listed_run(
+    ids: &mut dyn Iterator<Item = &(i64, i64)>,
+    from: i64,
+    up: bool,
+    capacity: u64,
+) -> Option<Loss> {
+    let mut expect = from;
+    let (mut n, mut t0, mut t1) = (0u64, i64::MAX, i64::MIN);
+    let mut ends = (from, from);
+    for &(id, ts) in ids {
+        if id != expect {
+            break;
+        }
+        n += 1;
+        t0 = t0.min(ts);
+        t1 = t1.max(ts);
+        ends = if up { (from, id) } else { (id, from) };
+        expect = if up {
+            id.saturating_add(1)
+        } else {
+            id.saturating_sub(1)
+        };
+    }
+    (n > 0).then(|| Loss {
+        what: format!(
+            "message rows {}..{} that the table's timestamp index lists are missing from the table (a damaged page)",
+            ends.0, ends.1
+        ),
+        messages: Some(n.min(capacity)),
+        span: Some((t0.max(0) as u64, t1.max(0) as u64)),
+        ..Loss::default()
+    })
 }
 
 /// Writes a rosbag2 `.db3` in the current schema (version 4: `schema`, `metadata`,

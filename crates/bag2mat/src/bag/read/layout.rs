@@ -52,25 +52,17 @@ impl BagReader {
         while pos < end {
             let Some((hb, data_pos, dlen)) = self.record_at(pos, end) else {
                 if end == self.len {
-                    let at_most = self.tail_capacity(pos);
-                    self.contents.losses.push(Loss {
-                        at_most,
-                        ..Loss::new(format!(
-                            "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
-                            self.len - pos
-                        ))
-                    });
-                } else {
-                    self.damaged_at(
-                        pos,
-                        end,
-                        "a record runs past the end of the chunk section",
-                        info_positions,
-                        &mut pos,
-                    );
-                    continue;
+                    self.truncated_tail(pos);
+                    break;
                 }
-                break;
+                self.damaged_at(
+                    pos,
+                    end,
+                    "a record runs past the end of the chunk section",
+                    info_positions,
+                    &mut pos,
+                );
+                continue;
             };
             let next = data_pos + dlen as u64;
             let h = match Header::parse(&hb) {
@@ -81,35 +73,10 @@ impl BagReader {
                 }
             };
             match h.op() {
-                Ok(Op::Chunk) => {
-                    let Ok(chunk) = ChunkHeader::decode(&h) else {
-                        self.damaged_at(pos, end, "damaged chunk header", info_positions, &mut pos);
+                Ok(op @ (Op::Chunk | Op::IndexData | Op::Connection)) => {
+                    if let Err(why) = self.top_record(&mut w, op, &h, pos, data_pos, dlen) {
+                        self.damaged_at(pos, end, why, info_positions, &mut pos);
                         continue;
-                    };
-                    w.chunks.push(ChunkLoc {
-                        pos,
-                        stored: Some(dlen as u64),
-                        size: Some(chunk.size as u64),
-                        index_data: BTreeMap::new(),
-                        info_counts: None,
-                        span: None,
-                    });
-                }
-                Ok(Op::IndexData) => {
-                    if let (Some(c), Ok(ix)) = (w.chunks.last_mut(), IndexData::decode(&h)) {
-                        // The entries the file holds, whatever the count field says.
-                        let count = (ix.count.unwrap_or(u32::MAX) as u64)
-                            .min(dlen as u64 / INDEX_ENTRY_LEN as u64);
-                        c.index_data
-                            .entry(ix.conn)
-                            .or_insert(ChunkIndexData { count, data_pos });
-                    }
-                }
-                Ok(Op::Connection) => {
-                    if let Ok(data) = self.bytes_at(data_pos, dlen)
-                        && let Ok(c) = Connection::decode(&h, &data)
-                    {
-                        w.connections.push(c);
                     }
                 }
                 Ok(Op::ChunkInfo) => {
@@ -130,6 +97,65 @@ impl BagReader {
             pos = next;
         }
         w
+    }
+
+    /// The incomplete record the file ends with (a truncated bag), as a loss.
+    fn truncated_tail(&mut self, pos: u64) {
+        let at_most = self.tail_capacity(pos);
+        self.contents.losses.push(Loss {
+            at_most,
+            ..Loss::new(format!(
+                "the last {} bytes of the file are an incomplete record (truncated bag); they were skipped",
+                self.len - pos
+            ))
+        });
+    }
+
+    /// A chunk, index data or connection record at `pos` (data at `data_pos`, `dlen`
+    /// bytes) the walk met: what it adds, or why the record is damaged.
+    fn top_record(
+        &mut self,
+        w: &mut Walk,
+        op: Op,
+        h: &Header,
+        pos: u64,
+        data_pos: u64,
+        dlen: u32,
+    ) -> Result<(), &'static str> {
+        match op {
+            Op::Chunk => {
+                let Ok(chunk) = ChunkHeader::decode(h) else {
+                    return Err("damaged chunk header");
+                };
+                w.chunks.push(ChunkLoc {
+                    pos,
+                    stored: Some(dlen as u64),
+                    size: Some(chunk.size as u64),
+                    index_data: BTreeMap::new(),
+                    info_counts: None,
+                    span: None,
+                });
+            }
+            Op::IndexData => {
+                if let (Some(c), Ok(ix)) = (w.chunks.last_mut(), IndexData::decode(h)) {
+                    // The entries the file holds, whatever the count field says.
+                    let count = (ix.count.unwrap_or(u32::MAX) as u64)
+                        .min(dlen as u64 / INDEX_ENTRY_LEN as u64);
+                    c.index_data
+                        .entry(ix.conn)
+                        .or_insert(ChunkIndexData { count, data_pos });
+                }
+            }
+            Op::Connection => {
+                if let Ok(data) = self.bytes_at(data_pos, dlen)
+                    && let Ok(c) = Connection::decode(h, &data)
+                {
+                    w.connections.push(c);
+                }
+            }
+            _ => {}
+        }
+        Ok(())
     }
 
     /// Records a damaged top-level record at `*pos` and moves `*pos` to the next chunk: the

@@ -82,9 +82,12 @@ pub fn imu_log<W: Write>(w: W, seconds: f64, rate: f64, seed: u64) -> io::Result
     let dt = (1e6 / rate).round() as u64;
     let t0 = 5_000_000u64;
     let mut b = Vec::with_capacity(256);
-    let batch = 256usize;
-    let (isb_rate, mut isb_n, mut next_batch) = (4.0 * rate, 0u16, t0);
-    let batch_us = (batch as f64 / (4.0 * rate) * 1e6) as u64;
+    let batch = Batch {
+        len: 256,
+        rate: 4.0 * rate,
+    };
+    let (mut isb_n, mut next_batch) = (0u16, t0);
+    let batch_us = (batch.len as f64 / (4.0 * rate) * 1e6) as u64;
     let (acc_mul, gyro_mul) = (
         32768.0f32 / (16.0 * 9.80665),
         32768.0f32 / (2000.0f32.to_radians()),
@@ -92,23 +95,7 @@ pub fn imu_log<W: Write>(w: W, seconds: f64, rate: f64, seed: u64) -> io::Result
     for i in 0..n {
         let t = t0 + i * dt;
         for k in 0..2u8 {
-            b.clear();
-            b.extend_from_slice(&t.to_le_bytes());
-            b.push(k);
-            for a in 0..6 {
-                let base = if a == 5 { -9.80665 } else { 0.0 };
-                let scale = if a < 3 { 1e-3 } else { 2e-2 };
-                b.extend_from_slice(
-                    &((base + scale * crate::formats::synthetic_noise(&mut st)) as f32)
-                        .to_le_bytes(),
-                );
-            }
-            b.extend_from_slice(&0u32.to_le_bytes());
-            b.extend_from_slice(&0u32.to_le_bytes());
-            b.extend_from_slice(&41.5f32.to_le_bytes());
-            b.extend_from_slice(&[1, 1]);
-            b.extend_from_slice(&(rate as u16 * 4).to_le_bytes());
-            b.extend_from_slice(&(rate as u16 * 4).to_le_bytes());
+            imu_body(&mut b, t, k, rate, &mut st);
             d.message(129, &b)?;
         }
         if i % ((rate / 10.0).round().max(1.0) as u64) == 0 {
@@ -123,40 +110,81 @@ pub fn imu_log<W: Write>(w: W, seconds: f64, rate: f64, seed: u64) -> io::Result
         if t >= next_batch && t + 2 * batch_us < t0 + n * dt {
             let last = t + 4 * batch_us >= t0 + n * dt;
             for (kind, mul) in [(0u8, acc_mul), (1u8, gyro_mul)] {
-                b.clear();
-                b.extend_from_slice(&t.to_le_bytes());
-                b.extend_from_slice(&isb_n.to_le_bytes());
-                b.push(kind);
-                b.push(0);
-                b.extend_from_slice(&(mul.round() as u16).to_le_bytes());
-                b.extend_from_slice(&(batch as u16).to_le_bytes());
-                b.extend_from_slice(&t.to_le_bytes());
-                b.extend_from_slice(&(isb_rate as f32).to_le_bytes());
-                d.message(130, &b)?;
-                let chunks = batch / ISBD_SAMPLES - usize::from(last);
-                for seq in 0..chunks {
-                    b.clear();
-                    b.extend_from_slice(&t.to_le_bytes());
-                    b.extend_from_slice(&isb_n.to_le_bytes());
-                    b.extend_from_slice(&(seq as u16).to_le_bytes());
-                    for axis in 0..3 {
-                        for _ in 0..ISBD_SAMPLES {
-                            let g = if kind == 0 && axis == 2 {
-                                -9.80665
-                            } else {
-                                0.0
-                            };
-                            let v =
-                                (g + 0.05 * crate::formats::synthetic_noise(&mut st)) * mul as f64;
-                            b.extend_from_slice(&(v.round() as i16).to_le_bytes());
-                        }
-                    }
-                    d.message(131, &b)?;
-                }
+                batch.write(&mut d, &mut b, (t, isb_n, kind, mul), last, &mut st)?;
                 isb_n = isb_n.wrapping_add(1);
             }
             next_batch = t + 2 * batch_us;
         }
     }
     d.finish()
+}
+
+/// An IMU message of instance `k` at `t` µs: noise around rest (gravity on −z).
+fn imu_body(b: &mut Vec<u8>, t: u64, k: u8, rate: f64, st: &mut u64) {
+    b.clear();
+    b.extend_from_slice(&t.to_le_bytes());
+    b.push(k);
+    for a in 0..6 {
+        let base = if a == 5 { -9.80665 } else { 0.0 };
+        let scale = if a < 3 { 1e-3 } else { 2e-2 };
+        b.extend_from_slice(
+            &((base + scale * crate::formats::synthetic_noise(st)) as f32).to_le_bytes(),
+        );
+    }
+    b.extend_from_slice(&0u32.to_le_bytes());
+    b.extend_from_slice(&0u32.to_le_bytes());
+    b.extend_from_slice(&41.5f32.to_le_bytes());
+    b.extend_from_slice(&[1, 1]);
+    b.extend_from_slice(&(rate as u16 * 4).to_le_bytes());
+    b.extend_from_slice(&(rate as u16 * 4).to_le_bytes());
+}
+
+/// The high-rate sensor batches of [`imu_log`]: `len` samples at `rate` Hz each.
+struct Batch {
+    len: usize,
+    rate: f64,
+}
+
+impl Batch {
+    /// One batch (`t` µs, number `isb_n`, sensor `kind` 0 acc / 1 gyro, `mul` LSB per
+    /// unit): its ISBH header and ISBD chunks, the last chunk left out on the `last` batch.
+    fn write<W: Write>(
+        &self,
+        d: &mut Writer<W>,
+        b: &mut Vec<u8>,
+        (t, isb_n, kind, mul): (u64, u16, u8, f32),
+        last: bool,
+        st: &mut u64,
+    ) -> io::Result<()> {
+        b.clear();
+        b.extend_from_slice(&t.to_le_bytes());
+        b.extend_from_slice(&isb_n.to_le_bytes());
+        b.push(kind);
+        b.push(0);
+        b.extend_from_slice(&(mul.round() as u16).to_le_bytes());
+        b.extend_from_slice(&(self.len as u16).to_le_bytes());
+        b.extend_from_slice(&t.to_le_bytes());
+        b.extend_from_slice(&(self.rate as f32).to_le_bytes());
+        d.message(130, b)?;
+        let chunks = self.len / ISBD_SAMPLES - usize::from(last);
+        for seq in 0..chunks {
+            b.clear();
+            b.extend_from_slice(&t.to_le_bytes());
+            b.extend_from_slice(&isb_n.to_le_bytes());
+            b.extend_from_slice(&(seq as u16).to_le_bytes());
+            for axis in 0..3 {
+                for _ in 0..ISBD_SAMPLES {
+                    let g = if kind == 0 && axis == 2 {
+                        -9.80665
+                    } else {
+                        0.0
+                    };
+                    let v = (g + 0.05 * crate::formats::synthetic_noise(st)) * mul as f64;
+                    b.extend_from_slice(&(v.round() as i16).to_le_bytes());
+                }
+            }
+            d.message(131, b)?;
+        }
+        Ok(())
+    }
 }

@@ -182,23 +182,7 @@ pub struct ImuLogSpec {
 /// and `vehicle_status` at 2 Hz, interleaved in time order as the logger writes them.
 pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
     let mut u = Writer::new(w, 0)?;
-    u.info("char[5] sys_name", b"PX4_t")?;
-    for f in [
-        SENSOR_COMBINED,
-        SENSOR_GYRO,
-        SENSOR_ACCEL,
-        VEHICLE_IMU,
-        VEHICLE_STATUS,
-    ] {
-        u.format(f)?;
-    }
-    u.add(0, 0, "sensor_combined")?;
-    for k in 0..spec.instances {
-        u.add(k, 1 + k as u16, "sensor_gyro")?;
-        u.add(k, 64 + k as u16, "sensor_accel")?;
-    }
-    u.add(0, 200, "vehicle_imu")?;
-    u.add(0, 201, "vehicle_status")?;
+    declare_imu_topics(&mut u, spec.instances)?;
     let mut state = spec.seed;
     let mut noise = || crate::formats::synthetic_noise(&mut state);
     let n = (spec.seconds * spec.rate) as u64;
@@ -206,11 +190,6 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
     let t0 = 10_000_000u64;
     let status_every = (spec.rate / 2.0).round().max(1.0) as u64;
     let mut b = Vec::with_capacity(64);
-    let f32s = |b: &mut Vec<u8>, v: &[f32]| {
-        for x in v {
-            b.extend_from_slice(&x.to_le_bytes());
-        }
-    };
     // the samples a dropout loses: those of its duration, half way through
     let lost = match spec.dropout_ms {
         Some(ms) => n / 2..n / 2 + (ms as f64 * 1e-3 * spec.rate).round() as u64,
@@ -228,40 +207,17 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
         let gyro: [f32; 3] = std::array::from_fn(|_| (1e-3 * noise()) as f32);
         let acc: [f32; 3] =
             std::array::from_fn(|k| (if k == 2 { -9.81 } else { 0.0 } + 0.02 * noise()) as f32);
-        b.clear();
-        b.extend_from_slice(&t.to_le_bytes());
-        f32s(&mut b, &gyro);
-        b.extend_from_slice(&(dt_us as u32).to_le_bytes());
-        b.extend_from_slice(&0i32.to_le_bytes());
-        f32s(&mut b, &acc);
-        b.extend_from_slice(&(dt_us as u32).to_le_bytes());
-        b.extend_from_slice(&[0, 0, 1, 1]);
+        combined_body(&mut b, t, gyro, acc, dt_us);
         u.data(0, &b)?;
         for k in 0..spec.instances {
             for (id, v) in [(1 + k as u16, gyro), (64 + k as u16, acc)] {
-                b.clear();
-                b.extend_from_slice(&(t + 150).to_le_bytes());
-                b.extend_from_slice(&(t - 50 * k as u64).to_le_bytes());
-                b.extend_from_slice(&(0x0024_0000u32 + k as u32).to_le_bytes());
-                f32s(&mut b, &v.map(|x| x + (1e-4 * noise()) as f32));
-                f32s(&mut b, &[35.5]);
-                b.extend_from_slice(&0u32.to_le_bytes());
-                b.extend_from_slice(&[0, 0, 0, 1]);
+                let v = v.map(|x| x + (1e-4 * noise()) as f32);
+                sensor_body(&mut b, t, k, v);
                 u.data(id, &b)?;
             }
         }
         if i % 2 == 1 {
-            b.clear();
-            b.extend_from_slice(&(t + 300).to_le_bytes());
-            b.extend_from_slice(&t.to_le_bytes());
-            b.extend_from_slice(&1u32.to_le_bytes());
-            b.extend_from_slice(&2u32.to_le_bytes());
-            let d = 2.0 * dt_us as f32 * 1e-6;
-            f32s(&mut b, &gyro.map(|x| x * d));
-            f32s(&mut b, &acc.map(|x| x * d));
-            b.extend_from_slice(&(2 * dt_us as u16).to_le_bytes());
-            b.extend_from_slice(&(2 * dt_us as u16).to_le_bytes());
-            b.extend_from_slice(&[0, 0, 1, 1]);
+            vehicle_imu_body(&mut b, t, gyro, acc, dt_us);
             u.data(200, &b)?;
         }
         if i % status_every == 0 {
@@ -272,4 +228,73 @@ pub fn imu_log<W: Write>(w: W, spec: &ImuLogSpec) -> io::Result<W> {
         }
     }
     u.finish()
+}
+
+/// The formats and subscriptions of [`imu_log`]: sensor_combined (id 0), `instances` ×
+/// sensor_gyro (1 + k) and sensor_accel (64 + k), vehicle_imu (200), vehicle_status (201).
+fn declare_imu_topics<W: Write>(u: &mut Writer<W>, instances: u8) -> io::Result<()> {
+    u.info("char[5] sys_name", b"PX4_t")?;
+    for f in [
+        SENSOR_COMBINED,
+        SENSOR_GYRO,
+        SENSOR_ACCEL,
+        VEHICLE_IMU,
+        VEHICLE_STATUS,
+    ] {
+        u.format(f)?;
+    }
+    u.add(0, 0, "sensor_combined")?;
+    for k in 0..instances {
+        u.add(k, 1 + k as u16, "sensor_gyro")?;
+        u.add(k, 64 + k as u16, "sensor_accel")?;
+    }
+    u.add(0, 200, "vehicle_imu")?;
+    u.add(0, 201, "vehicle_status")?;
+    Ok(())
+}
+
+fn put_f32s(b: &mut Vec<u8>, v: &[f32]) {
+    for x in v {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+/// A sensor_combined message at `t` µs.
+fn combined_body(b: &mut Vec<u8>, t: u64, gyro: [f32; 3], acc: [f32; 3], dt_us: u64) {
+    b.clear();
+    b.extend_from_slice(&t.to_le_bytes());
+    put_f32s(b, &gyro);
+    b.extend_from_slice(&(dt_us as u32).to_le_bytes());
+    b.extend_from_slice(&0i32.to_le_bytes());
+    put_f32s(b, &acc);
+    b.extend_from_slice(&(dt_us as u32).to_le_bytes());
+    b.extend_from_slice(&[0, 0, 1, 1]);
+}
+
+/// A sensor_gyro or sensor_accel message of instance `k` (logged 150 µs after `t`,
+/// sampled 50·k µs before it).
+fn sensor_body(b: &mut Vec<u8>, t: u64, k: u8, v: [f32; 3]) {
+    b.clear();
+    b.extend_from_slice(&(t + 150).to_le_bytes());
+    b.extend_from_slice(&(t - 50 * k as u64).to_le_bytes());
+    b.extend_from_slice(&(0x0024_0000u32 + k as u32).to_le_bytes());
+    put_f32s(b, &v);
+    put_f32s(b, &[35.5]);
+    b.extend_from_slice(&0u32.to_le_bytes());
+    b.extend_from_slice(&[0, 0, 0, 1]);
+}
+
+/// A vehicle_imu message: the deltas over two samples.
+fn vehicle_imu_body(b: &mut Vec<u8>, t: u64, gyro: [f32; 3], acc: [f32; 3], dt_us: u64) {
+    b.clear();
+    b.extend_from_slice(&(t + 300).to_le_bytes());
+    b.extend_from_slice(&t.to_le_bytes());
+    b.extend_from_slice(&1u32.to_le_bytes());
+    b.extend_from_slice(&2u32.to_le_bytes());
+    let d = 2.0 * dt_us as f32 * 1e-6;
+    put_f32s(b, &gyro.map(|x| x * d));
+    put_f32s(b, &acc.map(|x| x * d));
+    b.extend_from_slice(&(2 * dt_us as u16).to_le_bytes());
+    b.extend_from_slice(&(2 * dt_us as u16).to_le_bytes());
+    b.extend_from_slice(&[0, 0, 1, 1]);
 }

@@ -259,48 +259,8 @@ impl McapReader {
             lost: Vec::new(),
             contents: source::Contents::default(),
         };
-        let footer = r.read_footer();
-        let mut data_end = len;
-        let mut summary = None;
-        if let Some((footer_pos, f)) = footer {
-            data_end = footer_pos;
-            if f.summary_start != 0 {
-                match r.read_summary(footer_pos, &f) {
-                    Ok(s) => {
-                        r.summary_used = true;
-                        if s.trusted {
-                            data_end = f.summary_start;
-                        } else {
-                            // A damaged footer may misplace the summary: the walk goes on
-                            // to the footer and ends at the Data End record.
-                            r.statistics = None;
-                        }
-                        summary = Some(s);
-                    }
-                    Err(e) => {
-                        r.schemas.clear();
-                        r.mcap_channels.clear();
-                        r.statistics = None;
-                        r.contents.notes.push(format!(
-                            "the summary section is damaged ({e}); the data section was scanned instead"
-                        ));
-                    }
-                }
-            }
-        } else {
-            r.contents.notes.push(
-                "the file has no footer (the recording was cut short, or the file is truncated); its records were scanned".to_string(),
-            );
-        }
-        let mut hints: Vec<u64> = Vec::new();
-        if let Some(s) = &summary {
-            for ci in &s.chunk_indexes {
-                hints.push(ci.chunk_start_offset);
-                hints.extend(ci.message_index_offsets.iter().map(|x| x.1));
-            }
-        }
-        hints.sort_unstable();
-        hints.dedup();
+        let (data_end, mut summary) = r.summary_and_data_end();
+        let hints = resync_hints(summary.as_ref());
         let found_summary = r.walk(data_end, &hints)?;
         if summary.is_none()
             && let Some(s) = found_summary
@@ -314,6 +274,45 @@ impl McapReader {
         r.account_lost();
         r.build_channels();
         Ok(r)
+    }
+
+    /// The summary (when the footer locates one that reads) and where the data section
+    /// ends; a note when there is no footer or the summary is damaged.
+    fn summary_and_data_end(&mut self) -> (u64, Option<Summary>) {
+        let footer = self.read_footer();
+        let mut data_end = self.len;
+        let mut summary = None;
+        if let Some((footer_pos, f)) = footer {
+            data_end = footer_pos;
+            if f.summary_start != 0 {
+                match self.read_summary(footer_pos, &f) {
+                    Ok(s) => {
+                        self.summary_used = true;
+                        if s.trusted {
+                            data_end = f.summary_start;
+                        } else {
+                            // A damaged footer may misplace the summary: the walk goes on
+                            // to the footer and ends at the Data End record.
+                            self.statistics = None;
+                        }
+                        summary = Some(s);
+                    }
+                    Err(e) => {
+                        self.schemas.clear();
+                        self.mcap_channels.clear();
+                        self.statistics = None;
+                        self.contents.notes.push(format!(
+                            "the summary section is damaged ({e}); the data section was scanned instead"
+                        ));
+                    }
+                }
+            }
+        } else {
+            self.contents.notes.push(
+                "the file has no footer (the recording was cut short, or the file is truncated); its records were scanned".to_string(),
+            );
+        }
+        (data_end, summary)
     }
 
     /// The messages the chunk's message index lists for a wanted channel that were not
@@ -563,6 +562,21 @@ impl Source for McapReader {
         }
         out
     }
+}
+
+/// The positions the summary gives of chunks and message indexes, sorted: where a walk
+/// past damage tries to land first.
+fn resync_hints(summary: Option<&Summary>) -> Vec<u64> {
+    let mut hints: Vec<u64> = Vec::new();
+    if let Some(s) = summary {
+        for ci in &s.chunk_indexes {
+            hints.push(ci.chunk_start_offset);
+            hints.extend(ci.message_index_offsets.iter().map(|x| x.1));
+        }
+    }
+    hints.sort_unstable();
+    hints.dedup();
+    hints
 }
 
 /// Calls `f(offset, opcode, content)` for each record of `records`, in order; a record

@@ -140,50 +140,10 @@ impl McapReader {
                     |l| matches!(l, Loc::Chunk { pos, .. } if *pos == ci.chunk_start_offset),
                 )
             } else {
-                let fits = ci
-                    .chunk_start_offset
-                    .checked_add(ci.chunk_length)
-                    .is_some_and(|e| e <= self.len)
-                    && ci.chunk_length > RECORD_PREFIX;
-                let added = fits
-                    .then(|| {
-                        self.add_chunk(
-                            &mut w,
-                            ci.chunk_start_offset,
-                            ci.chunk_length - RECORD_PREFIX,
-                            Some(ci),
-                        )
-                        .ok()
-                    })
-                    .flatten();
-                if added.is_some() {
-                    self.contents.notes.push(format!(
-                        "the chunk at byte {} has a damaged record header; it was read where the summary locates it",
-                        ci.chunk_start_offset
-                    ));
-                }
-                added
+                self.summary_chunk(&mut w, ci)
             };
             // The summary's message indexes count the chunk when the walk found none.
-            let indexes: Vec<IndexRef> = ci
-                .message_index_offsets
-                .iter()
-                .filter_map(|&(ch, off)| {
-                    let (op, clen) = w.prefix(off)?;
-                    let b = w.get(off + RECORD_PREFIX, 6).ok()?;
-                    (op == Op::MessageIndex as u8
-                        && b.len() == 6
-                        && u16::from_le_bytes([b[0], b[1]]) == ch)
-                        .then(|| IndexRef {
-                            channel: ch,
-                            entries_pos: off + RECORD_PREFIX + 6,
-                            count: (u32::from_le_bytes(b[2..6].try_into().expect("4 bytes"))
-                                as u64)
-                                .min(clen.saturating_sub(6))
-                                / INDEX_ENTRY,
-                        })
-                })
-                .collect();
+            let indexes = summary_indexes(&mut w, ci);
             match k {
                 Some(k) if self.indexes[k].is_empty() && !indexes.is_empty() => {
                     self.contents.parts[k].counts = Some(
@@ -209,4 +169,51 @@ impl McapReader {
             }
         }
     }
+
+    /// A chunk the summary locates where the walk found none (its record header is
+    /// damaged): added as a part, with the summary's fields, when it fits in the file.
+    fn summary_chunk(&mut self, w: &mut Window, ci: &ChunkIndex) -> Option<usize> {
+        let fits = ci
+            .chunk_start_offset
+            .checked_add(ci.chunk_length)
+            .is_some_and(|e| e <= self.len)
+            && ci.chunk_length > RECORD_PREFIX;
+        let added = fits
+            .then(|| {
+                self.add_chunk(
+                    w,
+                    ci.chunk_start_offset,
+                    ci.chunk_length - RECORD_PREFIX,
+                    Some(ci),
+                )
+                .ok()
+            })
+            .flatten();
+        if added.is_some() {
+            self.contents.notes.push(format!(
+                "the chunk at byte {} has a damaged record header; it was read where the summary locates it",
+                ci.chunk_start_offset
+            ));
+        }
+        added
+    }
+}
+
+/// The summary's message indexes of chunk `ci` that frame as such records.
+fn summary_indexes(w: &mut Window, ci: &ChunkIndex) -> Vec<IndexRef> {
+    ci.message_index_offsets
+        .iter()
+        .filter_map(|&(ch, off)| {
+            let (op, clen) = w.prefix(off)?;
+            let b = w.get(off + RECORD_PREFIX, 6).ok()?;
+            (op == Op::MessageIndex as u8 && b.len() == 6 && u16::from_le_bytes([b[0], b[1]]) == ch)
+                .then(|| IndexRef {
+                    channel: ch,
+                    entries_pos: off + RECORD_PREFIX + 6,
+                    count: (u32::from_le_bytes(b[2..6].try_into().expect("4 bytes")) as u64)
+                        .min(clen.saturating_sub(6))
+                        / INDEX_ENTRY,
+                })
+        })
+        .collect()
 }
