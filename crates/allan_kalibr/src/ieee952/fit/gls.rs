@@ -241,40 +241,9 @@ pub(super) fn gls(
     shapes: Shapes,
 ) -> Option<Solve> {
     let (p, terms) = Problem::with_terms(data, sel, enabled, shapes)?;
-    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
-    // start: relative weights 1/A²
-    let w0: Vec<f64> = p.a.iter().map(|a| 1.0 / (a * a)).collect();
-    let mut coef = nnls_subsets(&p.g, &p.a, &w0, &terms, &signed, &feasible)?;
+    let (coef, mut delta, iterations, converged) =
+        reweight(&p, &terms, signed, delta_mode, max_iter)?;
     let no_basis = data.basis.is_none();
-    let mut delta = match delta_mode {
-        Delta::Fixed(d) => d,
-        _ => 0.0,
-    };
-    let mut iterations = 0;
-    let mut converged = false;
-    for _ in 0..max_iter {
-        iterations += 1;
-        let pred = p.pred(&coef);
-        let sigma = p.sigma(&coef);
-        if delta_mode == Delta::Estimate && !no_basis {
-            let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
-            let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
-            delta = solve_delta(sigma.as_ref()?, &p.a, &r, sel.len().saturating_sub(nfree));
-        }
-        let v = p.v(&sigma, delta);
-        let (gw, aw) = whiten(&v, &p.g, &p.a)?;
-        let ones = vec![1.0; gw.len()];
-        let new = nnls_subsets(&gw, &aw, &ones, &terms, &signed, &feasible)?;
-        let change = (0..TERM_COUNT)
-            .filter(|&j| new[j] != 0.0 || coef[j] != 0.0)
-            .map(|j| ((new[j] - coef[j]) / new[j].abs().max(coef[j].abs())).abs())
-            .fold(0.0, f64::max);
-        coef = new;
-        if change < GLS_REL_TOL {
-            converged = true;
-            break;
-        }
-    }
     let pred = p.pred(&coef);
     let sigma = p.sigma(&coef);
     let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
@@ -333,6 +302,55 @@ pub(super) fn gls(
         iterations,
         converged,
     })
+}
+
+/// The re-weighting of [`gls`] on `p`: from relative weights 1/A², each step solves under
+/// the covariance at the coefficients before it (δ re-estimated with
+/// [`Delta::Estimate`]) until no coefficient moves by [`GLS_REL_TOL`] or `max_iter` steps.
+/// Returns the coefficients, δ, the steps taken and whether they converged.
+fn reweight(
+    p: &Problem,
+    terms: &[usize],
+    signed: [bool; TERM_COUNT],
+    delta_mode: Delta,
+    max_iter: usize,
+) -> Option<([f64; TERM_COUNT], f64, usize, bool)> {
+    let sel = &p.sel;
+    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
+    // start: relative weights 1/A²
+    let w0: Vec<f64> = p.a.iter().map(|a| 1.0 / (a * a)).collect();
+    let mut coef = nnls_subsets(&p.g, &p.a, &w0, terms, &signed, &feasible)?;
+    let no_basis = p.data.basis.is_none();
+    let mut delta = match delta_mode {
+        Delta::Fixed(d) => d,
+        _ => 0.0,
+    };
+    let mut iterations = 0;
+    let mut converged = false;
+    for _ in 0..max_iter {
+        iterations += 1;
+        let pred = p.pred(&coef);
+        let sigma = p.sigma(&coef);
+        if delta_mode == Delta::Estimate && !no_basis {
+            let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
+            let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
+            delta = solve_delta(sigma.as_ref()?, &p.a, &r, sel.len().saturating_sub(nfree));
+        }
+        let v = p.v(&sigma, delta);
+        let (gw, aw) = whiten(&v, &p.g, &p.a)?;
+        let ones = vec![1.0; gw.len()];
+        let new = nnls_subsets(&gw, &aw, &ones, terms, &signed, &feasible)?;
+        let change = (0..TERM_COUNT)
+            .filter(|&j| new[j] != 0.0 || coef[j] != 0.0)
+            .map(|j| ((new[j] - coef[j]) / new[j].abs().max(coef[j].abs())).abs())
+            .fold(0.0, f64::max);
+        coef = new;
+        if change < GLS_REL_TOL {
+            converged = true;
+            break;
+        }
+    }
+    Some((coef, delta, iterations, converged))
 }
 
 /// Weighted least squares of the terms `enabled` on `sel` with the covariance held fixed at
