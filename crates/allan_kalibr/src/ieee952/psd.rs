@@ -500,50 +500,7 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
         return None;
     }
     let k_seg = p.segments.max(1) as f64;
-    // χ² (each bin's relative variance 1/K) at (f0, B), with the linear part solved by
-    // iterated reweighting from the first estimate's model
-    let chi2 = |fc: f64, bw: f64| -> Option<(f64, [f64; 3])> {
-        if !is_positive(bw) || !is_positive(fc) {
-            return None;
-        }
-        let g: Vec<[f64; 3]> = bins
-            .iter()
-            .map(|&i| {
-                let f = p.freq[i];
-                [1.0, (f - fc) / fc, super::lines::resonance_psd(f, fc, bw)]
-            })
-            .collect();
-        let mut model: Vec<f64> = bins.iter().map(|&i| p.density[i]).collect();
-        let mut c = [0.0; 3];
-        for _ in 0..RESONANCE_FIT_REWEIGHTS {
-            let mut n = vec![vec![0.0; 3]; 3];
-            let mut b = vec![0.0; 3];
-            for ((gi, &i), m) in g.iter().zip(&bins).zip(&model) {
-                let w = 1.0 / (m * m).max(f64::MIN_POSITIVE);
-                for r in 0..3 {
-                    b[r] += w * gi[r] * p.density[i];
-                    for s in 0..3 {
-                        n[r][s] += w * gi[r] * gi[s];
-                    }
-                }
-            }
-            let x = super::fit::solve_spd(&n, &b)?;
-            c = [x[0], x[1], x[2]];
-            for (m, gi) in model.iter_mut().zip(&g) {
-                *m = c[0] + c[1] * gi[1] + c[2] * gi[2];
-            }
-            if model.iter().any(|m| !is_positive(*m)) || !is_positive(c[2]) {
-                return None;
-            }
-        }
-        let x2 = bins
-            .iter()
-            .zip(&model)
-            .map(|(&i, m)| (p.density[i] / m - 1.0).powi(2))
-            .sum::<f64>()
-            * k_seg;
-        Some((x2, c))
-    };
+    let chi2 = |fc: f64, bw: f64| resonance_chi2(p, &bins, k_seg, fc, bw);
     let at = |fc: f64, lb: f64| chi2(fc, lb.exp()).map_or(f64::INFINITY, |r| r.0);
     let (mut fc, mut lb) = (f0, b0.ln());
     for _ in 0..RESONANCE_FIT_ROUNDS {
@@ -572,6 +529,58 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
         bandwidth,
         se: bandwidth * se_ln,
     })
+}
+
+/// χ² of the resonance shape at centre `fc` and bandwidth `bw` over the PSD's `bins` (each
+/// bin's relative variance 1/K, `k_seg` = K), with the linear part (c₀, c₁, σ²) solved by
+/// iterated reweighting from the first estimate's model; returns χ² and (c₀, c₁, σ²).
+fn resonance_chi2(
+    p: &Psd,
+    bins: &[usize],
+    k_seg: f64,
+    fc: f64,
+    bw: f64,
+) -> Option<(f64, [f64; 3])> {
+    if !is_positive(bw) || !is_positive(fc) {
+        return None;
+    }
+    let g: Vec<[f64; 3]> = bins
+        .iter()
+        .map(|&i| {
+            let f = p.freq[i];
+            [1.0, (f - fc) / fc, super::lines::resonance_psd(f, fc, bw)]
+        })
+        .collect();
+    let mut model: Vec<f64> = bins.iter().map(|&i| p.density[i]).collect();
+    let mut c = [0.0; 3];
+    for _ in 0..RESONANCE_FIT_REWEIGHTS {
+        let mut n = vec![vec![0.0; 3]; 3];
+        let mut b = vec![0.0; 3];
+        for ((gi, &i), m) in g.iter().zip(bins).zip(&model) {
+            let w = 1.0 / (m * m).max(f64::MIN_POSITIVE);
+            for r in 0..3 {
+                b[r] += w * gi[r] * p.density[i];
+                for s in 0..3 {
+                    n[r][s] += w * gi[r] * gi[s];
+                }
+            }
+        }
+        let x = super::fit::solve_spd(&n, &b)?;
+        c = [x[0], x[1], x[2]];
+        for (m, gi) in model.iter_mut().zip(&g) {
+            *m = c[0] + c[1] * gi[1] + c[2] * gi[2];
+        }
+        if model.iter().any(|m| !is_positive(*m)) || !is_positive(c[2]) {
+            return None;
+        }
+    }
+    let x2 = bins
+        .iter()
+        .zip(&model)
+        .map(|(&i, m)| (p.density[i] / m - 1.0).powi(2))
+        .sum::<f64>()
+        * k_seg;
+    Some((x2, c))
 }
 
 /// Reweighting passes of the resonance fit's linear part.
