@@ -348,16 +348,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
     } else {
         std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a]))
     };
-    for (a, (name, scan)) in input::AXIS_NAMES.iter().zip(&scans).enumerate() {
-        if Some(data_imu_sensor(a)) == absent {
-            continue;
-        }
-        match scan.problem(name) {
-            Some((true, what)) => return Err(Error::BadData { what }),
-            Some((false, what)) => notes.push(Note::warning(what)),
-            None => {}
-        }
-    }
+    check_scans(&scans, absent, notes)?;
     let rate = input::choose_rate(config.common.rate, check.rate, data.len())?;
     notes.extend(rate.message.clone().map(Note::info));
     findings.extend(rate.finding.clone());
@@ -370,6 +361,26 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
         early,
         checks_s,
     })
+}
+
+/// The finiteness and value checks of each column present (`absent`: the sensor the record
+/// lacks): a column that cannot be analysed is an error, a doubtful one a warning in `notes`.
+fn check_scans(
+    scans: &[input::ColumnScan; 6],
+    absent: Option<bag2mat::Sensor>,
+    notes: &mut Vec<Note>,
+) -> Result<(), Error> {
+    for (a, (name, scan)) in input::AXIS_NAMES.iter().zip(scans).enumerate() {
+        if Some(data_imu_sensor(a)) == absent {
+            continue;
+        }
+        match scan.problem(name) {
+            Some((true, what)) => return Err(Error::BadData { what }),
+            Some((false, what)) => notes.push(Note::warning(what)),
+            None => {}
+        }
+    }
+    Ok(())
 }
 
 /// The IEEE 952 section's curves and the seconds they took: none when the section is off

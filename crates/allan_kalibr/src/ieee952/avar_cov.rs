@@ -151,55 +151,20 @@ fn pair_sums(mi: usize, mj: usize, big_mi: usize, big_mj: usize, tau0: f64) -> [
     if h_lo > h_hi {
         return acc;
     }
+    let pair = Pair {
+        mif,
+        mjf,
+        bmi,
+        bmj,
+        tau0,
+    };
     let span = (h_hi - h_lo) as usize;
     if span <= EXACT_LAGS {
         for h in h_lo..=h_hi {
-            let hf = h as f64;
-            add_smooth(
-                &mut acc,
-                pair_count(hf, bmi, bmj),
-                &phi_smooth(hf, mif, mjf, tau0),
-                1.0,
-            );
+            pair.add_smooth_at(&mut acc, h as f64, 1.0);
         }
     } else {
-        let mut cuts: Vec<f64> = vec![h_lo as f64, h_hi as f64, 0.0, bmj - bmi];
-        for a in 0..3 {
-            for b in 0..3 {
-                cuts.push(a as f64 * mif - b as f64 * mjf);
-            }
-        }
-        // the flicker tail beyond the last kink: split geometrically
-        let s = 2.0 * (mif + mjf);
-        cuts.extend([-s, s, -2.0 * s, 2.0 * s]);
-        cuts.retain(|c| *c >= h_lo as f64 && *c <= h_hi as f64);
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup();
-        for w in cuts.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            let c = 0.5 * (a + b);
-            let half = 0.5 * (b - a);
-            for i in 0..4 {
-                for sign in [-1.0, 1.0] {
-                    let h = c + sign * half * GL_X[i];
-                    add_smooth(
-                        &mut acc,
-                        pair_count(h, bmi, bmj),
-                        &phi_smooth(h, mif, mjf, tau0),
-                        GL_W[i] * half,
-                    );
-                }
-            }
-        }
-        // trapezoid end corrections: Σ_{lo..=hi} f ≈ ∫ f + (f(lo) + f(hi))/2
-        for h in [h_lo as f64, h_hi as f64] {
-            add_smooth(
-                &mut acc,
-                pair_count(h, bmi, bmj),
-                &phi_smooth(h, mif, mjf, tau0),
-                0.5,
-            );
-        }
+        pair.add_smooth_quadrature(&mut acc, h_lo, h_hi);
     }
     // white-PM spikes at h = a·m_i − b·m_j, exactly
     let mut spikes: Vec<i64> = Vec::with_capacity(9);
@@ -225,6 +190,71 @@ fn pair_sums(mi: usize, mj: usize, big_mi: usize, big_mj: usize, tau0: f64) -> [
     let (ti, tj) = (mif * tau0, mjf * tau0);
     let d = 2.0 * ti * ti * tj * tj * bmi * bmj;
     acc.map(|v| v / d)
+}
+
+/// One pair of overlapping estimates of [`pair_sums`]: cluster sizes m_i, m_j and estimate
+/// counts M_i, M_j (as f64), and τ0.
+struct Pair {
+    mif: f64,
+    mjf: f64,
+    bmi: f64,
+    bmj: f64,
+    tau0: f64,
+}
+
+impl Pair {
+    /// Adds the smooth components at lag `h`, times `weight`, into `acc` ([`add_smooth`]).
+    fn add_smooth_at(&self, acc: &mut [f64; 10], h: f64, weight: f64) {
+        let Pair {
+            mif,
+            mjf,
+            bmi,
+            bmj,
+            tau0,
+        } = *self;
+        add_smooth(
+            acc,
+            pair_count(h, bmi, bmj),
+            &phi_smooth(h, mif, mjf, tau0),
+            weight,
+        );
+    }
+
+    /// The smooth components summed over the lags `h_lo..=h_hi` by 8-point Gauss–Legendre
+    /// quadrature between the kinks of φ (and geometric cuts of the flicker tail), with
+    /// the trapezoid end corrections.
+    fn add_smooth_quadrature(&self, acc: &mut [f64; 10], h_lo: i64, h_hi: i64) {
+        let Pair {
+            mif, mjf, bmi, bmj, ..
+        } = *self;
+        let mut cuts: Vec<f64> = vec![h_lo as f64, h_hi as f64, 0.0, bmj - bmi];
+        for a in 0..3 {
+            for b in 0..3 {
+                cuts.push(a as f64 * mif - b as f64 * mjf);
+            }
+        }
+        // the flicker tail beyond the last kink: split geometrically
+        let s = 2.0 * (mif + mjf);
+        cuts.extend([-s, s, -2.0 * s, 2.0 * s]);
+        cuts.retain(|c| *c >= h_lo as f64 && *c <= h_hi as f64);
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let c = 0.5 * (a + b);
+            let half = 0.5 * (b - a);
+            for i in 0..4 {
+                for sign in [-1.0, 1.0] {
+                    let h = c + sign * half * GL_X[i];
+                    self.add_smooth_at(acc, h, GL_W[i] * half);
+                }
+            }
+        }
+        // trapezoid end corrections: Σ_{lo..=hi} f ≈ ∫ f + (f(lo) + f(hi))/2
+        for h in [h_lo as f64, h_hi as f64] {
+            self.add_smooth_at(acc, h, 0.5);
+        }
+    }
 }
 
 /// The ten S^{tu} of the variance of one non-overlapping estimate: clusters k, l of size m

@@ -2,6 +2,8 @@
 //! curve point within [`FIT_TOL`] or its own 95 % band), and the verdict on the axis that
 //! follows from it ([`AxisVerdict`]).
 
+use std::ops::ControlFlow;
+
 #[cfg(doc)]
 use super::avar_cov;
 use super::{
@@ -65,20 +67,10 @@ fn declare_from(
     cfg: &Config,
     mut b: Bounds,
 ) -> Declared {
-    let np = fd.points.len();
     let mut last_fit = None;
-    let pos_from = |tau: f64| fd.points.iter().position(|p| p.tau >= tau).unwrap_or(np);
     loop {
         if b.end <= b.start || b.end - b.start < fit::MIN_FIT_POINTS {
-            let reason = match b.last_miss {
-                Some((tau, mis)) => format!(
-                    "the best model misses the curve by {:.0} % at τ = {} s",
-                    100.0 * mis,
-                    short(tau)
-                ),
-                None => format!("only {} usable points", b.end.saturating_sub(b.start)),
-            };
-            return (last_fit, AxisVerdict::NoReliableFit { reason }, f64::NAN);
+            return (last_fit, too_few_points(&b), f64::NAN);
         }
         let Some((f, misses, max_mis)) = fit_and_check(data, fd, valid, cfg, b.start, b.end) else {
             return (
@@ -90,94 +82,144 @@ fn declare_from(
             );
         };
         if misses.is_empty() {
-            let (f, max_mis, end) = if b.long_cut {
-                extend_long_end(data, fd, valid, cfg, b.start, (f, max_mis, b.end))
-            } else {
-                (f, max_mis, b.end)
-            };
-            let (lo_t, hi_t) = (fd.points[b.start].tau, fd.points[end - 1].tau);
-            if (hi_t / lo_t).log10() < MIN_RANGE_DECADES {
-                let reason = match b.last_miss {
-                    Some((tau, mis)) => format!(
-                        "the best model misses the curve by {:.0} % at τ = {} s, and fits only {} – {} s",
-                        100.0 * mis,
-                        short(tau),
-                        short(lo_t),
-                        short(hi_t)
-                    ),
-                    None => format!(
-                        "the usable range {} – {} s is shorter than a decade",
-                        short(lo_t),
-                        short(hi_t)
-                    ),
-                };
-                return (Some(f), AxisVerdict::NoReliableFit { reason }, max_mis);
-            }
-            let verdict = AxisVerdict::Fits {
-                range: (lo_t, hi_t),
-                short_cut: b.start > 0,
-                short_feature: b.feature,
-                band_limited: b.start > 0,
-                long_cut: end < np,
-                approximate: approximate(&f).then_some(f.delta),
-            };
-            return (Some(f), verdict, max_mis);
+            return declare_clean(data, fd, valid, cfg, &b, f, max_mis);
         }
-        let first = misses[0];
-        b.last_miss = misses
-            .iter()
-            .max_by(|x, y| x.size.total_cmp(&y.size))
-            .map(|m| (m.tau, m.size));
-        let start_zone = fd.points[(b.start + 2).min(b.end - 1)].tau;
-        if first.tau <= start_zone * (1.0 + 1e-12) {
-            // past the last miss inside the start zone
-            let last_in_zone = misses
-                .iter()
-                .filter(|m| m.tau <= start_zone * (1.0 + 1e-12))
-                .map(|m| m.tau)
-                .fold(first.tau, f64::max);
-            b.start = pos_from(last_in_zone * (1.0 + 1e-12));
-        } else {
-            let cut = Bounds {
-                end: pos_from(first.tau * (1.0 - 1e-12)),
-                long_cut: true,
-                ..b
-            };
-            // or a short-τ feature: the data above the model from the first miss on, for at
-            // most SHORT_FEATURE_SPAN, ending before N_READING_TAU
-            let feature: Vec<&Miss> = misses
-                .iter()
-                .take_while(|m| m.tau <= first.tau * SHORT_FEATURE_SPAN)
-                .collect();
-            let feature_end = feature.iter().map(|m| m.tau).fold(first.tau, f64::max);
-            let past = pos_from(feature_end * (1.0 + 1e-12));
-            if feature.iter().all(|m| m.above)
-                && past < b.end
-                && fd.points[past].tau <= N_READING_TAU
-            {
-                let ended = declare_from(data, fd, valid, cfg, cut);
-                let moved = Bounds {
-                    start: past,
-                    feature: true,
-                    ..b
-                };
-                let moved = declare_from(data, fd, valid, cfg, moved);
-                let keeps_n = moved
-                    .1
-                    .range()
-                    .is_some_and(|(lo, hi)| lo <= N_READING_TAU && hi >= N_READING_TAU);
-                return if keeps_n
-                    && declared_decades(&moved) > declared_decades(&ended) + SHORT_FEATURE_GAIN
-                {
-                    moved
-                } else {
-                    ended
-                };
-            }
-            b = cut;
+        match past_misses(data, fd, valid, cfg, b, &misses) {
+            ControlFlow::Break(declared) => return declared,
+            ControlFlow::Continue(next) => b = next,
         }
         last_fit = Some(f);
     }
+}
+
+/// The first position of the fit grid at or past `tau` (the grid's length when none is).
+fn position_from(fd: &fit::FitData, tau: f64) -> usize {
+    let np = fd.points.len();
+    fd.points.iter().position(|p| p.tau >= tau).unwrap_or(np)
+}
+
+/// The verdict when too few points are left in `b`: the largest miss met, or the count.
+fn too_few_points(b: &Bounds) -> AxisVerdict {
+    let reason = match b.last_miss {
+        Some((tau, mis)) => format!(
+            "the best model misses the curve by {:.0} % at τ = {} s",
+            100.0 * mis,
+            short(tau)
+        ),
+        None => format!("only {} usable points", b.end.saturating_sub(b.start)),
+    };
+    AxisVerdict::NoReliableFit { reason }
+}
+
+/// The declared fit of a range `b` whose fit `f` (largest misfit `max_mis`) misses no
+/// point: grown at the long end when it was cut there ([`extend_long_end`]), then a fit
+/// if it spans [`MIN_RANGE_DECADES`].
+fn declare_clean(
+    data: &CurveData,
+    fd: &fit::FitData,
+    valid: &[&CurvePoint],
+    cfg: &Config,
+    b: &Bounds,
+    f: fit::FitResult,
+    max_mis: f64,
+) -> Declared {
+    let np = fd.points.len();
+    let (f, max_mis, end) = if b.long_cut {
+        extend_long_end(data, fd, valid, cfg, b.start, (f, max_mis, b.end))
+    } else {
+        (f, max_mis, b.end)
+    };
+    let (lo_t, hi_t) = (fd.points[b.start].tau, fd.points[end - 1].tau);
+    if (hi_t / lo_t).log10() < MIN_RANGE_DECADES {
+        let reason = match b.last_miss {
+            Some((tau, mis)) => format!(
+                "the best model misses the curve by {:.0} % at τ = {} s, and fits only {} – {} s",
+                100.0 * mis,
+                short(tau),
+                short(lo_t),
+                short(hi_t)
+            ),
+            None => format!(
+                "the usable range {} – {} s is shorter than a decade",
+                short(lo_t),
+                short(hi_t)
+            ),
+        };
+        return (Some(f), AxisVerdict::NoReliableFit { reason }, max_mis);
+    }
+    let verdict = AxisVerdict::Fits {
+        range: (lo_t, hi_t),
+        short_cut: b.start > 0,
+        short_feature: b.feature,
+        band_limited: b.start > 0,
+        long_cut: end < np,
+        approximate: approximate(&f).then_some(f.delta),
+    };
+    (Some(f), verdict, max_mis)
+}
+
+/// The next candidate range after the fit of `b` missed `misses` (ascending τ): a miss in
+/// the start zone moves the start past the last miss there; a miss further up cuts the end
+/// before it — or, where it may be a short-τ feature, both ways are declared to the end and
+/// the better returned ([`Break`](ControlFlow::Break)).
+fn past_misses(
+    data: &CurveData,
+    fd: &fit::FitData,
+    valid: &[&CurvePoint],
+    cfg: &Config,
+    mut b: Bounds,
+    misses: &[Miss],
+) -> ControlFlow<Declared, Bounds> {
+    let first = misses[0];
+    b.last_miss = misses
+        .iter()
+        .max_by(|x, y| x.size.total_cmp(&y.size))
+        .map(|m| (m.tau, m.size));
+    let start_zone = fd.points[(b.start + 2).min(b.end - 1)].tau;
+    if first.tau <= start_zone * (1.0 + 1e-12) {
+        // past the last miss inside the start zone
+        let last_in_zone = misses
+            .iter()
+            .filter(|m| m.tau <= start_zone * (1.0 + 1e-12))
+            .map(|m| m.tau)
+            .fold(first.tau, f64::max);
+        b.start = position_from(fd, last_in_zone * (1.0 + 1e-12));
+        return ControlFlow::Continue(b);
+    }
+    let cut = Bounds {
+        end: position_from(fd, first.tau * (1.0 - 1e-12)),
+        long_cut: true,
+        ..b
+    };
+    // or a short-τ feature: the data above the model from the first miss on, for at
+    // most SHORT_FEATURE_SPAN, ending before N_READING_TAU
+    let feature: Vec<&Miss> = misses
+        .iter()
+        .take_while(|m| m.tau <= first.tau * SHORT_FEATURE_SPAN)
+        .collect();
+    let feature_end = feature.iter().map(|m| m.tau).fold(first.tau, f64::max);
+    let past = position_from(fd, feature_end * (1.0 + 1e-12));
+    if feature.iter().all(|m| m.above) && past < b.end && fd.points[past].tau <= N_READING_TAU {
+        let ended = declare_from(data, fd, valid, cfg, cut);
+        let moved = Bounds {
+            start: past,
+            feature: true,
+            ..b
+        };
+        let moved = declare_from(data, fd, valid, cfg, moved);
+        let keeps_n = moved
+            .1
+            .range()
+            .is_some_and(|(lo, hi)| lo <= N_READING_TAU && hi >= N_READING_TAU);
+        return ControlFlow::Break(
+            if keeps_n && declared_decades(&moved) > declared_decades(&ended) + SHORT_FEATURE_GAIN {
+                moved
+            } else {
+                ended
+            },
+        );
+    }
+    ControlFlow::Continue(cut)
 }
 
 /// A curve point the fitted model misses (beyond [`FIT_TOL`] and its own 95 % band).

@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::config_values::{file_values, inline_note};
-use super::imu::{ImuAnalysis, SensorValue};
+use super::imu::{AxisResult, ImuAnalysis, SensorValue};
 use super::{AxisVerdict, Overlap, Term};
 use crate::yaml::yaml_float;
 
@@ -220,87 +220,110 @@ pub(crate) fn terms_csv(a: &ImuAnalysis) -> String {
     s.push_str(&TERMS_COLUMNS.join(","));
     s.push('\n');
     for ax in &a.axes {
-        let an = &ax.analysis;
-        let sensor = ax.sensor;
-        let axis = ["x", "y", "z"][ax.axis];
-        let (lo_t, hi_t) = an.verdict.range().unwrap_or((f64::NAN, f64::NAN));
-        let (chi, delta) = an
-            .fit
-            .as_ref()
-            .filter(|_| an.verdict.fits())
-            .map_or((f64::NAN, f64::NAN), |f| (f.chi2_per_dof, f.delta));
-        let nan_adv = super::advisor::TermAdvice {
-            precision: f64::NAN,
-            record_10: f64::NAN,
-            record_25: f64::NAN,
-            at_least: false,
-        };
-        let adv = ax.advice;
-        let rows: [(&str, &Term, &str, Option<super::region::Reading>, _); 6] = [
-            ("Q", &an.terms.q, sensor.q_unit(), None, nan_adv),
-            (
-                "N",
-                &an.terms.n,
-                sensor.n_unit(),
-                an.region.n,
-                adv.map_or(nan_adv, |v| v.n),
-            ),
-            (
-                "B",
-                &an.terms.b,
-                sensor.unit(),
-                an.region.b,
-                adv.map_or(nan_adv, |v| v.b),
-            ),
-            (
-                "K",
-                &an.terms.k,
-                sensor.k_unit(),
-                an.region.k,
-                adv.map_or(nan_adv, |v| v.k),
-            ),
-            ("R", &an.terms.r, sensor.r_unit(), None, nan_adv),
-            ("G", &an.terms.g, sensor.unit(), None, nan_adv),
-        ];
-        for (name, t, unit, reg, adv) in rows {
-            let source = if an.verdict.fits() { "fit" } else { "region" };
-            let (rv, rl, rh) =
-                reg.map_or((f64::NAN, f64::NAN, f64::NAN), |r| (r.value, r.lo, r.hi));
-            let _ = writeln!(
-                s,
-                "{},{axis},{name},{},{},{},{},{},{:?},{unit},{source},{},{lo_t},{hi_t},{chi},{delta},{rv},{rl},{rh},{},{},{},{}",
-                sensor.name(),
-                t.value,
-                t.std_err,
-                t.lo,
-                t.hi,
-                t.reported().is_some(),
-                t.verdict,
-                fit_code(&an.verdict),
-                adv.precision,
-                adv.record_10,
-                adv.record_25,
-                adv.at_least
-            );
-        }
-        // the shape parameters, as rows of their own: the Gauss–Markov correlation time
-        // and the flicker floor's lower corner
-        for (name, value, t) in [
-            ("GT", an.terms.g_time, &an.terms.g),
-            ("BT", an.terms.b_corner, &an.terms.b),
-        ] {
-            let _ = writeln!(
-                s,
-                "{},{axis},{name},{value},NaN,NaN,NaN,{},{:?},s,{},{},{lo_t},{hi_t},{chi},{delta},NaN,NaN,NaN,NaN,NaN,NaN,false",
-                sensor.name(),
-                t.reported().is_some(),
-                t.verdict,
-                if an.verdict.fits() { "fit" } else { "region" },
-                fit_code(&an.verdict),
-            );
-        }
+        write_axis_terms(&mut s, ax);
     }
     s
+}
+
+/// One row of [`terms_csv`] before it is written: the term's name, the term, its unit, its
+/// region reading and its advice.
+type TermRow<'a> = (
+    &'static str,
+    &'a Term,
+    &'static str,
+    Option<super::region::Reading>,
+    super::advisor::TermAdvice,
+);
+
+/// The rows of [`terms_csv`] for the axis `ax`: its terms, then its shape parameters (the
+/// Gauss–Markov correlation time and the flicker floor's lower corner).
+fn write_axis_terms(s: &mut String, ax: &AxisResult) {
+    let an = &ax.analysis;
+    let sensor = ax.sensor;
+    let axis = ["x", "y", "z"][ax.axis];
+    let (lo_t, hi_t) = an.verdict.range().unwrap_or((f64::NAN, f64::NAN));
+    let (chi, delta) = an
+        .fit
+        .as_ref()
+        .filter(|_| an.verdict.fits())
+        .map_or((f64::NAN, f64::NAN), |f| (f.chi2_per_dof, f.delta));
+    for (name, t, unit, reg, adv) in term_rows(ax) {
+        let source = if an.verdict.fits() { "fit" } else { "region" };
+        let (rv, rl, rh) = reg.map_or((f64::NAN, f64::NAN, f64::NAN), |r| (r.value, r.lo, r.hi));
+        let _ = writeln!(
+            s,
+            "{},{axis},{name},{},{},{},{},{},{:?},{unit},{source},{},{lo_t},{hi_t},{chi},{delta},{rv},{rl},{rh},{},{},{},{}",
+            sensor.name(),
+            t.value,
+            t.std_err,
+            t.lo,
+            t.hi,
+            t.reported().is_some(),
+            t.verdict,
+            fit_code(&an.verdict),
+            adv.precision,
+            adv.record_10,
+            adv.record_25,
+            adv.at_least
+        );
+    }
+    // the shape parameters, as rows of their own: the Gauss–Markov correlation time
+    // and the flicker floor's lower corner
+    for (name, value, t) in [
+        ("GT", an.terms.g_time, &an.terms.g),
+        ("BT", an.terms.b_corner, &an.terms.b),
+    ] {
+        let _ = writeln!(
+            s,
+            "{},{axis},{name},{value},NaN,NaN,NaN,{},{:?},s,{},{},{lo_t},{hi_t},{chi},{delta},NaN,NaN,NaN,NaN,NaN,NaN,false",
+            sensor.name(),
+            t.reported().is_some(),
+            t.verdict,
+            if an.verdict.fits() { "fit" } else { "region" },
+            fit_code(&an.verdict),
+        );
+    }
+}
+
+/// The six terms of the axis `ax` as [`terms_csv`] rows: Q, N, B, K, R and the Gauss–Markov
+/// σ, with the region readings and advice of N, B and K (NaN advice for the others and
+/// without a sample count).
+fn term_rows(ax: &AxisResult) -> [TermRow<'_>; 6] {
+    let an = &ax.analysis;
+    let sensor = ax.sensor;
+    let nan_adv = super::advisor::TermAdvice {
+        precision: f64::NAN,
+        record_10: f64::NAN,
+        record_25: f64::NAN,
+        at_least: false,
+    };
+    let adv = ax.advice;
+    [
+        ("Q", &an.terms.q, sensor.q_unit(), None, nan_adv),
+        (
+            "N",
+            &an.terms.n,
+            sensor.n_unit(),
+            an.region.n,
+            adv.map_or(nan_adv, |v| v.n),
+        ),
+        (
+            "B",
+            &an.terms.b,
+            sensor.unit(),
+            an.region.b,
+            adv.map_or(nan_adv, |v| v.b),
+        ),
+        (
+            "K",
+            &an.terms.k,
+            sensor.k_unit(),
+            an.region.k,
+            adv.map_or(nan_adv, |v| v.k),
+        ),
+        ("R", &an.terms.r, sensor.r_unit(), None, nan_adv),
+        ("G", &an.terms.g, sensor.unit(), None, nan_adv),
+    ]
 }
 
 /// The Allan deviation of every axis with its bounds, range flag and the fitted model.

@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::chart_panels::{draw_legend, log_log_panel, titled_panels};
+use super::chart_panels::{LogLog, draw_legend, log_log_panel, titled_panels};
 use super::imu::{AxisResult, ImuAnalysis};
+use super::{Analysis, Point};
 
 /// Panel size in SVG user units (the PNG is drawn at [`PNG_SCALE`]).
 const PANEL: (u32, u32) = (560, 420);
@@ -149,6 +150,9 @@ where
     Ok(())
 }
 
+/// A panel's axis ranges (x0, x1, y0, y1).
+type Ranges = (f64, f64, f64, f64);
+
 fn panel<DB: DrawingBackend>(
     ax: &AxisResult,
     truth: Option<&[(f64, f64)]>,
@@ -158,15 +162,44 @@ fn panel<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let px = |v: f64| (v * scale).round() as u32;
     let an = &ax.analysis;
     let pts: Vec<_> = an
         .curve
         .iter()
         .filter(|p| p.tau > 0.0 && p.adev > 0.0 && p.adev.is_finite())
         .collect();
+    let r = panel_ranges(&pts, truth);
+    let (x0, x1, y0, y1) = r;
+    let caption = format!(
+        "{} — {}",
+        ax.sensor.axis_label(ax.axis),
+        match &an.verdict {
+            super::AxisVerdict::Fits { .. } => "model fits".to_string(),
+            super::AxisVerdict::NoReliableFit { .. } => "no reliable fit".to_string(),
+        }
+    );
+    let mut ctx = log_log_panel(
+        area,
+        caption,
+        (x0, x1),
+        (y0, y1),
+        ("τ [s]", &format!("Allan deviation [{}]", ax.sensor.unit())),
+        scale,
+    )?;
+    shade_undescribed(&mut ctx, an, r)?;
+    draw_data(&mut ctx, &pts, scale)?;
+    draw_model(&mut ctx, an, r, scale)?;
+    if let Some(tr) = truth {
+        draw_truth(&mut ctx, tr, (x0, x1), scale)?;
+    }
+    draw_legend(&mut ctx, scale)
+}
+
+/// The axis ranges of a panel: the curve's τ and its deviations with their 95 % bands, and
+/// the truth inside that τ range, padded in log space.
+fn panel_ranges(pts: &[&Point], truth: Option<&[(f64, f64)]>) -> Ranges {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in &pts {
+    for p in pts {
         x0 = x0.min(p.tau);
         x1 = x1.max(p.tau);
         for v in [p.adev, p.lo95, p.hi95] {
@@ -189,23 +222,19 @@ where
     }
     let (x0, x1) = (x0 / 1.3, x1 * 1.3);
     let (y0, y1) = (y0 / 2.0, y1 * 2.0);
-    let caption = format!(
-        "{} — {}",
-        ax.sensor.axis_label(ax.axis),
-        match &an.verdict {
-            super::AxisVerdict::Fits { .. } => "model fits".to_string(),
-            super::AxisVerdict::NoReliableFit { .. } => "no reliable fit".to_string(),
-        }
-    );
-    let mut ctx = log_log_panel(
-        area,
-        caption,
-        (x0, x1),
-        (y0, y1),
-        ("τ [s]", &format!("Allan deviation [{}]", ax.sensor.unit())),
-        scale,
-    )?;
-    // τ the model does not describe
+    (x0, x1, y0, y1)
+}
+
+/// Shades the τ the model does not describe: outside the verdict's range, or all of the
+/// panel without one.
+fn shade_undescribed<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    an: &Analysis,
+    (x0, x1, y0, y1): Ranges,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
     let shade = RGBColor(200, 200, 200).mix(0.45).filled();
     match an.verdict.range() {
         Some((lo, hi)) => {
@@ -220,7 +249,19 @@ where
             ctx.draw_series(std::iter::once(Rectangle::new([(x0, y0), (x1, y1)], shade)))?;
         }
     }
-    // 95 % band
+    Ok(())
+}
+
+/// The curve's 95 % band (where it has one) and the curve itself.
+fn draw_data<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    pts: &[&Point],
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
     let band: Vec<(f64, f64)> = pts
         .iter()
         .filter(|p| p.lo95 > 0.0 && p.hi95.is_finite())
@@ -249,76 +290,108 @@ where
     ))?
     .label("data")
     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data_color.stroke_width(2)));
-    let line_over = |a: f64, b: f64, f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
-        (0..LINE_POINTS)
-            .map(|k| {
-                let t = a * (b / a).powf(k as f64 / (LINE_POINTS - 1) as f64);
-                (t, f(t))
-            })
-            .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
-            .collect()
+    Ok(())
+}
+
+/// `f` at [`LINE_POINTS`] log-spaced τ from `a` to `b`, the points inside `y0..=y1` kept.
+fn line_over(a: f64, b: f64, (y0, y1): (f64, f64), f: &dyn Fn(f64) -> f64) -> Vec<(f64, f64)> {
+    (0..LINE_POINTS)
+        .map(|k| {
+            let t = a * (b / a).powf(k as f64 / (LINE_POINTS - 1) as f64);
+            (t, f(t))
+        })
+        .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
+        .collect()
+}
+
+/// Where there is a fit and a fitted range: each fitted term's line over the whole τ axis,
+/// the Gauss–Markov bias's, and the model over the fitted range.
+fn draw_model<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    an: &Analysis,
+    (x0, x1, y0, y1): Ranges,
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    let (Some(f), Some((lo, hi))) = (&an.fit, an.verdict.range()) else {
+        return Ok(());
     };
-    if let (Some(f), Some((lo, hi))) = (&an.fit, an.verdict.range()) {
-        let coef = f.coef;
-        // each fitted term's line, over the whole τ axis
-        let terms = an.terms.as_array();
-        for j in 0..super::fit::IEEE_TERMS {
-            let v = terms[j].value;
-            if !super::fit::is_positive(v) || coef[j] <= 0.0 {
-                continue;
-            }
-            let c = TERM_COLORS[j];
-            let name = super::fit::TERM_NAMES[j];
-            ctx.draw_series(DashedLineSeries::new(
-                line_over(x0, x1, &|t| {
-                    v * super::fit::basis_at(j, t, &f.shapes).sqrt()
-                }),
-                px(5.0),
-                px(4.0),
-                c.stroke_width(px(1.0).max(1)),
-            ))?
-            .label(format!(
-                "{name} = {v:.2e}{}",
-                if terms[j].verdict == super::Verdict::Resolved {
-                    ""
-                } else {
-                    " (not resolved)"
-                }
-            ))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+    let coef = f.coef;
+    // each fitted term's line, over the whole τ axis
+    let terms = an.terms.as_array();
+    for j in 0..super::fit::IEEE_TERMS {
+        let v = terms[j].value;
+        if !super::fit::is_positive(v) || coef[j] <= 0.0 {
+            continue;
         }
-        if coef[super::fit::GM] > 0.0 {
-            let (sigma, tg) = (an.terms.g.value, f.shapes.gm_t);
-            let c = TERM_COLORS[2];
-            ctx.draw_series(DashedLineSeries::new(
-                line_over(x0, x1, &|t| sigma * super::fit::gm_basis(t, tg).sqrt()),
-                px(2.0),
-                px(4.0),
-                c.stroke_width(px(1.0).max(1)),
-            ))?
-            .label(format!("Gauss–Markov σ = {sigma:.2e}, T = {tg:.3} s"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
-        }
-        let model = |t: f64| f.predict(t).max(0.0).sqrt();
-        ctx.draw_series(LineSeries::new(
-            line_over(lo, hi, &model),
-            BLACK.stroke_width(px(2.0)),
-        ))?
-        .label("model (fitted range)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
-    }
-    if let Some(tr) = truth {
-        let grey = RGBColor(90, 90, 90);
+        let c = TERM_COLORS[j];
+        let name = super::fit::TERM_NAMES[j];
         ctx.draw_series(DashedLineSeries::new(
-            tr.iter()
-                .copied()
-                .filter(|&(t, v)| t >= x0 && t <= x1 && v > 0.0),
-            px(2.0),
-            px(3.0),
-            grey.stroke_width(px(1.5).max(1)),
+            line_over(x0, x1, (y0, y1), &|t| {
+                v * super::fit::basis_at(j, t, &f.shapes).sqrt()
+            }),
+            px(5.0),
+            px(4.0),
+            c.stroke_width(px(1.0).max(1)),
         ))?
-        .label("truth (sim)")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2)));
+        .label(format!(
+            "{name} = {v:.2e}{}",
+            if terms[j].verdict == super::Verdict::Resolved {
+                ""
+            } else {
+                " (not resolved)"
+            }
+        ))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
     }
-    draw_legend(&mut ctx, scale)
+    if coef[super::fit::GM] > 0.0 {
+        let (sigma, tg) = (an.terms.g.value, f.shapes.gm_t);
+        let c = TERM_COLORS[2];
+        ctx.draw_series(DashedLineSeries::new(
+            line_over(x0, x1, (y0, y1), &|t| {
+                sigma * super::fit::gm_basis(t, tg).sqrt()
+            }),
+            px(2.0),
+            px(4.0),
+            c.stroke_width(px(1.0).max(1)),
+        ))?
+        .label(format!("Gauss–Markov σ = {sigma:.2e}, T = {tg:.3} s"))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+    }
+    let model = |t: f64| f.predict(t).max(0.0).sqrt();
+    ctx.draw_series(LineSeries::new(
+        line_over(lo, hi, (y0, y1), &model),
+        BLACK.stroke_width(px(2.0)),
+    ))?
+    .label("model (fitted range)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+    Ok(())
+}
+
+/// The truth curve `sim` wrote, inside the τ range `(x0, x1)`.
+fn draw_truth<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    tr: &[(f64, f64)],
+    (x0, x1): (f64, f64),
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    let grey = RGBColor(90, 90, 90);
+    ctx.draw_series(DashedLineSeries::new(
+        tr.iter()
+            .copied()
+            .filter(|&(t, v)| t >= x0 && t <= x1 && v > 0.0),
+        px(2.0),
+        px(3.0),
+        grey.stroke_width(px(1.5).max(1)),
+    ))?
+    .label("truth (sim)")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2)));
+    Ok(())
 }

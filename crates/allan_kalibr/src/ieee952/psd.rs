@@ -360,10 +360,8 @@ pub fn find_lines(p: &Psd) -> Vec<Line> {
     if n < 2 * FLOOR_MIN_BINS {
         return Vec::new();
     }
-    let (fl, marked) = (&p.floor, &p.marks);
+    let marked = &p.marks;
     let threshold = line_threshold(p);
-    let d = &p.density;
-    let df = p.resolution();
     let mut out: Vec<Line> = Vec::new();
     let mut k = FIRST_LINE_BIN;
     while k < n {
@@ -377,59 +375,76 @@ pub fn find_lines(p: &Psd) -> Vec<Line> {
             hi += 1;
         }
         k = hi + 1;
-        // a run needs a bin past the threshold (the wings alone are not a line)
-        let Some(top) = (lo..=hi).max_by(|&a, &b| (d[a] / fl[a]).total_cmp(&(d[b] / fl[b]))) else {
-            continue;
-        };
-        let ratio = d[top] / fl[top];
-        if ratio < threshold {
-            continue;
+        if let Some(l) = run_line(p, lo, hi, threshold) {
+            out.push(l);
         }
-        // the leakage of a sinusoid: ±PEAK_HALF_WIDTH bins at least
-        let (lo, hi) = (
-            lo.min(top.saturating_sub(PEAK_HALF_WIDTH)).max(1),
-            hi.max(top + PEAK_HALF_WIDTH).min(n - 1),
-        );
-        let excess: Vec<f64> = (lo..=hi).map(|i| (d[i] - fl[i]).max(0.0)).collect();
-        let sum: f64 = excess.iter().sum();
-        if !is_positive(sum) {
-            continue;
-        }
-        let power = sum * df;
-        let centroid: f64 = (lo..=hi)
-            .zip(&excess)
-            .map(|(i, e)| p.freq[i] * e)
-            .sum::<f64>()
-            / sum;
-        // the peak height, smoothed over three bins (a resonance's top is as noisy as any bin)
-        let peak = (lo..=hi)
-            .map(|i| {
-                let a = i.saturating_sub(1).max(lo);
-                let b = (i + 1).min(hi);
-                (a..=b).map(|j| (d[j] - fl[j]).max(0.0)).sum::<f64>() / (b - a + 1) as f64
-            })
-            .fold(0.0, f64::max);
-        let width = 2.0 * power / (PI * peak); // Hz, Lorentzian
-        let window = HANN_ENBW_BINS * df * 2.0 / PI; // a sinusoid's apparent width
-        let (mut frequency, mut bandwidth, mut bandwidth_se) = (centroid, 0.0, 0.0);
-        if width > RESONANCE_MIN_WIDTH * window {
-            // a resonance: its shape fitted to the PSD around it ([`fit_resonance`]); where
-            // that fails, the first estimate from the power over the peak height
-            let b0 = (width * width - window * window).max(0.0).sqrt();
-            match fit_resonance(p, centroid, b0) {
-                Some(r) => (frequency, bandwidth, bandwidth_se) = (r.frequency, r.bandwidth, r.se),
-                None => (bandwidth, bandwidth_se) = (b0, f64::NAN),
-            }
-        }
-        out.push(Line {
-            frequency,
-            amplitude: (2.0 * power).sqrt(),
-            bandwidth,
-            bandwidth_se,
-            peak_ratio: ratio,
-            floor: fl[top],
-        });
     }
+    without_wings(out)
+}
+
+/// The line of the run `lo..=hi` of line bins, if its highest bin over the floor reaches
+/// `threshold`: at the centroid of its excess over the floor (widened to a sinusoid's
+/// leakage), its power the excess summed; a resonance when wider than the window's own.
+fn run_line(p: &Psd, lo: usize, hi: usize, threshold: f64) -> Option<Line> {
+    let n = p.density.len();
+    let fl = &p.floor;
+    let d = &p.density;
+    let df = p.resolution();
+    // a run needs a bin past the threshold (the wings alone are not a line)
+    let top = (lo..=hi).max_by(|&a, &b| (d[a] / fl[a]).total_cmp(&(d[b] / fl[b])))?;
+    let ratio = d[top] / fl[top];
+    if ratio < threshold {
+        return None;
+    }
+    // the leakage of a sinusoid: ±PEAK_HALF_WIDTH bins at least
+    let (lo, hi) = (
+        lo.min(top.saturating_sub(PEAK_HALF_WIDTH)).max(1),
+        hi.max(top + PEAK_HALF_WIDTH).min(n - 1),
+    );
+    let excess: Vec<f64> = (lo..=hi).map(|i| (d[i] - fl[i]).max(0.0)).collect();
+    let sum: f64 = excess.iter().sum();
+    if !is_positive(sum) {
+        return None;
+    }
+    let power = sum * df;
+    let centroid: f64 = (lo..=hi)
+        .zip(&excess)
+        .map(|(i, e)| p.freq[i] * e)
+        .sum::<f64>()
+        / sum;
+    // the peak height, smoothed over three bins (a resonance's top is as noisy as any bin)
+    let peak = (lo..=hi)
+        .map(|i| {
+            let a = i.saturating_sub(1).max(lo);
+            let b = (i + 1).min(hi);
+            (a..=b).map(|j| (d[j] - fl[j]).max(0.0)).sum::<f64>() / (b - a + 1) as f64
+        })
+        .fold(0.0, f64::max);
+    let width = 2.0 * power / (PI * peak); // Hz, Lorentzian
+    let window = HANN_ENBW_BINS * df * 2.0 / PI; // a sinusoid's apparent width
+    let (mut frequency, mut bandwidth, mut bandwidth_se) = (centroid, 0.0, 0.0);
+    if width > RESONANCE_MIN_WIDTH * window {
+        // a resonance: its shape fitted to the PSD around it ([`fit_resonance`]); where
+        // that fails, the first estimate from the power over the peak height
+        let b0 = (width * width - window * window).max(0.0).sqrt();
+        match fit_resonance(p, centroid, b0) {
+            Some(r) => (frequency, bandwidth, bandwidth_se) = (r.frequency, r.bandwidth, r.se),
+            None => (bandwidth, bandwidth_se) = (b0, f64::NAN),
+        }
+    }
+    Some(Line {
+        frequency,
+        amplitude: (2.0 * power).sqrt(),
+        bandwidth,
+        bandwidth_se,
+        peak_ratio: ratio,
+        floor: fl[top],
+    })
+}
+
+/// The lines found, without the too broadly damped ones and the leftovers of a resonance's
+/// wings beside it, strongest first by [`Line::allan_ratio`].
+fn without_wings(mut out: Vec<Line>) -> Vec<Line> {
     // a line is lightly damped (bandwidth below half its frequency), and the leftovers of a
     // resonance's wings beside it are part of it, not lines of their own
     out.retain(|l| l.bandwidth < RESONANCE_MAX_REL_WIDTH * l.frequency);
@@ -485,50 +500,7 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
         return None;
     }
     let k_seg = p.segments.max(1) as f64;
-    // χ² (each bin's relative variance 1/K) at (f0, B), with the linear part solved by
-    // iterated reweighting from the first estimate's model
-    let chi2 = |fc: f64, bw: f64| -> Option<(f64, [f64; 3])> {
-        if !is_positive(bw) || !is_positive(fc) {
-            return None;
-        }
-        let g: Vec<[f64; 3]> = bins
-            .iter()
-            .map(|&i| {
-                let f = p.freq[i];
-                [1.0, (f - fc) / fc, super::lines::resonance_psd(f, fc, bw)]
-            })
-            .collect();
-        let mut model: Vec<f64> = bins.iter().map(|&i| p.density[i]).collect();
-        let mut c = [0.0; 3];
-        for _ in 0..RESONANCE_FIT_REWEIGHTS {
-            let mut n = vec![vec![0.0; 3]; 3];
-            let mut b = vec![0.0; 3];
-            for ((gi, &i), m) in g.iter().zip(&bins).zip(&model) {
-                let w = 1.0 / (m * m).max(f64::MIN_POSITIVE);
-                for r in 0..3 {
-                    b[r] += w * gi[r] * p.density[i];
-                    for s in 0..3 {
-                        n[r][s] += w * gi[r] * gi[s];
-                    }
-                }
-            }
-            let x = super::fit::solve_spd(&n, &b)?;
-            c = [x[0], x[1], x[2]];
-            for (m, gi) in model.iter_mut().zip(&g) {
-                *m = c[0] + c[1] * gi[1] + c[2] * gi[2];
-            }
-            if model.iter().any(|m| !is_positive(*m)) || !is_positive(c[2]) {
-                return None;
-            }
-        }
-        let x2 = bins
-            .iter()
-            .zip(&model)
-            .map(|(&i, m)| (p.density[i] / m - 1.0).powi(2))
-            .sum::<f64>()
-            * k_seg;
-        Some((x2, c))
-    };
+    let chi2 = |fc: f64, bw: f64| resonance_chi2(p, &bins, k_seg, fc, bw);
     let at = |fc: f64, lb: f64| chi2(fc, lb.exp()).map_or(f64::INFINITY, |r| r.0);
     let (mut fc, mut lb) = (f0, b0.ln());
     for _ in 0..RESONANCE_FIT_ROUNDS {
@@ -557,6 +529,58 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
         bandwidth,
         se: bandwidth * se_ln,
     })
+}
+
+/// χ² of the resonance shape at centre `fc` and bandwidth `bw` over the PSD's `bins` (each
+/// bin's relative variance 1/K, `k_seg` = K), with the linear part (c₀, c₁, σ²) solved by
+/// iterated reweighting from the first estimate's model; returns χ² and (c₀, c₁, σ²).
+fn resonance_chi2(
+    p: &Psd,
+    bins: &[usize],
+    k_seg: f64,
+    fc: f64,
+    bw: f64,
+) -> Option<(f64, [f64; 3])> {
+    if !is_positive(bw) || !is_positive(fc) {
+        return None;
+    }
+    let g: Vec<[f64; 3]> = bins
+        .iter()
+        .map(|&i| {
+            let f = p.freq[i];
+            [1.0, (f - fc) / fc, super::lines::resonance_psd(f, fc, bw)]
+        })
+        .collect();
+    let mut model: Vec<f64> = bins.iter().map(|&i| p.density[i]).collect();
+    let mut c = [0.0; 3];
+    for _ in 0..RESONANCE_FIT_REWEIGHTS {
+        let mut n = vec![vec![0.0; 3]; 3];
+        let mut b = vec![0.0; 3];
+        for ((gi, &i), m) in g.iter().zip(bins).zip(&model) {
+            let w = 1.0 / (m * m).max(f64::MIN_POSITIVE);
+            for r in 0..3 {
+                b[r] += w * gi[r] * p.density[i];
+                for s in 0..3 {
+                    n[r][s] += w * gi[r] * gi[s];
+                }
+            }
+        }
+        let x = super::fit::solve_spd(&n, &b)?;
+        c = [x[0], x[1], x[2]];
+        for (m, gi) in model.iter_mut().zip(&g) {
+            *m = c[0] + c[1] * gi[1] + c[2] * gi[2];
+        }
+        if model.iter().any(|m| !is_positive(*m)) || !is_positive(c[2]) {
+            return None;
+        }
+    }
+    let x2 = bins
+        .iter()
+        .zip(&model)
+        .map(|(&i, m)| (p.density[i] / m - 1.0).powi(2))
+        .sum::<f64>()
+        * k_seg;
+    Some((x2, c))
 }
 
 /// Reweighting passes of the resonance fit's linear part.

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::Analysis;
+use super::chart_panels::LogLog;
 use super::imu::{AxisResult, ImuAnalysis};
 
 /// Panel size in SVG user units (the PNG is drawn at [`PNG_SCALE`]).
@@ -135,6 +137,9 @@ fn log_bins(freq: &[f64], density: &[f64], bins: usize) -> Vec<Bin> {
     out
 }
 
+/// A panel's axis ranges (x0, x1, y0, y1).
+type Ranges = (f64, f64, f64, f64);
+
 fn panel<DB: DrawingBackend>(
     ax: &AxisResult,
     area: &DrawingArea<DB, Shift>,
@@ -156,8 +161,32 @@ where
     };
     let bins = log_bins(&p.freq, &p.density, CHART_BINS);
     let floor = log_bins(&p.freq, &p.floor, CHART_BINS);
+    let model = model_points(an, &bins);
+    let r = panel_ranges(&bins, &model);
+    let (x0, x1, y0, y1) = r;
+    let mut ctx = super::chart_panels::log_log_panel(
+        area,
+        format!("{label} — {} segments of {}", p.segments, p.segment),
+        (x0, x1),
+        (y0, y1),
+        ("f [Hz]", &format!("PSD [({})²/Hz]", ax.sensor.unit())),
+        scale,
+    )?;
+    draw_psd(&mut ctx, &bins, &floor, &model, scale)?;
+    mark_lines(&mut ctx, an, r, scale)?;
+    super::chart_panels::draw_legend(&mut ctx, scale)
+}
+
+/// Whether a density is plottable on a log axis.
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+/// The fitted model's PSD at the bins' frequencies (positive values only); none when the
+/// model does not fit.
+fn model_points(an: &Analysis, bins: &[Bin]) -> Vec<(f64, f64)> {
     let fit = an.fit.as_ref().filter(|_| an.verdict.fits());
-    let model: Vec<(f64, f64)> = fit.map_or_else(Vec::new, |x| {
+    fit.map_or_else(Vec::new, |x| {
         bins.iter()
             .map(|b| {
                 (
@@ -167,10 +196,14 @@ where
             })
             .filter(|&(_, v)| v.is_finite() && v > 0.0)
             .collect()
-    });
-    let positive = |v: f64| v.is_finite() && v > 0.0;
+    })
+}
+
+/// The axis ranges of a panel: the bins' frequencies, their mean and largest densities and
+/// the model's, padded in log space.
+fn panel_ranges(bins: &[Bin], model: &[(f64, f64)]) -> Ranges {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for b in &bins {
+    for b in bins {
         x0 = x0.min(b.freq);
         x1 = x1.max(b.freq);
         for v in [b.mean, b.max] {
@@ -180,7 +213,7 @@ where
             }
         }
     }
-    for &(_, v) in &model {
+    for &(_, v) in model {
         y0 = y0.min(v);
         y1 = y1.max(v);
     }
@@ -189,14 +222,21 @@ where
     }
     let (x0, x1) = (x0 / 1.2, x1 * 1.2);
     let (y0, y1) = (y0 / 3.0, y1 * 3.0);
-    let mut ctx = super::chart_panels::log_log_panel(
-        area,
-        format!("{label} — {} segments of {}", p.segments, p.segment),
-        (x0, x1),
-        (y0, y1),
-        ("f [Hz]", &format!("PSD [({})²/Hz]", ax.sensor.unit())),
-        scale,
-    )?;
+    (x0, x1, y0, y1)
+}
+
+/// The PSD's envelope (largest bin) and mean, its local floor and the fitted model.
+fn draw_psd<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    bins: &[Bin],
+    floor: &[Bin],
+    model: &[(f64, f64)],
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
     let data = RGBColor(0, 90, 170);
     ctx.draw_series(LineSeries::new(
         bins.iter()
@@ -234,6 +274,21 @@ where
         .label("fitted model")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
     }
+    Ok(())
+}
+
+/// A dashed mark at each line found inside the panel's frequencies; the legend names the
+/// strongest (all of them when there are at most three).
+fn mark_lines<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    an: &Analysis,
+    (x0, x1, y0, y1): Ranges,
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
     let red = RGBColor(214, 39, 40);
     for (k, l) in an.lines.iter().enumerate() {
         if !(l.frequency > x0 && l.frequency < x1) {
@@ -253,7 +308,7 @@ where
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], red));
         }
     }
-    super::chart_panels::draw_legend(&mut ctx, scale)
+    Ok(())
 }
 
 #[cfg(test)]

@@ -115,6 +115,31 @@ pub(crate) fn upper_bound<'a>(
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The N reading from the white-noise points `white` of `pts` (their τ and deviations
+/// `tau`, `adev`): the −½ line through them, read at 1 s, with the relative interval of the
+/// most precise of them (the narrowest).
+fn white_line(pts: &[&Point], tau: &[f64], adev: &[f64], white: &[usize]) -> Reading {
+    let line = (white
+        .iter()
+        .map(|&i| (adev[i] * tau[i].sqrt()).ln())
+        .sum::<f64>()
+        / white.len() as f64)
+        .exp();
+    // the most precise point: the narrowest relative interval
+    let best = white
+        .iter()
+        .copied()
+        .min_by(|&a, &b| (pts[a].hi95 / pts[a].lo95).total_cmp(&(pts[b].hi95 / pts[b].lo95)))
+        .unwrap_or(white[0]);
+    Reading {
+        value: line,
+        lo: line * pts[best].lo95 / adev[best],
+        hi: line * pts[best].hi95 / adev[best],
+        tau: 1.0,
+        kind: ReadingKind::Line,
+    }
+}
+
 /// Readings from `points` (the usable range of one curve, ascending τ, on the fit grid) with
 /// their 95 % bounds `lo95`/`hi95` (NaN when the sample count is unknown: then the readings
 /// carry no interval).
@@ -159,25 +184,7 @@ pub(crate) fn read(points: &[Point]) -> Readings {
     let n = if white.is_empty() {
         bound(&|t: f64| 1.0 / t.sqrt())
     } else {
-        let line = (white
-            .iter()
-            .map(|&i| (adev[i] * tau[i].sqrt()).ln())
-            .sum::<f64>()
-            / white.len() as f64)
-            .exp();
-        // the most precise point: the narrowest relative interval
-        let best = white
-            .iter()
-            .copied()
-            .min_by(|&a, &b| (pts[a].hi95 / pts[a].lo95).total_cmp(&(pts[b].hi95 / pts[b].lo95)))
-            .unwrap_or(white[0]);
-        Some(Reading {
-            value: line,
-            lo: line * pts[best].lo95 / adev[best],
-            hi: line * pts[best].hi95 / adev[best],
-            tau: 1.0,
-            kind: ReadingKind::Line,
-        })
+        Some(white_line(&pts, &tau, &adev, &white))
     };
     // B: the minimum, when flat there
     let b = if slope[imin].abs() <= SLOPE_TOL {

@@ -74,6 +74,19 @@ fn positive_points(tau: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The chart's log–log drawing context.
+type LogLog<'a, DB> = ChartContext<
+    'a,
+    DB,
+    plotters::coord::cartesian::Cartesian2d<
+        plotters::coord::combinators::LogCoord<f64>,
+        plotters::coord::combinators::LogCoord<f64>,
+    >,
+>;
+
+/// A read-off point: τ, value and the colour of its line.
+type Mark = (f64, f64, RGBColor);
+
 fn draw<DB: DrawingBackend>(
     chart: &Chart,
     root: &DrawingArea<DB, Shift>,
@@ -90,6 +103,47 @@ where
         .map(|y| positive_points(chart.tau, y))
         .chain([positive_points(chart.tau, &chart.fit.sigavg)])
         .collect();
+    let (x0, x1, y0, y1) = axis_ranges(chart, &curves);
+
+    let mut ctx = ChartBuilder::on(root)
+        .caption(&chart.title, ("sans-serif", px(26.0)))
+        .margin(px(16.0))
+        .x_label_area_size(px(60.0))
+        .y_label_area_size(px(95.0))
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    ctx.configure_mesh()
+        .x_desc("τ [sec]")
+        .y_desc(format!("Normal Allan Deviation [{}]", chart.unit))
+        .label_style(("sans-serif", px(16.0)))
+        .axis_desc_style(("sans-serif", px(20.0)))
+        .x_label_formatter(&|v| format_tick(*v))
+        .y_label_formatter(&|v| format_tick(*v))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .draw()?;
+
+    let labels = ["x", "y", "z"].map(|a| format!("{a}-{}", chart.name));
+    draw_curves(&mut ctx, &curves, &labels, scale)?;
+    draw_fit_lines(&mut ctx, chart, (x0, x1, y0, y1), scale)?;
+
+    // Read-off points: σ at τ≈1 on the red line, σ_b at τ≈3 on the blue line.
+    let fit = chart.fit;
+    let marks = [(fit.tau_at1, fit.white, RED), (fit.tau_at2, fit.bias, BLUE)];
+    draw_marks(&mut ctx, &marks, (y0, y1), scale)?;
+
+    let position = legend_corner(&ctx, &curves, &marks, &labels, px(17.0) as i32);
+    ctx.configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", px(17.0)))
+        .draw()?;
+    Ok(())
+}
+
+/// The axis ranges (x0, x1, y0, y1) of the chart: the curves' points and the two read-off
+/// values, padded a bit in log space.
+fn axis_ranges(chart: &Chart, curves: &[Vec<(f64, f64)>]) -> (f64, f64, f64, f64) {
     let all = curves.iter().flatten();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in all {
@@ -111,25 +165,20 @@ where
     }
     let (y0, y1) = (y0 / 1.6, y1 * 1.6);
     let (x0, x1) = (x0 / 1.3, x1 * 1.3);
+    (x0, x1, y0, y1)
+}
 
-    let mut ctx = ChartBuilder::on(root)
-        .caption(&chart.title, ("sans-serif", px(26.0)))
-        .margin(px(16.0))
-        .x_label_area_size(px(60.0))
-        .y_label_area_size(px(95.0))
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-    ctx.configure_mesh()
-        .x_desc("τ [sec]")
-        .y_desc(format!("Normal Allan Deviation [{}]", chart.unit))
-        .label_style(("sans-serif", px(16.0)))
-        .axis_desc_style(("sans-serif", px(20.0)))
-        .x_label_formatter(&|v| format_tick(*v))
-        .y_label_formatter(&|v| format_tick(*v))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(200, 200, 200))
-        .draw()?;
-
-    let labels = ["x", "y", "z"].map(|a| format!("{a}-{}", chart.name));
+/// The x, y, z curves and their average, in MATLAB's colours, with their legend entries.
+fn draw_curves<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    curves: &[Vec<(f64, f64)>],
+    labels: &[String; 3],
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
     for (i, pts) in curves.iter().enumerate() {
         let color = MATLAB_COLORS[i];
         let label = if i < 3 {
@@ -144,20 +193,12 @@ where
         .label(label)
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
     }
+    Ok(())
+}
 
-    // Fitted lines over the whole τ range, clipped to the y range (log-spaced samples).
+/// The legend texts of the −½ (white) and +½ (bias) fitted lines.
+fn fit_labels(chart: &Chart) -> (String, String) {
     let fit = chart.fit;
-    let line = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
-        (0..FIT_LINE_POINTS)
-            .map(|k| {
-                let t = x0 * (x1 / x0).powf(k as f64 / (FIT_LINE_POINTS - 1) as f64);
-                (t, f(t))
-            })
-            .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
-            .collect()
-    };
-    let red = RED.mix(0.5);
-    let blue = BLUE.mix(0.5);
     let white_label = format!(
         "−½ fit: σ = {} {} (τ = {} s)",
         value6(fit.white),
@@ -177,6 +218,34 @@ where
             super::report::matlab_fixed(fit.tau_at2, 2)
         )
     };
+    (white_label, bias_label)
+}
+
+/// The −½ (red) and +½ (blue) fitted lines over the whole τ range `(x0, x1, y0, y1)`,
+/// clipped to its y range (log-spaced samples).
+fn draw_fit_lines<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    chart: &Chart,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    let fit = chart.fit;
+    let line = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+        (0..FIT_LINE_POINTS)
+            .map(|k| {
+                let t = x0 * (x1 / x0).powf(k as f64 / (FIT_LINE_POINTS - 1) as f64);
+                (t, f(t))
+            })
+            .filter(|&(_, y)| y.is_finite() && y >= y0 && y <= y1)
+            .collect()
+    };
+    let red = RED.mix(0.5);
+    let blue = BLUE.mix(0.5);
+    let (white_label, bias_label) = fit_labels(chart);
     ctx.draw_series(LineSeries::new(
         line(&|t| fit.h_fit1(t)),
         red.stroke_width(px(3.0)),
@@ -189,10 +258,21 @@ where
     ))?
     .label(bias_label)
     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(4)));
+    Ok(())
+}
 
-    // Read-off points: σ at τ≈1 on the red line, σ_b at τ≈3 on the blue line.
-    let marks = [(fit.tau_at1, fit.white, RED), (fit.tau_at2, fit.bias, BLUE)];
-    for (t, v, c) in marks {
+/// The read-off points inside the y range `(y0, y1)`: a filled circle ringed in black.
+fn draw_marks<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    marks: &[Mark; 2],
+    (y0, y1): (f64, f64),
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
+    for &(t, v, c) in marks {
         if t > 0.0 && v.is_finite() && v >= y0 && v <= y1 {
             ctx.draw_series(std::iter::once(Circle::new((t, v), px(7.0), c.filled())))?;
             ctx.draw_series(std::iter::once(Circle::new(
@@ -202,10 +282,19 @@ where
             )))?;
         }
     }
+    Ok(())
+}
 
-    // Legend in the corner that hides the fewest curve points and neither read-off point
-    // (upstream uses "southeast", which often covers the +1/2 read-off).
-    let font = px(17.0) as i32;
+/// Legend in the corner that hides the fewest curve points and neither read-off point
+/// (upstream uses "southeast", which often covers the +1/2 read-off); `font` is the legend's
+/// font size in pixels.
+fn legend_corner<'a, DB: DrawingBackend + 'a>(
+    ctx: &LogLog<'a, DB>,
+    curves: &[Vec<(f64, f64)>],
+    marks: &[Mark; 2],
+    labels: &[String; 3],
+    font: i32,
+) -> SeriesLabelPosition {
     let longest = [labels[0].len(), 16, 60].into_iter().max().unwrap_or(60) as i32;
     let legend_w = longest * font * 55 / 100 + 50;
     let legend_h = 6 * (font + 10) + 16;
@@ -215,7 +304,7 @@ where
         .flatten()
         .map(|p| (ctx.backend_coord(p), 1))
         .collect();
-    for (t, v, _) in marks {
+    for &(t, v, _) in marks {
         if t > 0.0 && v.is_finite() {
             weighted.push((ctx.backend_coord(&(t, v)), 100_000));
         }
@@ -239,18 +328,11 @@ where
             .map(|(_, w)| w)
             .sum()
     };
-    let position = corners
+    corners
         .into_iter()
         .min_by_key(|(_, bx, by)| cost(*bx, *by))
         .map(|(p, _, _)| p)
-        .unwrap_or(SeriesLabelPosition::LowerRight);
-    ctx.configure_series_labels()
-        .position(position)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font(("sans-serif", px(17.0)))
-        .draw()?;
-    Ok(())
+        .unwrap_or(SeriesLabelPosition::LowerRight)
 }
 
 /// `%.6f` as upstream's text box, but NaN spelled out.

@@ -193,80 +193,15 @@ pub fn sig2_tiled(p: &mut [f64], ms: &[u64]) -> Vec<f64> {
 /// The tiled walk of [`sig2_tiled`]; `prepare` is called on each tile (`p` entries of the
 /// tile) just before it is walked.
 fn walk_tiles(p: &mut [f64], ms: &[u64], mut prepare: impl FnMut(&mut [f64])) -> Vec<f64> {
-    struct State {
-        m: usize,
-        next: usize, // next boundary, in P numbering (P[next] = p[next-1])
-        end: usize,  // last boundary K*m
-        last_p: f64,
-        last_b: f64,
-        have_b: bool,
-        acc: f64,
-    }
     let n = p.len();
-    let mut st: Vec<State> = ms
-        .iter()
-        .map(|&m| {
-            let m = m as usize;
-            State {
-                m,
-                next: m.max(1),
-                end: n.checked_div(m).unwrap_or(0) * m,
-                last_p: 0.0, // P[0]
-                last_b: 0.0,
-                have_b: false,
-                acc: 0.0,
-            }
-        })
-        .collect();
+    let mut st: Vec<TileWalk> = ms.iter().map(|&m| TileWalk::new(m as usize, n)).collect();
     let mut tile_start = 1;
     while tile_start <= n {
         let tile_end = (tile_start + TILE).min(n + 1);
         prepare(&mut p[tile_start - 1..tile_end - 1]);
         let p: &[f64] = p;
         for s in st.iter_mut() {
-            let stop = (tile_end - 1).min(s.end);
-            if s.next > stop {
-                continue;
-            }
-            let m = s.m;
-            // Locals (registers) for the walk; four accumulators break the add chain.
-            let (mut next, mut lp, mut lb) = (s.next, s.last_p, s.last_b);
-            let (mut acc0, mut acc1, mut acc2, mut acc3) = (s.acc, 0.0, 0.0, 0.0);
-            if !s.have_b {
-                let pv = p[next - 1];
-                lb = pv - lp;
-                lp = pv;
-                next += m;
-                s.have_b = true;
-            }
-            while next + 3 * m <= stop {
-                let p1 = p[next - 1];
-                let p2 = p[next + m - 1];
-                let p3 = p[next + 2 * m - 1];
-                let p4 = p[next + 3 * m - 1];
-                let (b1, b2, b3, b4) = (p1 - lp, p2 - p1, p3 - p2, p4 - p3);
-                let (d1, d2, d3, d4) = (b1 - lb, b2 - b1, b3 - b2, b4 - b3);
-                acc0 += d1 * d1;
-                acc1 += d2 * d2;
-                acc2 += d3 * d3;
-                acc3 += d4 * d4;
-                lb = b4;
-                lp = p4;
-                next += 4 * m;
-            }
-            while next <= stop {
-                let pv = p[next - 1];
-                let b = pv - lp;
-                let d = b - lb;
-                acc0 += d * d;
-                lb = b;
-                lp = pv;
-                next += m;
-            }
-            s.next = next;
-            s.last_p = lp;
-            s.last_b = lb;
-            s.acc = (acc0 + acc1) + (acc2 + acc3);
+            s.walk(p, tile_end);
         }
         tile_start = tile_end;
     }
@@ -280,6 +215,82 @@ fn walk_tiles(p: &mut [f64], ms: &[u64], mut prepare: impl FnMut(&mut [f64])) ->
             (0.5 * (s.acc / (k - 1) as f64)).sqrt() / mf
         })
         .collect()
+}
+
+/// Where the walk of one m in [`walk_tiles`] stands between tiles.
+struct TileWalk {
+    m: usize,
+    next: usize, // next boundary, in P numbering (P[next] = p[next-1])
+    end: usize,  // last boundary K*m
+    last_p: f64,
+    last_b: f64,
+    have_b: bool,
+    acc: f64,
+}
+
+impl TileWalk {
+    /// Before the first tile, for cluster size `m` on `n` prefix entries.
+    fn new(m: usize, n: usize) -> Self {
+        TileWalk {
+            m,
+            next: m.max(1),
+            end: n.checked_div(m).unwrap_or(0) * m,
+            last_p: 0.0, // P[0]
+            last_b: 0.0,
+            have_b: false,
+            acc: 0.0,
+        }
+    }
+
+    /// Walks this m's cluster boundaries inside the tile ending before P numbering
+    /// `tile_end`, accumulating the squared differences of the block sums.
+    #[inline]
+    fn walk(&mut self, p: &[f64], tile_end: usize) {
+        let s = self;
+        let stop = (tile_end - 1).min(s.end);
+        if s.next > stop {
+            return;
+        }
+        let m = s.m;
+        // Locals (registers) for the walk; four accumulators break the add chain.
+        let (mut next, mut lp, mut lb) = (s.next, s.last_p, s.last_b);
+        let (mut acc0, mut acc1, mut acc2, mut acc3) = (s.acc, 0.0, 0.0, 0.0);
+        if !s.have_b {
+            let pv = p[next - 1];
+            lb = pv - lp;
+            lp = pv;
+            next += m;
+            s.have_b = true;
+        }
+        while next + 3 * m <= stop {
+            let p1 = p[next - 1];
+            let p2 = p[next + m - 1];
+            let p3 = p[next + 2 * m - 1];
+            let p4 = p[next + 3 * m - 1];
+            let (b1, b2, b3, b4) = (p1 - lp, p2 - p1, p3 - p2, p4 - p3);
+            let (d1, d2, d3, d4) = (b1 - lb, b2 - b1, b3 - b2, b4 - b3);
+            acc0 += d1 * d1;
+            acc1 += d2 * d2;
+            acc2 += d3 * d3;
+            acc3 += d4 * d4;
+            lb = b4;
+            lp = p4;
+            next += 4 * m;
+        }
+        while next <= stop {
+            let pv = p[next - 1];
+            let b = pv - lp;
+            let d = b - lb;
+            acc0 += d * d;
+            lb = b;
+            lp = pv;
+            next += m;
+        }
+        s.next = next;
+        s.last_p = lp;
+        s.last_b = lb;
+        s.acc = (acc0 + acc1) + (acc2 + acc3);
+    }
 }
 
 /// `sig2` for cluster size `m` exactly as `allan.m` computes it (kalibr_allan.md §2.1):

@@ -8,8 +8,9 @@
 //! 2-per-octave sub-grid ([`FitConfig::per_octave`]).
 //!
 //! The terms' basis functions and shapes are in [`super::model`], the small dense linear algebra
-//! (whitening, active-set NNLS, normal equations, SPD solve) in `linalg`; this module is the
-//! fit itself: GLS with the discrepancy, the τ range, term selection and the intervals.
+//! (whitening, active-set NNLS, normal equations, SPD solve) in `linalg`, one GLS solve with
+//! the discrepancy in `gls`; this module is the fit itself: the τ range, term selection and
+//! the intervals.
 //! How far a range may go on past the first point the model misses is `range_end`'s joint
 //! test of the extension.
 //!
@@ -87,6 +88,7 @@
 
 use super::avar_cov::CovBasis;
 
+mod gls;
 mod linalg;
 mod range_end;
 use super::model::effective_coef;
@@ -95,8 +97,9 @@ pub use super::model::{
     FLICKER_AVAR, GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA,
     TERM_COUNT, TERM_NAMES, alpha_index, basis, basis_at, flicker_band, gm_basis,
 };
+use gls::{Delta, FixedLs, Problem, Solve, fixed_ls, gls};
 pub(in crate::ieee952) use linalg::solve_spd;
-use linalg::{covariance, nnls_subsets, whiten};
+use linalg::{covariance, whiten};
 pub(in crate::ieee952) use range_end::extension_agrees;
 
 /// Fit settings.
@@ -281,378 +284,6 @@ const NUISANCE: [usize; 3] = [0, 2, 4];
 /// χ²(1) quantile at 0.99: a nuisance term enters when it lowers the fit's χ² by more than
 /// this (a 1 % chance of adding a term the data do not have).
 pub const SELECT_CHI2: f64 = 6.634_896_601_021_214;
-/// Iterations of the discrepancy root-finding (bisection in log δ over 18 e-folds: 2⁻³⁰ of
-/// that is a relative precision of 2e-8 in δ).
-const DELTA_BISECT: usize = 30;
-/// Bracket of δ: far below any useful precision, and 10× the value itself.
-const DELTA_RANGE: (f64, f64) = (1e-7, 10.0);
-/// The re-weighting stops when no coefficient moves by more than this fraction.
-const GLS_REL_TOL: f64 = 1e-6;
-
-/// How δ is set in one solve.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Delta {
-    /// Statistical covariance only.
-    Zero,
-    /// Given.
-    Fixed(f64),
-    /// Estimated (χ²/dof = 1).
-    Estimate,
-}
-
-/// One GLS solve.
-#[derive(Clone, Debug)]
-struct Solve {
-    coef: [f64; TERM_COUNT],
-    cov: [[f64; TERM_COUNT]; TERM_COUNT],
-    /// χ² with the covariance used (Σ + δ²D).
-    chi2: f64,
-    /// χ² with Σ alone (NaN without a basis).
-    chi2_stat: f64,
-    dof: usize,
-    delta: f64,
-    iterations: usize,
-    converged: bool,
-}
-
-struct Problem<'d, 'a> {
-    data: &'d FitData<'a>,
-    sel: Vec<usize>,
-    g: Vec<[f64; TERM_COUNT]>,
-    a: Vec<f64>,
-    shapes: Shapes,
-}
-
-impl<'d, 'a> Problem<'d, 'a> {
-    /// The problem on the points `sel` and the terms fitted in it (those `enabled` that have
-    /// a shape); `None` without a term or with no more points than terms.
-    fn with_terms(
-        data: &'d FitData<'a>,
-        sel: &[usize],
-        enabled: [bool; TERM_COUNT],
-        shapes: Shapes,
-    ) -> Option<(Self, Vec<usize>)> {
-        let terms: Vec<usize> = (0..TERM_COUNT)
-            .filter(|&j| enabled[j] && shapes.has(j))
-            .collect();
-        if terms.is_empty() || sel.len() < terms.len() + 1 {
-            return None;
-        }
-        Some((Problem::new(data, sel, shapes), terms))
-    }
-
-    /// The points `sel` of `data` under `shapes`; the fixed lines' Allan variance is taken
-    /// off the data (their columns are zero: they are not solved for).
-    fn new(data: &'d FitData<'a>, sel: &[usize], shapes: Shapes) -> Self {
-        let fixed = shapes.fixed_coef();
-        let g = sel
-            .iter()
-            .map(|&i| {
-                std::array::from_fn(|j| {
-                    if fixed[j] != 0.0 {
-                        0.0
-                    } else {
-                        basis_at(j, data.points[i].tau, &shapes)
-                    }
-                })
-            })
-            .collect();
-        let a = sel
-            .iter()
-            .map(|&i| {
-                let tau = data.points[i].tau;
-                data.points[i].avar
-                    - (0..TERM_COUNT)
-                        .map(|j| fixed[j] * basis_at(j, tau, &shapes))
-                        .sum::<f64>()
-            })
-            .collect();
-        Problem {
-            data,
-            sel: sel.to_vec(),
-            g,
-            a,
-            shapes,
-        }
-    }
-
-    fn pred(&self, c: &[f64; TERM_COUNT]) -> Vec<f64> {
-        self.g
-            .iter()
-            .map(|gi| (0..TERM_COUNT).map(|j| c[j] * gi[j]).sum())
-            .collect()
-    }
-
-    /// Statistical covariance at c (the 1/τ² component only where it is a positive Q).
-    fn sigma(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
-        let v = self.sigma_terms(c)?;
-        Some(self.with_line_variance(c, v))
-    }
-
-    /// A resonance's own estimate varies like a narrow-band noise's: 2·(its AVAR)²/ν on the
-    /// diagonal, ν = [`LineShape::edf`] (its white-noise stand-in in the covariance has the
-    /// EDF of white noise, far more).
-    fn with_line_variance(&self, c: &[f64; TERM_COUNT], mut v: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
-        let fixed = self.shapes.fixed_coef();
-        for (k, &i) in self.sel.iter().enumerate() {
-            let tau = self.data.points[i].tau;
-            for (s, l) in self.shapes.lines.iter().enumerate() {
-                if let Some(l) = l
-                    && l.bandwidth > 0.0
-                {
-                    let coef = if l.fixed() {
-                        fixed[LINE0 + s]
-                    } else {
-                        c[LINE0 + s]
-                    };
-                    let a = coef.max(0.0) * l.avar(tau);
-                    v[k][k] += 2.0 * a * a / l.edf();
-                }
-            }
-        }
-        v
-    }
-
-    /// The covariance of the power laws (and the lines' white-noise stand-ins) at c.
-    fn sigma_terms(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
-        let b = self.data.basis?;
-        let mut cp = *c;
-        cp[0] = cp[0].max(0.0);
-        let fixed = self.shapes.fixed_coef();
-        for j in LINE0..TERM_COUNT {
-            if fixed[j] != 0.0 {
-                cp[j] = fixed[j];
-            }
-        }
-        let idx: Vec<usize> = self.sel.iter().map(|&i| self.data.basis_index[i]).collect();
-        let shaped = (cp[2] != 0.0 && self.shapes.b_lo > 0.0)
-            || cp[GM] != 0.0
-            || cp[4] != 0.0
-            || (LINE0..TERM_COUNT).any(|j| cp[j] != 0.0);
-        if !shaped {
-            return Some(b.cov(&idx, &cp));
-        }
-        let per: Vec<[f64; TERM_COUNT]> = self
-            .sel
-            .iter()
-            .map(|&i| effective_coef(&cp, &self.shapes, self.data.points[i].tau))
-            .collect();
-        Some(b.cov_pointwise(&idx, &per))
-    }
-
-    /// V = Σ + δ²·diag(A²) with A the measured AVAR; without a basis, diag(A²) alone (δ
-    /// factored out). The discrepancy is a fraction of the curve as measured: scaling it by
-    /// the model instead lets a model that overshoots a stretch of the curve weight that
-    /// stretch down and run away from it.
-    fn v(&self, sigma: &Option<Vec<Vec<f64>>>, delta: f64) -> Vec<Vec<f64>> {
-        let k = self.a.len();
-        match sigma {
-            Some(s) => {
-                let mut v = s.clone();
-                for i in 0..k {
-                    v[i][i] += delta * delta * self.a[i] * self.a[i];
-                }
-                v
-            }
-            None => {
-                let mut v = vec![vec![0.0; k]; k];
-                for i in 0..k {
-                    v[i][i] = self.a[i] * self.a[i];
-                }
-                v
-            }
-        }
-    }
-}
-
-/// χ² = rᵀV⁻¹r.
-fn chi2_of(v: &[Vec<f64>], r: &[f64]) -> Option<f64> {
-    let (_, rw) = whiten(v, &[], r)?;
-    Some(rw.iter().map(|x| x * x).sum())
-}
-
-/// δ ≥ 0 with rᵀ(Σ + δ²·diag(A²))⁻¹r = dof (0 when already ≤ dof).
-fn solve_delta(sigma: &[Vec<f64>], a: &[f64], r: &[f64], dof: usize) -> f64 {
-    let target = dof.max(1) as f64;
-    let at = |d: f64| -> f64 {
-        let mut v = sigma.to_vec();
-        for i in 0..a.len() {
-            v[i][i] += d * d * a[i] * a[i];
-        }
-        chi2_of(&v, r).unwrap_or(f64::INFINITY)
-    };
-    if at(0.0) <= target {
-        return 0.0;
-    }
-    let (mut lo, mut hi) = (DELTA_RANGE.0.ln(), DELTA_RANGE.1.ln());
-    if at(DELTA_RANGE.1) > target {
-        return DELTA_RANGE.1;
-    }
-    for _ in 0..DELTA_BISECT {
-        let mid = 0.5 * (lo + hi);
-        if at(mid.exp()) > target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi.exp()
-}
-
-/// GLS of the terms `enabled` (those in `signed` may be negative) on the points `sel`.
-#[allow(clippy::too_many_arguments)]
-fn gls(
-    data: &FitData,
-    sel: &[usize],
-    enabled: [bool; TERM_COUNT],
-    signed: [bool; TERM_COUNT],
-    delta_mode: Delta,
-    max_iter: usize,
-    shapes: Shapes,
-) -> Option<Solve> {
-    let (p, terms) = Problem::with_terms(data, sel, enabled, shapes)?;
-    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
-    // start: relative weights 1/A²
-    let w0: Vec<f64> = p.a.iter().map(|a| 1.0 / (a * a)).collect();
-    let mut coef = nnls_subsets(&p.g, &p.a, &w0, &terms, &signed, &feasible)?;
-    let no_basis = data.basis.is_none();
-    let mut delta = match delta_mode {
-        Delta::Fixed(d) => d,
-        _ => 0.0,
-    };
-    let mut iterations = 0;
-    let mut converged = false;
-    for _ in 0..max_iter {
-        iterations += 1;
-        let pred = p.pred(&coef);
-        let sigma = p.sigma(&coef);
-        if delta_mode == Delta::Estimate && !no_basis {
-            let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
-            let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
-            delta = solve_delta(sigma.as_ref()?, &p.a, &r, sel.len().saturating_sub(nfree));
-        }
-        let v = p.v(&sigma, delta);
-        let (gw, aw) = whiten(&v, &p.g, &p.a)?;
-        let ones = vec![1.0; gw.len()];
-        let new = nnls_subsets(&gw, &aw, &ones, &terms, &signed, &feasible)?;
-        let change = (0..TERM_COUNT)
-            .filter(|&j| new[j] != 0.0 || coef[j] != 0.0)
-            .map(|j| ((new[j] - coef[j]) / new[j].abs().max(coef[j].abs())).abs())
-            .fold(0.0, f64::max);
-        coef = new;
-        if change < GLS_REL_TOL {
-            converged = true;
-            break;
-        }
-    }
-    let pred = p.pred(&coef);
-    let sigma = p.sigma(&coef);
-    let nfree = (0..TERM_COUNT).filter(|&j| coef[j] != 0.0).count();
-    let dof = sel.len().saturating_sub(nfree);
-    let r: Vec<f64> = p.a.iter().zip(&pred).map(|(a, q)| a - q).collect();
-    if delta_mode == Delta::Estimate {
-        delta = match &sigma {
-            Some(s) => solve_delta(s, &p.a, &r, dof),
-            // relative least squares: δ² = Σ(r/A)²/dof
-            None => (r
-                .iter()
-                .zip(&p.a)
-                .map(|(ri, q)| (ri / q).powi(2))
-                .sum::<f64>()
-                / dof.max(1) as f64)
-                .sqrt(),
-        };
-    }
-    let v = p.v(&sigma, delta);
-    let (gw, _) = whiten(&v, &p.g, &p.a)?;
-    let ones = vec![1.0; gw.len()];
-    let free_terms: Vec<usize> = terms.iter().copied().filter(|&j| coef[j] != 0.0).collect();
-    let mut cov = if free_terms.is_empty() {
-        [[0.0; TERM_COUNT]; TERM_COUNT]
-    } else {
-        covariance(&gw, &ones, &free_terms)?
-    };
-    if no_basis {
-        // the weights are relative: scale by δ² (no statistical meaning, kept for the record)
-        for row in cov.iter_mut() {
-            for v in row.iter_mut() {
-                *v *= delta * delta;
-            }
-        }
-    }
-    let chi2 = if no_basis {
-        if delta > 0.0 {
-            chi2_of(&v, &r)? / (delta * delta)
-        } else {
-            0.0
-        }
-    } else {
-        chi2_of(&v, &r)?
-    };
-    let chi2_stat = match &sigma {
-        Some(s) => chi2_of(s, &r).unwrap_or(f64::NAN),
-        None => f64::NAN,
-    };
-    Some(Solve {
-        coef,
-        cov,
-        chi2,
-        chi2_stat,
-        dof,
-        delta,
-        iterations,
-        converged,
-    })
-}
-
-/// Weighted least squares of the terms `enabled` on `sel` with the covariance held fixed at
-/// the coefficients `at` and discrepancy `delta` (no re-weighting): the χ² of nested models
-/// under one covariance, so that their difference is a likelihood-ratio statistic (with the
-/// covariance re-evaluated per model, a model could lower its χ² by inflating its own
-/// variances). Returns the coefficients, χ², the whitened residuals and the coefficients'
-/// covariance.
-#[allow(clippy::too_many_arguments)]
-fn fixed_ls(
-    data: &FitData,
-    sel: &[usize],
-    enabled: [bool; TERM_COUNT],
-    signed: [bool; TERM_COUNT],
-    at: &[f64; TERM_COUNT],
-    delta: f64,
-    shapes: Shapes,
-) -> Option<FixedLs> {
-    let (p, terms) = Problem::with_terms(data, sel, enabled, shapes)?;
-    let feasible = |c: &[f64; TERM_COUNT]| p.pred(c).iter().all(|v| is_positive(*v));
-    let sigma = p.sigma(at);
-    let v = p.v(&sigma, delta);
-    let (gw, aw) = whiten(&v, &p.g, &p.a)?;
-    let ones = vec![1.0; gw.len()];
-    let c = nnls_subsets(&gw, &aw, &ones, &terms, &signed, &feasible)?;
-    let r: Vec<f64> = p.a.iter().zip(p.pred(&c)).map(|(a, q)| a - q).collect();
-    let (_, rw) = whiten(&v, &[], &r)?;
-    let chi2 = rw.iter().map(|x| x * x).sum::<f64>()
-        / if data.basis.is_none() {
-            delta * delta
-        } else {
-            1.0
-        };
-    let free: Vec<usize> = terms.iter().copied().filter(|&j| c[j] != 0.0).collect();
-    let cov = if free.is_empty() {
-        [[0.0; TERM_COUNT]; TERM_COUNT]
-    } else {
-        covariance(&gw, &ones, &free)?
-    };
-    Some((c, chi2, rw, cov))
-}
-
-/// What [`fixed_ls`] returns: coefficients, χ², whitened residuals, covariance.
-type FixedLs = (
-    [f64; TERM_COUNT],
-    f64,
-    Vec<f64>,
-    [[f64; TERM_COUNT]; TERM_COUNT],
-);
-
 /// Median of χ²(1): a robust scale is median(e²)/this.
 const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
 
@@ -831,26 +462,11 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         gls(data, used, terms, signed, est, cfg.max_iter, shapes)?
     };
     if !cfg.discrepancy && data.basis.is_some() {
-        // plain GLS: standard errors scaled against misfit
-        let scale = (s.chi2 / s.dof.max(1) as f64).max(1.0);
-        for row in s.cov.iter_mut() {
-            for v in row.iter_mut() {
-                *v *= scale;
-            }
-        }
+        scale_by_misfit(&mut s);
     }
-    let mut left_out = [false; TERM_COUNT];
     let mut coef = s.coef;
     let mut cov = s.cov;
-    let mut left_out_coef = [0.0; TERM_COUNT];
-    for j in 0..TERM_COUNT {
-        if cfg.terms[j] && !terms[j] && base.has(j) {
-            left_out[j] = true;
-            coef[j] = 0.0;
-            cov[j][j] = full.as_ref().map_or(f64::NAN, |f| f.cov[j][j]);
-            left_out_coef[j] = full.as_ref().map_or(0.0, |f| f.coef[j].max(0.0));
-        }
-    }
+    let (left_out, left_out_coef) = leave_out(cfg, terms, base, full.as_ref(), &mut coef, &mut cov);
     // the fixed lines' coefficients are the PSD's
     for (j, v) in shapes.fixed_coef().iter().enumerate() {
         if *v != 0.0 {
@@ -897,6 +513,42 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
     })
 }
 
+/// Plain GLS (no discrepancy): the standard errors of `s` scaled against misfit (by its
+/// χ²/dof, when above 1).
+fn scale_by_misfit(s: &mut Solve) {
+    // plain GLS: standard errors scaled against misfit
+    let scale = (s.chi2 / s.dof.max(1) as f64).max(1.0);
+    for row in s.cov.iter_mut() {
+        for v in row.iter_mut() {
+            *v *= scale;
+        }
+    }
+}
+
+/// The terms of `cfg` the selection left out of `terms` (with a shape in `base`): their
+/// coefficients in `coef` set to 0, their variances in `cov` taken from the fit of every
+/// IEEE term `full`; returns which were left out and their coefficients in `full`.
+fn leave_out(
+    cfg: &FitConfig,
+    terms: [bool; TERM_COUNT],
+    base: Shapes,
+    full: Option<&Solve>,
+    coef: &mut [f64; TERM_COUNT],
+    cov: &mut [[f64; TERM_COUNT]; TERM_COUNT],
+) -> ([bool; TERM_COUNT], [f64; TERM_COUNT]) {
+    let mut left_out = [false; TERM_COUNT];
+    let mut left_out_coef = [0.0; TERM_COUNT];
+    for j in 0..TERM_COUNT {
+        if cfg.terms[j] && !terms[j] && base.has(j) {
+            left_out[j] = true;
+            coef[j] = 0.0;
+            cov[j][j] = full.map_or(f64::NAN, |f| f.cov[j][j]);
+            left_out_coef[j] = full.map_or(0.0, |f| f.coef[j].max(0.0));
+        }
+    }
+    (left_out, left_out_coef)
+}
+
 /// The forward selection of the nuisance terms, the Gauss–Markov bump and the flicker
 /// floor's corner (with `cfg.select`): each step adds the candidate whose χ² drop beyond its
 /// threshold is largest, while one is positive. Returns the terms and shapes chosen (the
@@ -908,9 +560,7 @@ fn select_terms(
     full: Option<&Solve>,
     est: Delta,
 ) -> Option<([bool; TERM_COUNT], Shapes)> {
-    let signed = signed_terms(cfg);
     let base = data.base_shapes();
-    let mut shapes = base;
     if cfg.select {
         let mut t = [false; TERM_COUNT];
         t[1] = cfg.terms[1];
@@ -919,85 +569,120 @@ fn select_terms(
             t[j] = cfg.terms[j] && base.has(j);
         }
         if t.iter().any(|x| *x) {
-            // each step tests the candidates under the covariance of the current model (the
-            // null hypothesis), with the full model's discrepancy (see [`fixed_ls`])
-            let d = match (full, est) {
-                (Some(f), Delta::Estimate) if data.basis.is_some() => f.delta,
-                _ if data.basis.is_none() => 1.0,
-                _ => 0.0,
-            };
-            let dmode = Delta::Fixed(d);
-            let grid = shape_grid(data, used, GM_GRID);
-            let corners = if cfg.flicker_corner {
-                shape_grid(data, used, CORNER_GRID)
-            } else {
-                Vec::new()
-            };
-            loop {
-                let base = gls(data, used, t, signed, dmode, cfg.max_iter, shapes)?;
-                let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
-                    fixed_ls(data, used, tt, signed, &base.coef, d, sh).map(|x| x.1)
-                };
-                let cur = chi(t, shapes)?;
-                // (term added or none, χ² drop beyond its threshold, shapes)
-                let mut best: Option<(Option<usize>, f64, Shapes)> = None;
-                let mut consider = |j: Option<usize>, excess: f64, sh: Shapes| {
-                    if best.is_none_or(|b| excess > b.1) {
-                        best = Some((j, excess, sh));
-                    }
-                };
-                for j in NUISANCE {
-                    if cfg.terms[j] && !t[j] {
-                        let mut tt = t;
-                        tt[j] = true;
-                        if let Some(c) = chi(tt, shapes) {
-                            consider(Some(j), cur - c - SELECT_CHI2, shapes);
-                        }
-                    }
-                }
-                if cfg.terms[GM] && !t[GM] {
-                    let mut tt = t;
-                    tt[GM] = true;
-                    // the best correlation time; a bump only where the data locate it (a
-                    // best time at either end of the search is a trend the power laws
-                    // miss, not a bump)
-                    let best_t = grid
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(i, &tg)| {
-                            let sh = Shapes { gm_t: tg, ..shapes };
-                            chi(tt, sh).map(|c| (i, c, sh))
-                        })
-                        .min_by(|a, b| a.1.total_cmp(&b.1));
-                    if let Some((i, c, sh)) = best_t
-                        && i > 0
-                        && i + 1 < grid.len()
-                    {
-                        consider(Some(GM), cur - c - SELECT_CHI2_GM, sh);
-                    }
-                }
-                if t[2] && shapes.b_lo == 0.0 {
-                    for &lo in &corners {
-                        let sh = Shapes { b_lo: lo, ..shapes };
-                        if let Some(c) = chi(t, sh) {
-                            consider(None, cur - c - SELECT_CHI2, sh);
-                        }
-                    }
-                }
-                match best {
-                    Some((j, excess, sh)) if excess > 0.0 => {
-                        if let Some(j) = j {
-                            t[j] = true;
-                        }
-                        shapes = sh;
-                    }
-                    _ => break,
-                }
-            }
-            return Some((t, shapes));
+            return select_forward(data, used, cfg, full, est, t);
         }
     }
     Some((ieee_only(cfg.terms), base))
+}
+
+/// [`select_terms`]' steps from the terms `t` always fitted (N, K, the lines), from the
+/// base shapes: each adds the best candidate of [`best_candidate`] while its χ² drop beyond
+/// its threshold is positive.
+fn select_forward(
+    data: &FitData,
+    used: &[usize],
+    cfg: &FitConfig,
+    full: Option<&Solve>,
+    est: Delta,
+    mut t: [bool; TERM_COUNT],
+) -> Option<([bool; TERM_COUNT], Shapes)> {
+    let signed = signed_terms(cfg);
+    let mut shapes = data.base_shapes();
+    // each step tests the candidates under the covariance of the current model (the
+    // null hypothesis), with the full model's discrepancy (see [`fixed_ls`])
+    let d = match (full, est) {
+        (Some(f), Delta::Estimate) if data.basis.is_some() => f.delta,
+        _ if data.basis.is_none() => 1.0,
+        _ => 0.0,
+    };
+    let dmode = Delta::Fixed(d);
+    let grid = shape_grid(data, used, GM_GRID);
+    let corners = if cfg.flicker_corner {
+        shape_grid(data, used, CORNER_GRID)
+    } else {
+        Vec::new()
+    };
+    loop {
+        let base = gls(data, used, t, signed, dmode, cfg.max_iter, shapes)?;
+        let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
+            fixed_ls(data, used, tt, signed, &base.coef, d, sh).map(|x| x.1)
+        };
+        let cur = chi(t, shapes)?;
+        match best_candidate(cfg, t, shapes, cur, (&grid, &corners), &chi) {
+            Some((j, excess, sh)) if excess > 0.0 => {
+                if let Some(j) = j {
+                    t[j] = true;
+                }
+                shapes = sh;
+            }
+            _ => break,
+        }
+    }
+    Some((t, shapes))
+}
+
+/// A candidate step of the selection: the term added (none for a corner of the flicker
+/// floor), its χ² drop beyond its threshold, and the shapes with it.
+type Candidate = (Option<usize>, f64, Shapes);
+
+/// The best candidate step from the terms `t` and `shapes` (χ² `cur`, `chi` the χ² of a
+/// candidate under the current model's covariance): each nuisance term not in yet, the
+/// Gauss–Markov bump at its best correlation time on `grids.0` (only an interior one), and
+/// each corner of the flicker floor on `grids.1`.
+fn best_candidate(
+    cfg: &FitConfig,
+    t: [bool; TERM_COUNT],
+    shapes: Shapes,
+    cur: f64,
+    (grid, corners): (&[f64], &[f64]),
+    chi: &dyn Fn([bool; TERM_COUNT], Shapes) -> Option<f64>,
+) -> Option<Candidate> {
+    // (term added or none, χ² drop beyond its threshold, shapes)
+    let mut best: Option<Candidate> = None;
+    let mut consider = |j: Option<usize>, excess: f64, sh: Shapes| {
+        if best.is_none_or(|b| excess > b.1) {
+            best = Some((j, excess, sh));
+        }
+    };
+    for j in NUISANCE {
+        if cfg.terms[j] && !t[j] {
+            let mut tt = t;
+            tt[j] = true;
+            if let Some(c) = chi(tt, shapes) {
+                consider(Some(j), cur - c - SELECT_CHI2, shapes);
+            }
+        }
+    }
+    if cfg.terms[GM] && !t[GM] {
+        let mut tt = t;
+        tt[GM] = true;
+        // the best correlation time; a bump only where the data locate it (a
+        // best time at either end of the search is a trend the power laws
+        // miss, not a bump)
+        let best_t = grid
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &tg)| {
+                let sh = Shapes { gm_t: tg, ..shapes };
+                chi(tt, sh).map(|c| (i, c, sh))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((i, c, sh)) = best_t
+            && i > 0
+            && i + 1 < grid.len()
+        {
+            consider(Some(GM), cur - c - SELECT_CHI2_GM, sh);
+        }
+    }
+    if t[2] && shapes.b_lo == 0.0 {
+        for &lo in corners {
+            let sh = Shapes { b_lo: lo, ..shapes };
+            if let Some(c) = chi(t, sh) {
+                consider(None, cur - c - SELECT_CHI2, sh);
+            }
+        }
+    }
+    best
 }
 
 /// The final model of a fit, for the checks made under its covariance (`s`): the terms it
@@ -1286,6 +971,7 @@ const INVERSION_REL_TOL: f64 = 1e-3;
 #[cfg(test)]
 mod tests {
     use super::super::oadev::Overlap;
+    use super::linalg::nnls_subsets;
     use super::*;
 
     /// Noise-free data: the fit must return the generating coefficients to rounding.
