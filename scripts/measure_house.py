@@ -47,6 +47,8 @@ def fns(text):
             l = re.sub(r'"(\\.|[^"\\])*"', '""', lines[j])
             l = re.sub(r"'(\\.|[^'\\])'", "''", l)
             l = l.split('//')[0]
+            # `[T; N]` in a signature is no end of a declaration
+            l = re.sub(r'\[[^\]]*\]', '[]', l)
             if not started and ';' in l and '{' not in l:
                 break
             depth += l.count('{') - l.count('}')
@@ -75,7 +77,7 @@ def main():
             for name, ln, at in fns(t):
                 if ln > LONG:
                     head = '\n'.join(t.split('\n')[max(0, at - 6):at])
-                    st['long'].append((ln, f'{rel}:{name}', 'reason' if re.search(r'(?i)long|over 80|reason', head) else ''))
+                    st['long'].append((ln, f'{rel}:{name}', 'reason' if re.search(r'(?im)^\s*//.*\b(long because|long:|long on purpose|over 80 lines)', head) else ''))
     st['long'].sort(reverse=True)
     print(f"## {crate}: pub fn {st['pub_fn']}, pub(crate|super) fn {st['crate_fn']}, pub mod {st['pub_mod']}, Result<_, String> {st['rs']}, files>1000 {st['big']}")
     print(f"   fn > {LONG} lines ({len(st['long'])}): " + ', '.join(f'{n} {l}{" ["+r+"]" if r else ""}' for l, n, r in [(b, a, c) for a, b, c in st['long']]))
