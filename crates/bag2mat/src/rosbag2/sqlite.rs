@@ -276,6 +276,32 @@ impl Sqlite3Reader {
         }
     }
 
+    /// The payload of a walked row (at walk position `pos`, of `topic`, recorded at `ts`)
+    /// when its topic is wanted; a row naming no topic the table holds is noted as stray.
+    fn take_payload(
+        &self,
+        w: &mut Walked2,
+        row: &rusqlite::Row,
+        (pos, topic, ts): (u64, u32, i64),
+        wanted: &[u32],
+    ) -> Result<(), rusqlite::Error> {
+        if let Some(data) = row.get_ref(3)?.as_blob_or_null()? {
+            let a = w.arena.len();
+            w.arena.extend_from_slice(data);
+            w.rows
+                .push((pos, topic, ts.max(0) as u64, a..w.arena.len()));
+        } else if wanted.contains(&topic) {
+            return Err(rusqlite::Error::InvalidColumnType(
+                3,
+                "data".into(),
+                rusqlite::types::Type::Null,
+            ));
+        } else if !self.contents.channels.iter().any(|c| c.id == topic) {
+            w.stray_topic.push((pos, topic));
+        }
+        Ok(())
+    }
+
     /// Walks the rows from `start` until `stop` (the next part's first id), resuming past
     /// damaged pages: the ids and record times of all, and the payloads of the topics
     /// `wanted` names (buffered until the walk is judged).
@@ -289,15 +315,7 @@ impl Sqlite3Reader {
                 .min(self.capacity),
             None => self.capacity,
         };
-        let list: Vec<String> = wanted.iter().map(|c| c.to_string()).collect();
-        let sql = format!(
-            "SELECT id, timestamp, topic_id, CASE WHEN topic_id IN ({}) THEN data END FROM messages NOT INDEXED WHERE id >= ?1",
-            if list.is_empty() {
-                "NULL".to_string()
-            } else {
-                list.join(",")
-            }
-        );
+        let sql = walk_sql(wanted);
         let mut seek_at = Some(start);
         while let Some(at) = seek_at.take() {
             let mut rows = 0u64;
@@ -334,23 +352,7 @@ impl Sqlite3Reader {
                         continue;
                     };
                     // A field that does not read is this row's loss only.
-                    let fields = (|| -> Result<(), rusqlite::Error> {
-                        if let Some(data) = row.get_ref(3)?.as_blob_or_null()? {
-                            let a = w.arena.len();
-                            w.arena.extend_from_slice(data);
-                            w.rows
-                                .push((pos, topic, ts.max(0) as u64, a..w.arena.len()));
-                        } else if wanted.contains(&topic) {
-                            return Err(rusqlite::Error::InvalidColumnType(
-                                3,
-                                "data".into(),
-                                rusqlite::types::Type::Null,
-                            ));
-                        } else if !self.contents.channels.iter().any(|c| c.id == topic) {
-                            w.stray_topic.push((pos, topic));
-                        }
-                        Ok(())
-                    })();
+                    let fields = self.take_payload(&mut w, row, (pos, topic, ts), wanted);
                     if let Err(e) = fields {
                         w.bad_fields
                             .push((pos, Some(topic), format!("row {id}: sqlite3: {e}")));
@@ -375,6 +377,20 @@ impl Sqlite3Reader {
         }
         w
     }
+}
+
+/// The query of a part's walk: every row from an id on, the payload only of the wanted
+/// topics.
+fn walk_sql(wanted: &[u32]) -> String {
+    let list: Vec<String> = wanted.iter().map(|c| c.to_string()).collect();
+    format!(
+        "SELECT id, timestamp, topic_id, CASE WHEN topic_id IN ({}) THEN data END FROM messages NOT INDEXED WHERE id >= ?1",
+        if list.is_empty() {
+            "NULL".to_string()
+        } else {
+            list.join(",")
+        }
+    )
 }
 
 /// The rows of a part's walk that were kept but do not read, as losses: rows whose fields

@@ -270,6 +270,8 @@ pub(super) fn columns(lay: &Layout) -> Vec<Col> {
 /// the row and the bytes it took with its line end; `None` hands the line to the `csv`
 /// crate ([`parse_csv`]), which reads it or says why not. Trailing columns past the last
 /// one read are skipped.
+// Long because: the hot loop of the text reader (every field of every line); one body
+// keeps the position and the row in registers, and issue 20's benchmark holds it to time.
 pub(super) fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
     let ws = matches!(lay.delim, Delim::Whitespace(_));
     let d = match lay.delim {

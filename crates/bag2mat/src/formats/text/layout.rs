@@ -244,18 +244,12 @@ pub(super) fn layout(
         )?,
         None => None,
     };
-    if opts.gyro_scale.is_some() && gyro_unit.is_none() && gyro.is_some() {
-        return Err(bad(
-            path,
-            "--gyro-scale gives LSB per unit: say which unit with --gyro-unit rad/s|deg/s".into(),
-        ));
-    }
-    if opts.acc_scale.is_some() && acc_unit.is_none() && acc.is_some() {
-        return Err(bad(
-            path,
-            "--acc-scale gives LSB per unit: say which unit with --acc-unit m/s^2|g|mg".into(),
-        ));
-    }
+    scales_have_units(
+        path,
+        opts,
+        gyro_unit.is_some() || gyro.is_none(),
+        acc_unit.is_some() || acc.is_none(),
+    )?;
     let what = layout_text(
         n_cols,
         delim,
@@ -279,6 +273,29 @@ pub(super) fn layout(
         what,
         euroc,
     })
+}
+
+/// A raw-count scale (`--gyro-scale`, `--acc-scale`) needs the unit it counts in
+/// (`gyro_ok`, `acc_ok`: the unit is known, or the sensor has no columns).
+fn scales_have_units(
+    path: &Path,
+    opts: &InputOptions,
+    gyro_ok: bool,
+    acc_ok: bool,
+) -> Result<(), Error> {
+    if opts.gyro_scale.is_some() && !gyro_ok {
+        return Err(bad(
+            path,
+            "--gyro-scale gives LSB per unit: say which unit with --gyro-unit rad/s|deg/s".into(),
+        ));
+    }
+    if opts.acc_scale.is_some() && !acc_ok {
+        return Err(bad(
+            path,
+            "--acc-scale gives LSB per unit: say which unit with --acc-unit m/s^2|g|mg".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// A file that is text but no table of numbers, for the input-kind error.

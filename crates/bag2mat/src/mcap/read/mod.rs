@@ -315,6 +315,39 @@ impl McapReader {
         (data_end, summary)
     }
 
+    /// The damage a part's walk skipped, as a loss when nothing counts what it held
+    /// (`unindexed`: as many Imu messages as its bytes fit), else as a note (the index
+    /// shows every message it lists was delivered).
+    fn damage_report(
+        &self,
+        part: usize,
+        unindexed: bool,
+        damage: &[(String, u64)],
+        out: &mut PartRead,
+    ) {
+        let what = format!(
+            "{}: {}",
+            self.contents.parts[part].label,
+            damage
+                .iter()
+                .map(|d| d.0.as_str())
+                .collect::<Vec<_>>()
+                .join("; ")
+        );
+        if unindexed {
+            // Nothing counts what the skipped bytes held: as many Imu messages as fit.
+            let bytes: u64 = damage.iter().map(|d| d.1).sum();
+            out.lost.push(Loss {
+                what,
+                at_most: Some(bytes / MIN_IMU_RECORD),
+                ..Loss::default()
+            });
+        } else {
+            // Every message the index lists was delivered: the damage cost none.
+            out.notes.push(what);
+        }
+    }
+
     /// The messages the chunk's message index lists for a wanted channel that were not
     /// delivered (`delivered_at`: channel and offset, sorted), as one loss per channel.
     fn unread_listed(
@@ -512,19 +545,7 @@ impl Source for McapReader {
         });
         if short {
             delivered_at.sort_unstable();
-            let why = if damage.is_empty() && no_channel > 0 {
-                format!(
-                    "{no_channel} message record(s) name a channel no Channel record defines (a damaged channel id)"
-                )
-            } else if damage.is_empty() {
-                "its record is not a readable message".to_string()
-            } else {
-                damage
-                    .iter()
-                    .map(|d| d.0.as_str())
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            };
+            let why = short_reason(&damage, no_channel);
             out.lost
                 .extend(self.unread_listed(part, indexes, want, &delivered_at, &why));
         } else if no_channel > 0 && indexes.is_empty() {
@@ -538,29 +559,27 @@ impl Source for McapReader {
             });
         }
         if !damage.is_empty() && (out.lost.is_empty() || !short) {
-            let what = format!(
-                "{}: {}",
-                self.contents.parts[part].label,
-                damage
-                    .iter()
-                    .map(|d| d.0.as_str())
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            );
-            if indexes.is_empty() {
-                // Nothing counts what the skipped bytes held: as many Imu messages as fit.
-                let bytes: u64 = damage.iter().map(|d| d.1).sum();
-                out.lost.push(Loss {
-                    what,
-                    at_most: Some(bytes / MIN_IMU_RECORD),
-                    ..Loss::default()
-                });
-            } else {
-                // Every message the index lists was delivered: the damage cost none.
-                out.notes.push(what);
-            }
+            self.damage_report(part, indexes.is_empty(), &damage, &mut out);
         }
         out
+    }
+}
+
+/// Why messages the index lists could not be read: the damage met, else records naming
+/// an undefined channel, else records that are no readable message.
+fn short_reason(damage: &[(String, u64)], no_channel: u64) -> String {
+    if damage.is_empty() && no_channel > 0 {
+        format!(
+            "{no_channel} message record(s) name a channel no Channel record defines (a damaged channel id)"
+        )
+    } else if damage.is_empty() {
+        "its record is not a readable message".to_string()
+    } else {
+        damage
+            .iter()
+            .map(|d| d.0.as_str())
+            .collect::<Vec<_>>()
+            .join("; ")
     }
 }
 
