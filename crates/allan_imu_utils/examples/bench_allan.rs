@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use allan_imu_utils::{estimator, factors};
+use allan_imu_utils::{allan_variance, factors, mean_period, thetas};
 
 /// Seed of the synthetic white noise (a fixed LCG).
 const SEED: u64 = 0x0123_4567_89AB_CDEF;
@@ -29,7 +29,7 @@ fn main() {
         })
         .collect();
     let t: Vec<f64> = (0..n).map(|i| 1.6e9 + i as f64 * 0.005).collect();
-    let f = factors::factors(n, 100);
+    let f = factors(n, 100);
     println!(
         "N {n}, {} factors, 6 axes, {} threads",
         f.len(),
@@ -37,15 +37,12 @@ fn main() {
     );
     for _ in 0..repeats {
         let t0 = Instant::now();
-        let period = estimator::mean_period(&t);
-        let thetas: Vec<Vec<f64>> = axes
-            .iter()
-            .map(|x| estimator::thetas(x, 1.0 / period))
-            .collect();
+        let period = mean_period(&t);
+        let thetas: Vec<Vec<f64>> = axes.iter().map(|x| thetas(x, 1.0 / period)).collect();
         let t1 = Instant::now();
         let mut check = 0.0;
         for th in &thetas {
-            check += estimator::allan_variance(th, &f, period)[0];
+            check += allan_variance(th, &f, period)[0];
         }
         let t2 = Instant::now();
         println!(

@@ -226,17 +226,3 @@ pub fn fit_all(axes: &[AxisAllan]) -> Vec<AxisFit> {
         })
         .collect()
 }
-
-/// Checks there is enough data, runs the Allan step and the fits.
-pub fn analyse(c: &Collected<'_>, max_cluster: usize) -> Result<Analysis, Error> {
-    check_enough(c, max_cluster)?;
-    let (axes, gyro_mean) = allan_step(c, max_cluster, false)?;
-    let fits = fit_all(&axes);
-    Ok(Analysis {
-        max_cluster,
-        axes,
-        gyro_mean,
-        fits,
-        absent: None,
-    })
-}

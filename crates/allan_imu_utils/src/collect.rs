@@ -74,19 +74,9 @@ impl<'a> Collected<'a> {
         self.offset..self.offset + self.len()
     }
 
-    /// True when nothing was collected.
-    pub fn is_empty(&self) -> bool {
-        self.t.is_empty()
-    }
-
     /// Topic name as stored in the bag.
     pub fn topic(&self) -> &str {
         &self.series.topic
-    }
-
-    /// Messages on the topic in the bag.
-    pub fn available(&self) -> usize {
-        self.series.len()
     }
 
     /// The pushed gyro values of axis `k` (0–2: x, y, z) in pseudo-deg/h, in message order.

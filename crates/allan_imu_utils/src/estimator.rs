@@ -82,6 +82,7 @@ fn advise_huge_pages(v: &mut Vec<f64>) {
 fn advise_huge_pages(_: &mut Vec<f64>) {}
 
 /// Plain mean (`getAvgValue`): sequential sum over N.
+#[cfg(test)]
 pub fn mean(x: &[f64]) -> f64 {
     let mut sum = 0.0;
     for &v in x {
@@ -105,6 +106,7 @@ pub fn divisor(n: usize, m: usize, period: f64) -> f64 {
 /// `Σ_k ((θ[k+2m] − 2θ[k+m]) + θ[k])²`, 0 when N − 2m ≤ 0: the workspace's overlapping
 /// kernel (`allan_kalibr::ieee952::oadev::second_diff_sum`), whose squared terms are
 /// upstream's bit for bit.
+#[cfg(test)]
 pub fn second_diff_sum(theta: &[f64], m: usize) -> f64 {
     allan_kalibr::ieee952::oadev::second_diff_sum(theta, m)
 }

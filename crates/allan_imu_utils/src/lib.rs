@@ -4,10 +4,10 @@
 //! OpenCV yaml — plus a yaml with the fit read correctly and plots.
 //!
 //! Specification: `imu_utils.md` (project specs). Modules, in pipeline order:
-//! [`collect`] (stop rule), [`factors`] (cluster grid), [`estimator`] (Allan variance),
-//! [`fit`] (start point, dogleg, derived values), [`report`] (stdout and curve files),
-//! [`opencv_yaml`] (both yaml files), [`plot`]; [`launch`] and [`cli`] turn the user's
-//! flags or roslaunch file into a [`cli::Config`]; [`run`] ties them together.
+//! `collect` (stop rule), `factors` (cluster grid), `estimator` (Allan variance),
+//! `fit` (start point, dogleg, derived values), `report` (stdout and curve files),
+//! `opencv_yaml` (both yaml files), `plot`; `launch` and `cli` turn the user's
+//! flags or roslaunch file into a [`Config`]; `run` ties them together.
 //!
 //! # Quirks reproduced on purpose (imu_utils.md §6)
 //! 1. `*_n` is the fitted ADEV at 1 s times √freq (discrete), not a density.
@@ -26,23 +26,29 @@
 //! 14. Short data only warns.
 //!
 //! The corrected reading is written beside the compat one, never instead of it
-//! ([`opencv_yaml::YamlMode`]).
+//! (`opencv_yaml::YamlMode`).
 
 // Index loops over the fixed 5-vectors of the fit mirror upstream's (Eigen/Ceres) operation
 // order term by term, which iterator chains would obscure.
 #![allow(clippy::needless_range_loop)]
 
-pub mod analysis;
-pub mod cli;
-pub mod collect;
-pub mod error;
-pub mod estimator;
-pub mod factors;
-pub mod fit;
-pub mod launch;
-pub mod opencv_yaml;
-pub mod plot;
-pub mod report;
-pub mod run;
+mod analysis;
+mod cli;
+mod collect;
+mod error;
+mod estimator;
+mod factors;
+mod fit;
+mod launch;
+mod opencv_yaml;
+mod plot;
+mod report;
+mod run;
 
+// What the binary, the tests and the benchmark use; everything else is the crate's own.
+pub use cli::{Args, Config, TOOL};
 pub use error::Error;
+pub use estimator::{allan_variance, mean_period, thetas};
+pub use factors::factors;
+pub use fit::{AxisFit, Sensor};
+pub use run::{CurvesOutcome, Outcome, run, run_curves, sections};

@@ -3,7 +3,7 @@
 
 use std::process::ExitCode;
 
-use allan_imu_utils::cli::{Args, Config, TOOL};
+use allan_imu_utils::{Args, Config, TOOL};
 use allan_kalibr::front;
 
 /// Out of memory is reported as an error, not an abort.
@@ -18,7 +18,5 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
-    front::finish(TOOL, &config.common, || {
-        allan_imu_utils::run::sections(&config)
-    })
+    front::finish(TOOL, &config.common, || allan_imu_utils::sections(&config))
 }

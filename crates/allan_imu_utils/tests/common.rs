@@ -123,9 +123,8 @@ pub fn rel_err(actual: f64, expected: f64) -> f64 {
 
 /// allan_imu_utils' settings for `topic` of `bag` into `out` (IMU name `x`, header time,
 /// quiet, no plots), as the command line would give them.
-pub fn imu_utils_config(bag: &Path, topic: &str, out: &Path) -> allan_imu_utils::cli::Config {
-    let mut c =
-        allan_imu_utils::cli::Config::new(allan_kalibr::Input::Samples(bag.to_path_buf()), out);
+pub fn imu_utils_config(bag: &Path, topic: &str, out: &Path) -> allan_imu_utils::Config {
+    let mut c = allan_imu_utils::Config::new(allan_kalibr::Input::Samples(bag.to_path_buf()), out);
     c.common.topics = bag2mat::TopicSelector::one(topic);
     c.name = "x".into();
     c.plots = false;

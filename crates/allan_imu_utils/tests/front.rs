@@ -18,9 +18,9 @@ fn run(dir: &Path, args: &[&str]) -> Output {
 #[test]
 fn issue21_one_spelling_with_upstream_aliases() {
     for s in ["-o", "--out-dir", "--data-save-path", "--outdir"] {
-        let a = allan_imu_utils::cli::Args::try_parse_from(["allan_imu_utils", "x.bag", s, "o"])
+        let a = allan_imu_utils::Args::try_parse_from(["allan_imu_utils", "x.bag", s, "o"])
             .expect("parses");
-        let c = allan_imu_utils::cli::Config::try_from(a).expect("resolves");
+        let c = allan_imu_utils::Config::try_from(a).expect("resolves");
         assert_eq!(c.common.out_dir, Path::new("o"), "{s}");
     }
 }

@@ -18,7 +18,7 @@ fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
     );
     let analyse = |input: &std::path::Path, topic: &str, out: &str| {
         let out = dir.path().join(out);
-        let args = allan_imu_utils::cli::Args::try_parse_from([
+        let args = allan_imu_utils::Args::try_parse_from([
             "allan_imu_utils",
             input.to_str().unwrap(),
             "--topic",
@@ -31,7 +31,7 @@ fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        allan_imu_utils::run::run(&args.try_into().unwrap()).unwrap();
+        allan_imu_utils::run(&args.try_into().unwrap()).unwrap();
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (
             read("p3_imu_param.yaml"),

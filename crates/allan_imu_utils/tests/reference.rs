@@ -5,8 +5,8 @@
 
 use std::collections::BTreeMap;
 
-use allan_imu_utils::cli::Config;
-use allan_imu_utils::run::{Outcome, run};
+use allan_imu_utils::Config;
+use allan_imu_utils::{Outcome, run};
 
 use crate::common::{AXES, CASES, Case, parse_c_float, rel_err};
 use crate::fit_reference::{CHAOTIC_W_REL_TOL, YAML_REL_TOL};

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use allan_imu_utils::cli::Config;
+use allan_imu_utils::Config;
 use bag2mat::test_tools::{ROS2_MODES, rosbags_convert};
 
 use crate::common::{CASES, imu_utils_config, kalibr_config};
@@ -13,7 +13,7 @@ use crate::common::{CASES, imu_utils_config, kalibr_config};
 fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let mut c: Config = imu_utils_config(bag, topic, out);
     c.common.ieee952 = false;
-    let o = allan_imu_utils::run::run(&c)
+    let o = allan_imu_utils::run(&c)
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);
     let yaml = std::fs::read_to_string(out.join("x_imu_param.yaml")).unwrap();
