@@ -139,7 +139,7 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
     };
     let mut header = [0u8; 128];
     let got = read_full(&mut r, &mut header).map_err(|e| Error::io(path, e))?;
-    level5_header(&header[..got]).map_err(err)?;
+    level5_header(&header[..got]).map_err(|e| err(e.to_string()))?;
     let mut pos = 128u64;
     let mut names = Vec::new();
     while pos < len {
@@ -154,7 +154,7 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
                 let mut z = flate2::read::ZlibDecoder::new((&mut r).take(n as u64));
                 let (ity, _, _) = read_tag(&mut z).map_err(|e| at(format!("zlib: {e}")))?;
                 let found = if ity == MI_MATRIX {
-                    Some(matrix(&mut z, false).map_err(at)?)
+                    Some(matrix(&mut z, false).map_err(|e| at(e.to_string()))?)
                 } else {
                     None
                 };
@@ -166,7 +166,7 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
                 let padded = (n as u64).div_ceil(8) * 8;
                 let mut body = (&mut r).take(padded);
                 let found = if ty == MI_MATRIX {
-                    Some(matrix(&mut body, VALUES_AT).map_err(at)?)
+                    Some(matrix(&mut body, VALUES_AT).map_err(|e| at(e.to_string()))?)
                 } else {
                     None
                 };
@@ -200,24 +200,67 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
     }))
 }
 
+/// What is wrong with the bytes of a MAT file (the text each gives is the `Error::Mat` the
+/// user reads).
+#[derive(Debug, thiserror::Error)]
+enum MatFormatError {
+    /// The 128-byte header is not a little-endian Level-5 one.
+    #[error("{0}")]
+    Header(&'static str),
+    #[error("{what}: {source}")]
+    Io {
+        what: &'static str,
+        source: std::io::Error,
+    },
+    /// A sub-element larger than names and dimension lists are.
+    #[error("{what} of {n} bytes")]
+    Oversized { what: &'static str, n: u32 },
+    #[error("{0} missing")]
+    Missing(&'static str),
+    #[error("'{name}' is not a numeric matrix (class {class})")]
+    NotNumeric { name: String, class: u8 },
+    /// `data_imu`'s dimensions, when they are not N×7.
+    #[error("data_imu is {0}; expected N×7 [t ax ay az wx wy wz]")]
+    Shape(String),
+    #[error("'{0}' is complex")]
+    Complex(String),
+    #[error("'{name}' holds {n} bytes of type {ty} for {rows}×{COLS}")]
+    Size {
+        name: String,
+        n: u32,
+        ty: u32,
+        rows: usize,
+    },
+    #[error("unsupported numeric storage type {0}")]
+    StorageType(u32),
+}
+
 /// The 128-byte header of a MATLAB Level-5 MAT file (`header`: what the file holds of it),
 /// little-endian; else what it is instead (v7.3/HDF5, big-endian, no MAT file).
-fn level5_header(header: &[u8]) -> Result<(), String> {
+fn level5_header(header: &[u8]) -> Result<(), MatFormatError> {
     if header.len() >= 8 && &header[..8] == b"\x89HDF\r\n\x1a\n"
         || header.starts_with(b"MATLAB 7.3")
     {
-        return Err(
-            "MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')".into(),
-        );
+        return Err(MatFormatError::Header(
+            "MAT v7.3 (HDF5) files are not supported; re-save with save(..., '-v7')",
+        ));
     }
     if header.len() < 128 || header[..4].contains(&0) {
-        return Err("not a MATLAB Level-5 MAT file (header missing)".into());
+        return Err(MatFormatError::Header(
+            "not a MATLAB Level-5 MAT file (header missing)",
+        ));
     }
     match &header[126..128] {
         b"IM" => {}
-        b"MI" => return Err("big-endian MAT files are not supported".into()),
+        b"MI" => {
+            return Err(MatFormatError::Header(
+                "big-endian MAT files are not supported",
+            ));
+        }
         _ => {
-            return Err("not a MATLAB Level-5 MAT file (no endian indicator)".into());
+            return Err(MatFormatError::Header(
+                "not a MATLAB Level-5 MAT file (no endian indicator)",
+            ));
         }
     }
     Ok(())
@@ -248,11 +291,12 @@ fn read_tag(r: &mut impl Read) -> std::io::Result<(u32, u32, bool)> {
 }
 
 /// A small sub-element (flags, dimensions, name): type and bytes, padding consumed.
-fn small_element(r: &mut impl Read, what: &str) -> Result<(u32, Vec<u8>), String> {
+fn small_element(r: &mut impl Read, what: &'static str) -> Result<(u32, Vec<u8>), MatFormatError> {
     /// Names and dimension lists are short; a larger size means a corrupt file.
     const MAX_SUB_ELEMENT: u32 = 1 << 16;
     let mut t = [0u8; 8];
-    r.read_exact(&mut t).map_err(|e| format!("{what}: {e}"))?;
+    r.read_exact(&mut t)
+        .map_err(|source| MatFormatError::Io { what, source })?;
     let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
     if first >> 16 != 0 {
         let n = ((first >> 16) as usize).min(4);
@@ -260,11 +304,11 @@ fn small_element(r: &mut impl Read, what: &str) -> Result<(u32, Vec<u8>), String
     }
     let n = u32::from_le_bytes([t[4], t[5], t[6], t[7]]);
     if n > MAX_SUB_ELEMENT {
-        return Err(format!("{what} of {n} bytes"));
+        return Err(MatFormatError::Oversized { what, n });
     }
     let mut data = vec![0u8; (n as usize).div_ceil(8) * 8];
     r.read_exact(&mut data)
-        .map_err(|e| format!("{what}: {e}"))?;
+        .map_err(|source| MatFormatError::Io { what, source })?;
     data.truncate(n as usize);
     Ok((first, data))
 }
@@ -343,15 +387,15 @@ fn decode_into(col: &mut Vec<f64>, ty: u32, b: &[u8]) {
 
 /// Parses a miMATRIX body; reads the values only when it is `data_imu`, and with
 /// `defer_values` not even then: it stops before them ([`Parsed::Values`]).
-fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, String> {
+fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, MatFormatError> {
     let (ty, flags) = small_element(r, "array flags")?;
     if ty != MI_UINT32 || flags.len() < 8 {
-        return Err("array flags missing".into());
+        return Err(MatFormatError::Missing("array flags"));
     }
     let (class, complex) = (flags[0], flags[1] & 0x08 != 0);
     let (ty, dims) = small_element(r, "dimensions")?;
     if ty != MI_INT32 {
-        return Err("dimensions missing".into());
+        return Err(MatFormatError::Missing("dimensions"));
     }
     let dims: Vec<usize> = dims
         .chunks_exact(4)
@@ -364,24 +408,25 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, String> {
     }
     // Classes 6..=15 are numeric (double, single, int8 … uint64).
     if !(6..=15).contains(&class) {
-        return Err(format!("'{name}' is not a numeric matrix (class {class})"));
+        return Err(MatFormatError::NotNumeric { name, class });
     }
     if dims.len() != 2 || dims[1] != COLS {
-        return Err(format!(
-            "data_imu is {}; expected N×7 [t ax ay az wx wy wz]",
+        return Err(MatFormatError::Shape(
             dims.iter()
                 .map(|d| d.to_string())
                 .collect::<Vec<_>>()
-                .join("×")
+                .join("×"),
         ));
     }
     if complex {
-        return Err(format!("'{name}' is complex"));
+        return Err(MatFormatError::Complex(name));
     }
     let rows = dims[0];
     let mut t = [0u8; 8];
-    r.read_exact(&mut t)
-        .map_err(|e| format!("real part: {e}"))?;
+    r.read_exact(&mut t).map_err(|source| MatFormatError::Io {
+        what: "real part",
+        source,
+    })?;
     let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
     let (ty, n, inline) = if first >> 16 != 0 {
         (first & 0xffff, first >> 16, true)
@@ -390,9 +435,7 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, String> {
     };
     let width = type_width(ty)?;
     if n as usize != rows * COLS * width {
-        return Err(format!(
-            "'{name}' holds {n} bytes of type {ty} for {rows}×{COLS}"
-        ));
+        return Err(MatFormatError::Size { name, n, ty, rows });
     }
     if inline {
         // Only an empty matrix fits in a small element here (0 bytes).
@@ -408,7 +451,10 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, String> {
         while left > 0 {
             let k = left.min(8192);
             r.read_exact(&mut buf[..k * width])
-                .map_err(|e| format!("values: {e}"))?;
+                .map_err(|source| MatFormatError::Io {
+                    what: "values",
+                    source,
+                })?;
             decode_into(col, ty, &buf[..k * width]);
             left -= k;
         }
@@ -416,13 +462,13 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, String> {
     Ok(Parsed::DataImu(d))
 }
 
-fn type_width(ty: u32) -> Result<usize, String> {
+fn type_width(ty: u32) -> Result<usize, MatFormatError> {
     Ok(match ty {
         1 | 2 => 1,
         3 | 4 => 2,
         5..=7 => 4,
         9 | 12 | 13 => 8,
-        other => return Err(format!("unsupported numeric storage type {other}")),
+        other => return Err(MatFormatError::StorageType(other)),
     })
 }
 
