@@ -187,7 +187,7 @@ fn issue18_3_warm_up_is_flagged_on_every_axis_and_the_skip_outlasts_it() {
 /// `sim bag` with a moving IMU (its ellipse), through sim's library as its binary runs it.
 fn sim_ellipse_bag(path: &Path) {
     use clap::Parser;
-    let cli = sim::cli::Cli::try_parse_from([
+    let cli = sim::Cli::try_parse_from([
         "sim",
         "bag",
         "-o",
@@ -201,11 +201,11 @@ fn sim_ellipse_bag(path: &Path) {
         "-q",
     ])
     .unwrap();
-    let sim::cli::Command::Bag(a) = cli.command else {
+    let sim::Command::Bag(a) = cli.command else {
         unreachable!()
     };
-    let cfg = sim::bag_sim::BagConfig::try_from(*a).unwrap();
-    sim::bag_sim::run(&cfg).unwrap();
+    let cfg = sim::BagConfig::try_from(*a).unwrap();
+    sim::run_bag(&cfg).unwrap();
 }
 
 #[test]

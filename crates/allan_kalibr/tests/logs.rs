@@ -16,7 +16,7 @@ fn values(yaml: &str) -> Vec<String> {
 fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("sim.bag");
-    let sim::cli::Command::Bag(a) = sim::cli::Cli::try_parse_from([
+    let sim::Command::Bag(a) = sim::Cli::try_parse_from([
         "sim",
         "bag",
         "-o",
@@ -36,7 +36,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
     else {
         panic!("not a bag command")
     };
-    sim::bag_sim::run(&sim::bag_sim::BagConfig::try_from(*a).unwrap()).unwrap();
+    sim::run_bag(&sim::BagConfig::try_from(*a).unwrap()).unwrap();
     let root = bag2mat::test_tools::euroc_dataset_from_bag(
         &bag,
         "imu",

@@ -122,6 +122,8 @@ pub fn encode(imu: &Imu, endian: Endian, out: &mut Vec<u8>) -> Result<(), Error>
 struct Split<'a> {
     endian: Endian,
     stamp: RosTime,
+    /// Only the whole-message decoder (the tests' round trips) reads it.
+    #[cfg(test)]
     frame_id: &'a [u8],
     body: &'a [u8],
 }
@@ -170,14 +172,18 @@ fn split(data: &[u8]) -> Result<Split<'_>, Error> {
             ))
         })?;
     // The length counts the terminating NUL; a writer that leaves it out still decodes.
-    let id = &p[12..12 + id_len];
-    let frame_id = id.strip_suffix(&[0]).unwrap_or(id);
+    #[cfg(test)]
+    let frame_id = {
+        let id = &p[12..12 + id_len];
+        id.strip_suffix(&[0]).unwrap_or(id)
+    };
     Ok(Split {
         endian,
         stamp: RosTime {
             sec: sec as u32,
             nsec,
         },
+        #[cfg(test)]
         frame_id,
         body: &body[..BODY_DOUBLES * 8],
     })
@@ -201,6 +207,7 @@ pub(crate) fn decode_sample(data: &[u8]) -> Result<ImuSample, Error> {
 }
 
 /// Decodes a whole message (`seq` = 0).
+#[cfg(test)]
 pub fn decode(data: &[u8]) -> Result<Imu, Error> {
     let s = split(data)?;
     Ok(Imu::from_body(0, s.stamp, s.frame_id, |i| {

@@ -15,7 +15,7 @@
 //! * [`rosbag2`]: ROS 2 bag directories, `metadata.yaml`, the sqlite3 storage and rosbag2's
 //!   FILE/MESSAGE zstd compression; [`rosbag2::Ros2BagWriter`].
 //! * [`imu_msg`]: the ROS 1 `sensor_msgs/Imu` layout, md5 and 2571-byte definition;
-//!   [`cdr`]: `sensor_msgs/msg/Imu` in CDR (ROS 2); [`Sensor`]: its two sensors and their
+//!   `cdr`: `sensor_msgs/msg/Imu` in CDR (ROS 2); [`Sensor`]: its two sensors and their
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
@@ -24,7 +24,7 @@
 //!   outliers, warm-up, motion), typed findings every tool prints and the analysers obey.
 //! * [`formats`]: raw IMU logs from outside ROS — EuRoC/ASL and plain text, NumPy, PX4
 //!   ULog, ArduPilot DataFlash — each a [`source::Source`] over rows its reader decoded
-//!   ([`decoded`]); [`cursor`]: the bounds-checked byte reader the binary formats parse with.
+//!   (`decoded`); `cursor`: the bounds-checked byte reader the binary formats parse with.
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
 //!
@@ -33,25 +33,25 @@
 #![deny(missing_docs)]
 
 pub mod bag;
-pub mod cdr;
-pub mod cli;
+mod cdr;
+mod cli;
 pub mod convert;
-pub mod cursor;
-pub mod decoded;
+mod cursor;
+mod decoded;
 pub mod detect;
 mod error;
 pub mod formats;
 pub mod imu_msg;
 pub mod info;
 pub mod input;
-pub mod mapped;
+mod mapped;
 pub mod mat;
 pub mod mcap;
 pub mod printable;
 pub mod record_check;
 pub mod rosbag2;
 mod rows;
-pub mod sensor;
+mod sensor;
 pub mod series;
 pub mod shared;
 pub mod source;
@@ -59,9 +59,10 @@ pub mod source;
 pub mod test_tools;
 mod time;
 pub mod timing;
-pub mod zstd;
+mod zstd;
 
 pub use bag::Compression;
+pub use cli::{Args, Invocation, run};
 pub use error::{Error, TopicSummary};
 pub use rows::{ROW_LEN, Row, Rows, permute};
 pub use sensor::Sensor;

@@ -4,8 +4,8 @@
 
 use std::process::ExitCode;
 
-use bag2mat::cli::{Args, Invocation, run};
 use bag2mat::shared::cli;
+use bag2mat::{Args, Invocation, run};
 use clap::Parser;
 
 const TOOL: &str = "bag2mat";

@@ -1,7 +1,7 @@
 //! `sim` binary: parse the command line, run the library, report errors once.
 
 use clap::Parser;
-use sim::cli::Cli;
+use sim::Cli;
 use std::process::ExitCode;
 
 const TOOL: &str = "sim";
@@ -27,13 +27,13 @@ fn main() -> ExitCode {
         }
         Err(e) => return bag2mat::shared::cli::usage(TOOL, &e.render().to_string()),
     };
-    match sim::command::run(cli) {
+    match sim::run(cli) {
         Ok(code) => code,
         // What the user typed cannot be run: a usage error (exit 2).
         Err(e)
             if matches!(
-                e.downcast_ref::<sim::error::SimError>(),
-                Some(sim::error::SimError::InvalidArgument(_))
+                e.downcast_ref::<sim::SimError>(),
+                Some(sim::SimError::InvalidArgument(_))
             ) =>
         {
             bag2mat::shared::cli::usage(TOOL, &format!("{e:#}"))

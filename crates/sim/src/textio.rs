@@ -6,7 +6,7 @@ use crate::error::{Result, SimError};
 use crate::rotation::matrix_from_quat;
 use crate::spline::Pose;
 use bag2mat::shared::cfmt::push_g;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -41,13 +41,6 @@ pub struct PoseRow {
     pub gyro: Vector3<f64>,
     /// Acc (specific force), m/s².
     pub acc: Vector3<f64>,
-}
-
-impl PoseRow {
-    /// Rotation matrix of the row's quaternion.
-    pub fn r(&self) -> Matrix3<f64> {
-        matrix_from_quat(self.q)
-    }
 }
 
 /// Write a file atomically from a string.

@@ -2,7 +2,7 @@
 
 use crate::util::{SEED, START, ok, run_in};
 use bag2mat::{ReadOptions, read_imu_series};
-use sim::noise::{NoiseGenerator, Preset};
+use sim::{NoiseGenerator, Preset};
 
 #[test]
 fn same_flags_give_byte_identical_bags_and_another_seed_differs() {
@@ -78,7 +78,7 @@ fn default_bag_content_matches_the_seed_run() {
         &ReadOptions { quiet: true },
     )
     .unwrap();
-    let n = sim::bag_sim::message_count(200.0, 60.0);
+    let n = sim::message_count(200.0, 60.0);
     assert_eq!(s.len() as u64, n, "message count");
     assert_eq!(s.topic, "imu");
     // Oracle: replay the noise model with the same seed (static: gyro 0, acc (0, 0, 9.81)).

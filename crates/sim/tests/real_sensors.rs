@@ -45,7 +45,7 @@ for s in ('gyroscope', 'accelerometer'):
         assert dd['white_per_sample_sigma'] < dd['white_per_sample_sigma_naive'], dd
 print(t['model']['accelerometer']['axes']['z']['white_noise'])
 "#;
-    let n = sim::bag_sim::message_count(200.0, 20.0).to_string();
+    let n = sim::message_count(200.0, 20.0).to_string();
     let out = Command::new(PYTHON)
         .arg("-c")
         .arg(script)
@@ -112,7 +112,7 @@ fn spec_per_axis_and_flags_override_it() {
         ],
     );
     let y = std::fs::read_to_string(d.path().join("s.bag.truth.yaml")).unwrap();
-    let m = sim::noise::truth_file::read_model(&d.path().join("s.bag.truth.yaml")).unwrap();
+    let m = sim::read_model(&d.path().join("s.bag.truth.yaml")).unwrap();
     // --gyro-noise overrides every axis, including the spec's y.
     assert!(m.gyro.axes.iter().all(|a| a.white_noise == 0.001), "{y}");
     assert_eq!(m.gyro.chain.internal_rate_hz, Some(1000.0));
@@ -269,9 +269,9 @@ fn a_moving_bag_carries_the_sensor_chains_delay_on_its_motion() {
     for i in 200..s.gyro[0].len() {
         let t = i as f64 / 200.0;
         let (now, late_g, late_a) = (
-            sim::motion::ellipse(t),
-            sim::motion::ellipse(t - gyro_delay),
-            sim::motion::ellipse(t - acc_delay),
+            sim::ellipse(t),
+            sim::ellipse(t - gyro_delay),
+            sim::ellipse(t - acc_delay),
         );
         for k in 0..3 {
             g0 = g0.max((s.gyro[k][i] - now.gyro[k]).abs());

@@ -2,9 +2,9 @@
 //! message through the python rosbag API, compared exactly with an in-process replay.
 
 use crate::util::{SEED, START, ok};
-use sim::motion::Motion;
-use sim::noise::{NoiseGenerator, Preset};
-use sim::rotation::quat_from_matrix;
+use sim::Motion;
+use sim::quat_from_matrix;
+use sim::{NoiseGenerator, Preset};
 use std::process::Command;
 
 /// Debian's interpreter (the one that sees python3-rosbag).
@@ -64,7 +64,7 @@ fn rosbag_tools_accept_sim_bags_and_read_the_values_written() {
         let path = d.path().join(&name);
         let (s, info, err) = run(Command::new("rosbag").arg("info").arg("--yaml").arg(&path));
         assert!(s, "{name}: rosbag info failed: {err}");
-        let n = sim::bag_sim::message_count(200.0, 5.0);
+        let n = sim::message_count(200.0, 5.0);
         for needle in [
             format!("messages: {n}"),
             format!("compression: {compression}"),

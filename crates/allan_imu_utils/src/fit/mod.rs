@@ -2,9 +2,9 @@
 //! acc-only point filter, the linear start point (`C …` line), the Ceres dogleg fit of the
 //! log variance, and the values derived from the fitted parameters.
 
-pub mod dogleg;
-pub mod init;
-pub mod model;
+pub(crate) mod dogleg;
+pub(crate) mod init;
+pub(crate) mod model;
 
 pub use model::Params;
 

@@ -754,9 +754,9 @@ mod tests {
     /// within [`RESONANCE_BW_REL_TOL`], and its standard error is stated.
     #[test]
     fn issue_17_resonance_bandwidth_fitted_with_its_own_floor() {
-        use sim::noise::generate::axis_series;
-        use sim::noise::model::Sensor;
-        use sim::noise::profiles::Profile;
+        use sim::Profile;
+        use sim::Sensor;
+        use sim::axis_series;
         let (rate, n) = (200.0, 4 * 3600 * 200);
         let model = Profile::Vibration.model();
         let truth = model.sensor(Sensor::Gyro).axes[0].lines[0];

@@ -1,14 +1,14 @@
 //! Accuracy of the N and K estimates on simulated static IMU data (issue 6 targets).
 //!
-//! Each axis is simulated by the workspace's own generator, `sim::noise::NoiseGenerator`
+//! Each axis is simulated by the workspace's own generator, `sim::NoiseGenerator`
 //! (vio_data_simulation's `addIMUnoise`: white σ/√Δt plus the bias, then the bias step
-//! σ_b·√Δt), with the presets of `sim::noise::Preset`. Relative errors and interval coverage are
+//! σ_b·√Δt), with the presets of `sim::Preset`. Relative errors and interval coverage are
 //! tabulated; the full 4 h × 200 Hz × 3 presets × 3 seeds study is `#[ignore]`d (run it with
 //! `cargo test --release accuracy_full -- --ignored --nocapture`), a short variant runs always.
 
 use super::{Config, Verdict, analyse};
 use rayon::prelude::*;
-use sim::noise::{ContinuousNoise, NoiseGenerator};
+use sim::{ContinuousNoise, NoiseGenerator};
 
 /// Base of every simulation seed (preset p, seed s, axis a use BASE_SEED + 1000·s + 10·p + a,
 /// so presets are independent draws: with a shared seed the gyro medium and high presets, whose
@@ -25,9 +25,9 @@ pub(super) struct Preset {
     pub acc_k: f64,
 }
 
-/// The three presets, with their values from `sim::noise::Preset`.
+/// The three presets, with their values from `sim::Preset`.
 pub(super) fn presets() -> [Preset; 3] {
-    use sim::noise::Preset as P;
+    use sim::Preset as P;
     [("low", P::Low), ("medium", P::Medium), ("high", P::High)].map(|(name, p)| {
         let c = p.params();
         Preset {

@@ -15,10 +15,10 @@ use super::files::{
 };
 use super::{Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
-use sim::noise::generate::axis_series;
-use sim::noise::model::{AxisModel, Chain, Filter, ImuModel, Sensor as SimSensor, SensorModel};
-use sim::noise::profiles::Profile;
-use sim::noise::truth::AxisTruth;
+use sim::AxisTruth;
+use sim::Profile;
+use sim::axis_series;
+use sim::{AxisModel, Chain, Filter, ImuModel, Sensor as SimSensor, SensorModel};
 
 /// Output rate, Hz.
 const RATE: f64 = 400.0;

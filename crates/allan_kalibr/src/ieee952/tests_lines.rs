@@ -8,10 +8,10 @@
 
 use super::{Analysis, Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
-use sim::noise::generate::axis_series;
-use sim::noise::model::{AxisModel, ImuModel, Line, Sensor as SimSensor, SensorModel};
-use sim::noise::profiles::Profile;
-use sim::noise::truth::AxisTruth;
+use sim::AxisTruth;
+use sim::Profile;
+use sim::axis_series;
+use sim::{AxisModel, ImuModel, Line, Sensor as SimSensor, SensorModel};
 
 /// Output rate, Hz.
 const RATE: f64 = 200.0;
@@ -334,7 +334,7 @@ const ISSUE17_1B_K: f64 = 10.0;
 /// R is resolved, and every K is covered by its interval or bounded at or above the truth.
 #[test]
 fn issue18_5_clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
-    let c = sim::noise::Preset::High.params();
+    let c = sim::Preset::High.params();
     let model = ImuModel::from_continuous("high", &c);
     let n = (1800.0 * RATE) as usize;
     let cfg = Config::default();

@@ -3,7 +3,7 @@
 //! output LSB, digital low-pass and decimation, warm-up) × seeds, scored against the exact
 //! truth `sim` computes for the same model (issue 9's `AxisTruth`).
 //!
-//! Each axis is simulated by `sim::noise::generate::axis_series` and analysed as a user
+//! Each axis is simulated by `sim::axis_series` and analysed as a user
 //! would: the section's warm-up check, and when it warns, the analysis again with the
 //! start it suggests skipped (`--skip-start`). The truth of a term is what the data can
 //! show: N is the long-τ white level of the whole chain (aliasing and the LSB rounding
@@ -11,10 +11,10 @@
 
 use super::{Analysis, Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
-use sim::noise::generate::axis_series;
-use sim::noise::model::Sensor as SimSensor;
-use sim::noise::profiles::Profile;
-use sim::noise::truth::AxisTruth;
+use sim::AxisTruth;
+use sim::Profile;
+use sim::Sensor as SimSensor;
+use sim::axis_series;
 
 /// Seeds of the study (one simulation stream per profile, seed and axis).
 pub(super) const SEEDS: [u64; 3] = [101, 102, 103];
@@ -51,7 +51,7 @@ pub(super) struct Case {
 }
 
 fn truth_of(
-    model: &sim::noise::model::ImuModel,
+    model: &sim::ImuModel,
     s: SimSensor,
     axis: usize,
     rate: f64,

@@ -61,6 +61,7 @@ impl Biquad {
     }
 
     /// |H(e^{2πiν})|² at normalised frequency ν (cycles per sample).
+    #[cfg(test)]
     pub fn gain2(&self, nu: f64) -> f64 {
         let w = 2.0 * std::f64::consts::PI * nu;
         let (c1, s1, c2, s2) = (w.cos(), w.sin(), (2.0 * w).cos(), (2.0 * w).sin());
@@ -119,6 +120,7 @@ pub fn enbw(chain: &ResolvedChain) -> f64 {
 
 /// Per-sample standard deviation at the output of white noise of density `n` through the
 /// chain: N·√(f_i·Σh²) (module doc).
+#[cfg(test)]
 pub fn per_sample_sigma(n: f64, chain: &ResolvedChain) -> f64 {
     let h = impulse_response(chain);
     n * (chain.internal_rate * autocorrelation(&h, 0)).sqrt()

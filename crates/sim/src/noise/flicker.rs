@@ -32,6 +32,7 @@ pub const LO_MARGIN: f64 = 40.0;
 /// T_max = τ_hi · HI_MARGIN.
 pub const HI_MARGIN: f64 = 16.0;
 /// √(2 ln 2 / π): the flicker Allan-deviation floor per unit B.
+#[cfg(test)]
 pub const FLOOR_PER_B: f64 = 0.664_282_470_267_960_1;
 
 /// One Gauss–Markov component: standard deviation and time constant.

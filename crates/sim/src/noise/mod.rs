@@ -35,16 +35,18 @@
 //!   [`psd`]: the spectral integrals and closed forms it is checked against;
 //!   [`truth_file`]: `<bag>.truth.yaml` and `<bag>.truth.csv`.
 
-pub mod filter;
-pub mod flicker;
-pub mod generate;
-pub mod model;
-pub mod profiles;
-pub mod psd;
-pub mod quad;
-pub mod spec;
-pub mod truth;
-pub mod truth_file;
+pub(crate) mod filter;
+pub(crate) mod flicker;
+pub(crate) mod generate;
+pub(crate) mod model;
+pub(crate) mod profiles;
+#[cfg(test)]
+pub(crate) mod psd;
+#[cfg(test)]
+pub(crate) mod quad;
+pub(crate) mod spec;
+pub(crate) mod truth;
+pub(crate) mod truth_file;
 
 #[cfg(test)]
 mod tests_stat;
@@ -89,12 +91,14 @@ pub fn quantization_step(q: f64) -> f64 {
 
 /// Allan deviation of white noise of density `sigma` (unit/√Hz) at averaging time `tau` (s):
 /// σ_A(τ) = σ/√τ — the −½ slope line, which reads σ at τ = 1 s (IEEE 952 Annex C).
+#[cfg(test)]
 pub fn adev_white(sigma: f64, tau: f64) -> f64 {
     sigma / tau.sqrt()
 }
 
 /// Allan deviation of a random walk of strength `sigma_b` (unit/s/√Hz) at `tau` (s):
 /// σ_A(τ) = σ_b·√(τ/3) — the +½ slope line, which reads σ_b at τ = 3 s.
+#[cfg(test)]
 pub fn adev_random_walk(sigma_b: f64, tau: f64) -> f64 {
     sigma_b * (tau / 3.0).sqrt()
 }

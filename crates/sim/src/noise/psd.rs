@@ -105,11 +105,6 @@ pub fn closed_quantization(q: f64, tau: f64) -> f64 {
     3.0 * q * q / (tau * tau)
 }
 
-/// Ramp R: R²τ²/2.
-pub fn closed_ramp(r: f64, tau: f64) -> f64 {
-    r * r * tau * tau / 2.0
-}
-
 /// Ideal flicker (S = B²/(2πf) at every f): (2 ln 2/π)·B² at every τ.
 pub fn closed_flicker(b: f64) -> f64 {
     2.0 * std::f64::consts::LN_2 / PI * b * b

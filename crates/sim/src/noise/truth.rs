@@ -8,7 +8,7 @@
 //! ```text
 //! AVAR(m) = (1/(2m²))·Σ_{|k|≤2m} g(k)·R(k),  g(k) = 2m − 3|k| (|k| ≤ m), −(2m − |k|) (m < |k| ≤ 2m)
 //! ```
-//! which is the same quantity as the spectral form of [`super::psd::avar_discrete`] (Fourier
+//! which is the same quantity as the spectral form of `super::psd::avar_discrete` (Fourier
 //! pair; the tests check one against the other), with closed forms where they exist:
 //!
 //! | term | output sequence | AVAR(m), τ = m·Δt |

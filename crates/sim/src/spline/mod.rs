@@ -25,9 +25,9 @@
 //! c_j ← c_j·exp(1.5 r_j), r_j = log(R_spl(τ_j)ᵀ R_j), p_j += 1.5 (p_j − p_spl(τ_j)),
 //! re-extrapolating the pads, until the largest knot residual is below 1e-12.
 
-pub mod basis;
-pub mod segment;
-pub mod so3;
+pub(crate) mod basis;
+pub(crate) mod segment;
+pub(crate) mod so3;
 
 use crate::error::{Result, SimError};
 use nalgebra::{Matrix3, Vector3};

@@ -65,6 +65,7 @@ pub fn so3_value(c: &[Matrix3<f64>; 4], u: f64) -> Matrix3<f64> {
 }
 
 /// R, Ṙ, R̈ by Lovegrove's product rule (module doc) — the slow, obviously-correct oracle.
+#[cfg(test)]
 pub fn so3_product_rule(
     c: &[Matrix3<f64>; 4],
     u: f64,
