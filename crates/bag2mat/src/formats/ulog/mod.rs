@@ -120,7 +120,7 @@ const IS_TYPE: [bool; 256] = {
 };
 
 /// The step at `at`: the hop and every part walk the messages the same way.
-#[inline]
+#[inline(always)]
 fn step(win: &Window, at: u64, appended_at: Option<u64>) -> Step {
     let Some(h) = win.get(at, 3) else {
         return Step::Cut(at);
