@@ -3,6 +3,26 @@
 
 use super::*;
 
+/// Why a chunk's body cannot be read (the part's error, as its text).
+#[derive(Debug, thiserror::Error)]
+pub(super) enum ChunkError {
+    #[error("chunk record runs past the end of the file")]
+    PastEnd,
+    #[error("not a chunk record")]
+    NotChunk,
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    #[error("{0}")]
+    Io(std::io::Error),
+    #[error("{codec}: {source}")]
+    Decompress {
+        codec: &'static str,
+        source: std::io::Error,
+    },
+    #[error("chunk body is {got} bytes, its header says {size}")]
+    Size { got: usize, size: usize },
+}
+
 impl BagReader {
     /// Reads and decompresses the chunk whose record starts at `pos`, and hands its body to
     /// `f`. The raw and decompressed bytes live in per-thread buffers reused from chunk to
@@ -10,20 +30,18 @@ impl BagReader {
     pub(super) fn with_chunk_body<R>(
         &self,
         pos: u64,
-        f: impl FnOnce(&[u8]) -> Result<R, String>,
-    ) -> Result<R, String> {
-        let (h, data_pos, dlen) = self
-            .record_at(pos, self.len)
-            .ok_or("chunk record runs past the end of the file")?;
+        f: impl FnOnce(&[u8]) -> R,
+    ) -> Result<R, ChunkError> {
+        let (h, data_pos, dlen) = self.record_at(pos, self.len).ok_or(ChunkError::PastEnd)?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
             let compression = self.read_chunk_into(&h, data_pos, dlen, raw, body)?;
-            if compression == Compression::None {
+            Ok(if compression == Compression::None {
                 f(raw)
             } else {
                 f(body)
-            }
+            })
         })
     }
 
@@ -35,32 +53,37 @@ impl BagReader {
         dlen: u32,
         raw: &mut Vec<u8>,
         body: &mut Vec<u8>,
-    ) -> Result<Compression, String> {
-        let h = Header::parse(h_bytes).map_err(|e| e.to_string())?;
-        if h.op().map_err(|e| e.to_string())? != Op::Chunk {
-            return Err("not a chunk record".into());
+    ) -> Result<Compression, ChunkError> {
+        let h = Header::parse(h_bytes)?;
+        if h.op()? != Op::Chunk {
+            return Err(ChunkError::NotChunk);
         }
-        let ChunkHeader { compression, size } =
-            ChunkHeader::decode(&h).map_err(|e| e.to_string())?;
+        let ChunkHeader { compression, size } = ChunkHeader::decode(&h)?;
         let size = size as usize;
         raw.resize(dlen as usize, 0);
         self.file
             .read_exact_at(raw, data_pos)
-            .map_err(|e| e.to_string())?;
+            .map_err(ChunkError::Io)?;
         body.clear();
         let got = match compression {
             Compression::None => raw.len(),
             Compression::Bz2 => bzip2::read::BzDecoder::new(&raw[..])
                 .take(size as u64 + 1)
                 .read_to_end(body)
-                .map_err(|e| format!("bz2: {e}"))?,
+                .map_err(|source| ChunkError::Decompress {
+                    codec: "bz2",
+                    source,
+                })?,
             Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&raw[..])
                 .take(size as u64 + 1)
                 .read_to_end(body)
-                .map_err(|e| format!("lz4: {e}"))?,
+                .map_err(|source| ChunkError::Decompress {
+                    codec: "lz4",
+                    source,
+                })?,
         };
         if got != size {
-            return Err(format!("chunk body is {got} bytes, its header says {size}"));
+            return Err(ChunkError::Size { got, size });
         }
         Ok(compression)
     }
@@ -98,10 +121,9 @@ impl BagReader {
                     }
                 }
             });
-            Ok(())
         });
         if let Err(e) = r {
-            out.error = Some(e);
+            out.error = Some(e.to_string());
             return out;
         }
         let short = c.index_data.iter().any(|(conn, d)| {

@@ -373,7 +373,6 @@ impl BagReader {
                     }
                     BodyRecord::Message(c, ..) => *counts.entry(c).or_default() += 1,
                 });
-                Ok(())
             });
             if r.is_err() {
                 continue;

@@ -414,13 +414,24 @@ fn magic_line(path: &Path, head: &[u8]) -> Result<(), Error> {
 
 /// The bag header after the version line: the index position (0: none), the chunk count
 /// it states and where the first record after it starts; or what is wrong with it.
-fn bag_header(head: &[u8]) -> Result<(u64, Option<u32>, u64), String> {
-    let rec = record::raw_record(head, MAGIC.len())
-        .ok_or_else(|| "the bag header record is incomplete".to_string())?;
-    let h = Header::parse(rec.header).map_err(|e| e.to_string())?;
+fn bag_header(head: &[u8]) -> Result<(u64, Option<u32>, u64), BagHeaderDamage> {
+    let rec = record::raw_record(head, MAGIC.len()).ok_or(BagHeaderDamage::Incomplete)?;
+    let h = Header::parse(rec.header)?;
     let b = BagHeader::decode(&h).map_err(|e| match e {
-        RecordError::Unexpected(_) => "the first record is not the bag header".into(),
-        e => e.to_string(),
+        RecordError::Unexpected(_) => BagHeaderDamage::NotFirst,
+        e => BagHeaderDamage::Record(e),
     })?;
     Ok((b.index_pos.unwrap_or(0), b.chunk_count, rec.end as u64))
+}
+
+/// Why the bag header does not read (the chunks after it are then walked without the
+/// index).
+#[derive(Debug, thiserror::Error)]
+enum BagHeaderDamage {
+    #[error("the bag header record is incomplete")]
+    Incomplete,
+    #[error("the first record is not the bag header")]
+    NotFirst,
+    #[error(transparent)]
+    Record(#[from] RecordError),
 }
