@@ -23,12 +23,17 @@ pub(crate) fn decompress_stream<R: Read, W: Write>(input: R, out: &mut W) -> std
 
 /// Decompresses `data` (whole zstd frames) into `out`, which is cleared first. At most
 /// `limit` bytes are accepted (a damaged size field cannot make it allocate more).
-pub(crate) fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Result<(), String> {
+pub(crate) fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Result<(), ZstdError> {
     out.clear();
     let mut w = LimitedWriter { out, limit };
-    decompress_stream(data, &mut w).map_err(|e| format!("zstd: {e}"))?;
+    decompress_stream(data, &mut w)?;
     Ok(())
 }
+
+/// Data that does not decompress as zstd (or past its limit).
+#[derive(Debug, thiserror::Error)]
+#[error("zstd: {0}")]
+pub(crate) struct ZstdError(#[from] std::io::Error);
 
 struct LimitedWriter<'a> {
     out: &'a mut Vec<u8>,

@@ -270,7 +270,7 @@ impl Source for BagDir {
                     Ok(()) => sink(g, t, &buf),
                     Err(e) => {
                         skipped += 1;
-                        skip_reason.get_or_insert(e);
+                        skip_reason.get_or_insert(e.to_string());
                     }
                 }
             });

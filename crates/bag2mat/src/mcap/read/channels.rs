@@ -86,21 +86,18 @@ impl McapReader {
         let mut found = Vec::new();
         let _ = self.with_records(
             loc,
-            |_, op, content| {
-                match Op::from_byte(op) {
-                    Some(Op::Schema) => {
-                        if let Ok(s) = Schema::decode(content) {
-                            found.push((Some(s), None));
-                        }
+            |_, op, content| match Op::from_byte(op) {
+                Some(Op::Schema) => {
+                    if let Ok(s) = Schema::decode(content) {
+                        found.push((Some(s), None));
                     }
-                    Some(Op::Channel) => {
-                        if let Ok(c) = record::Channel::decode(content) {
-                            found.push((None, Some(c)));
-                        }
-                    }
-                    _ => {}
                 }
-                Ok(())
+                Some(Op::Channel) => {
+                    if let Ok(c) = record::Channel::decode(content) {
+                        found.push((None, Some(c)));
+                    }
+                }
+                _ => {}
             },
             &|| Vec::new(),
         );

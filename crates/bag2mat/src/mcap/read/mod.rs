@@ -392,15 +392,15 @@ impl McapReader {
     fn with_records(
         &self,
         loc: usize,
-        f: impl FnMut(u64, u8, &[u8]) -> Result<(), String>,
+        f: impl FnMut(u64, u8, &[u8]),
         listed: &dyn Fn() -> Vec<u64>,
-    ) -> Result<Vec<(String, u64)>, String> {
-        let loc = self.locs.get(loc).ok_or("no such part")?;
+    ) -> Result<Vec<(String, u64)>, ChunkError> {
+        let loc = self.locs.get(loc).ok_or(ChunkError::NoPart)?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
             let records = self.records_of(loc, raw, body)?;
-            frame_records(records, f, listed)
+            Ok(frame_records(records, f, listed))
         })
     }
 
@@ -411,13 +411,13 @@ impl McapReader {
         loc: &Loc,
         raw: &'b mut Vec<u8>,
         body: &'b mut Vec<u8>,
-    ) -> Result<&'b [u8], String> {
+    ) -> Result<&'b [u8], ChunkError> {
         match loc {
             Loc::Loose { start, end } => {
                 raw.resize((end - start) as usize, 0);
                 self.file
                     .read_exact_at(raw, *start)
-                    .map_err(|e| e.to_string())?;
+                    .map_err(ChunkError::Io)?;
                 Ok(raw)
             }
             Loc::Chunk {
@@ -429,12 +429,12 @@ impl McapReader {
                 ..
             } => {
                 if records_pos.saturating_add(*compressed_size) > self.len {
-                    return Err("the chunk's records run past the end of the file".into());
+                    return Err(ChunkError::PastEnd);
                 }
                 raw.resize(*compressed_size as usize, 0);
                 self.file
                     .read_exact_at(raw, *records_pos)
-                    .map_err(|e| e.to_string())?;
+                    .map_err(ChunkError::Io)?;
                 // A damaged size field must not fail records the CRC vouches for: the
                 // output is bounded by what the stored bytes decompress to (or the size
                 // stated, if larger), never preallocated.
@@ -448,30 +448,30 @@ impl McapReader {
                         lz4_flex::frame::FrameDecoder::new(&raw[..])
                             .take(limit.saturating_add(1))
                             .read_to_end(body)
-                            .map_err(|e| format!("lz4: {e}"))?;
+                            .map_err(ChunkError::Lz4)?;
                         body
                     }
                     "zstd" => {
                         crate::zstd::decompress_into(raw, body, limit)?;
                         body
                     }
-                    other => return Err(format!("unsupported chunk compression '{other}'")),
+                    other => return Err(ChunkError::Compression(other.to_string())),
                 };
                 let crc_ok = *crc != 0 && crc32fast::hash(records) == *crc;
                 // Without a CRC, the stored records of an uncompressed chunk are what
                 // its record length frames, whatever its size field says.
                 let framed = *crc == 0 && compression.is_empty();
                 if records.len() as u64 != *uncompressed_size && !crc_ok && !framed {
-                    return Err(format!(
-                        "chunk records are {} bytes, its header says {uncompressed_size}",
-                        records.len()
-                    ));
+                    return Err(ChunkError::Size {
+                        got: records.len(),
+                        stated: *uncompressed_size,
+                    });
                 }
                 if *crc != 0 && !crc_ok {
-                    return Err(format!(
-                        "chunk CRC {:08x} differs from the stored {crc:08x}",
-                        crc32fast::hash(records)
-                    ));
+                    return Err(ChunkError::Crc {
+                        got: crc32fast::hash(records),
+                        stored: *crc,
+                    });
                 }
                 Ok(records)
             }
@@ -518,7 +518,7 @@ impl Source for McapReader {
                     let ch = u16::from_le_bytes([content[0], content[1]]);
                     if !self.mcap_channels.contains_key(&ch) {
                         no_channel += 1;
-                        return Ok(());
+                        return;
                     }
                     if want(ch as u32) {
                         let t = u64::from_le_bytes(content[6..14].try_into().expect("8 bytes"));
@@ -527,14 +527,13 @@ impl Source for McapReader {
                         delivered_at.push((ch, at));
                     }
                 }
-                Ok(())
             },
             &listed,
         );
         let damage = match r {
             Ok(d) => d,
             Err(e) => {
-                out.error = Some(e);
+                out.error = Some(e.to_string());
                 return out;
             }
         };
@@ -598,14 +597,35 @@ fn resync_hints(summary: Option<&Summary>) -> Vec<u64> {
     hints
 }
 
+/// Why a part's stored records cannot be read (the part's error, as its text).
+#[derive(Debug, thiserror::Error)]
+enum ChunkError {
+    #[error("no such part")]
+    NoPart,
+    #[error("{0}")]
+    Io(std::io::Error),
+    #[error("the chunk's records run past the end of the file")]
+    PastEnd,
+    #[error("lz4: {0}")]
+    Lz4(std::io::Error),
+    #[error(transparent)]
+    Zstd(#[from] crate::zstd::ZstdError),
+    #[error("unsupported chunk compression '{0}'")]
+    Compression(String),
+    #[error("chunk records are {got} bytes, its header says {stated}")]
+    Size { got: usize, stated: u64 },
+    #[error("chunk CRC {got:08x} differs from the stored {stored:08x}")]
+    Crc { got: u32, stored: u32 },
+}
+
 /// Calls `f(offset, opcode, content)` for each record of `records`, in order; a record
 /// whose framing is damaged is skipped to the next offset `listed()` gives. Returns what
 /// was skipped: (why, bytes).
 fn frame_records(
     records: &[u8],
-    mut f: impl FnMut(u64, u8, &[u8]) -> Result<(), String>,
+    mut f: impl FnMut(u64, u8, &[u8]),
     listed: &dyn Fn() -> Vec<u64>,
-) -> Result<Vec<(String, u64)>, String> {
+) -> Vec<(String, u64)> {
     let total = records.len();
     let mut damage = Vec::new();
     let mut offsets: Option<Vec<u64>> = None;
@@ -621,7 +641,7 @@ fn frame_records(
             Some((op, content, n))
                 if op != Op::Message as u8 || content.len() >= MESSAGE_FIXED_LEN =>
             {
-                f(at as u64, op, content)?;
+                f(at as u64, op, content);
                 at += n;
             }
             _ => {
@@ -641,5 +661,5 @@ fn frame_records(
             }
         }
     }
-    Ok(damage)
+    damage
 }
