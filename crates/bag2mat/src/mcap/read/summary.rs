@@ -3,6 +3,18 @@
 
 use super::*;
 
+/// Why the summary section cannot be used (the note says so, and the data section is
+/// scanned instead).
+#[derive(Debug, thiserror::Error)]
+pub(super) enum SummaryError {
+    #[error("its offsets {start}..{end} are outside the file")]
+    Outside { start: u64, end: u64 },
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    #[error("{0}")]
+    Record(#[from] CursorError),
+}
+
 impl McapReader {
     /// The footer and its offset, when the file ends with a footer record and the magic.
     pub(super) fn read_footer(&self) -> Option<(u64, Footer)> {
@@ -25,26 +37,28 @@ impl McapReader {
     /// Reads the summary section: schemas, channels, statistics and chunk indexes. A CRC
     /// that does not match leaves its counts untrusted; its chunk indexes still locate
     /// chunks (each is checked against the data section).
-    pub(super) fn read_summary(&mut self, footer_pos: u64, f: &Footer) -> Result<Summary, String> {
+    pub(super) fn read_summary(
+        &mut self,
+        footer_pos: u64,
+        f: &Footer,
+    ) -> Result<Summary, SummaryError> {
         let end = if f.summary_offset_start != 0 {
             f.summary_offset_start
         } else {
             footer_pos
         };
         if f.summary_start < MAGIC.len() as u64 || f.summary_start > end || end > footer_pos {
-            return Err(format!(
-                "its offsets {}..{} are outside the file",
-                f.summary_start, end
-            ));
+            return Err(SummaryError::Outside {
+                start: f.summary_start,
+                end,
+            });
         }
         let mut trusted = true;
         if f.summary_crc != 0 {
             // The CRC covers the summary and summary-offset sections and the footer up to
             // (not including) its CRC field.
             let mut b = vec![0u8; (footer_pos + RECORD_PREFIX + 16 - f.summary_start) as usize];
-            self.file
-                .read_exact_at(&mut b, f.summary_start)
-                .map_err(|e| e.to_string())?;
+            self.file.read_exact_at(&mut b, f.summary_start)?;
             let crc = crc32fast::hash(&b);
             if crc != f.summary_crc {
                 trusted = false;
@@ -55,9 +69,7 @@ impl McapReader {
             }
         }
         let mut b = vec![0u8; (end - f.summary_start) as usize];
-        self.file
-            .read_exact_at(&mut b, f.summary_start)
-            .map_err(|e| e.to_string())?;
+        self.file.read_exact_at(&mut b, f.summary_start)?;
         let chunk_indexes = self.summary_records(&b, trusted)?;
         Ok(Summary {
             chunk_indexes,
@@ -71,7 +83,7 @@ impl McapReader {
         &mut self,
         b: &[u8],
         trusted: bool,
-    ) -> Result<Vec<ChunkIndex>, String> {
+    ) -> Result<Vec<ChunkIndex>, SummaryError> {
         let mut c = Cursor::new(b);
         let mut chunk_indexes = Vec::new();
         while c.pos() < b.len() {
@@ -80,7 +92,7 @@ impl McapReader {
             let framed = c.le::<u8>("opcode").and_then(|op| Ok((op, c.bytes64()?)));
             let (op, content) = match framed {
                 Ok(x) => x,
-                Err(e) if trusted => return Err(e.to_string()),
+                Err(e) if trusted => return Err(e.into()),
                 Err(_) => break,
             };
             let rec = (|| -> Result<(), CursorError> {
@@ -107,7 +119,7 @@ impl McapReader {
             if let Err(e) = rec
                 && trusted
             {
-                return Err(e.to_string());
+                return Err(e.into());
             }
         }
         Ok(chunk_indexes)
