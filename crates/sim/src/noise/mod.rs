@@ -176,7 +176,7 @@ impl ContinuousNoise {
 
 impl DiscreteNoise {
     /// Back to continuous-time parameters (inverse of [`ContinuousNoise::discretize`]).
-    pub fn to_continuous(&self) -> ContinuousNoise {
+    pub fn to_continuous(self) -> ContinuousNoise {
         ContinuousNoise {
             gyro_noise: white_to_continuous(self.gyro_noise, self.dt),
             gyro_bias_rw: random_walk_to_continuous(self.gyro_bias_step, self.dt),

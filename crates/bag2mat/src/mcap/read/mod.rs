@@ -445,7 +445,7 @@ impl McapReader {
                     "" => raw,
                     "lz4" => {
                         body.clear();
-                        lz4_flex::frame::FrameDecoder::new(&raw[..])
+                        lz4_flex::frame::FrameDecoder::new(raw)
                             .take(limit.saturating_add(1))
                             .read_to_end(body)
                             .map_err(ChunkError::Lz4)?;
