@@ -110,17 +110,7 @@ mod result;
 mod terms;
 
 #[cfg(test)]
-mod tests_accuracy;
-#[cfg(test)]
-mod tests_bandlimited;
-#[cfg(test)]
-mod tests_lines;
-#[cfg(test)]
-mod tests_profiles;
-#[cfg(test)]
 mod tests_real;
-#[cfg(test)]
-mod tests_stable32;
 
 pub use avar_cov::CovBasis;
 pub use fit::FitConfig;
