@@ -45,9 +45,9 @@ cargo test --workspace "$@"
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
 # Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
 # runs beside them.
-cargo test -p allan_kalibr --lib -- --ignored --exact \
-  ieee952::tests_profiles::profiles_study ieee952::tests_bandlimited::bandlimited_study \
-  ieee952::tests_lines::lines_study
+cargo test -p allan_kalibr --test main -- --ignored --exact \
+  studies::profiles::profiles_study studies::bandlimited::bandlimited_study \
+  studies::lines::lines_study
 
 # Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
 # with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,

@@ -1,6 +1,7 @@
 //! Integration tests of allan_kalibr: parity with the real kalibr_allan outputs in
 //! `testdata/` (reference.rs), the binary run as a user would (cli.rs) and its IEEE 952 side:
-//! other tools' curves, warm-up and gap checks (ieee952.rs).
+//! other tools' curves, warm-up and gap checks (ieee952.rs); the studies of the IEEE 952
+//! estimator on simulated and real data (studies.rs, the long ones `#[ignore]`d).
 
 mod cli;
 mod common;
@@ -11,3 +12,4 @@ mod ieee952;
 mod issue18;
 mod logs;
 mod reference;
+mod studies;

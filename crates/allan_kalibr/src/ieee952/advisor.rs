@@ -93,7 +93,7 @@ fn k_at_least(k: &Term, n: &Term, record: f64) -> TermAdvice {
 }
 
 /// The advice for an analysed axis (None without a sample count: no precision known).
-pub(crate) fn advise(a: &Analysis) -> Option<Advice> {
+pub fn advise(a: &Analysis) -> Option<Advice> {
     let n = a.n?;
     let record = n as f64 * a.tau0;
     Some(Advice {

@@ -93,11 +93,7 @@ impl CurveData {
         out
     }
     /// Overlapping Allan variance of `y` on the grid of `cfg`, with the noise identification.
-    pub(crate) fn from_samples(
-        y: &[f64],
-        tau0: f64,
-        cfg: &Config,
-    ) -> Result<CurveData, Ieee952Error> {
+    pub fn from_samples(y: &[f64], tau0: f64, cfg: &Config) -> Result<CurveData, Ieee952Error> {
         check_config(tau0, cfg)?;
         if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(Ieee952Error::NonFinite { index, value });

@@ -834,6 +834,26 @@ mod tests {
 #[cfg(test)]
 mod tests_issue18 {
     use super::*;
+    use sim::noise::{ContinuousNoise, NoiseGenerator};
+
+    /// One gyro axis of white noise `n` and random walk `k` from `sim`'s generator, `len`
+    /// samples `dt` apart (the accuracy study's simulator, tests/studies/accuracy.rs).
+    fn simulate_axis(n: f64, k: f64, dt: f64, len: usize, seed: u64) -> Vec<f64> {
+        let c = ContinuousNoise {
+            gyro_noise: n,
+            gyro_bias_rw: k,
+            acc_noise: 0.0,
+            acc_bias_rw: 0.0,
+        };
+        let mut g = NoiseGenerator::new(c.discretize(dt), seed);
+        (0..len)
+            .map(|_| {
+                let (mut gyro, mut acc) = ([0.0; 3], [0.0; 3]);
+                g.apply(&mut gyro, &mut acc);
+                gyro[0]
+            })
+            .collect()
+    }
 
     /// Issue 18.10: imu_utils' own output folders of the four reference cases, read without
     /// a sample count: three of them end at the grid's quirk factor 2^k + 1, for which the
@@ -886,7 +906,6 @@ mod tests_issue18 {
     /// fit the whole curve, K resolved and covered on 6/6).
     #[test]
     fn issue18_10_allan_variance_ros_csv_of_a_noisy_record_fits_to_the_long_end() {
-        use super::super::tests_accuracy::simulate_axis;
         let (rate, secs) = (100.0, 7200.0);
         let (n_true, k_true) = (0.01, 1e-3); // K's +½ line crosses N's −½ line at 17 s
         let bin = (rate * AVR_PERIOD_STEP).round() as usize;

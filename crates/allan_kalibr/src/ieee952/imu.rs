@@ -174,7 +174,7 @@ impl ImuCurves {
     }
 
     /// The fits and the advice; `checks` as in [`analyse_imu`].
-    pub(crate) fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
+    pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
         an.checks = checks;
         an
@@ -311,13 +311,13 @@ impl ImuAnalysis {
 
     /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
     /// what the curve allows.
-    pub(crate) fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
+    pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
         self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
     }
 
     /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
     /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
-    pub(crate) fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
+    pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
         self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
     }
 

@@ -110,17 +110,7 @@ mod result;
 mod terms;
 
 #[cfg(test)]
-mod tests_accuracy;
-#[cfg(test)]
-mod tests_bandlimited;
-#[cfg(test)]
-mod tests_lines;
-#[cfg(test)]
-mod tests_profiles;
-#[cfg(test)]
 mod tests_real;
-#[cfg(test)]
-mod tests_stable32;
 
 pub use avar_cov::CovBasis;
 pub use fit::FitConfig;
@@ -131,7 +121,7 @@ pub use tau_grid::GridSpec;
 
 pub use curve_data::{CurveData, CurvePoint};
 pub use pipeline::analyse;
-pub(crate) use pipeline::analyse_curve;
+pub use pipeline::analyse_curve;
 pub(crate) use result::short;
 pub use result::{
     AlphaSource, Analysis, AxisVerdict, FitSummary, LineTerm, Point, Term, Terms, Verdict,

@@ -50,7 +50,7 @@ pub struct NoiseId {
 pub const MAX_ID_POINTS: usize = 1 << 14;
 
 /// Identifies the dominant power-law noise at cluster size m.
-pub(crate) fn identify(phase: &Phase, m: usize) -> NoiseId {
+pub fn identify(phase: &Phase, m: usize) -> NoiseId {
     identify_on(phase.x(), m)
 }
 

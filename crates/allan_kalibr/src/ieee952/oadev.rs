@@ -79,7 +79,7 @@ impl Phase {
     }
 
     /// Number of rate samples n.
-    pub(crate) fn n_rate(&self) -> usize {
+    pub fn n_rate(&self) -> usize {
         self.x.len() - 1
     }
 

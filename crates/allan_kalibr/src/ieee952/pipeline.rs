@@ -19,7 +19,7 @@ pub fn analyse(y: &[f64], tau0: f64, cfg: &Config) -> Result<Analysis, Ieee952Er
 /// Analyses a measured curve. `basis` is the statistical covariance of its fit grid
 /// ([`CurveData::basis`]; shared by the axes of an IMU), `None` when the sample count is
 /// unknown.
-pub(crate) fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
+pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -> Analysis {
     let valid: Vec<&CurvePoint> = data
         .points
         .iter()

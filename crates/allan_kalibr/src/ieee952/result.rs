@@ -172,7 +172,7 @@ pub struct LineTerm {
 
 impl Terms {
     /// Terms in the order Q, N, B, K, R.
-    pub(crate) fn as_array(&self) -> [Term; 5] {
+    pub fn as_array(&self) -> [Term; 5] {
         [self.q, self.n, self.b, self.k, self.r]
     }
 }
@@ -209,12 +209,12 @@ pub enum AxisVerdict {
 
 impl AxisVerdict {
     /// The model describes a declared range.
-    pub(crate) fn fits(&self) -> bool {
+    pub fn fits(&self) -> bool {
         matches!(self, AxisVerdict::Fits { .. })
     }
 
     /// The declared range, when the model fits.
-    pub(crate) fn range(&self) -> Option<(f64, f64)> {
+    pub fn range(&self) -> Option<(f64, f64)> {
         match self {
             AxisVerdict::Fits { range, .. } => Some(*range),
             AxisVerdict::NoReliableFit { .. } => None,
@@ -322,7 +322,7 @@ pub struct FitSummary {
 
 impl FitSummary {
     /// Model AVAR at τ.
-    pub(crate) fn predict(&self, tau: f64) -> f64 {
+    pub fn predict(&self, tau: f64) -> f64 {
         fit::predict(&self.coef, &self.shapes, tau)
     }
 }

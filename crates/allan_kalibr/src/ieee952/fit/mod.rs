@@ -32,7 +32,7 @@
 //! has; high-precision points are capped at δ, noisy ones keep their statistical weight.
 //! The alternatives, measured on the real-IMU curves of `testdata/real_curves`: Σ alone
 //! (χ²/dof 10³–10⁵, terms dropped and invented), and Σ scaled by χ²/dof (same weights, same
-//! wrong terms, only wider intervals) — see the `tests_real` module.
+//! wrong terms, only wider intervals) — see `tests/studies/real.rs`.
 //!
 //! # Which τ the model may describe ([`choose_start`])
 //! The model's log-AVAR is convex in log τ (a sum of power laws). A band-limited sensor's

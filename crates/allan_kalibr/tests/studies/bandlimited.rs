@@ -10,10 +10,11 @@
 //! and analysed by `allan_kalibr`'s run, the terms read back from `ieee952_terms.csv` by
 //! their column names.
 
-use super::files::{
+use allan_kalibr::ieee952;
+use allan_kalibr::ieee952::files::{
     COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT,
 };
-use super::{Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::ieee952::{Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -171,11 +172,12 @@ fn mat_cases() -> Vec<Outcome> {
     bag2mat::mat::write_data_imu(&mat, &data).expect("write .mat");
     drop(data);
     let out = dir.path().join("out");
-    let mut config = crate::run::Config::new(crate::front::Input::Samples(mat), out.clone());
+    let mut config =
+        allan_kalibr::run::Config::new(allan_kalibr::front::Input::Samples(mat), out.clone());
     config.common.topics = bag2mat::TopicSelector::one("/imu0");
     config.title = "bmi088-like".into();
-    crate::run::run(&config).expect("allan_kalibr run on the .mat");
-    let csv = std::fs::read_to_string(out.join(super::files::TERMS_FILE)).expect("terms file");
+    allan_kalibr::run::run(&config).expect("allan_kalibr run on the .mat");
+    let csv = std::fs::read_to_string(out.join(ieee952::files::TERMS_FILE)).expect("terms file");
     let mut lines = csv.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
@@ -227,7 +229,7 @@ fn mat_cases() -> Vec<Outcome> {
 }
 
 /// Issue 10's band-limited acceptance. A study (≈ 15 s on two cores in the optimised test
-/// build) that scripts/test.sh runs: `cargo test -p allan_kalibr --lib bandlimited_study
+/// build) that scripts/test.sh runs: `cargo test -p allan_kalibr --test main bandlimited_study
 /// -- --ignored`.
 #[test]
 #[ignore = "study run by scripts/test.sh"]

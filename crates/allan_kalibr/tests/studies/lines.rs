@@ -6,7 +6,8 @@
 //! its bump over the noise's at that τ, the measure the verdict prints). Scored against
 //! `sim`'s exact truth, as issue 10's studies are.
 
-use super::{Analysis, Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::ieee952;
+use allan_kalibr::ieee952::{Analysis, Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -44,7 +45,7 @@ fn amplitude_for(k: f64, frac: f64, white: f64) -> f64 {
     let (mut best, mut at) = (0.0, 1.0);
     let mut m = 1.0f64;
     while m < 1e7 {
-        let v = super::lines::sinusoid_avar(m.round(), nu0);
+        let v = ieee952::lines::sinusoid_avar(m.round(), nu0);
         if v > best {
             (best, at) = (v, m.round());
         }
@@ -118,7 +119,7 @@ fn run_case(frac: f64, k: f64, seed: u64, duration: f64) -> Case {
         label: format!("f0 {frac}·rate ({f0} Hz), {k}× the floor, seed {seed}"),
         f0,
         n_err: an.terms.n.value / n_eff - 1.0,
-        b: super::tests_profiles::b_dominates_a_decade(&at, b_true, RATE, n)
+        b: super::profiles::b_dominates_a_decade(&at, b_true, RATE, n)
             .then_some((an.terms.b.value, an.terms.b.verdict)),
         b_true,
         k: (
@@ -164,7 +165,7 @@ fn print(c: &Case) {
 fn issue17_1_mid_curve_line_does_not_truncate_the_fit() {
     let c = run_case(0.002, 6.0, 0x17_01, 7200.0);
     print(&c);
-    let bump = super::psd::BUMP_X / (std::f64::consts::PI * c.f0);
+    let bump = ieee952::psd::BUMP_X / (std::f64::consts::PI * c.f0);
     assert!(
         c.range_end >= BOTH_SIDES * bump,
         "{}: range ends at {} s, the line's bump is at {bump} s",
@@ -237,7 +238,7 @@ fn lines_study() {
     let mut jobs = Vec::new();
     for frac in [0.002, 0.01, 0.05, 0.2, 0.45] {
         for k in [3.0, 10.0] {
-            for seed in super::tests_profiles::SEEDS {
+            for seed in super::profiles::SEEDS {
                 jobs.push((frac, k, seed));
             }
         }
@@ -291,10 +292,7 @@ fn lines_study() {
     let over: Vec<String> = cases
         .iter()
         .flat_map(|c| {
-            super::tests_profiles::yaml_over_bounds(
-                &c.label,
-                &[(bag2mat::Sensor::Gyro, 0, &c.analysis)],
-            )
+            super::profiles::yaml_over_bounds(&c.label, &[(bag2mat::Sensor::Gyro, 0, &c.analysis)])
         })
         .collect();
     assert!(over.is_empty(), "{over:?}");

@@ -9,7 +9,8 @@
 //! show: N is the long-τ white level of the whole chain (aliasing and the LSB rounding
 //! included, √(S₀·Δt + LSB²/12·Δt)); B, K, Q, R are the model's own figures.
 
-use super::{Analysis, Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::ieee952;
+use allan_kalibr::ieee952::{Analysis, Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -101,7 +102,7 @@ pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64)
     let n = (duration * rate).round() as usize;
     let mut cfg = Config::default();
     if std::env::var("NO_GM").is_ok() {
-        cfg.fit.terms[super::fit::GM] = false;
+        cfg.fit.terms[ieee952::fit::GM] = false;
     }
     let jobs: Vec<(SimSensor, usize)> = [SimSensor::Gyro, SimSensor::Acc]
         .into_iter()
@@ -142,7 +143,7 @@ pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64)
         .collect()
 }
 
-fn fmt_term(t: &super::Term) -> String {
+fn fmt_term(t: &ieee952::Term) -> String {
     match t.verdict {
         Verdict::Resolved => format!("{:.3e} [{:.2e},{:.2e}]", t.value, t.lo, t.hi),
         v => format!("({v:?} < {:.2e})", t.hi),
@@ -269,7 +270,7 @@ pub(super) fn b_dominates_a_decade(at: &AxisTruth, b: f64, rate: f64, n: usize) 
 }
 
 /// Issue 17: every number the yaml files take — each sensor's N and K
-/// ([`super::imu::ImuAnalysis::noise_density`], [`super::imu::ImuAnalysis::random_walk`]) —
+/// ([`ieee952::imu::ImuAnalysis::noise_density`], [`ieee952::imu::ImuAnalysis::random_walk`]) —
 /// is within the data's own 95 % bound on an axis it can come from, computed here from the
 /// curve alone: min over τ of σ_hi95(τ)·√τ for N, σ_hi95(τ)·√(3/τ) for K. `axes` are one
 /// record's (sensor, axis, analysis); returns the breaches.
@@ -277,7 +278,7 @@ pub(super) fn yaml_over_bounds(
     label: &str,
     axes: &[(bag2mat::Sensor, usize, &Analysis)],
 ) -> Vec<String> {
-    use super::imu::{AxisResult, ImuAnalysis};
+    use allan_kalibr::ieee952::imu::{AxisResult, ImuAnalysis};
     let imu = ImuAnalysis {
         rate: f64::NAN,
         axes: axes
@@ -473,7 +474,7 @@ pub(super) fn print_scores(s: &Scores) {
 
 /// Issue 10's acceptance on realistic sims: every profile × 3 seeds, 4 h at 200 Hz.
 /// A study (≈ 40 s on two cores in the optimised test build) that scripts/test.sh runs:
-/// `cargo test -p allan_kalibr --lib profiles_study -- --ignored`.
+/// `cargo test -p allan_kalibr --test main profiles_study -- --ignored`.
 #[test]
 #[ignore = "study run by scripts/test.sh"]
 fn profiles_study() {

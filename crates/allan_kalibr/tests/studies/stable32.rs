@@ -2,8 +2,9 @@
 //! overlapping and normal ADEV equal at Stable32's printed 5 significant digits at every listed
 //! τ, and where our noise identification gives Stable32's α, the 68.3 % bounds within 1 %.
 
-use super::oadev::{Overlap, Phase};
-use super::{ci, edf, noise_id};
+use allan_kalibr::ieee952;
+use allan_kalibr::ieee952::oadev::{Overlap, Phase};
+use allan_kalibr::ieee952::{ci, edf, noise_id};
 use std::io::Read;
 
 /// Reference folder (TEMPORARY absolute path in the scratch crate; in the workspace this is
@@ -248,7 +249,8 @@ fn ocxo_alpha_agreement_is_reported() {
 fn analyse_runs_on_clock_data() {
     // Not IMU data (flicker PM / white PM dominate): the full pipeline must still give a finite
     // curve with bounds around every point, and a fit whose misfit shows in χ²/dof.
-    let a = super::analyse(&gps_rate(), 1.0, &super::Config::default()).expect("GPS rate series");
+    let a =
+        ieee952::analyse(&gps_rate(), 1.0, &ieee952::Config::default()).expect("GPS rate series");
     assert!(!a.curve.is_empty());
     for (i, p) in a.curve.iter().enumerate() {
         assert!(
@@ -313,7 +315,7 @@ fn allantools_oadev(data: &[f64], data_type: &str, ms: &[usize]) -> Vec<(usize, 
 }
 
 fn check_against_allantools(label: &str, rate: &[f64], data: &[f64], data_type: &str) {
-    let curve = super::CurveData::from_samples(rate, 1.0, &super::Config::default())
+    let curve = ieee952::CurveData::from_samples(rate, 1.0, &ieee952::Config::default())
         .unwrap_or_else(|e| panic!("{label}: {e}"));
     let ms: Vec<usize> = curve.points.iter().map(|p| p.m).collect();
     let theirs = allantools_oadev(data, data_type, &ms);

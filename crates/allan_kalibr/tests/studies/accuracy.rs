@@ -4,9 +4,11 @@
 //! (vio_data_simulation's `addIMUnoise`: white σ/√Δt plus the bias, then the bias step
 //! σ_b·√Δt), with the presets of `sim::Preset`. Relative errors and interval coverage are
 //! tabulated; the full 4 h × 200 Hz × 3 presets × 3 seeds study is `#[ignore]`d (run it with
-//! `cargo test --release accuracy_full -- --ignored --nocapture`), a short variant runs always.
+//! `cargo test --release -p allan_kalibr --test main accuracy_full -- --ignored --nocapture`),
+//! a short variant runs always.
 
-use super::{Config, Verdict, analyse};
+use allan_kalibr::ieee952;
+use allan_kalibr::ieee952::{Config, Verdict, analyse};
 use rayon::prelude::*;
 use sim::{ContinuousNoise, NoiseGenerator};
 
@@ -260,7 +262,7 @@ pub(super) fn k_rel_bound(n: f64, k: f64, t: f64) -> f64 {
 #[test]
 #[ignore = "method comparison on 20 Hz data (K statistics do not depend on the rate); --ignored --nocapture"]
 fn accuracy_methods() {
-    use super::FitConfig;
+    use allan_kalibr::ieee952::FitConfig;
     let seeds: Vec<u64> = (1..=8).collect();
     let presets = [presets()[1]];
     let base = Config::default();
@@ -518,7 +520,7 @@ fn n_efficiency() {
 #[test]
 #[ignore = "timing breakdown on one 2.88 M-sample axis; --ignored --nocapture (release)"]
 fn timing_breakdown() {
-    use super::{Overlap, Phase, edf, noise_id};
+    use allan_kalibr::ieee952::{Overlap, Phase, edf, noise_id};
     let y = simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED);
     let cfg = Config::default();
     let ms = cfg.grid.cluster_sizes(y.len());
@@ -578,12 +580,12 @@ fn one_case() {
     );
     let r = analyse(&y, 0.05, &Config::default()).unwrap();
     println!("truth N {n:e} K {k:e}");
-    super::tests_real::print_row(
+    super::real::print_row(
         "sim",
         if a < 3 {
-            super::imu::Sensor::Gyro
+            ieee952::imu::Sensor::Gyro
         } else {
-            super::imu::Sensor::Acc
+            ieee952::imu::Sensor::Acc
         },
         a % 3,
         &r,
@@ -605,7 +607,7 @@ fn one_case() {
 #[test]
 #[ignore = "OADEV cost per cluster size on one 2.88 M-sample axis; --ignored --nocapture (release)"]
 fn oadev_cost_per_m() {
-    use super::{Overlap, Phase};
+    use allan_kalibr::ieee952::{Overlap, Phase};
     let y = simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED);
     let ph = Phase::from_rate(&y, 0.005);
     for m in [1usize, 8, 64, 512, 4096, 32768, 262_144] {
@@ -625,7 +627,7 @@ fn oadev_cost_per_m() {
 }
 
 /// The analysis of one gyro axis of preset `preset` (seed's low, medium, high), 4 h at 20 Hz.
-fn gyro_4h_at_20hz(preset: usize, seed: u64) -> super::Analysis {
+fn gyro_4h_at_20hz(preset: usize, seed: u64) -> ieee952::Analysis {
     let (rate, duration) = (20.0, 4.0 * 3600.0);
     let p = presets()[preset];
     let y = simulate_axis(
@@ -672,7 +674,7 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
     const CR_RECORD_FACTOR: f64 = 2.0;
     let a = gyro_4h_at_20hz(1, BASE_SEED + 11);
     assert_eq!(a.terms.k.verdict, Verdict::Resolved, "{:?}", a.terms.k);
-    let adv = super::advisor::advise(&a).expect("sample count known");
+    let adv = ieee952::advisor::advise(&a).expect("sample count known");
     let z2 = 1.959_963_984_540_054f64.powi(2);
     let cr = 2.0 * a.terms.n.value * z2 / (a.terms.k.value * 0.25 * 0.25);
     let ratio = adv.k.record_25 / cr;
@@ -689,8 +691,8 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
 #[test]
 #[ignore = "timing of the section's stages on six 2.88 M-sample axes; --ignored --nocapture"]
 fn section_stage_timings() {
-    use super::imu::ImuCurves;
-    use super::{Phase, analyse_curve, noise_id, psd};
+    use allan_kalibr::ieee952::imu::ImuCurves;
+    use allan_kalibr::ieee952::{Phase, analyse_curve, noise_id, psd};
     let ys: Vec<Vec<f64>> = (0..6)
         .map(|a| simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED + a))
         .collect();
