@@ -834,7 +834,7 @@ mod tests {
 #[cfg(test)]
 mod tests_issue18 {
     use super::*;
-    use sim::noise::{ContinuousNoise, NoiseGenerator};
+    use sim::{ContinuousNoise, NoiseGenerator};
 
     /// One gyro axis of white noise `n` and random walk `k` from `sim`'s generator, `len`
     /// samples `dt` apart (the accuracy study's simulator, tests/studies/accuracy.rs).
