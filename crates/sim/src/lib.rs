@@ -71,5 +71,5 @@ pub use noise::model::{AxisModel, Chain, Filter, ImuModel, Line, Sensor, SensorM
 pub use noise::profiles::Profile;
 pub use noise::truth::AxisTruth;
 pub use noise::truth_file::read_model;
-pub use noise::{ContinuousNoise, NoiseGenerator, Preset};
+pub use noise::{ContinuousNoise, NoiseGenerator, Preset, white_rw_axis};
 pub use rotation::quat_from_matrix;

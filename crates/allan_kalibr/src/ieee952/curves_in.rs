@@ -834,26 +834,7 @@ mod tests {
 #[cfg(test)]
 mod tests_issue18 {
     use super::*;
-    use sim::{ContinuousNoise, NoiseGenerator};
-
-    /// One gyro axis of white noise `n` and random walk `k` from `sim`'s generator, `len`
-    /// samples `dt` apart (the accuracy study's simulator, tests/studies/accuracy.rs).
-    fn simulate_axis(n: f64, k: f64, dt: f64, len: usize, seed: u64) -> Vec<f64> {
-        let c = ContinuousNoise {
-            gyro_noise: n,
-            gyro_bias_rw: k,
-            acc_noise: 0.0,
-            acc_bias_rw: 0.0,
-        };
-        let mut g = NoiseGenerator::new(c.discretize(dt), seed);
-        (0..len)
-            .map(|_| {
-                let (mut gyro, mut acc) = ([0.0; 3], [0.0; 3]);
-                g.apply(&mut gyro, &mut acc);
-                gyro[0]
-            })
-            .collect()
-    }
+    use sim::white_rw_axis as simulate_axis;
 
     /// Issue 18.10: imu_utils' own output folders of the four reference cases, read without
     /// a sample count: three of them end at the grid's quirk factor 2^k + 1, for which the

@@ -122,7 +122,7 @@ pub use tau_grid::GridSpec;
 pub use curve_data::{CurveData, CurvePoint};
 pub use pipeline::analyse;
 pub use pipeline::analyse_curve;
-pub(crate) use result::short;
+pub use result::short;
 pub use result::{
     AlphaSource, Analysis, AxisVerdict, FitSummary, LineTerm, Point, Term, Terms, Verdict,
 };

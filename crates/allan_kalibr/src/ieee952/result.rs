@@ -279,8 +279,8 @@ impl std::fmt::Display for AxisVerdict {
     }
 }
 
-/// A number in 3 significant digits for messages.
-pub(crate) fn short(x: f64) -> String {
+/// A number in 3 significant digits, as the section's messages print it.
+pub fn short(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }

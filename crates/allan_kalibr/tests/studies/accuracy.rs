@@ -10,7 +10,6 @@
 use allan_kalibr::ieee952;
 use allan_kalibr::ieee952::{Config, Verdict, analyse};
 use rayon::prelude::*;
-use sim::{ContinuousNoise, NoiseGenerator};
 
 /// Base of every simulation seed (preset p, seed s, axis a use BASE_SEED + 1000·s + 10·p + a,
 /// so presets are independent draws: with a shared seed the gyro medium and high presets, whose
@@ -43,23 +42,8 @@ pub(super) fn presets() -> [Preset; 3] {
 }
 
 /// One axis: white noise density n and random walk k (continuous), `len` samples at `dt`,
-/// from sim's generator (its gyro x channel; the other channels' draws are discarded).
-pub(super) fn simulate_axis(n: f64, k: f64, dt: f64, len: usize, seed: u64) -> Vec<f64> {
-    let c = ContinuousNoise {
-        gyro_noise: n,
-        gyro_bias_rw: k,
-        acc_noise: 0.0,
-        acc_bias_rw: 0.0,
-    };
-    let mut g = NoiseGenerator::new(c.discretize(dt), seed);
-    (0..len)
-        .map(|_| {
-            let (mut gyro, mut acc) = ([0.0; 3], [0.0; 3]);
-            g.apply(&mut gyro, &mut acc);
-            gyro[0]
-        })
-        .collect()
-}
+/// from sim's generator.
+pub(super) use sim::white_rw_axis as simulate_axis;
 
 /// Result of one (preset, seed, axis).
 #[derive(Clone, Debug)]

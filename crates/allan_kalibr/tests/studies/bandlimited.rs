@@ -10,10 +10,6 @@
 //! and analysed by `allan_kalibr`'s run, the terms read back from `ieee952_terms.csv` by
 //! their column names.
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::files::{
-    COL_AXIS, COL_CI95_HI, COL_CI95_LO, COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT,
-};
 use allan_kalibr::ieee952::{Config, CurveData, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
@@ -177,36 +173,16 @@ fn mat_cases() -> Vec<Outcome> {
     config.common.topics = bag2mat::TopicSelector::one("/imu0");
     config.title = "bmi088-like".into();
     allan_kalibr::run::run(&config).expect("allan_kalibr run on the .mat");
-    let csv = std::fs::read_to_string(out.join(ieee952::files::TERMS_FILE)).expect("terms file");
-    let mut lines = csv.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
-    let (cs, ca, ct, cv, cl, ch, cd) = (
-        col(COL_SENSOR),
-        col(COL_AXIS),
-        col(COL_TERM),
-        col(COL_VALUE),
-        col(COL_CI95_LO),
-        col(COL_CI95_HI),
-        col(COL_VERDICT),
-    );
-    let rows: Vec<Vec<String>> = lines
-        .map(|l| l.split(',').map(str::to_string).collect())
-        .collect();
+    let rows = crate::ieee952::terms(&out);
     let mut out_cases = Vec::new();
     for (s, sname) in [
         (SimSensor::Gyro, "gyroscope"),
         (SimSensor::Acc, "accelerometer"),
     ] {
         for (a, aname) in ["x", "y", "z"].iter().enumerate() {
-            let find = |term: &str| {
-                rows.iter()
-                    .find(|r| r[cs] == sname && r[ca] == *aname && r[ct] == term)
-                    .unwrap_or_else(|| panic!("{sname} {aname} {term} in the terms file"))
-            };
-            let num = |r: &Vec<String>, c: usize| r[c].parse::<f64>().expect("number");
+            let find = |t: &str| crate::ieee952::term(&rows, sname, aname, t);
             let (nr, kr) = (find("N"), find("K"));
-            let verdict = match kr[cd].as_str() {
+            let verdict = match kr.verdict.as_str() {
                 "Resolved" => Verdict::Resolved,
                 "NotSignificant" => Verdict::NotSignificant,
                 "NeverDominant" => Verdict::NeverDominant,
@@ -218,8 +194,8 @@ fn mat_cases() -> Vec<Outcome> {
             let (n_true, k_true) = truth(&m, s, a, n);
             out_cases.push(Outcome {
                 label: format!(".mat corner {MAT_CORNER}·rate {} {aname}", s.short()),
-                n_err: num(nr, cv) / n_true - 1.0,
-                k: (verdict, num(kr, cv), num(kr, cl), num(kr, ch)),
+                n_err: nr.value / n_true - 1.0,
+                k: (verdict, kr.value, kr.lo, kr.hi),
                 k_true,
                 range: String::new(),
             });

@@ -4,7 +4,7 @@
 use allan_kalibr::ieee952;
 use allan_kalibr::ieee952::curves_in::{self, Options};
 use allan_kalibr::ieee952::imu::Sensor;
-use allan_kalibr::ieee952::{Analysis, Config, analyse_curve};
+use allan_kalibr::ieee952::{Analysis, Config, analyse_curve, short};
 
 pub(super) const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/real_curves");
 
@@ -28,21 +28,6 @@ pub(super) fn analyse_imu_dir(name: &str, duration: f64, cfg: &Config) -> Vec<(S
         }
     }
     out
-}
-
-/// A number in 3 significant digits, as the section's messages print it (a copy of the
-/// crate's private `short` in src/ieee952/result.rs: a formatting helper, not API).
-fn short(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let e = x.abs().log10().floor() as i32;
-    if (-3..5).contains(&e) {
-        let d = (2 - e).max(0) as usize;
-        format!("{x:.d$}")
-    } else {
-        format!("{x:.2e}")
-    }
 }
 
 pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Analysis) {

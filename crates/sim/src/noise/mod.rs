@@ -91,6 +91,26 @@ pub fn quantization_step(q: f64) -> f64 {
 
 /// Allan deviation of white noise of density `sigma` (unit/√Hz) at averaging time `tau` (s):
 /// σ_A(τ) = σ/√τ — the −½ slope line, which reads σ at τ = 1 s (IEEE 952 Annex C).
+/// One axis of white noise `n` and random walk `k` (continuous), `len` samples `dt` apart,
+/// from [`NoiseGenerator`] seeded with `seed`: its gyro x channel (the other channels' draws
+/// are discarded). The tests' white-plus-random-walk series, made in one place.
+pub fn white_rw_axis(n: f64, k: f64, dt: f64, len: usize, seed: u64) -> Vec<f64> {
+    let c = ContinuousNoise {
+        gyro_noise: n,
+        gyro_bias_rw: k,
+        acc_noise: 0.0,
+        acc_bias_rw: 0.0,
+    };
+    let mut g = NoiseGenerator::new(c.discretize(dt), seed);
+    (0..len)
+        .map(|_| {
+            let (mut gyro, mut acc) = ([0.0; 3], [0.0; 3]);
+            g.apply(&mut gyro, &mut acc);
+            gyro[0]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 pub fn adev_white(sigma: f64, tau: f64) -> f64 {
     sigma / tau.sqrt()
