@@ -15,7 +15,7 @@ fn bin() -> Command {
 }
 
 fn launch_file() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../launch_equivalents/my_imu.launch")
+    bag2mat::test_tools::workspace().join("launch_equivalents/my_imu.launch")
 }
 
 fn text(b: &[u8]) -> String {

@@ -537,8 +537,7 @@ mod tests {
 
     #[test]
     fn reads_the_real_imu_utils_yaml() {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../testdata/p1_high_200hz/imu_utils/p1_imu_param.yaml");
+        let p = bag2mat::test_tools::testdata().join("p1_high_200hz/imu_utils/p1_imu_param.yaml");
         let v = read_imu_utils_yaml(&p).unwrap();
         assert_eq!(v["gyr_n"], 4.1388663882331872e-01);
         assert_eq!(v["acc_w"], 4.2834587892313708e-03);

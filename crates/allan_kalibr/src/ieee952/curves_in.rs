@@ -842,14 +842,14 @@ mod tests_issue18 {
     /// reliable fit. The count must allow every point with a value, and every axis fit.
     #[test]
     fn issue18_10_imu_utils_folders_without_a_sample_count_fit_every_axis() {
-        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata");
+        let root = bag2mat::test_tools::testdata();
         for case in [
             "p1_high_200hz",
             "p2_medium_100hz",
             "p3_short_61s",
             "p4_high_100hz_60min",
         ] {
-            let dir = PathBuf::from(format!("{root}/{case}/imu_utils"));
+            let dir = root.join(case).join("imu_utils");
             let c = read(&[dir], &Options::default()).unwrap();
             let cfg = super::super::Config::default();
             for s in &c.sensors {

@@ -6,14 +6,14 @@ use allan_kalibr::ieee952::curves_in::{self, Options};
 use allan_kalibr::ieee952::imu::Sensor;
 use allan_kalibr::ieee952::{Analysis, Config, analyse_curve, short};
 
-pub(super) const REAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/real_curves");
-
 /// (folder, record length in s from its launch file, see the folder's README).
 pub(super) const IMUS: [(&str, f64); 3] = [("A3", 7200.0), ("N3", 7200.0), ("BMI160", 12000.0)];
 
 pub(super) fn analyse_imu_dir(name: &str, duration: f64, cfg: &Config) -> Vec<(Sensor, Analysis)> {
     let c = curves_in::read(
-        &[std::path::PathBuf::from(format!("{REAL}/{name}"))],
+        &[bag2mat::test_tools::testdata()
+            .join("real_curves")
+            .join(name)],
         &Options {
             duration: Some(duration),
             ..Options::default()

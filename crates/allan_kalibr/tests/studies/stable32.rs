@@ -9,7 +9,6 @@ use std::io::Read;
 
 /// Reference folder (TEMPORARY absolute path in the scratch crate; in the workspace this is
 /// CARGO_MANIFEST_DIR/../../testdata/external).
-const EXTERNAL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/external");
 /// Issue 6: bounds within 1 % of Stable32's where the identified α agrees.
 const BOUND_REL_TOL: f64 = 0.01;
 /// Stable32's Min/Max Sigma are at confidence factor 0.683 (file headers).
@@ -25,8 +24,9 @@ struct Row {
 }
 
 fn read_text(name: &str) -> String {
-    let path = format!("{EXTERNAL}/{name}");
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let file = bag2mat::test_tools::testdata().join("external").join(name);
+    let path = file.display();
+    let bytes = std::fs::read(&file).unwrap_or_else(|e| panic!("{path}: {e}"));
     if name.ends_with(".gz") {
         let mut s = String::new();
         flate2::read::GzDecoder::new(&bytes[..])

@@ -734,8 +734,7 @@ mod tests {
 
     #[test]
     fn ar1_against_mpmath_reference_file() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../testdata/noise_truth/ar1_avar_mpmath.csv");
+        let path = bag2mat::test_tools::testdata().join("noise_truth/ar1_avar_mpmath.csv");
         let text = std::fs::read_to_string(&path).unwrap();
         let mut n = 0;
         for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
