@@ -7,8 +7,6 @@ use allan_kalibr::ieee952::oadev::{Overlap, Phase};
 use allan_kalibr::ieee952::{ci, edf, noise_id};
 use std::io::Read;
 
-/// Reference folder (TEMPORARY absolute path in the scratch crate; in the workspace this is
-/// CARGO_MANIFEST_DIR/../../testdata/external).
 /// Issue 6: bounds within 1 % of Stable32's where the identified α agrees.
 const BOUND_REL_TOL: f64 = 0.01;
 /// Stable32's Min/Max Sigma are at confidence factor 0.683 (file headers).
