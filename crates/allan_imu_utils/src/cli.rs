@@ -133,7 +133,7 @@ impl TryFrom<Args> for Config {
         let text_rate =
             allan_kalibr::front::rate_for_text(a.common.input.as_deref(), a.common.rate);
         if let (Some(input), Some(rate), None) = (&a.common.input, a.common.rate, text_rate) {
-            let kind = bag2mat::detect::input_kind(input)
+            let kind = bag2mat::input_kind(input)
                 .map(|k| k.describe())
                 .unwrap_or("input");
             return Err(Error::Config(format!(

@@ -168,7 +168,7 @@ pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::front::Section>, Er
 /// into `out_dir`; with several, into `out_dir/<topic folder>`.
 pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
-    let read = bag2mat::series::read_imu_topics_with(
+    let read = bag2mat::read_imu_topics_with(
         config.common.samples_path(),
         &config.common.topics,
         &bag2mat::ReadOptions {
@@ -180,7 +180,7 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
     let several = read.series.len() > 1 || config.common.topics.all_imu;
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
-    let folders = bag2mat::series::topic_folder_names(&names);
+    let folders = bag2mat::topic_folder_names(&names);
     let mut outs = Vec::new();
     for (series, folder) in read.series.into_iter().zip(folders) {
         let mut c = config.clone();
@@ -264,8 +264,8 @@ fn stand_in_and_skip(
     series: &mut bag2mat::ImuSeries,
     notes: &mut Vec<Note>,
 ) -> Result<Option<bag2mat::Sensor>, Error> {
-    let absent = series.stand_in_absent(bag2mat::series::StandIn::Zeros);
-    notes.extend(absent.map(bag2mat::series::absent_warning));
+    let absent = series.stand_in_absent(bag2mat::StandIn::Zeros);
+    notes.extend(absent.map(bag2mat::absent_warning));
     if let Some(s) = config.common.skip_start {
         let (k, warning) = skip_start(series, s)?;
         notes.extend(warning.map(Note::warning));

@@ -128,7 +128,7 @@ fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
     assert!(gk.text.contains(&format!("in {lost} gap(s)")), "{gk}");
     assert!(gk.time.is_some() && gk.sample.is_some());
     // bag2mat info
-    let info = bag2mat::info::info(&bag, true).unwrap();
+    let info = bag2mat::info(&bag, true).unwrap();
     let t = &info.topics[0];
     assert_eq!((t.missing as f64, t.gaps as f64), (lost, lost), "{t:?}");
     assert_eq!(gaps(&t.findings), gk);

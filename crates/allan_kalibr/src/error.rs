@@ -27,7 +27,7 @@ pub enum Error {
     /// The input is neither a `.mat` nor a bag bag2mat reads.
     #[error(
         "{path}: unknown input type (expected a .mat file or a bag: {})",
-        bag2mat::source::ACCEPTED
+        bag2mat::ACCEPTED
     )]
     UnknownInput {
         /// The file.

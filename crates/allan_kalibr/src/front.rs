@@ -302,12 +302,8 @@ impl CommonArgs {
 /// text log (for every other input the rate is the stamps'; the reader refuses a rate it
 /// cannot use, so a flag that does nothing is an error).
 pub fn rate_for_text(input: Option<&Path>, rate: Option<f64>) -> Option<f64> {
-    let text = input.is_some_and(|p| {
-        matches!(
-            bag2mat::detect::input_kind(p),
-            Ok(bag2mat::source::InputKind::Text)
-        )
-    });
+    let text =
+        input.is_some_and(|p| matches!(bag2mat::input_kind(p), Ok(bag2mat::InputKind::Text)));
     rate.filter(|_| text)
 }
 

@@ -29,7 +29,7 @@ pub struct ImuData {
     /// The stamps in nanoseconds and what the record check needs besides the samples.
     pub clock: Clock,
     /// A sensor the topic does not carry (PX4 `sensor_gyro`, a gyro-only DataFlash
-    /// instance): its columns hold zeros as a stand-in (`bag2mat::series::StandIn::Zeros`),
+    /// instance): its columns hold zeros as a stand-in (`bag2mat::StandIn::Zeros`),
     /// never analysed nor written.
     pub absent: Option<bag2mat::Sensor>,
 }
@@ -65,7 +65,7 @@ impl ImuData {
     /// Builds the columns from a bag2mat series with the chosen time column (bagconvert's
     /// record time by default), through bag2mat's one series-to-matrix conversion.
     pub(crate) fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
-        let absent = s.stand_in_absent(bag2mat::series::StandIn::Zeros);
+        let absent = s.stand_in_absent(bag2mat::StandIn::Zeros);
         let topic = s.topic.clone();
         let notes = s.notes.clone();
         let (used, other) = match time {
@@ -195,7 +195,7 @@ pub(crate) fn load_all(
     if is_mat(path) {
         return Ok(vec![load_mat(path)?]);
     }
-    match bag2mat::series::read_imu_topics_with(path, sel, &bag2mat::ReadOptions { quiet }, opts) {
+    match bag2mat::read_imu_topics_with(path, sel, &bag2mat::ReadOptions { quiet }, opts) {
         Ok(r) => Ok(r
             .series
             .into_iter()

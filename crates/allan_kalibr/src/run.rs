@@ -175,7 +175,7 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
         .map(|d| d.topic.clone().unwrap_or_default())
         .collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
-    let folders = bag2mat::series::topic_folder_names(&names);
+    let folders = bag2mat::topic_folder_names(&names);
     let mut outs = Vec::new();
     for (data, folder) in datas.into_iter().zip(folders) {
         let mut c = config.clone();
@@ -336,7 +336,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
     );
     let mut findings = check.findings.clone();
     bag2mat::record_check::drop_absent(&mut findings, absent);
-    notes.extend(absent.map(bag2mat::series::absent_warning));
+    notes.extend(absent.map(bag2mat::absent_warning));
     let whole = check.keep.is_all();
     let data = data.select(&check.keep);
     if data.len() < 3 {

@@ -272,7 +272,7 @@ fn issue18_6_a_clock_step_and_duplicates_are_found_not_sorted_in() {
     let r = n_ratios(&out, &truth);
     assert!((mean(&r) - 1.0).abs() < N_MEAN_REL_TOL, "N / truth: {r:?}");
     // bag2mat info reads the same rate (before: 204 Hz)
-    let info = bag2mat::info::info(&bag, true).unwrap();
+    let info = bag2mat::info(&bag, true).unwrap();
     let t = &info.topics[0];
     assert!((t.rate.unwrap() - 200.0).abs() < 1e-6, "{t:?}");
     assert!(

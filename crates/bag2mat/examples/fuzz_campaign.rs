@@ -53,9 +53,9 @@ use bag2mat::bag::BagWriter;
 use bag2mat::bag::record::{Header, Op, raw_record};
 use bag2mat::imu_msg::Imu;
 use bag2mat::mcap::ChunkCompression;
-use bag2mat::rosbag2::{Ros2BagWriter, Storage};
 use bag2mat::test_tools::{self, btree_pages, mcap_records, reported_losses, rowid_fields};
 use bag2mat::{Compression, RosTime};
+use bag2mat::{Ros2BagWriter, Storage};
 
 /// The campaign's seed (every variant derives from it).
 const SEED: u64 = 0x1212_2026_0000_0012;
@@ -388,7 +388,7 @@ fn db3_regions(path: &Path, b: &[u8]) -> Vec<Region> {
 /// start (read with our reader from the clean file: only where rows are, never their
 /// values).
 fn source_units(path: &Path) -> Vec<(usize, Vec<u32>)> {
-    let src = bag2mat::input::open(path).expect("open clean file");
+    let src = bag2mat::open_input(path).expect("open clean file");
     let bytes = std::fs::read(path).expect("read clean file");
     let imu_ids: Vec<u32> = src
         .channels()

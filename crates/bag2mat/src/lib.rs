@@ -2,9 +2,9 @@
 //!
 //! No other crate encodes a record:
 //!
-//! * [`source`]: one interface over every input — a ROS 1 bag, a ROS 2 bag directory, an
+//! * `source`: one interface ([`Source`]) over every input — a ROS 1 bag, a ROS 2 bag directory, an
 //!   `.mcap`, a `.db3`, a zstd-compressed storage file — recognised from its content.
-//! * [`series`]: the one read path: Imu topics as columns in record-time order, with the
+//! * `series`: the one read path ([`read_imu_topics`]): Imu topics as columns in record-time order, with the
 //!   topic rules every tool shares (exact name, else the other slash form; a missing topic
 //!   lists the input's topics), parallel decode, sorting and the accounting of what the
 //!   container promised against what was delivered.
@@ -12,18 +12,18 @@
 //!   and [`bag::BagWriter`] (files `rosbag info/check` accept).
 //! * [`mcap`]: MCAP, our own record-level reader (with or without summary, recovery of files
 //!   cut short) and writer.
-//! * [`rosbag2`]: ROS 2 bag directories, `metadata.yaml`, the sqlite3 storage and rosbag2's
-//!   FILE/MESSAGE zstd compression; [`rosbag2::Ros2BagWriter`].
+//! * `rosbag2`: ROS 2 bag directories, `metadata.yaml`, the sqlite3 storage and rosbag2's
+//!   FILE/MESSAGE zstd compression; [`Ros2BagWriter`].
 //! * [`imu_msg`]: the ROS 1 `sensor_msgs/Imu` layout, md5 and 2571-byte definition;
 //!   `cdr`: `sensor_msgs/msg/Imu` in CDR (ROS 2); [`Sensor`]: its two sensors and their
 //!   units, the one sensor type of the workspace.
 //! * [`mat`]: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written;
 //!   [`convert`]: the bagconvert rules (rows, output paths) and the csv/npy alternatives.
-//! * [`info`]: what an input holds (`bag2mat info`); [`record_check`]: is a record fit for
+//! * `info`: what an input holds ([`info()`]) (`bag2mat info`); [`record_check`]: is a record fit for
 //!   an Allan analysis (clocks, duplicates, gaps through [`timing`], the one gap rule;
 //!   outliers, warm-up, motion), typed findings every tool prints and the analysers obey.
 //! * [`formats`]: raw IMU logs from outside ROS — EuRoC/ASL and plain text, NumPy, PX4
-//!   ULog, ArduPilot DataFlash — each a [`source::Source`] over rows its reader decoded
+//!   ULog, ArduPilot DataFlash — each a [`Source`] over rows its reader decoded
 //!   (`decoded`); `cursor`: the bounds-checked byte reader the binary formats parse with.
 //! * [`shared`]: helpers every binary shares — atomic outputs, progress bars, the plot font
 //!   and the PNG+SVG chart writer, C `printf` formats.
@@ -38,23 +38,23 @@ mod cli;
 pub mod convert;
 mod cursor;
 mod decoded;
-pub mod detect;
+mod detect;
 mod error;
 pub mod formats;
 pub mod imu_msg;
-pub mod info;
-pub mod input;
+mod info;
+mod input;
 mod mapped;
 pub mod mat;
 pub mod mcap;
-pub mod printable;
+mod printable;
 pub mod record_check;
-pub mod rosbag2;
+mod rosbag2;
 mod rows;
 mod sensor;
-pub mod series;
+mod series;
 pub mod shared;
-pub mod source;
+mod source;
 #[cfg(any(test, feature = "test-support"))]
 pub mod test_tools;
 mod time;
@@ -63,11 +63,17 @@ mod zstd;
 
 pub use bag::Compression;
 pub use cli::{Args, Invocation, run};
+pub use detect::input_kind;
 pub use error::{Error, TopicSummary};
+pub use info::{InfoReport, TopicInfo, info, info_with};
+pub use input::open as open_input;
+pub use printable::escape as escape_printable;
+pub use rosbag2::{Ros2BagWriter, Storage, TopicId};
 pub use rows::{ROW_LEN, Row, Rows, permute};
 pub use sensor::Sensor;
 pub use series::{
-    ImuRead, ImuSeries, ReadOptions, TimeColumn, TopicReport, TopicSelector, read_imu_series,
-    read_imu_topics,
+    ImuRead, ImuSeries, ReadOptions, StandIn, TimeColumn, TopicReport, TopicSelector,
+    absent_warning, read_imu_series, read_imu_topics, read_imu_topics_with, topic_folder_names,
 };
+pub use source::{ACCEPTED, InputKind, Source};
 pub use time::RosTime;

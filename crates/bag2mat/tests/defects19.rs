@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use bag2mat::mcap::ChunkCompression;
-use bag2mat::rosbag2::{Ros2BagWriter, Storage};
 use bag2mat::test_tools::{
     BtreePage, McapRecord, btree_pages, mcap_chunk_records, mcap_records, reported_losses,
     rowid_fields,
 };
+use bag2mat::{Ros2BagWriter, Storage};
 
 use crate::util::{run, synthetic};
 

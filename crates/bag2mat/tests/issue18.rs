@@ -16,7 +16,7 @@ const N: usize = 60_000;
 
 /// `bag2mat info`'s Imu topic: its rate, and its findings of `kind`.
 fn imu_topic(path: &Path, kind: Kind) -> (f64, Vec<Finding>) {
-    let info = bag2mat::info::info(path, true).unwrap();
+    let info = bag2mat::info(path, true).unwrap();
     let t = info.topics.iter().find(|t| t.imu).expect("an Imu topic");
     let f = t
         .findings

@@ -165,7 +165,7 @@ fn defect_20_2_ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() 
             assert!((rate - 800.0).abs() < 0.01, "{}: {rate}", s.topic);
         }
     }
-    let out = bag2mat::info::info(&ours, true).unwrap().text(&ours);
+    let out = bag2mat::info(&ours, true).unwrap().text(&ours);
     for topic in ["sensor_gyro_fifo", "sensor_accel_fifo"] {
         let line = out
             .lines()
@@ -614,7 +614,7 @@ fn damaged_logs_of_every_format_never_panic() {
                     assert!(!e.to_string().is_empty());
                 }
             }
-            let _ = bag2mat::info::info(&p, true);
+            let _ = bag2mat::info(&p, true);
             assert!(
                 t.elapsed().as_secs_f64() < 10.0,
                 "{name} variant {v} took {:?}",

@@ -408,9 +408,9 @@ fn damaged_mcap_and_db3_never_panic() {
     // A chunk's body damaged in a file with chunk CRCs (ours; rosbags writes none): the
     // other chunks are read and the loss is named.
     let ours_dir = dir.path().join("ours");
-    let mut w = bag2mat::rosbag2::Ros2BagWriter::create(
+    let mut w = bag2mat::Ros2BagWriter::create(
         &ours_dir,
-        bag2mat::rosbag2::Storage::Mcap(bag2mat::mcap::ChunkCompression::None),
+        bag2mat::Storage::Mcap(bag2mat::mcap::ChunkCompression::None),
     )
     .unwrap();
     let t = w.add_imu_topic("imu").unwrap();

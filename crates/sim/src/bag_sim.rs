@@ -21,8 +21,8 @@ use bag2mat::bag::BagWriter;
 use bag2mat::bag::write::ConnId;
 use bag2mat::imu_msg::Imu;
 use bag2mat::mcap::ChunkCompression;
-use bag2mat::rosbag2::{Ros2BagWriter, Storage, TopicId};
 use bag2mat::{Compression, RosTime};
+use bag2mat::{Ros2BagWriter, Storage, TopicId};
 use std::path::{Path, PathBuf};
 
 /// Settings of `sim bag`.

@@ -21,7 +21,7 @@ pub fn beside_ours(a: &ImuAnalysis, input: &Path, topic: &str) -> String {
     };
     let mut s = format!(
         "\n=> the dataset's sensor.yaml for '{}' states (continuous time) | measured here (here/stated)\n",
-        bag2mat::printable::escape(topic)
+        bag2mat::escape_printable(topic)
     );
     let ours = |v: Option<SensorValue>| match v {
         Some(v) if v.upper_bound => format!("< {:.4e} (95 % upper bound)", v.value),

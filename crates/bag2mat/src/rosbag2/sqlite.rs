@@ -54,8 +54,6 @@ pub struct Sqlite3Reader {
     /// whether any walk broke.
     walked: Mutex<Walked>,
     contents: source::Contents,
-    /// The `schema` table's version, when the file has one (ROS 2 Iron and later).
-    pub schema_version: Option<i64>,
 }
 
 /// What the parts' walks found that only the whole read can judge.
@@ -178,15 +176,6 @@ impl Sqlite3Reader {
                 });
             }
         }
-        let schema_version = if tables.iter().any(|x| x == "schema") {
-            conn.query_row("SELECT max(schema_version) FROM schema", [], |r| {
-                r.get::<_, Option<i64>>(0)
-            })
-            .ok()
-            .flatten()
-        } else {
-            None
-        };
         let index: Option<String> = conn
             .query_row(
                 "SELECT name FROM sqlite_master WHERE type = 'index' AND tbl_name = 'messages' ORDER BY name LIKE '%timestamp%' DESC LIMIT 1",
@@ -217,7 +206,6 @@ impl Sqlite3Reader {
                 notes,
                 losses,
             },
-            schema_version,
         })
     }
 
