@@ -512,7 +512,6 @@ fn decode_planned(
         .map(|k| Rows::zeroed(plan.iter().map(|p| p[k]).sum()))
         .collect();
     let outs: Vec<PartOut>;
-    let mut rebuilt: Option<Vec<Rows>> = None;
     {
         // slots[k][i]: topic k's rows of part i.
         let mut slots: Vec<std::vec::IntoIter<RowsMut>> = columns
@@ -548,11 +547,8 @@ fn decode_planned(
                     r[k].append(&t.overflow);
                 }
             }
-            rebuilt = Some(r);
+            return (r, outs);
         }
-    }
-    if let Some(r) = rebuilt {
-        columns = r;
     }
     (columns, outs)
 }
