@@ -12,9 +12,6 @@ use allan_kalibr::ieee952::files::{
     COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE, TERMS_FILE,
 };
 use bag2mat::mat::{DataImu, write_data_imu};
-use rand::SeedableRng;
-use rand::rngs::StdRng;
-use rand_distr::{Distribution, StandardNormal};
 
 /// Sample rate of the simulated records, Hz.
 const RATE: f64 = 50.0;
@@ -54,9 +51,14 @@ fn ok(o: &Output) -> String {
 /// constant) and a gap in the stamps (at, seconds).
 pub fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) -> DataImu {
     let n = (DURATION * RATE) as usize;
-    let mut rng = StdRng::seed_from_u64(seed);
+    let noise = sim::ContinuousNoise {
+        gyro_noise: GYRO.0,
+        gyro_bias_rw: GYRO.1,
+        acc_noise: ACC.0,
+        acc_bias_rw: ACC.1,
+    };
+    let mut g = sim::NoiseGenerator::new(noise.discretize(1.0 / RATE), seed);
     let mut m = DataImu::with_capacity(n);
-    let mut walk = [0.0; 6];
     for i in 0..n {
         let mut t = i as f64 / RATE;
         if let Some((at, len)) = gap
@@ -64,14 +66,9 @@ pub fn simulate(seed: u64, warmup: Option<(f64, f64)>, gap: Option<(f64, f64)>) 
         {
             t += len;
         }
-        let mut row = [t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        for c in 0..6 {
-            let (nd, k) = if c < 3 { ACC } else { GYRO };
-            let w: f64 = StandardNormal.sample(&mut rng);
-            let r: f64 = StandardNormal.sample(&mut rng);
-            walk[c] += k / RATE.sqrt() * r;
-            row[1 + c] = nd * RATE.sqrt() * w + walk[c];
-        }
+        let (mut gyro, mut acc) = ([0.0; 3], [0.0; 3]);
+        g.apply(&mut gyro, &mut acc);
+        let mut row = [t, acc[0], acc[1], acc[2], gyro[0], gyro[1], gyro[2]];
         if let Some((amp, tau)) = warmup {
             row[4] += amp * (-t / tau).exp();
         }

@@ -436,9 +436,6 @@ mod tests {
     use super::super::model::basis;
     use super::super::oadev::{Overlap, Phase};
     use super::*;
-    use rand::SeedableRng;
-    use rand::rngs::StdRng;
-    use rand_distr::{Distribution, StandardNormal};
 
     /// Greenhall's continuous-time EDF vs our variance at moderate m, where the sampled and
     /// continuous models agree to O(1/m).
@@ -513,19 +510,9 @@ mod tests {
         let (nd, kd) = (0.2f64, 0.05f64);
         let c = [0.0, nd * nd, 0.0, kd * kd, 0.0, 0.0];
         let ms = [2usize, 3, 8, 40];
-        let mut rng = StdRng::seed_from_u64(RNG_SEED);
         let mut samples: Vec<[f64; 4]> = Vec::with_capacity(reps);
-        for _ in 0..reps {
-            let mut b = 0.0;
-            let y: Vec<f64> = (0..n)
-                .map(|_| {
-                    let w: f64 = StandardNormal.sample(&mut rng);
-                    let v: f64 = StandardNormal.sample(&mut rng);
-                    let out = b + nd / tau0.sqrt() * w;
-                    b += kd * tau0.sqrt() * v;
-                    out
-                })
-                .collect();
+        for rep in 0..reps as u64 {
+            let y = sim::white_rw_axis(nd, kd, tau0, n, RNG_SEED + rep);
             let ph = Phase::from_rate(&y, tau0);
             samples.push(std::array::from_fn(|i| {
                 ph.avar(ms[i], Overlap::Overlapping).unwrap().avar

@@ -405,19 +405,15 @@ mod tests {
 
     #[test]
     fn fast_matches_cluster_average_oracle() {
-        let mut rng = StdRng::seed_from_u64(RNG_SEED);
         for &n in &[3usize, 4, 7, 50, 257, 1000] {
-            // white noise plus a random walk plus an offset, so every term matters
-            let mut b = 0.0;
-            let y: Vec<f64> = (0..n)
-                .map(|_| {
-                    let w: f64 = StandardNormal.sample(&mut rng);
-                    let s: f64 = StandardNormal.sample(&mut rng);
-                    b += 0.1 * s;
-                    3.0 + w + b
-                })
-                .collect();
-            let tau0 = 0.005;
+            // white noise (σ 1) plus a random walk (steps of σ 0.1) plus an offset, so every
+            // term matters
+            let tau0 = 0.005f64;
+            let y: Vec<f64> =
+                sim::white_rw_axis(tau0.sqrt(), 0.1 / tau0.sqrt(), tau0, n, RNG_SEED + n as u64)
+                    .into_iter()
+                    .map(|v| 3.0 + v)
+                    .collect();
             let ph = Phase::from_rate(&y, tau0);
             for m in 1..=n {
                 for kind in [Overlap::Overlapping, Overlap::Normal] {
@@ -446,18 +442,14 @@ mod tests {
 
     #[test]
     fn issue17_3_the_curve_is_the_exact_overlapping_adev_at_every_cluster_size() {
-        let mut rng = StdRng::seed_from_u64(RNG_SEED + 4);
         let n = 6_000;
-        let mut b = 0.0;
-        let y: Vec<f64> = (0..n)
-            .map(|_| {
-                let w: f64 = StandardNormal.sample(&mut rng);
-                let s: f64 = StandardNormal.sample(&mut rng);
-                b += 0.05 * s;
-                -1.5 + w + b
-            })
-            .collect();
-        let tau0 = 0.01;
+        let tau0 = 0.01f64;
+        // white noise (σ 1) plus a random walk (steps of σ 0.05) plus an offset
+        let y: Vec<f64> =
+            sim::white_rw_axis(tau0.sqrt(), 0.05 / tau0.sqrt(), tau0, n, RNG_SEED + 4)
+                .into_iter()
+                .map(|v| v - 1.5)
+                .collect();
         let cfg = super::super::Config::default();
         let curve = super::super::CurveData::from_samples(&y, tau0, &cfg).unwrap();
         let ms: Vec<usize> = curve.points.iter().map(|p| p.m).collect();
