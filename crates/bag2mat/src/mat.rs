@@ -10,6 +10,7 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::cursor::Le;
 use crate::error::Error;
 use crate::shared::output::write_atomic;
 
@@ -144,7 +145,7 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
     let mut names = Vec::new();
     while pos < len {
         let at = |w: String| err(format!("byte {pos}: {w}"));
-        let (ty, n, small) = read_tag(&mut r).map_err(|e| at(e.to_string()))?;
+        let Tag { ty, n, small, .. } = Tag::read(&mut r).map_err(|e| at(e.to_string()))?;
         if small {
             pos += 8;
             continue;
@@ -152,8 +153,8 @@ pub fn read_data_imu(path: &Path) -> Result<DataImu, Error> {
         let found = match ty {
             MI_COMPRESSED => {
                 let mut z = flate2::read::ZlibDecoder::new((&mut r).take(n as u64));
-                let (ity, _, _) = read_tag(&mut z).map_err(|e| at(format!("zlib: {e}")))?;
-                let found = if ity == MI_MATRIX {
+                let inner = Tag::read(&mut z).map_err(|e| at(format!("zlib: {e}")))?;
+                let found = if inner.ty == MI_MATRIX {
                     Some(matrix(&mut z, false).map_err(|e| at(e.to_string()))?)
                 } else {
                     None
@@ -278,39 +279,67 @@ fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     Ok(got)
 }
 
-/// An element tag: (type, byte count, small-element form). In the small form the data (≤ 4
-/// bytes) sits in the tag's second word, which this consumes too.
-fn read_tag(r: &mut impl Read) -> std::io::Result<(u32, u32, bool)> {
-    let mut t = [0u8; 8];
-    r.read_exact(&mut t)?;
-    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
-    if first >> 16 != 0 {
-        return Ok((first & 0xffff, first >> 16, true));
+/// An element's 8-byte tag, the one record every MAT element starts with.
+#[derive(Debug, Clone, Copy)]
+struct Tag {
+    /// The data type (`miMATRIX`, `miDOUBLE`, …).
+    ty: u32,
+    /// The data's byte count.
+    n: u32,
+    /// The small-element form: type and count share the first word, and the data (at most
+    /// 4 bytes) sits in the second.
+    small: bool,
+    /// The second word's bytes (a small element's data).
+    word: [u8; 4],
+}
+
+impl Tag {
+    /// The tag the 8 bytes `t` hold.
+    fn parse(t: &[u8; 8]) -> Tag {
+        let (first, second) = t.split_at(4);
+        let first = <u32 as Le>::from_le(first);
+        let word = [second[0], second[1], second[2], second[3]];
+        if first >> 16 != 0 {
+            return Tag {
+                ty: first & 0xffff,
+                n: first >> 16,
+                small: true,
+                word,
+            };
+        }
+        Tag {
+            ty: first,
+            n: <u32 as Le>::from_le(second),
+            small: false,
+            word,
+        }
     }
-    Ok((first, u32::from_le_bytes([t[4], t[5], t[6], t[7]]), false))
+
+    /// Reads the next tag (in the small form, its data too).
+    fn read(r: &mut impl Read) -> std::io::Result<Tag> {
+        let mut t = [0u8; 8];
+        r.read_exact(&mut t)?;
+        Ok(Tag::parse(&t))
+    }
 }
 
 /// A small sub-element (flags, dimensions, name): type and bytes, padding consumed.
 fn small_element(r: &mut impl Read, what: &'static str) -> Result<(u32, Vec<u8>), MatFormatError> {
     /// Names and dimension lists are short; a larger size means a corrupt file.
     const MAX_SUB_ELEMENT: u32 = 1 << 16;
-    let mut t = [0u8; 8];
-    r.read_exact(&mut t)
-        .map_err(|source| MatFormatError::Io { what, source })?;
-    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
-    if first >> 16 != 0 {
-        let n = ((first >> 16) as usize).min(4);
-        return Ok((first & 0xffff, t[4..4 + n].to_vec()));
+    let tag = Tag::read(r).map_err(|source| MatFormatError::Io { what, source })?;
+    if tag.small {
+        let n = (tag.n as usize).min(4);
+        return Ok((tag.ty, tag.word[..n].to_vec()));
     }
-    let n = u32::from_le_bytes([t[4], t[5], t[6], t[7]]);
-    if n > MAX_SUB_ELEMENT {
-        return Err(MatFormatError::Oversized { what, n });
+    if tag.n > MAX_SUB_ELEMENT {
+        return Err(MatFormatError::Oversized { what, n: tag.n });
     }
-    let mut data = vec![0u8; (n as usize).div_ceil(8) * 8];
+    let mut data = vec![0u8; (tag.n as usize).div_ceil(8) * 8];
     r.read_exact(&mut data)
         .map_err(|source| MatFormatError::Io { what, source })?;
-    data.truncate(n as usize);
-    Ok((first, data))
+    data.truncate(tag.n as usize);
+    Ok((tag.ty, data))
 }
 
 enum Parsed {
@@ -399,7 +428,7 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, MatFormatErro
     }
     let dims: Vec<usize> = dims
         .chunks_exact(4)
-        .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]).max(0) as usize)
+        .map(|b| <i32 as Le>::from_le(b).max(0) as usize)
         .collect();
     let (_, name) = small_element(r, "array name")?;
     let name = String::from_utf8_lossy(&name).into_owned();
@@ -422,17 +451,15 @@ fn matrix(r: &mut impl Read, defer_values: bool) -> Result<Parsed, MatFormatErro
         return Err(MatFormatError::Complex(name));
     }
     let rows = dims[0];
-    let mut t = [0u8; 8];
-    r.read_exact(&mut t).map_err(|source| MatFormatError::Io {
+    let Tag {
+        ty,
+        n,
+        small: inline,
+        ..
+    } = Tag::read(r).map_err(|source| MatFormatError::Io {
         what: "real part",
         source,
     })?;
-    let first = u32::from_le_bytes([t[0], t[1], t[2], t[3]]);
-    let (ty, n, inline) = if first >> 16 != 0 {
-        (first & 0xffff, first >> 16, true)
-    } else {
-        (first, u32::from_le_bytes([t[4], t[5], t[6], t[7]]), false)
-    };
     let width = type_width(ty)?;
     if n as usize != rows * COLS * width {
         return Err(MatFormatError::Size { name, n, ty, rows });
@@ -472,18 +499,19 @@ fn type_width(ty: u32) -> Result<usize, MatFormatError> {
     })
 }
 
+/// One value of storage type `ty` from its `b` (exactly [`type_width`] bytes).
 fn number(ty: u32, b: &[u8]) -> f64 {
     match ty {
-        1 => b[0] as i8 as f64,
-        2 => b[0] as f64,
-        3 => i16::from_le_bytes([b[0], b[1]]) as f64,
-        4 => u16::from_le_bytes([b[0], b[1]]) as f64,
-        5 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-        6 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-        7 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-        9 => f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
-        12 => i64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]) as f64,
-        _ => u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]) as f64,
+        1 => <i8 as Le>::from_le(b) as f64,
+        2 => <u8 as Le>::from_le(b) as f64,
+        3 => <i16 as Le>::from_le(b) as f64,
+        4 => <u16 as Le>::from_le(b) as f64,
+        5 => <i32 as Le>::from_le(b) as f64,
+        6 => <u32 as Le>::from_le(b) as f64,
+        7 => <f32 as Le>::from_le(b) as f64,
+        9 => <f64 as Le>::from_le(b),
+        12 => <i64 as Le>::from_le(b) as f64,
+        _ => <u64 as Le>::from_le(b) as f64,
     }
 }
 
