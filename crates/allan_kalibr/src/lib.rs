@@ -59,7 +59,42 @@ pub mod kalibr;
 pub mod run;
 pub mod yaml;
 
+pub use cli::{Args, TOOL};
 pub use error::Error;
-pub use front::{Common, CurvesInput, Input};
-pub use kalibr::estimator::Estimator;
-pub use run::{Analysis, Config, CurvesOutput, RunOutput, analyse, run, run_curves, run_on};
+pub use front::{
+    Common, CommonArgs, Input, Section, finish as finish_job, parse as parse_args, rate_for_text,
+};
+pub use ieee952::advisor::advise;
+pub use ieee952::ci::chi2_interval;
+pub use ieee952::curves_in::{
+    CurvesError, ImuUtilsRaw, Options as CurvesOptions, read as read_curves,
+};
+pub use ieee952::edf::greenhall_edf;
+pub use ieee952::files::{
+    COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_RESOLVED,
+    COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU,
+    CURVES_FILE, TERMS_FILE, write_outputs as write_ieee952_files,
+};
+pub use ieee952::fit::GM;
+pub use ieee952::imu::{
+    AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
+    summary_text as ieee952_summary_text,
+};
+pub use ieee952::lines::{resonance_avar, resonance_poles, sinusoid_avar};
+pub use ieee952::noise_id::{NoiseId, identify, identify_on};
+pub use ieee952::oadev::{second_diff_sum, second_diff_sums};
+pub use ieee952::plot::{find_truth, write_chart as write_ieee952_chart};
+pub use ieee952::psd::{BUMP_X, find_lines, welch};
+pub use ieee952::region::{B_FLOOR_FACTOR, Reading, ReadingKind};
+pub use ieee952::stated::section_text as ieee952_section_text;
+pub use ieee952::{
+    Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CurveData, CurvePoint,
+    FitConfig, GridSpec, IdMethod, Overlap, Phase, Term, Verdict, analyse as analyse_ieee952,
+    analyse_curve, short,
+};
+pub use input::{ImuData, load as load_input, snap_rate, value_problem};
+pub use kalibr::chart_fit::{ChartFit, gen_chart};
+pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
+pub use kalibr::grid::TauGrid;
+pub use kalibr::report::{chart_lines, final_lines};
+pub use run::{Analysis, Config, RunOutput, analyse, run, sections};
