@@ -38,7 +38,7 @@ pub struct AxisAllan {
     /// Allan variances (pseudo-(deg/h)² or (m/s²)²).
     pub variance: Vec<f64>,
     /// The IEEE 952 section's noise identification at each factor (empty unless asked for).
-    pub noise_ids: Vec<allan_kalibr::ieee952::noise_id::NoiseId>,
+    pub noise_ids: Vec<allan_kalibr::NoiseId>,
 }
 
 impl AxisAllan {
@@ -59,7 +59,7 @@ pub fn allan_step(
     max_cluster: usize,
     ieee: bool,
 ) -> Result<(Vec<AxisAllan>, [f64; 3]), Error> {
-    use allan_kalibr::ieee952::noise_id;
+    use allan_kalibr::identify_on;
     let n = c.len();
     let period = estimator::mean_period(&c.t);
     let freq = 1.0 / period;
@@ -85,9 +85,7 @@ pub fn allan_step(
         }
         let variance = estimator::allan_variance(&theta, &f, period);
         let noise_ids = if ieee {
-            f.par_iter()
-                .map(|&m| noise_id::identify_on(&theta, m))
-                .collect()
+            f.par_iter().map(|&m| identify_on(&theta, m)).collect()
         } else {
             Vec::new()
         };
@@ -144,11 +142,7 @@ impl Analysis {
     /// The analysis of curves read from an imu_utils data directory (imu_utils.md §5.2): the
     /// taus and deviations of its files (pseudo-deg/h for the gyro), the given fits, at the
     /// rate `freq`; sample-dependent fields (counts, stamps, gyro means) are unknown.
-    pub fn from_curves(
-        raw: &allan_kalibr::ieee952::curves_in::ImuUtilsRaw,
-        fits: Vec<AxisFit>,
-        freq: f64,
-    ) -> Analysis {
+    pub fn from_curves(raw: &allan_kalibr::ImuUtilsRaw, fits: Vec<AxisFit>, freq: f64) -> Analysis {
         let period = 1.0 / freq;
         let axis = |name: &'static str, t: &[f64], dev: &[f64]| AxisAllan {
             name,

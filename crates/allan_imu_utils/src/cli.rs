@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 
-use allan_kalibr::front::{Common, CommonArgs, Input};
+use allan_kalibr::{Common, CommonArgs, Input};
 
 use crate::error::Error;
 use crate::launch::{self, LaunchParams, LaunchValue};
@@ -130,8 +130,7 @@ impl TryFrom<Args> for Config {
         a.common
             .curve_flags_need_curves(&[])
             .map_err(Error::Config)?;
-        let text_rate =
-            allan_kalibr::front::rate_for_text(a.common.input.as_deref(), a.common.rate);
+        let text_rate = allan_kalibr::rate_for_text(a.common.input.as_deref(), a.common.rate);
         if let (Some(input), Some(rate), None) = (&a.common.input, a.common.rate, text_rate) {
             let kind = bag2mat::input_kind(input)
                 .map(|k| k.describe())

@@ -49,7 +49,7 @@ pub enum Error {
     },
     /// `--curves` input that cannot be read.
     #[error(transparent)]
-    Curves(#[from] allan_kalibr::ieee952::curves_in::CurvesError),
+    Curves(#[from] allan_kalibr::CurvesError),
     /// A roslaunch file could not be used.
     #[error("{path}: {what}")]
     Launch {

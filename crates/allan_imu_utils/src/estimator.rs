@@ -104,11 +104,10 @@ pub fn divisor(n: usize, m: usize, period: f64) -> f64 {
 }
 
 /// `Σ_k ((θ[k+2m] − 2θ[k+m]) + θ[k])²`, 0 when N − 2m ≤ 0: the workspace's overlapping
-/// kernel (`allan_kalibr::ieee952::oadev::second_diff_sum`), whose squared terms are
-/// upstream's bit for bit.
+/// kernel (`allan_kalibr::second_diff_sum`), whose squared terms are upstream's bit for bit.
 #[cfg(test)]
 pub fn second_diff_sum(theta: &[f64], m: usize) -> f64 {
-    allan_kalibr::ieee952::oadev::second_diff_sum(theta, m)
+    allan_kalibr::second_diff_sum(theta, m)
 }
 
 /// Factors per sweep of [`allan_variance`]: enough that the small ones share each tile of θ
@@ -118,15 +117,15 @@ const FACTORS_PER_SWEEP: usize = 8;
 
 /// Overlapping Allan variances of one axis for every factor, in factor order
 /// (`calcVariance`): groups of consecutive factors in parallel, each group in one
-/// cache-blocked sweep over θ (`allan_kalibr::ieee952::oadev::second_diff_sums`, the same
-/// sums as [`second_diff_sum`] bit for bit).
+/// cache-blocked sweep over θ (`allan_kalibr::second_diff_sums`, the same sums as
+/// [`second_diff_sum`] bit for bit).
 pub fn allan_variance(theta: &[f64], factors: &[usize], period: f64) -> Vec<f64> {
     let n = theta.len();
     factors
         .par_chunks(FACTORS_PER_SWEEP)
         .with_max_len(1)
         .flat_map_iter(|g| {
-            allan_kalibr::ieee952::oadev::second_diff_sums(theta, g)
+            allan_kalibr::second_diff_sums(theta, g)
                 .into_iter()
                 .zip(g)
                 .map(move |(s, &m)| s / divisor(n, m, period))

@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use allan_imu_utils::{Args, Config, TOOL};
-use allan_kalibr::front;
+use allan_kalibr::{finish_job, parse_args};
 
 /// Out of memory is reported as an error, not an abort.
 #[global_allocator]
@@ -12,11 +12,11 @@ static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOn
 
 fn main() -> ExitCode {
     bag2mat::shared::alloc::start_threads(TOOL);
-    let config = match front::parse::<Args, Config>(TOOL, |a| {
+    let config = match parse_args::<Args, Config>(TOOL, |a| {
         Config::try_from(a).map_err(|e| e.to_string())
     }) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    front::finish(TOOL, &config.common, || allan_imu_utils::sections(&config))
+    finish_job(TOOL, &config.common, || allan_imu_utils::sections(&config))
 }

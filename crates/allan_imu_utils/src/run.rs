@@ -7,8 +7,11 @@ use std::time::{Duration, Instant};
 use bag2mat::shared::note::Note;
 use rayon::prelude::*;
 
-use allan_kalibr::ieee952::imu::{self, ImuAnalysis, Sensor};
-use allan_kalibr::ieee952::{CurveData, CurvePoint, Overlap, curves_in, files};
+use allan_kalibr::{
+    CurveData, CurvePoint, ImuAnalysis, Overlap, analyse_imu_curves, ieee952_summary_text,
+    read_curves, write_ieee952_files,
+};
+use bag2mat::Sensor;
 
 use crate::analysis::{self, Analysis, AxisAllan};
 use crate::cli::Config;
@@ -67,7 +70,7 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool, tau0: f64) -> CurveData {
                 tau: m as f64 * tau0,
                 avar: v * scale,
                 id: id.and_then(|x| x.alpha),
-                id_method: id.map_or(allan_kalibr::ieee952::IdMethod::None, |x| x.method),
+                id_method: id.map_or(allan_kalibr::IdMethod::None, |x| x.method),
             }
         })
         .collect();
@@ -135,11 +138,11 @@ pub struct CurvesOutcome {
 }
 
 /// The whole job as the binary says it: [`run`] or [`run_curves`], each result an
-/// [`allan_kalibr::front::Section`].
-pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::front::Section>, Error> {
+/// [`allan_kalibr::Section`].
+pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::Section>, Error> {
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
         let o = run_curves(config)?;
-        return Ok(vec![allan_kalibr::front::Section {
+        return Ok(vec![allan_kalibr::Section {
             notes: o.notes,
             text: o.stdout + &o.ieee952_text,
             written: o.files,
@@ -148,7 +151,7 @@ pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::front::Section>, Er
     }
     Ok(run(config)?
         .into_iter()
-        .map(|o| allan_kalibr::front::Section {
+        .map(|o| allan_kalibr::Section {
             topic: Some(o.topic),
             notes: o.notes,
             findings: o.findings,
@@ -239,9 +242,9 @@ fn run_series(
     let t2 = Instant::now();
     let files = write_outputs(&analysis, ieee.as_ref(), config, &topic)?;
     timings.push(("write_outputs", t2.elapsed()));
-    let ieee952_text = ieee.as_ref().map(|a| {
-        allan_kalibr::ieee952::stated::section_text(a, config.common.samples_path(), &topic)
-    });
+    let ieee952_text = ieee
+        .as_ref()
+        .map(|a| allan_kalibr::ieee952_section_text(a, config.common.samples_path(), &topic));
     Ok(Outcome {
         topic,
         stdout: report::stdout_text(&analysis),
@@ -326,7 +329,7 @@ fn ieee952_section(
 ) -> Option<ImuAnalysis> {
     let section_rate = check
         .rate
-        .map(allan_kalibr::input::snap_rate)
+        .map(allan_kalibr::snap_rate)
         .unwrap_or(axes[0].freq);
     if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
         notes.push(Note::warning(format!(
@@ -347,7 +350,7 @@ fn ieee952_section(
     }
 }
 
-/// The value check of every analysed column (`allan_kalibr::input::value_problem`): a
+/// The value check of every analysed column (`allan_kalibr::value_problem`): a
 /// column no analysis can use is an error, an odd one a warning.
 fn check_values(
     collected: &collect::Collected,
@@ -363,7 +366,7 @@ fn check_values(
             } else {
                 collected.acc_m_s2(k - 3)
             };
-            allan_kalibr::input::value_problem(collect::FIELDS[k], col)
+            allan_kalibr::value_problem(collect::FIELDS[k], col)
         })
         .collect();
     for problem in problems {
@@ -409,10 +412,10 @@ fn section(
             )
         })
         .collect();
-    let mut an = imu::analyse_curves(
+    let mut an = analyse_imu_curves(
         &sensors,
         section_rate,
-        &allan_kalibr::ieee952::Config::default(),
+        &allan_kalibr::Ieee952Config::default(),
     );
     an.checks = findings.to_vec();
     an
@@ -448,10 +451,10 @@ fn write_outputs(
 /// The section's files (prefixed `<name>_`) and chart.
 fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = files::write_outputs(an, &config.common.out_dir, &prefix, rostopic)?;
+    let mut out = write_ieee952_files(an, &config.common.out_dir, &prefix, rostopic)?;
     if config.plots {
-        let truth = allan_kalibr::ieee952::plot::find_truth(config.common.samples_path(), an);
-        out.extend(allan_kalibr::ieee952::plot::write_chart(
+        let truth = allan_kalibr::find_truth(config.common.samples_path(), an);
+        out.extend(allan_kalibr::write_ieee952_chart(
             an,
             &config.name,
             truth.as_ref(),
@@ -469,7 +472,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let allan_kalibr::Input::Curves(input) = &config.common.input else {
         return Err(Error::Config("no --curves given".into()));
     };
-    let c = curves_in::read(&input.paths, &input.options)?;
+    let c = read_curves(&input.paths, &input.options)?;
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
@@ -504,14 +507,14 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
         .iter()
         .map(|s| (s.sensor, s.axes.clone()))
         .collect();
-    let mut an = imu::analyse_curves(&sensors, c.rate, &allan_kalibr::ieee952::Config::default());
+    let mut an = analyse_imu_curves(&sensors, c.rate, &allan_kalibr::Ieee952Config::default());
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let rostopic = config.common.named_topic();
     files.extend(write_ieee952(&an, config, rostopic)?);
     Ok(CurvesOutcome {
         stdout,
-        ieee952_text: imu::summary_text(&an),
+        ieee952_text: ieee952_summary_text(&an),
         notes,
         files,
         analysis,

@@ -3,7 +3,7 @@
 //! `cargo run --release -p allan_kalibr --example bench_oadev -- FILE.mat RATE`
 use std::time::Instant;
 
-use allan_kalibr::ieee952::{GridSpec, Phase};
+use allan_kalibr::{GridSpec, Phase};
 use rayon::prelude::*;
 
 fn cpu_seconds() -> f64 {
@@ -29,8 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let n: usize = d.columns[1..]
             .par_iter()
             .map(|y| {
-                allan_kalibr::ieee952::psd::welch(y, 200.0)
-                    .map_or(0, |p| allan_kalibr::ieee952::psd::find_lines(&p).len())
+                allan_kalibr::welch(y, 200.0).map_or(0, |p| allan_kalibr::find_lines(&p).len())
             })
             .sum();
         eprintln!(
@@ -72,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .par_iter()
                 .map(|p| {
                     ms.iter()
-                        .map(|&m| allan_kalibr::ieee952::oadev::second_diff_sum(p.x(), m))
+                        .map(|&m| allan_kalibr::second_diff_sum(p.x(), m))
                         .sum()
                 })
                 .collect()
@@ -96,7 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 #[allow(dead_code)]
 fn l1_kernel() {
-    use allan_kalibr::ieee952::oadev::second_diff_sum;
+    use allan_kalibr::second_diff_sum;
     let x: Vec<f64> = (0..1200).map(|i| (i as f64 * 0.37).sin()).collect();
     let t = Instant::now();
     let mut s = 0.0;

@@ -2,8 +2,7 @@
 //! `cargo run --release -p allan_kalibr --example profile_fast -- FILE.mat RATE`
 use std::time::Instant;
 
-use allan_kalibr::kalibr::estimator::{prefix_in_place, sig2_prefix_fused, sig2_tiled};
-use allan_kalibr::kalibr::grid::TauGrid;
+use allan_kalibr::{TauGrid, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();

@@ -359,8 +359,8 @@ pub const RATE_ROUND_REL: f64 = 1e-6;
 /// Decimals of the round rates [`snap_rate`] snaps to within [`RATE_ROUND_REL`].
 pub const RATE_ROUND_DECIMALS: i32 = 3;
 
-/// A rate from the stamps within [`RATE_SNAP_REL`] of an integer is that integer; else one
-/// within [`RATE_ROUND_REL`] of a rate with few decimals is that rate.
+/// A rate from the stamps within `RATE_SNAP_REL` of an integer is that integer; else one
+/// within `RATE_ROUND_REL` of a rate with few decimals is that rate.
 pub fn snap_rate(m: f64) -> f64 {
     let r = m.round();
     if r >= 1.0 && ((m - r) / r).abs() <= RATE_SNAP_REL {

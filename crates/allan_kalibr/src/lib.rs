@@ -3,33 +3,40 @@
 //! Reproduces the MATLAB half of rpng/kalibr_allan (`9d38ea9`: `SCRIPT_allan_matparallel.m`,
 //! `allan.m`, `SCRIPT_process_results.m`, `gen_chart.m`) in seconds instead of hours, and adds
 //! what users ask for: Kalibr's `imu.yaml`, the curves as CSV, readable plots, and an IEEE
-//! Std 952 analysis with intervals and verdicts ([`ieee952`]).
+//! Std 952 analysis with intervals and verdicts (`ieee952`).
 //! The behaviour contract is `shared/specs/kalibr_allan.md`.
 //!
 //! ## Brief overview
-//! The crate holds two analyses in two module trees, [`kalibr`] and [`ieee952`], no module
-//! name shared between them:
-//! * [`kalibr`]: the kalibr_allan reproduction: [`kalibr::grid`], the 2000-point τ grid
-//!   exactly as upstream builds it; [`kalibr::estimator`], the non-overlapping `sig2` per
-//!   axis (prefix-sum fast path, bit-exact replay of upstream's recursion, slow oracle);
-//!   [`kalibr::chart_fit`], gen_chart's fixed-slope fits and read-offs; [`kalibr::report`],
-//!   the exact printed text; [`kalibr::curves`], the CSV; [`kalibr::chart`], the two charts.
-//! * [`yaml`]: Kalibr imu.yaml and the YAML spelling both halves write.
-//! * [`input`]: `.mat`/`.bag` loading and the update-rate check; [`run`](mod@run): the whole
-//!   job.
-//! * [`ieee952`]: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
-//!   run after their upstream-compatible output, unless `--compat-only`: overlapping Allan
-//!   deviation with Greenhall-EDF intervals ([`ieee952::oadev`], [`ieee952::edf`],
-//!   [`ieee952::ci`], [`ieee952::noise_id`]); the 5-term model (plus a Gauss–Markov bump and
-//!   a flicker floor's corner) fitted by GLS under the points' covariance
-//!   ([`ieee952::avar_cov`]) with a model-discrepancy component, on the τ range the model
-//!   can describe ([`ieee952::fit`]); per-axis verdicts and per-term 95 % intervals, the IEEE
-//!   952 region readings as cross-check and fallback ([`ieee952::region`]); record-length
-//!   advice ([`ieee952::advisor`]); the record check's findings named in the verdicts
+//! The crate holds two analyses in two private module trees, `kalibr` and `ieee952`, no
+//! module name shared between them; callers reach both through the flat names below.
+//! * `kalibr`: the kalibr_allan reproduction: `kalibr::grid`, the 2000-point τ grid
+//!   exactly as upstream builds it ([`TauGrid`]); `kalibr::estimator`, the non-overlapping
+//!   `sig2` per axis (prefix-sum fast path, bit-exact replay of upstream's recursion, slow
+//!   oracle: [`Estimator`]); `kalibr::chart_fit`, gen_chart's fixed-slope fits and read-offs
+//!   ([`gen_chart`], [`ChartFit`]); `kalibr::report`, the exact printed text
+//!   ([`chart_lines`], [`final_lines`]); `kalibr::curves`, the CSV; `kalibr::chart`, the two
+//!   charts.
+//! * `yaml`: Kalibr imu.yaml and the YAML spelling both halves write.
+//! * `input`: `.mat`/`.bag` loading and the update-rate check ([`load_input`],
+//!   [`snap_rate`]); `run`: the whole job ([`run()`], [`Config`]).
+//! * `ieee952`: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
+//!   run after their upstream-compatible output, unless `--compat-only`
+//!   ([`analyse_ieee952`], [`analyse_curve`], [`Ieee952Config`]): overlapping Allan
+//!   deviation with Greenhall-EDF intervals (`ieee952::oadev`, `ieee952::edf`,
+//!   `ieee952::ci`, `ieee952::noise_id`: [`Phase`], [`greenhall_edf`], [`chi2_interval`],
+//!   [`identify`]); the 5-term model (plus a Gauss–Markov bump and a flicker floor's corner)
+//!   fitted by GLS under the points' covariance (`ieee952::avar_cov`) with a
+//!   model-discrepancy component, on the τ range the model can describe (`ieee952::fit`,
+//!   [`FitConfig`]); per-axis verdicts and per-term 95 % intervals ([`AxisVerdict`],
+//!   [`Verdict`]), the IEEE 952 region readings as cross-check and fallback
+//!   (`ieee952::region`, [`Reading`]); record-length advice (`ieee952::advisor`,
+//!   [`advise`]); the record check's findings named in the verdicts
 //!   (`bag2mat::record_check`: clocks, gaps, outliers, warm-up, motion);
-//!   other tools' Allan curves (`--curves`, [`ieee952::curves_in`]); the section's text
-//!   ([`ieee952::imu`]), its files (terms and curves CSV, Kalibr/VINS/ORB-SLAM3 yaml, with
-//!   named columns `sim compare` reads: [`ieee952::files`]) and chart ([`ieee952::plot`]).
+//!   other tools' Allan curves (`--curves`, `ieee952::curves_in`: [`read_curves`]); the
+//!   section's text (`ieee952::imu`: [`ieee952_summary_text`]), its files (terms and curves
+//!   CSV, Kalibr/VINS/ORB-SLAM3 yaml, with named columns `sim compare` reads:
+//!   `ieee952::files`, [`write_ieee952_files`], [`TERMS_FILE`], [`CURVES_FILE`]) and chart
+//!   (`ieee952::plot`: [`write_ieee952_chart`]).
 //!
 //! ## Units and conventions
 //! Accelerometer in m/s², gyroscope in rad/s, as in the bag. The four numbers are
@@ -50,16 +57,51 @@
 //! * The update rate drives the grid; timestamps are only counted (they are checked here
 //!   and a warning printed, which upstream never does).
 
-pub mod cli;
-pub mod error;
-pub mod front;
-pub mod ieee952;
-pub mod input;
-pub mod kalibr;
-pub mod run;
-pub mod yaml;
+mod cli;
+mod error;
+mod front;
+mod ieee952;
+mod input;
+mod kalibr;
+mod run;
+mod yaml;
 
+pub use cli::{Args, TOOL};
 pub use error::Error;
-pub use front::{Common, CurvesInput, Input};
-pub use kalibr::estimator::Estimator;
-pub use run::{Analysis, Config, CurvesOutput, RunOutput, analyse, run, run_curves, run_on};
+pub use front::{
+    Common, CommonArgs, Input, Section, finish as finish_job, parse as parse_args, rate_for_text,
+};
+pub use ieee952::advisor::advise;
+pub use ieee952::ci::chi2_interval;
+pub use ieee952::curves_in::{
+    CurvesError, ImuUtilsRaw, Options as CurvesOptions, read as read_curves,
+};
+pub use ieee952::edf::greenhall_edf;
+pub use ieee952::files::{
+    COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_RESOLVED,
+    COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU,
+    CURVES_FILE, TERMS_FILE, write_outputs as write_ieee952_files,
+};
+pub use ieee952::fit::GM;
+pub use ieee952::imu::{
+    AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
+    summary_text as ieee952_summary_text,
+};
+pub use ieee952::lines::{resonance_avar, resonance_poles, sinusoid_avar};
+pub use ieee952::noise_id::{NoiseId, identify, identify_on};
+pub use ieee952::oadev::{second_diff_sum, second_diff_sums};
+pub use ieee952::plot::{find_truth, write_chart as write_ieee952_chart};
+pub use ieee952::psd::{BUMP_X, find_lines, welch};
+pub use ieee952::region::{B_FLOOR_FACTOR, Reading, ReadingKind};
+pub use ieee952::stated::section_text as ieee952_section_text;
+pub use ieee952::{
+    Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CurveData, CurvePoint,
+    FitConfig, GridSpec, IdMethod, Overlap, Phase, Term, Verdict, analyse as analyse_ieee952,
+    analyse_curve, short,
+};
+pub use input::{ImuData, load as load_input, snap_rate, value_problem};
+pub use kalibr::chart_fit::{ChartFit, gen_chart};
+pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
+pub use kalibr::grid::TauGrid;
+pub use kalibr::report::{chart_lines, final_lines};
+pub use run::{Analysis, Config, RunOutput, analyse, run, sections};

@@ -3,8 +3,7 @@
 
 use std::process::ExitCode;
 
-use allan_kalibr::cli::{Args, TOOL};
-use allan_kalibr::{Config, front};
+use allan_kalibr::{Args, Config, TOOL, finish_job, parse_args, sections};
 
 /// Out of memory is reported as an error, not an abort.
 #[global_allocator]
@@ -12,11 +11,9 @@ static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOn
 
 fn main() -> ExitCode {
     bag2mat::shared::alloc::start_threads(TOOL);
-    let config = match front::parse::<Args, Config>(TOOL, Config::try_from) {
+    let config = match parse_args::<Args, Config>(TOOL, Config::try_from) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    front::finish(TOOL, &config.common, || {
-        allan_kalibr::run::sections(&config)
-    })
+    finish_job(TOOL, &config.common, || sections(&config))
 }

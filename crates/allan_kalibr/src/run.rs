@@ -132,7 +132,7 @@ impl std::fmt::Display for Timings {
     }
 }
 
-/// The whole job as the binary says it: [`run`] or [`run_curves`], each result a
+/// The whole job as the binary says it: [`run`] or `run_curves`, each result a
 /// [`crate::front::Section`] (the topic, notes, findings, text, files and timings).
 pub fn sections(config: &Config) -> Result<Vec<crate::front::Section>, Error> {
     if let crate::front::Input::Curves(curves) = &config.common.input {
@@ -534,8 +534,6 @@ pub struct CurvesOutput {
     pub notes: Vec<Note>,
     /// Files written.
     pub written: Vec<PathBuf>,
-    /// The analysis.
-    pub analysis: crate::ieee952::imu::ImuAnalysis,
 }
 
 /// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat
@@ -580,7 +578,6 @@ pub fn run_curves(
         text: crate::ieee952::imu::summary_text(&an),
         notes: Vec::new(),
         written,
-        analysis: an,
     })
 }
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use allan_kalibr::input;
+use allan_kalibr::load_input;
 use bag2mat::mat::{DataImu, write_data_imu};
 
 use crate::common::{CASES, final_full, process_lines, rel_err};
@@ -161,7 +161,7 @@ fn bag_input_prints_upstream_text_and_writes_outputs() {
 #[test]
 fn mat_input_matches_bag_input() {
     let case = &CASES[2];
-    let d = input::load(&case.bag(), case.topic, true).unwrap();
+    let d = load_input(&case.bag(), case.topic, true).unwrap();
     let tmp = tempfile::tempdir().unwrap();
     let mat = tmp.path().join("p3.mat");
     let mut m = DataImu::with_capacity(d.len());

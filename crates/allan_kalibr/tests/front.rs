@@ -15,7 +15,7 @@ fn run(args: &[&Path]) -> Output {
 }
 
 fn config(args: &[&str]) -> allan_kalibr::Config {
-    let a = allan_kalibr::cli::Args::try_parse_from(
+    let a = allan_kalibr::Args::try_parse_from(
         std::iter::once("allan_kalibr").chain(args.iter().copied()),
     )
     .expect("parses");

@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use allan_kalibr::ieee952::files::{
+use allan_kalibr::{
     COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_SENSOR,
     COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE, TERMS_FILE,
 };

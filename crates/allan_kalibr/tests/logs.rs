@@ -45,7 +45,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
     );
     let analyse = |input: &std::path::Path, topic: &str, out: &str| {
         let out = dir.path().join(out);
-        let args = allan_kalibr::cli::Args::try_parse_from([
+        let args = allan_kalibr::Args::try_parse_from([
             "allan_kalibr",
             input.to_str().unwrap(),
             "--topic",
@@ -55,7 +55,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        let run = allan_kalibr::run::run(&args.try_into().unwrap())
+        let run = allan_kalibr::run(&args.try_into().unwrap())
             .unwrap()
             .remove(0);
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();

@@ -3,11 +3,9 @@
 //! or bit-identical (`--bit-exact`), NaN exactly where the reference has NaN, and the printed
 //! lines identical.
 
-use allan_kalibr::Estimator;
-use allan_kalibr::input::{self, ImuData};
-use allan_kalibr::kalibr::chart_fit::gen_chart;
-use allan_kalibr::kalibr::grid::TauGrid;
-use allan_kalibr::kalibr::report;
+use allan_kalibr::{
+    ChartFit, Estimator, ImuData, TauGrid, chart_lines, final_lines, gen_chart, load_input,
+};
 
 use crate::common::{CASES, Case, final_full, n_rows, process_lines, ref_curves, rel_err};
 
@@ -83,15 +81,11 @@ fn fit_on_reference_curves_matches_final_numbers_and_text() {
     }
 }
 
-fn check_text(
-    case: &Case,
-    acc: &allan_kalibr::kalibr::chart_fit::ChartFit,
-    gyr: &allan_kalibr::kalibr::chart_fit::ChartFit,
-) {
-    let mut lines: Vec<String> = report::chart_lines(acc).into();
-    lines.extend(report::chart_lines(gyr));
+fn check_text(case: &Case, acc: &ChartFit, gyr: &ChartFit) {
+    let mut lines: Vec<String> = chart_lines(acc).into();
+    lines.extend(chart_lines(gyr));
     assert_eq!(lines, process_lines(case), "{}: gen_chart lines", case.name);
-    let fin: Vec<String> = report::final_lines(acc, gyr).into();
+    let fin: Vec<String> = final_lines(acc, gyr).into();
     let expected: Vec<String> = case
         .kalibr("final.txt")
         .lines()
@@ -132,7 +126,7 @@ fn curve_errors(
 
 fn load(case: &Case) -> ImuData {
     let d =
-        input::load(&case.bag(), case.topic, true).unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        load_input(&case.bag(), case.topic, true).unwrap_or_else(|e| panic!("{}: {e}", case.name));
     assert_eq!(d.len(), n_rows(case), "{}: rows", case.name);
     d
 }

@@ -254,14 +254,14 @@ pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Inter
             .position(|h| *h == name)
             .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
     };
-    use allan_kalibr::ieee952::files as f;
+    use allan_kalibr::{COL_CI95_HI, COL_CI95_LO, COL_RESOLVED, COL_SENSOR, COL_TERM, COL_VALUE};
     let (cs, ct, cv, cl, ch, cr) = (
-        col(f::COL_SENSOR)?,
-        col(f::COL_TERM)?,
-        col(f::COL_VALUE)?,
-        col(f::COL_CI95_LO)?,
-        col(f::COL_CI95_HI)?,
-        col(f::COL_RESOLVED)?,
+        col(COL_SENSOR)?,
+        col(COL_TERM)?,
+        col(COL_VALUE)?,
+        col(COL_CI95_LO)?,
+        col(COL_CI95_HI)?,
+        col(COL_RESOLVED)?,
     );
     // Per (sensor, term): (value, lo, hi, resolved) of each axis.
     type AxisRows = Vec<(f64, f64, f64, bool)>;
@@ -324,10 +324,7 @@ pub fn compare(cfg: &CompareConfig) -> Result<Comparison> {
         let iu =
             read_imu_utils_yaml(&dir.join("imu_utils").join(format!("{name}_imu_param.yaml")))?;
         let ka = read_kalibr_yaml(&dir.join("kalibr").join("imu.yaml"))?;
-        let ie = read_ieee_terms(
-            &dir.join("kalibr")
-                .join(allan_kalibr::ieee952::files::TERMS_FILE),
-        )?;
+        let ie = read_ieee_terms(&dir.join("kalibr").join(allan_kalibr::TERMS_FILE))?;
         let t = truth_values(&cfg.root, p)?;
         for s in [Sensor::Gyro, Sensor::Acc] {
             for q in [Quantity::WhiteNoise, Quantity::RandomWalk] {

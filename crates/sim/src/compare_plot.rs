@@ -52,7 +52,7 @@ fn kalibr_curve(path: &Path, column: &str) -> Result<Vec<(f64, f64)>> {
 
 /// Mean over the three axes of the IEEE 952 overlapping deviation (`ieee952_curves.csv`).
 fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
-    use allan_kalibr::ieee952::files as f;
+    use allan_kalibr::{CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU};
     let text = read(path)?;
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
@@ -63,10 +63,10 @@ fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
             .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
     };
     let (ca, cm, ct, cd) = (
-        col(f::CURVE_AXIS)?,
-        col(f::CURVE_M)?,
-        col(f::CURVE_TAU)?,
-        col(f::CURVE_ADEV)?,
+        col(CURVE_AXIS)?,
+        col(CURVE_M)?,
+        col(CURVE_TAU)?,
+        col(CURVE_ADEV)?,
     );
     let mut by_m: std::collections::BTreeMap<u64, (f64, f64, usize)> = Default::default();
     for l in lines {
@@ -261,7 +261,7 @@ pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result
             curves.push(Curves {
                 preset: p.name(),
                 kalibr: kalibr_curve(&dir.join("allan_curves.csv"), column)?,
-                ieee: ieee_curve(&dir.join(allan_kalibr::ieee952::files::CURVES_FILE), axes)?,
+                ieee: ieee_curve(&dir.join(allan_kalibr::CURVES_FILE), axes)?,
                 truth: if sensor == "gyro" {
                     (t.gyro_noise, t.gyro_bias_rw)
                 } else {

@@ -408,7 +408,8 @@ impl CovBasis {
 }
 
 /// Cov(Â_i, Â_j) of two overlapping estimates by the term-by-term sum (the slow, obviously
-/// correct version the basis is checked against).
+/// correct version the basis is checked against; tests only).
+#[cfg(test)]
 pub fn avar_cov_pair_exact(
     mi: usize,
     mj: usize,

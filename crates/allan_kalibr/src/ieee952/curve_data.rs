@@ -57,7 +57,7 @@ impl CurveData {
         }
     }
 
-    /// The same curve with the PSD and the lines of its samples `y` ([`psd`]).
+    /// The same curve with the PSD and the lines of its samples `y` (`psd`).
     pub fn with_spectrum(mut self, y: &[f64]) -> Self {
         self.psd = psd::welch(y, 1.0 / self.tau0);
         self.lines = self.psd.as_ref().map(psd::find_lines).unwrap_or_default();

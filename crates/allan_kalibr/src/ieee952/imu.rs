@@ -114,7 +114,8 @@ pub fn analyse_curves(
     }
 }
 
-/// The part of [`analyse_imu`] that reads the samples: each axis' curve. What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
+/// The part of the analysis of six rate series that reads the samples: each axis' curve.
+/// What follows ([`ImuCurves::finish`]) needs only these, so a caller may hand
 /// the sample columns on (the compat path turns them into prefix sums in place) while the
 /// fits run.
 #[derive(Debug, Clone)]
@@ -173,7 +174,9 @@ impl ImuCurves {
         Ok(ImuCurves { rate, sensors })
     }
 
-    /// The fits and the advice; `checks` as in [`analyse_imu`].
+    /// The fits and the advice; `checks` are the record check's findings on the series
+    /// (`bag2mat::record_check`, which the caller has run to cut the record), named by the
+    /// section and the files.
     pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
         an.checks = checks;
@@ -181,41 +184,10 @@ impl ImuCurves {
     }
 }
 
-/// Analyses six rate series (gyro x y z in rad/s, then acc x y z in m/s²) at `rate` Hz;
-/// `checks` are the record check's findings on them (`bag2mat::record_check`, which the
-/// caller has run to cut the record), named by the section and the files.
-pub fn analyse_imu(
-    series: [&[f64]; 6],
-    rate: f64,
-    checks: Vec<Finding>,
-    cfg: &Config,
-) -> Result<ImuAnalysis, Ieee952Error> {
-    Ok(ImuCurves::from_samples(series, rate, cfg)?.finish(checks, cfg))
-}
-
-/// [`analyse_imu`] with the default settings, as both binaries run it beside their compat
-/// output: data the analysis cannot use (too short, non-finite) only cost the section, and
-/// the reason is added to `notes`.
-pub fn analyse_section(
-    series: [&[f64]; 6],
-    rate: f64,
-    checks: Vec<Finding>,
-    notes: &mut Vec<bag2mat::shared::note::Note>,
-) -> Option<ImuAnalysis> {
-    section_curves(series, rate, notes).map(|c| c.finish(checks, &Config::default()))
-}
-
-/// The sample-reading part of [`analyse_section`] ([`ImuCurves::from_samples`] with the
-/// default settings; the reason it cannot run goes into `notes`).
-pub fn section_curves(
-    series: [&[f64]; 6],
-    rate: f64,
-    notes: &mut Vec<bag2mat::shared::note::Note>,
-) -> Option<ImuCurves> {
-    section_curves_of(series, None, rate, notes)
-}
-
-/// [`section_curves`] without the `absent` sensor (a one-sensor topic).
+/// The sample-reading part of the section both binaries print beside their compat output
+/// ([`ImuCurves::from_samples_of`] with the default settings, without the `absent` sensor of
+/// a one-sensor topic): data the analysis cannot use (too short, non-finite) only cost the
+/// section, and the reason is added to `notes`.
 pub(crate) fn section_curves_of(
     series: [&[f64]; 6],
     absent: Option<Sensor>,

@@ -43,7 +43,7 @@
 //! Allan variance) — a bias instability only where there is a floor, not at the V where the
 //! white-noise and random-walk lines cross, and only where that floor is the curve's own
 //! lowest point within [`B_FLOOR_TOL`]. Where the data leave the flicker
-//! floor's shape open (a flat floor or one with a lower corner, [`fit::flicker_band`]), each
+//! floor's shape open (a flat floor or one with a lower corner, [`model::flicker_band`]), each
 //! interval spans every plausible shape ([`fit::FitResult::alternatives`]). A fit whose
 //! model misses the curve beyond its statistics by more than [`APPROX_DELTA`], or whose
 //! χ²/dof exceeds [`APPROX_CHI2`], is declared "approximately" (its terms lean on the
@@ -80,26 +80,26 @@
 //! at 4 h (N/K = 300 s) that is 20 %: about a third of all axes land outside ±20 % whatever the
 //! method. The fit here reaches the bound within sampling error in the accuracy study.
 
-pub mod advisor;
-pub mod avar_cov;
-pub mod ci;
-pub mod curves_in;
-pub mod edf;
-pub mod files;
-pub mod fit;
-pub mod imu;
-pub mod input_error;
-pub mod lines;
-pub(crate) mod model;
-pub mod noise_id;
-pub mod oadev;
-pub mod plot;
-pub mod psd;
-pub mod psd_plot;
-pub mod region;
-pub mod stated;
-pub mod tau_grid;
-pub mod vio_files;
+pub(crate) mod advisor;
+mod avar_cov;
+pub(crate) mod ci;
+pub(crate) mod curves_in;
+pub(crate) mod edf;
+pub(crate) mod files;
+pub(crate) mod fit;
+pub(crate) mod imu;
+mod input_error;
+pub(crate) mod lines;
+mod model;
+pub(crate) mod noise_id;
+pub(crate) mod oadev;
+pub(crate) mod plot;
+pub(crate) mod psd;
+mod psd_plot;
+pub(crate) mod region;
+pub(crate) mod stated;
+mod tau_grid;
+mod vio_files;
 
 mod chart_panels;
 mod config_values;

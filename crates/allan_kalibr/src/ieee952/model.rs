@@ -285,8 +285,3 @@ const SLOPE_STEP: f64 = 1.1;
 pub(in crate::ieee952) fn is_positive(v: f64) -> bool {
     v > 0.0
 }
-
-/// Index into an EDF table row for α ∈ 2..=−2.
-pub fn alpha_index(alpha: i32) -> usize {
-    (2 - alpha.clamp(-2, 2)) as usize
-}

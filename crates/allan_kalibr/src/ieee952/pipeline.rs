@@ -110,10 +110,6 @@ fn fit_data<'a>(
                 }
             })
             .collect(),
-        curve_index: fit_ms
-            .iter()
-            .map(|&m| data.points.iter().position(|p| p.m == m).unwrap_or(0))
-            .collect(),
         basis,
         basis_index: fit_ms
             .iter()

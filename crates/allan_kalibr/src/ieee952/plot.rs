@@ -76,7 +76,7 @@ pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
 
 /// Draws the chart into `<dir>/<prefix>ieee952_allan.{png,svg}` (the workspace's PNG+SVG
 /// writer) and, where the analysis has PSDs, the PSD chart beside it
-/// ([`super::psd_plot`]), the two rendered in parallel; returns the paths.
+/// (`psd_plot`), the two rendered in parallel; returns the paths.
 pub fn write_chart(
     a: &ImuAnalysis,
     title: &str,

@@ -167,8 +167,8 @@ pub(crate) fn model_psd(
     s
 }
 
-/// Welch PSD of `y` at `rate` Hz; `None` for a record too short for [`MIN_SEGMENTS`]
-/// segments of [`MIN_SEGMENT`] samples.
+/// Welch PSD of `y` at `rate` Hz; `None` for a record too short for `MIN_SEGMENTS`
+/// segments of `MIN_SEGMENT` samples.
 pub fn welch(y: &[f64], rate: f64) -> Option<Psd> {
     let n = y.len();
     let mut seg = SEGMENT;
@@ -350,8 +350,8 @@ fn line_threshold(p: &Psd) -> f64 {
     chi2_ratio_quantile(nu, 1.0 - per_bin).max(LINE_MIN_RATIO)
 }
 
-/// Lines of a PSD (module docs), strongest first by [`Line::allan_ratio`]: each run of
-/// line bins ([`floor`]) is one line, at the centroid of its excess over the floor, with
+/// Lines of a PSD (module docs), strongest first by `Line::allan_ratio`: each run of
+/// line bins (`floor`) is one line, at the centroid of its excess over the floor, with
 /// the excess summed as its power; a peak wider than the window's own is a resonance, its
 /// shape fitted (first width from the power over the peak height, a Lorentzian's
 /// ∫ = S_peak·πB/2).

@@ -61,7 +61,7 @@ pub enum Verdict {
     /// Significant, but the curve never shows it on its own: its line never comes within
     /// 20 % of the curve in the fitted range (e.g. a bias instability under the V of the
     /// white-noise and random-walk lines), or, for B, the curve's lowest point is not at
-    /// 0.664·B within [`B_FLOOR_TOL`]. Its value leans on the model.
+    /// 0.664·B within `B_FLOOR_TOL`. Its value leans on the model.
     NeverDominant,
     /// No reliable fit: the value is the IEEE 952 region reading, with its own interval.
     RegionReading,
@@ -84,7 +84,7 @@ pub struct Term {
     pub std_err: f64,
     /// Lower end of the interval at `Config::term_confidence`, in the term's unit: the
     /// square root of the coefficient interval {c ≥ 0 : |ĉ − c| ≤ z·se(c)}
-    /// ([`fit::inverted_interval`]). NaN without a sample count.
+    /// (`fit::inverted_interval`). NaN without a sample count.
     pub lo: f64,
     /// Upper end of the interval.
     pub hi: f64,
@@ -181,7 +181,7 @@ impl Terms {
 #[derive(Clone, Debug, PartialEq)]
 pub enum AxisVerdict {
     /// The model describes the curve over `range` (τ of the first and last fit point, s):
-    /// every curve point there is within [`FIT_TOL`] or its own 95 % band of the model.
+    /// every curve point there is within `FIT_TOL` or its own 95 % band of the model.
     Fits {
         /// Declared range, s.
         range: (f64, f64),
@@ -197,7 +197,7 @@ pub enum AxisVerdict {
         /// bump, a dip, a turn-down).
         long_cut: bool,
         /// The model misses the curve beyond its statistics by this relative discrepancy δ
-        /// (when above [`APPROX_DELTA`]: within [`FIT_TOL`] but the terms are approximate).
+        /// (when above `APPROX_DELTA`: within `FIT_TOL` but the terms are approximate).
         approximate: Option<f64>,
     },
     /// No reliable fit; the terms are the IEEE 952 region readings.

@@ -8,7 +8,7 @@ use std::path::Path;
 use super::imu::{ImuAnalysis, Sensor, SensorValue};
 
 /// The IEEE 952 section as both analysers print it: the summary, then the figures the
-/// input's `sensor.yaml` states for `topic` beside ours ([`beside_ours`]).
+/// input's `sensor.yaml` states for `topic` beside ours (`beside_ours`).
 pub fn section_text(a: &ImuAnalysis, input: &Path, topic: &str) -> String {
     super::imu::summary_text(a) + &beside_ours(a, input, topic)
 }

@@ -20,18 +20,7 @@ pub(crate) fn csv_float(x: f64) -> String {
     }
 }
 
-/// Writes the CSV.
-pub fn write_csv(
-    w: &mut dyn Write,
-    tau1: &[f64],
-    sig2: &[Vec<f64>; 6],
-    acc_avg: &[f64],
-    gyro_avg: &[f64],
-) -> std::io::Result<()> {
-    write_csv_of(w, tau1, sig2, acc_avg, gyro_avg, None)
-}
-
-/// [`write_csv`] for a topic that may lack a sensor: that sensor's three columns and its
+/// Writes the CSV for a topic that may lack a sensor: that sensor's three columns and its
 /// average are left out (the others keep their names, so readers by name still work).
 pub(crate) fn write_csv_of(
     w: &mut dyn Write,

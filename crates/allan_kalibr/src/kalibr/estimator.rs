@@ -9,7 +9,7 @@
 //!   own running-mean rounding, spec §2, which can reach ~1e-7 on low-noise axes).
 //! * [`Estimator::BitExact`]: replays upstream's recursive running mean, O(n) per m, so the
 //!   curves are bit-identical to the reference.
-//! * [`sig2_oracle`]: the textbook definition (each block summed directly), for tests.
+//! * `sig2_oracle`: the textbook definition (each block summed directly), for tests.
 
 use std::hint::black_box;
 
@@ -141,7 +141,8 @@ impl KahanPrefix {
 /// Samples per plain-summed chunk of [`KahanPrefix::extend`].
 const PREFIX_CHUNK: usize = 64;
 
-/// Prefix sums with `P[0] = 0` (length n + 1), for [`sig2_from_prefix`].
+/// Prefix sums with `P[0] = 0` (length n + 1), for `sig2_from_prefix` (tests only).
+#[cfg(test)]
 pub fn compensated_prefix(x: &[f64]) -> Vec<f64> {
     let mut p = Vec::with_capacity(x.len() + 1);
     p.push(0.0);
@@ -150,8 +151,9 @@ pub fn compensated_prefix(x: &[f64]) -> Vec<f64> {
     p
 }
 
-/// `sig2` for cluster size `m ≥ 1` from [`compensated_prefix`] output (length n + 1); one m
-/// at a time (the reference for [`sig2_tiled`]).
+/// `sig2` for cluster size `m ≥ 1` from `compensated_prefix` output (length n + 1); one m
+/// at a time (the reference for [`sig2_tiled`]; tests only).
+#[cfg(test)]
 pub fn sig2_from_prefix(prefix: &[f64], m: usize) -> f64 {
     let n = prefix.len() - 1;
     if m == 0 || m > n {
@@ -185,7 +187,7 @@ pub fn sig2_prefix_fused(x: &mut [f64], ms: &[u64]) -> Vec<f64> {
 /// Cache-blocked: the prefix array is walked tile by tile and every m takes its cluster
 /// boundaries (multiples of m) inside the tile, so each tile comes from memory once instead
 /// of once per m. Squared differences of block sums are accumulated and divided by m² at the
-/// end. Matches [`sig2_from_prefix`] to rounding.
+/// end. Matches `sig2_from_prefix` to rounding.
 pub fn sig2_tiled(p: &mut [f64], ms: &[u64]) -> Vec<f64> {
     walk_tiles(p, ms, |_| {})
 }
@@ -334,6 +336,7 @@ pub(crate) fn sig2_recursive(x: &[f64], m: usize) -> f64 {
 
 /// The slow, obviously-correct `sig2`: sum each of the K blocks directly, take the mean,
 /// average the squared differences of consecutive means. O(n) per m; tests only.
+#[cfg(test)]
 pub fn sig2_oracle(x: &[f64], m: usize) -> f64 {
     if m == 0 || m > x.len() {
         return f64::NAN;

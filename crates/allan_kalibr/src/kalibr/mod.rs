@@ -11,9 +11,9 @@
 //! Kalibr's `imu.yaml` ([`crate::yaml`]) is written from these numbers too, but its YAML
 //! spelling is shared with the IEEE 952 files and lives at the crate root.
 
-pub mod chart;
-pub mod chart_fit;
-pub mod curves;
-pub mod estimator;
-pub mod grid;
-pub mod report;
+pub(crate) mod chart;
+pub(crate) mod chart_fit;
+pub(crate) mod curves;
+pub(crate) mod estimator;
+pub(crate) mod grid;
+pub(crate) mod report;

@@ -63,13 +63,9 @@ pub fn final_lines(accel: &ChartFit, gyro: &ChartFit) -> [String; 4] {
     ]
 }
 
-/// The whole printed text of SCRIPT_process_results.m (interpreter warnings excluded).
-pub fn full_text(accel: &ChartFit, gyro: &ChartFit) -> String {
-    full_text_of(accel, gyro, None)
-}
-
-/// [`full_text`] for a topic that may lack a sensor: the absent sensor's chart and final
-/// lines are replaced by one line saying it is absent (no figures for it).
+/// The whole printed text of SCRIPT_process_results.m (interpreter warnings excluded), for a
+/// topic that may lack a sensor: the absent sensor's chart and final lines are replaced by
+/// one line saying it is absent (no figures for it).
 pub(crate) fn full_text_of(
     accel: &ChartFit,
     gyro: &ChartFit,

@@ -7,8 +7,7 @@
 //! `cargo test --release -p allan_kalibr --test main accuracy_full -- --ignored --nocapture`),
 //! a short variant runs always.
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::{Config, Verdict, analyse};
+use allan_kalibr::{Ieee952Analysis, Ieee952Config, Verdict, advise, analyse_ieee952};
 use rayon::prelude::*;
 
 /// Base of every simulation seed (preset p, seed s, axis a use BASE_SEED + 1000·s + 10·p + a,
@@ -84,7 +83,7 @@ pub(super) fn study(
     duration: f64,
     presets: &[Preset],
     seeds: &[u64],
-    cfg: &Config,
+    cfg: &Ieee952Config,
 ) -> Vec<Case> {
     let dt = 1.0 / rate;
     let len = (duration * rate).round() as usize;
@@ -111,7 +110,7 @@ pub(super) fn study(
                         len,
                         BASE_SEED + 1000 * s + 10 * pi as u64 + a as u64,
                     );
-                    let r = analyse(&y, dt, cfg).expect("simulated series must analyse");
+                    let r = analyse_ieee952(&y, dt, cfg).expect("simulated series must analyse");
                     let (tn, tk) = (r.terms.n, r.terms.k);
                     Case {
                         preset: p.name,
@@ -223,7 +222,7 @@ fn accuracy_full() {
         4.0 * 3600.0,
         &presets(),
         &[1, 2, 3],
-        &Config::default(),
+        &Ieee952Config::default(),
     );
     println!(
         "full study: {} series in {:.1} s",
@@ -246,12 +245,12 @@ pub(super) fn k_rel_bound(n: f64, k: f64, t: f64) -> f64 {
 #[test]
 #[ignore = "method comparison on 20 Hz data (K statistics do not depend on the rate); --ignored --nocapture"]
 fn accuracy_methods() {
-    use allan_kalibr::ieee952::FitConfig;
+    use allan_kalibr::FitConfig;
     let seeds: Vec<u64> = (1..=8).collect();
     let presets = [presets()[1]];
-    let base = Config::default();
-    let with = |f: FitConfig| Config { fit: f, ..base };
-    let variants: [(&str, Config); 5] = [
+    let base = Ieee952Config::default();
+    let with = |f: FitConfig| Ieee952Config { fit: f, ..base };
+    let variants: [(&str, Ieee952Config); 5] = [
         ("default (discrepancy, trim, band limit, selection)", base),
         (
             "plain GLS (no discrepancy)",
@@ -408,7 +407,13 @@ fn accuracy_short() {
     // CI variant: 4 h at 20 Hz (the K statistics depend on the record length, not the rate),
     // medium preset, one seed: 6 series of 288 000 samples.
     let duration = 4.0 * 3600.0;
-    let cases = study(20.0, duration, &presets()[1..2], &[1], &Config::default());
+    let cases = study(
+        20.0,
+        duration,
+        &presets()[1..2],
+        &[1],
+        &Ieee952Config::default(),
+    );
     print_table(&cases);
     print_summary(&cases);
     // Six cases say nothing about a 95 % coverage (all six are covered only 74 % of the time
@@ -424,7 +429,13 @@ fn accuracy_coverage() {
     let duration = 4.0 * 3600.0;
     let seeds: Vec<u64> = (11..=20).collect();
     let t0 = std::time::Instant::now();
-    let cases = study(20.0, duration, &presets(), &seeds, &Config::default());
+    let cases = study(
+        20.0,
+        duration,
+        &presets(),
+        &seeds,
+        &Ieee952Config::default(),
+    );
     println!(
         "coverage study: {} series in {:.1} s",
         cases.len(),
@@ -477,7 +488,7 @@ fn n_efficiency() {
         let mut chis = Vec::new();
         for s in 0..120u64 {
             let y = simulate_axis(0.01, k, dt, 50_000, BASE_SEED + 777 + s);
-            let r = analyse(&y, dt, &Config::default()).unwrap();
+            let r = analyse_ieee952(&y, dt, &Ieee952Config::default()).unwrap();
             errs.push(r.terms.n.value / 0.01 - 1.0);
             ses.push(r.terms.n.std_err / r.terms.n.value);
             chis.push(r.fit.unwrap().chi2_per_dof);
@@ -504,28 +515,28 @@ fn n_efficiency() {
 #[test]
 #[ignore = "timing breakdown on one 2.88 M-sample axis; --ignored --nocapture (release)"]
 fn timing_breakdown() {
-    use allan_kalibr::ieee952::{Overlap, Phase, edf, noise_id};
+    use allan_kalibr::{Overlap, Phase, greenhall_edf, identify};
     let y = simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED);
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let ms = cfg.grid.cluster_sizes(y.len());
     let t = std::time::Instant::now();
     let ph = Phase::from_rate(&y, 0.005);
     let pts = ph.avar_many(&ms, Overlap::Overlapping);
     let t_avar = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let ids: Vec<_> = ms.iter().map(|&m| noise_id::identify(&ph, m)).collect();
+    let ids: Vec<_> = ms.iter().map(|&m| identify(&ph, m)).collect();
     let t_id = t.elapsed().as_secs_f64();
     let n_phase = y.len() + 1;
     let t = std::time::Instant::now();
     let e: f64 = ms
         .iter()
         .flat_map(|&m| {
-            (-2..=2).map(move |a| edf::greenhall_edf(a, m, n_phase, Overlap::Overlapping).unwrap())
+            (-2..=2).map(move |a| greenhall_edf(a, m, n_phase, Overlap::Overlapping).unwrap())
         })
         .sum();
     let t_edf = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let a = analyse(&y, 0.005, &cfg).unwrap();
+    let a = analyse_ieee952(&y, 0.005, &cfg).unwrap();
     let t_all = t.elapsed().as_secs_f64();
     println!(
         "{} m: phase+OADEV {t_avar:.3} s (parallel), noise ID {t_id:.3} s (serial), EDF×5 {t_edf:.3} s (serial), analyse total {t_all:.3} s; fit iterations {} ({} ids, {} pts, edf sum {e:.0})",
@@ -562,14 +573,14 @@ fn one_case() {
         288_000,
         BASE_SEED + 1000 * s + 10 * seed_pi + a as u64,
     );
-    let r = analyse(&y, 0.05, &Config::default()).unwrap();
+    let r = analyse_ieee952(&y, 0.05, &Ieee952Config::default()).unwrap();
     println!("truth N {n:e} K {k:e}");
     super::real::print_row(
         "sim",
         if a < 3 {
-            ieee952::imu::Sensor::Gyro
+            bag2mat::Sensor::Gyro
         } else {
-            ieee952::imu::Sensor::Acc
+            bag2mat::Sensor::Acc
         },
         a % 3,
         &r,
@@ -591,7 +602,7 @@ fn one_case() {
 #[test]
 #[ignore = "OADEV cost per cluster size on one 2.88 M-sample axis; --ignored --nocapture (release)"]
 fn oadev_cost_per_m() {
-    use allan_kalibr::ieee952::{Overlap, Phase};
+    use allan_kalibr::{Overlap, Phase};
     let y = simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED);
     let ph = Phase::from_rate(&y, 0.005);
     for m in [1usize, 8, 64, 512, 4096, 32768, 262_144] {
@@ -611,7 +622,7 @@ fn oadev_cost_per_m() {
 }
 
 /// The analysis of one gyro axis of preset `preset` (seed's low, medium, high), 4 h at 20 Hz.
-fn gyro_4h_at_20hz(preset: usize, seed: u64) -> ieee952::Analysis {
+fn gyro_4h_at_20hz(preset: usize, seed: u64) -> Ieee952Analysis {
     let (rate, duration) = (20.0, 4.0 * 3600.0);
     let p = presets()[preset];
     let y = simulate_axis(
@@ -621,7 +632,7 @@ fn gyro_4h_at_20hz(preset: usize, seed: u64) -> ieee952::Analysis {
         (duration * rate) as usize,
         seed,
     );
-    analyse(&y, 1.0 / rate, &Config::default()).expect("simulated series analyses")
+    analyse_ieee952(&y, 1.0 / rate, &Ieee952Config::default()).expect("simulated series analyses")
 }
 
 /// A term the data do not show is reported with a usable 95 % upper bound: positive and
@@ -658,7 +669,7 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
     const CR_RECORD_FACTOR: f64 = 2.0;
     let a = gyro_4h_at_20hz(1, BASE_SEED + 11);
     assert_eq!(a.terms.k.verdict, Verdict::Resolved, "{:?}", a.terms.k);
-    let adv = ieee952::advisor::advise(&a).expect("sample count known");
+    let adv = advise(&a).expect("sample count known");
     let z2 = 1.959_963_984_540_054f64.powi(2);
     let cr = 2.0 * a.terms.n.value * z2 / (a.terms.k.value * 0.25 * 0.25);
     let ratio = adv.k.record_25 / cr;
@@ -675,25 +686,24 @@ fn k_record_formula_matches_the_fit_where_k_is_resolved() {
 #[test]
 #[ignore = "timing of the section's stages on six 2.88 M-sample axes; --ignored --nocapture"]
 fn section_stage_timings() {
-    use allan_kalibr::ieee952::imu::ImuCurves;
-    use allan_kalibr::ieee952::{Phase, analyse_curve, noise_id, psd};
+    use allan_kalibr::{ImuCurves, Phase, analyse_curve, find_lines, identify, welch};
     let ys: Vec<Vec<f64>> = (0..6)
         .map(|a| simulate_axis(0.015, 5e-5, 0.005, 2_880_000, BASE_SEED + a))
         .collect();
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let ms = cfg.grid.cluster_sizes(ys[0].len());
     let t = std::time::Instant::now();
     let ph = Phase::from_rate(&ys[0], 0.005);
     let pts = ph.avar_curve(&ms);
     let t_avar = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let _ids: Vec<_> = pts.iter().map(|p| noise_id::identify(&ph, p.m)).collect();
+    let _ids: Vec<_> = pts.iter().map(|p| identify(&ph, p.m)).collect();
     let t_id = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let p = psd::welch(&ys[0], 200.0).unwrap();
+    let p = welch(&ys[0], 200.0).unwrap();
     let t_psd = t.elapsed().as_secs_f64();
     let t = std::time::Instant::now();
-    let _l = psd::find_lines(&p);
+    let _l = find_lines(&p);
     let t_lines = t.elapsed().as_secs_f64();
     println!(
         "one axis: {} m, phase+OADEV {t_avar:.3} s, noise ID {t_id:.3} s (serial), PSD {t_psd:.3} s, lines {t_lines:.3} s",

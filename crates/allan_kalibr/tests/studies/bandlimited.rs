@@ -10,7 +10,7 @@
 //! and analysed by `allan_kalibr`'s run, the terms read back from `ieee952_terms.csv` by
 //! their column names.
 
-use allan_kalibr::ieee952::{Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::{CurveData, Ieee952Config, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -113,7 +113,7 @@ fn print(o: &Outcome) {
 
 fn in_memory_cases() -> Vec<Outcome> {
     let n = (DURATION * RATE) as usize;
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let jobs: Vec<(f64, SimSensor)> = CORNERS
         .iter()
         .flat_map(|&f| [SimSensor::Gyro, SimSensor::Acc].map(|s| (f, s)))
@@ -168,11 +168,10 @@ fn mat_cases() -> Vec<Outcome> {
     bag2mat::mat::write_data_imu(&mat, &data).expect("write .mat");
     drop(data);
     let out = dir.path().join("out");
-    let mut config =
-        allan_kalibr::run::Config::new(allan_kalibr::front::Input::Samples(mat), out.clone());
+    let mut config = allan_kalibr::Config::new(allan_kalibr::Input::Samples(mat), out.clone());
     config.common.topics = bag2mat::TopicSelector::one("/imu0");
     config.title = "bmi088-like".into();
-    allan_kalibr::run::run(&config).expect("allan_kalibr run on the .mat");
+    allan_kalibr::run(&config).expect("allan_kalibr run on the .mat");
     let rows = crate::ieee952::terms(&out);
     let mut out_cases = Vec::new();
     for (s, sname) in [

@@ -6,8 +6,9 @@
 //! its bump over the noise's at that τ, the measure the verdict prints). Scored against
 //! `sim`'s exact truth, as issue 10's studies are.
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::{Analysis, Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::{
+    BUMP_X, CurveData, Ieee952Analysis, Ieee952Config, Verdict, analyse_curve, sinusoid_avar,
+};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -45,7 +46,7 @@ fn amplitude_for(k: f64, frac: f64, white: f64) -> f64 {
     let (mut best, mut at) = (0.0, 1.0);
     let mut m = 1.0f64;
     while m < 1e7 {
-        let v = ieee952::lines::sinusoid_avar(m.round(), nu0);
+        let v = sinusoid_avar(m.round(), nu0);
         if v > best {
             (best, at) = (v, m.round());
         }
@@ -76,7 +77,7 @@ struct Case {
     range_end: f64,
     record: f64,
     line_err: f64,
-    analysis: Analysis,
+    analysis: Ieee952Analysis,
 }
 
 impl Case {
@@ -100,7 +101,7 @@ fn run_case(frac: f64, k: f64, seed: u64, duration: f64) -> Case {
     };
     let m = model_with(line);
     let y = axis_series(&m, SimSensor::Gyro, 0, RATE, n, seed, 0.0).expect("series");
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let data = CurveData::from_samples(&y, 1.0 / RATE, &cfg).expect("curve");
     let basis = data.basis(cfg.fit.per_octave);
     let an = analyse_curve(&data, &cfg, basis.as_ref());
@@ -165,7 +166,7 @@ fn print(c: &Case) {
 fn issue17_1_mid_curve_line_does_not_truncate_the_fit() {
     let c = run_case(0.002, 6.0, 0x17_01, 7200.0);
     print(&c);
-    let bump = ieee952::psd::BUMP_X / (std::f64::consts::PI * c.f0);
+    let bump = BUMP_X / (std::f64::consts::PI * c.f0);
     assert!(
         c.range_end >= BOTH_SIDES * bump,
         "{}: range ends at {} s, the line's bump is at {bump} s",
@@ -214,7 +215,7 @@ fn issue17_2_a_short_tau_line_is_named_not_called_band_limited() {
         acc: SensorModel::uniform(AxisModel::default()),
     };
     let y = axis_series(&model, SimSensor::Gyro, 0, RATE, n, 0x17_02, 0.0).expect("series");
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let data = CurveData::from_samples(&y, 1.0 / RATE, &cfg).expect("curve");
     let basis = data.basis(cfg.fit.per_octave);
     let an = analyse_curve(&data, &cfg, basis.as_ref());
@@ -335,7 +336,7 @@ fn issue18_5_clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
     let c = sim::Preset::High.params();
     let model = ImuModel::from_continuous("high", &c);
     let n = (1800.0 * RATE) as usize;
-    let cfg = Config::default();
+    let cfg = Ieee952Config::default();
     let mut jobs = Vec::new();
     for seed in [0x18_05u64, 0x18_06, 0x18_07] {
         for s in [SimSensor::Gyro, SimSensor::Acc] {

@@ -9,8 +9,7 @@
 //! show: N is the long-τ white level of the whole chain (aliasing and the LSB rounding
 //! included, √(S₀·Δt + LSB²/12·Δt)); B, K, Q, R are the model's own figures.
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::{Analysis, Config, CurveData, Verdict, analyse_curve};
+use allan_kalibr::{CurveData, GM, Ieee952Analysis, Ieee952Config, Term, Verdict, analyse_curve};
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
@@ -44,7 +43,7 @@ pub(super) struct Case {
     pub seed: u64,
     pub label: String,
     pub truth: Truth,
-    pub analysis: Analysis,
+    pub analysis: Ieee952Analysis,
     /// Seconds skipped after the warm-up warning (0: none).
     pub skipped: f64,
     /// The truth's Allan deviation at the curve's τ.
@@ -80,7 +79,7 @@ fn truth_of(
 
 /// Analyses `y` as the section does, and again after the `--skip-start` the record
 /// check's warm-up advises, if it finds one. Returns the analysis and the seconds skipped.
-fn analyse_as_user(y: &[f64], tau0: f64, cfg: &Config) -> (Analysis, f64) {
+fn analyse_as_user(y: &[f64], tau0: f64, cfg: &Ieee952Config) -> (Ieee952Analysis, f64) {
     let run = |y: &[f64]| {
         let data = CurveData::from_samples(y, tau0, cfg).expect("simulated series");
         let basis = data.basis(cfg.fit.per_octave);
@@ -100,9 +99,9 @@ fn analyse_as_user(y: &[f64], tau0: f64, cfg: &Config) -> (Analysis, f64) {
 pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64) -> Vec<Case> {
     let model = profile.model();
     let n = (duration * rate).round() as usize;
-    let mut cfg = Config::default();
+    let mut cfg = Ieee952Config::default();
     if std::env::var("NO_GM").is_ok() {
-        cfg.fit.terms[ieee952::fit::GM] = false;
+        cfg.fit.terms[GM] = false;
     }
     let jobs: Vec<(SimSensor, usize)> = [SimSensor::Gyro, SimSensor::Acc]
         .into_iter()
@@ -143,7 +142,7 @@ pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64)
         .collect()
 }
 
-fn fmt_term(t: &ieee952::Term) -> String {
+fn fmt_term(t: &Term) -> String {
     match t.verdict {
         Verdict::Resolved => format!("{:.3e} [{:.2e},{:.2e}]", t.value, t.lo, t.hi),
         v => format!("({v:?} < {:.2e})", t.hi),
@@ -270,15 +269,15 @@ pub(super) fn b_dominates_a_decade(at: &AxisTruth, b: f64, rate: f64, n: usize) 
 }
 
 /// Issue 17: every number the yaml files take — each sensor's N and K
-/// ([`ieee952::imu::ImuAnalysis::noise_density`], [`ieee952::imu::ImuAnalysis::random_walk`]) —
+/// ([`allan_kalibr::ImuAnalysis::noise_density`], [`allan_kalibr::ImuAnalysis::random_walk`]) —
 /// is within the data's own 95 % bound on an axis it can come from, computed here from the
 /// curve alone: min over τ of σ_hi95(τ)·√τ for N, σ_hi95(τ)·√(3/τ) for K. `axes` are one
 /// record's (sensor, axis, analysis); returns the breaches.
 pub(super) fn yaml_over_bounds(
     label: &str,
-    axes: &[(bag2mat::Sensor, usize, &Analysis)],
+    axes: &[(bag2mat::Sensor, usize, &Ieee952Analysis)],
 ) -> Vec<String> {
-    use allan_kalibr::ieee952::imu::{AxisResult, ImuAnalysis};
+    use allan_kalibr::{AxisResult, ImuAnalysis};
     let imu = ImuAnalysis {
         rate: f64::NAN,
         axes: axes
@@ -293,7 +292,7 @@ pub(super) fn yaml_over_bounds(
         checks: Vec::new(),
         notes: Vec::new(),
     };
-    let curve_bound = |a: &Analysis, per_unit: &dyn Fn(f64) -> f64| {
+    let curve_bound = |a: &Ieee952Analysis, per_unit: &dyn Fn(f64) -> f64| {
         a.curve
             .iter()
             .filter(|p| p.hi95.is_finite())
@@ -511,7 +510,7 @@ fn profiles_study() {
     let over: Vec<String> = cases
         .chunks(6)
         .flat_map(|rec| {
-            let axes: Vec<(bag2mat::Sensor, usize, &Analysis)> = rec
+            let axes: Vec<(bag2mat::Sensor, usize, &Ieee952Analysis)> = rec
                 .iter()
                 .map(|c| {
                     let s = if c.label.starts_with("gyro") {

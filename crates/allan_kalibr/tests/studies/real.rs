@@ -1,22 +1,27 @@
 //! Real-IMU curves (`testdata/real_curves`: DJI A3, DJI N3, Bosch BMI160, written by
 //! imu_utils from 2–3.3 h static recordings).
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::curves_in::{self, Options};
-use allan_kalibr::ieee952::imu::Sensor;
-use allan_kalibr::ieee952::{Analysis, Config, analyse_curve, short};
+use allan_kalibr::{
+    AxisVerdict, B_FLOOR_FACTOR, CurvesOptions, GM, Ieee952Analysis, Ieee952Config, Reading,
+    ReadingKind, Term, Verdict, analyse_curve, read_curves, short,
+};
+use bag2mat::Sensor;
 
 /// (folder, record length in s from its launch file, see the folder's README).
 pub(super) const IMUS: [(&str, f64); 3] = [("A3", 7200.0), ("N3", 7200.0), ("BMI160", 12000.0)];
 
-pub(super) fn analyse_imu_dir(name: &str, duration: f64, cfg: &Config) -> Vec<(Sensor, Analysis)> {
-    let c = curves_in::read(
+pub(super) fn analyse_imu_dir(
+    name: &str,
+    duration: f64,
+    cfg: &Ieee952Config,
+) -> Vec<(Sensor, Ieee952Analysis)> {
+    let c = read_curves(
         &[bag2mat::test_tools::testdata()
             .join("real_curves")
             .join(name)],
-        &Options {
+        &CurvesOptions {
             duration: Some(duration),
-            ..Options::default()
+            ..CurvesOptions::default()
         },
     )
     .unwrap();
@@ -30,15 +35,15 @@ pub(super) fn analyse_imu_dir(name: &str, duration: f64, cfg: &Config) -> Vec<(S
     out
 }
 
-pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Analysis) {
+pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Ieee952Analysis) {
     let f = a.fit.as_ref();
-    let t = |x: &ieee952::Term| {
+    let t = |x: &Term| {
         format!(
             "{:.3e} [{:.2e},{:.2e}] {:?}",
             x.value, x.lo, x.hi, x.verdict
         )
     };
-    let r = |x: Option<ieee952::region::Reading>| {
+    let r = |x: Option<Reading>| {
         x.map_or("-".into(), |x| {
             format!("{:.3e} [{:.2e},{:.2e}] {:?}", x.value, x.lo, x.hi, x.kind)
         })
@@ -72,9 +77,9 @@ pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Analysis) {
 #[test]
 #[ignore = "development table; --ignored --nocapture"]
 fn real_curves_table() {
-    let mut cfg = Config::default();
+    let mut cfg = Ieee952Config::default();
     if std::env::var("NO_GM").is_ok() {
-        cfg.fit.terms[ieee952::fit::GM] = false;
+        cfg.fit.terms[GM] = false;
     }
     if std::env::var("NO_CORNER").is_ok() {
         cfg.fit.flicker_corner = false;
@@ -92,7 +97,7 @@ fn real_curve_residuals() {
     let spec = std::env::var("REAL_AXIS").unwrap_or("N3:acc:x".into());
     let f: Vec<&str> = spec.split(':').collect();
     let d = IMUS.iter().find(|x| x.0 == f[0]).unwrap().1;
-    let all = analyse_imu_dir(f[0], d, &Config::default());
+    let all = analyse_imu_dir(f[0], d, &Ieee952Config::default());
     let k = if f[1] == "gyr" { 0 } else { 3 } + "xyz".find(f[2]).unwrap();
     let (s, a) = &all[k];
     print_row(f[0], *s, k % 3, a);
@@ -128,7 +133,7 @@ const MIN_FITTING_SHARE: f64 = 0.90;
 /// 1 s — the curve points of [`tau_lo`, `tau_hi`] whose local log-log slope is within 0.1 of
 /// −½, within an octave of the one nearest 1 s — read at 1 s (least squares in log: the
 /// geometric mean of σ(τ)·√τ over them).
-pub(super) fn n_reading_at_1s(a: &Analysis, tau_lo: f64, tau_hi: f64) -> f64 {
+pub(super) fn n_reading_at_1s(a: &Ieee952Analysis, tau_lo: f64, tau_hi: f64) -> f64 {
     const SLOPE_TOL: f64 = 0.1;
     const WINDOW: f64 = 2.0;
     let c: Vec<_> = a
@@ -155,7 +160,7 @@ pub(super) fn n_reading_at_1s(a: &Analysis, tau_lo: f64, tau_hi: f64) -> f64 {
 }
 
 /// Checks one analysed real axis; returns (fits over a range with 1 s and 2 decades, line).
-pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
+pub(super) fn check_real_axis(label: &str, a: &Ieee952Analysis) -> (bool, String) {
     let Some((lo, hi)) = a.verdict.range() else {
         let why = a.verdict.to_string();
         assert!(
@@ -168,7 +173,7 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
     // model stays within the tolerance (checked below) but its terms are not claimed
     let approximate = matches!(
         a.verdict,
-        ieee952::AxisVerdict::Fits {
+        AxisVerdict::Fits {
             approximate: Some(_),
             ..
         }
@@ -200,27 +205,27 @@ pub(super) fn check_real_axis(label: &str, a: &Analysis) -> (bool, String) {
         .map(|p| p.adev)
         .fold(f64::INFINITY, f64::min);
     let b = a.terms.b;
-    if b.verdict == ieee952::Verdict::Resolved && !approximate {
-        let f = ieee952::region::B_FLOOR_FACTOR * b.value;
+    if b.verdict == Verdict::Resolved && !approximate {
+        let f = B_FLOOR_FACTOR * b.value;
         assert!(
             (f / floor - 1.0).abs() <= B_FLOOR_TOL,
             "{label}: 0.664·B = {f:e} vs the floor {floor:e} of the fitted range, tol {B_FLOOR_TOL}"
         );
     }
     let f = a.fit.as_ref().expect("a fitting axis has a fit");
-    let t = |x: &ieee952::Term| {
-        if x.verdict == ieee952::Verdict::Resolved {
+    let t = |x: &Term| {
+        if x.verdict == Verdict::Resolved {
             format!("{:.3e} [{:.2e}, {:.2e}]", x.value, x.lo, x.hi)
         } else {
             format!("< {:.2e} ({:?})", x.hi, x.verdict)
         }
     };
-    let r = |x: Option<ieee952::region::Reading>| {
+    let r = |x: Option<Reading>| {
         x.map_or("-".into(), |x| match x.kind {
-            ieee952::region::ReadingKind::Line => {
+            ReadingKind::Line => {
                 format!("{:.3e} [{:.2e}, {:.2e}]", x.value, x.lo, x.hi)
             }
-            ieee952::region::ReadingKind::UpperBound => format!("< {:.2e}", x.hi),
+            ReadingKind::UpperBound => format!("< {:.2e}", x.hi),
         })
     };
     (
@@ -249,7 +254,7 @@ fn real_curves_acceptance() {
     let mut fitting = 0;
     let mut total = 0;
     for (name, d) in IMUS {
-        for (i, (s, a)) in analyse_imu_dir(name, d, &Config::default())
+        for (i, (s, a)) in analyse_imu_dir(name, d, &Ieee952Config::default())
             .iter()
             .enumerate()
         {
@@ -283,15 +288,15 @@ fn real_curves_acceptance_elsewhere() {
             Some((d, secs)) if secs.parse::<f64>().is_ok() => (d, secs.parse().ok()),
             _ => (item, None),
         };
-        let c = curves_in::read(
+        let c = read_curves(
             &[std::path::PathBuf::from(dir)],
-            &Options {
+            &CurvesOptions {
                 duration,
-                ..Options::default()
+                ..CurvesOptions::default()
             },
         )
         .unwrap();
-        let cfg = Config::default();
+        let cfg = Ieee952Config::default();
         for s in &c.sensors {
             let basis = s.axes[0].basis(cfg.fit.per_octave);
             for (i, ax) in s.axes.iter().enumerate() {

@@ -2,9 +2,10 @@
 //! overlapping and normal ADEV equal at Stable32's printed 5 significant digits at every listed
 //! τ, and where our noise identification gives Stable32's α, the 68.3 % bounds within 1 %.
 
-use allan_kalibr::ieee952;
-use allan_kalibr::ieee952::oadev::{Overlap, Phase};
-use allan_kalibr::ieee952::{ci, edf, noise_id};
+use allan_kalibr::{
+    CurveData, IdMethod, Ieee952Config, Overlap, Phase, analyse_ieee952, chi2_interval,
+    greenhall_edf, identify,
+};
 use std::io::Read;
 
 /// Issue 6: bounds within 1 % of Stable32's where the identified α agrees.
@@ -125,7 +126,7 @@ fn check_bounds(
     let (mut compared, mut worst, mut worst_hw) = (0, 0.0f64, 0.0f64);
     println!("{label}: m, alpha Stable32/ours (method), lo dev %, hi dev %, half-width dev %");
     for (i, r) in rows.iter().enumerate() {
-        let id = noise_id::identify(phase, r.m);
+        let id = identify(phase, r.m);
         let dev = phase.avar(r.m, kind).unwrap().avar.sqrt();
         if id.alpha != Some(r.alpha) {
             println!(
@@ -134,8 +135,8 @@ fn check_bounds(
             );
             continue;
         }
-        let nu = edf::greenhall_edf(r.alpha, r.m, n_phase, kind).unwrap();
-        let (lo, hi) = ci::chi2_interval(dev, nu, STABLE32_CONFIDENCE).unwrap();
+        let nu = greenhall_edf(r.alpha, r.m, n_phase, kind).unwrap();
+        let (lo, hi) = chi2_interval(dev, nu, STABLE32_CONFIDENCE).unwrap();
         let dl = lo / r.lo - 1.0;
         let dh = hi / r.hi - 1.0;
         let dhw_lo = (dev - lo) / (r.sigma - r.lo) - 1.0;
@@ -228,8 +229,8 @@ fn ocxo_alpha_agreement_is_reported() {
     let mut agree = 0;
     let mut lag1 = 0;
     for r in &rows {
-        let id = noise_id::identify(&phase, r.m);
-        if id.method == noise_id::IdMethod::Lag1 {
+        let id = identify(&phase, r.m);
+        if id.method == IdMethod::Lag1 {
             lag1 += 1;
             agree += (id.alpha == Some(r.alpha)) as usize;
         }
@@ -247,8 +248,7 @@ fn ocxo_alpha_agreement_is_reported() {
 fn analyse_runs_on_clock_data() {
     // Not IMU data (flicker PM / white PM dominate): the full pipeline must still give a finite
     // curve with bounds around every point, and a fit whose misfit shows in χ²/dof.
-    let a =
-        ieee952::analyse(&gps_rate(), 1.0, &ieee952::Config::default()).expect("GPS rate series");
+    let a = analyse_ieee952(&gps_rate(), 1.0, &Ieee952Config::default()).expect("GPS rate series");
     assert!(!a.curve.is_empty());
     for (i, p) in a.curve.iter().enumerate() {
         assert!(
@@ -313,7 +313,7 @@ fn allantools_oadev(data: &[f64], data_type: &str, ms: &[usize]) -> Vec<(usize, 
 }
 
 fn check_against_allantools(label: &str, rate: &[f64], data: &[f64], data_type: &str) {
-    let curve = ieee952::CurveData::from_samples(rate, 1.0, &ieee952::Config::default())
+    let curve = CurveData::from_samples(rate, 1.0, &Ieee952Config::default())
         .unwrap_or_else(|e| panic!("{label}: {e}"));
     let ms: Vec<usize> = curve.points.iter().map(|p| p.m).collect();
     let theirs = allantools_oadev(data, data_type, &ms);

@@ -1,7 +1,7 @@
 //! Statistical proof that the generator makes what the truth says (issue 9, "Proof each term
 //! is right"): for every term alone and for each profile, the overlapping Allan deviation of
-//! generated data (`allan_kalibr::ieee952::oadev`) lies inside the χ² 99 % interval
-//! (`ieee952::ci`) of the truth at every octave τ.
+//! generated data (`allan_kalibr::Phase`) lies inside the χ² 99 % interval
+//! (`allan_kalibr::chi2_interval`) of the truth at every octave τ.
 //!
 //! Degrees of freedom: the exact Gaussian EDF of [`FilteredWhite::edf`] where white noise
 //! (filtered or not, plus the LSB) dominates and m ≤ [`EXACT_EDF_MAX_M`]; elsewhere
@@ -18,9 +18,7 @@
 //! mildly positively correlated, which makes the count's spread larger, so the allowance is
 //! a little strict rather than loose). Seeds are fixed: the outcome is deterministic.
 
-use allan_kalibr::ieee952::ci::chi2_interval;
-use allan_kalibr::ieee952::edf::greenhall_edf;
-use allan_kalibr::ieee952::oadev::{Overlap, Phase};
+use allan_kalibr::{Overlap, Phase, chi2_interval, greenhall_edf};
 use statrs::distribution::{Binomial, DiscreteCDF};
 
 use super::generate::axis_series;

@@ -1,7 +1,7 @@
 //! The exact theoretical Allan variance of the generated output sequence, term by term.
 //!
 //! "Exact" means: the expectation of the fully overlapping estimator (as
-//! `allan_kalibr::ieee952::oadev` computes it) on the discrete sequence `sim` writes, at every
+//! `allan_kalibr::Phase` computes it) on the discrete sequence `sim` writes, at every
 //! cluster size m — including the low-pass filter, the aliasing of the decimation and the
 //! discrete averaging kernel at short τ. Each term is independent of the others, so the
 //! variances add. The route is the autocovariance R(k) of each term's output sequence:
@@ -23,8 +23,9 @@
 //! | line: sinusoid A, f₀ (random phase) | A·sin(2πf₀nΔt + φ) | A²·sin⁴(πmν₀)/(m²·sin²(πν₀)), ν₀ = f₀Δt |
 //! | line: resonance A, f₀, B | R(k) = (A²/2)·e^(−a\|k\|)(cos bk + (a/b) sin b\|k\|) | the AR(1) form with a complex pole |
 //!
-//! The two line rows are `allan_kalibr::ieee952::lines` (the estimator's line terms use the
-//! same mathematics); the tests here check them against the spectral integral.
+//! The two line rows are `allan_kalibr::sinusoid_avar` and `allan_kalibr::resonance_avar`
+//! (the estimator's line terms use the same mathematics); the tests here check them against
+//! the spectral integral.
 //! The AR(1) bracket cancels catastrophically when mΔt ≪ T (both terms ≈ 2m/β, the result
 //! ≈ 2m³β/3): below x = mβ = [`AR1_SERIES_BELOW`] it is evaluated from its power series in
 //! β, whose coefficients are polynomials in m (derived symbolically; checked in the tests
@@ -473,13 +474,13 @@ pub struct AxisTruth {
 enum LineTruth {
     /// A², ν₀.
     Sinusoid { a2: f64, nu0: f64 },
-    /// σ² and the poles (a, b) of `allan_kalibr::ieee952::lines::resonance_poles`.
+    /// σ² and the poles (a, b) of `allan_kalibr::resonance_poles`.
     Resonance { var: f64, a: f64, b: f64 },
 }
 
 impl LineTruth {
     fn new(l: &super::model::Line, dt: f64) -> LineTruth {
-        use allan_kalibr::ieee952::lines::resonance_poles;
+        use allan_kalibr::resonance_poles;
         let a2 = l.amplitude * l.amplitude;
         if l.bandwidth == 0.0 {
             LineTruth::Sinusoid {
@@ -497,7 +498,7 @@ impl LineTruth {
     }
 
     fn avar(&self, m: usize) -> f64 {
-        use allan_kalibr::ieee952::lines::{resonance_avar, sinusoid_avar};
+        use allan_kalibr::{resonance_avar, sinusoid_avar};
         match *self {
             LineTruth::Sinusoid { a2, nu0 } => a2 * sinusoid_avar(m as f64, nu0),
             LineTruth::Resonance { var, a, b } => var * resonance_avar(m, a, b),
@@ -788,7 +789,7 @@ mod tests {
                 .resolve(crate::noise::model::Sensor::Gyro, 1.0 / dt)
                 .unwrap();
             let tr = AxisTruth::new(&a, &chain, dt, 1_000_000);
-            let (pa, pb) = allan_kalibr::ieee952::lines::resonance_poles(f0, bw, dt);
+            let (pa, pb) = allan_kalibr::resonance_poles(f0, bw, dt);
             let var = 0.5 * l.amplitude * l.amplitude;
             // S_d(ν) = Re(c) + Re[c·(u/(1 − u) + v/(1 − v))], u = z e^(−iθ), v = z e^(iθ)
             let sd = |nu: f64| {
@@ -915,7 +916,7 @@ mod tests {
 
     #[test]
     fn warmup_closed_form_matches_the_estimator_on_the_sequence() {
-        use allan_kalibr::ieee952::oadev::{Overlap, Phase};
+        use allan_kalibr::{Overlap, Phase};
         let (a, t, dt, n) = (3e-3, 120.0f64, 0.01f64, 60_000usize);
         let w = (-dt / t).exp();
         let y: Vec<f64> = (0..n).map(|i| a * w.powi(i as i32)).collect();

@@ -415,7 +415,7 @@ fn deterministic_axis_yaml(
     let dt = 1.0 / info.rate;
     let u = s.unit();
     for l in &a.lines {
-        let (pa, pb) = allan_kalibr::ieee952::lines::resonance_poles(l.frequency, l.bandwidth, dt);
+        let (pa, pb) = allan_kalibr::resonance_poles(l.frequency, l.bandwidth, dt);
         let _ = writeln!(
             o,
             "        line_{}hz: {{cycles_per_sample: {}, decay_per_sample: {}, radians_per_sample: {}}}   # nu0 = f*dt; a resonance's autocovariance (A^2/2)*exp(-a|k|)*(cos(b k) + (a/b) sin(b|k|))",

@@ -82,6 +82,8 @@
 //! variance of a narrow-band estimate), and a ramp's — deterministic, but its estimate
 //! carries the noise's cross term — to random walk, so that an R read off the longest
 //! points is as uncertain as those points are (issue 18.5).
+//!
+//! [`flicker_band`]: super::model::flicker_band
 
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
@@ -93,9 +95,11 @@ mod linalg;
 mod range_end;
 use super::model::effective_coef;
 pub(in crate::ieee952) use super::model::is_positive;
+#[cfg(test)]
+pub(in crate::ieee952) use super::model::{FLICKER_AVAR, flicker_band};
 pub use super::model::{
-    FLICKER_AVAR, GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA,
-    TERM_COUNT, TERM_NAMES, alpha_index, basis, basis_at, flicker_band, gm_basis,
+    GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA, TERM_COUNT,
+    TERM_NAMES, basis, basis_at, gm_basis,
 };
 use gls::{Delta, FixedLs, Problem, Solve, fixed_ls, gls};
 pub(in crate::ieee952) use linalg::solve_spd;
@@ -112,16 +116,16 @@ pub struct FitConfig {
     pub per_octave: u32,
     /// Iteration cap of the re-weighting.
     pub max_iter: usize,
-    /// Forward selection of the nuisance terms Q, B, R (see [`fit`]).
+    /// Forward selection of the nuisance terms Q, B, R (see `fit`).
     pub select: bool,
     /// Model-discrepancy variance component (see the module docs). Off: plain GLS with the
     /// statistical covariance, standard errors scaled by √max(1, χ²/dof).
     pub discrepancy: bool,
-    /// Choose the start of the fitted range ([`choose_start`]); off: fit every point.
+    /// Choose the start of the fitted range (`choose_start`); off: fit every point.
     pub trim: bool,
     /// Allow a negative 1/τ² coefficient (the low-pass correction; module docs).
     pub band_limit: bool,
-    /// Allow the flicker floor a lower corner ([`flicker_band`]).
+    /// Allow the flicker floor a lower corner (`flicker_band`).
     pub flicker_corner: bool,
 }
 
@@ -156,8 +160,6 @@ pub struct FitPoint {
 pub struct FitData<'a> {
     /// Points, ascending τ, AVAR > 0.
     pub points: Vec<FitPoint>,
-    /// Index of each point into the caller's curve.
-    pub curve_index: Vec<usize>,
     /// Statistical covariance (None when the sample count is unknown: then only relative
     /// weights, no intervals).
     pub basis: Option<&'a CovBasis>,
@@ -416,6 +418,8 @@ pub const MIN_FIT_POINTS: usize = TERM_COUNT + 2;
 /// refitted with its own δ. Terms left out are reported at 0 with the upper bound of the
 /// all-terms fit (ĉ + z·se); a quantization taken out again (below) with that of the
 /// selected fit that had it.
+///
+/// [`flicker_band`]: super::model::flicker_band
 pub(crate) fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResult> {
     let f = fit_terms(data, used, cfg)?;
     // A quantization term whose line never comes near the curve is not one the curve shows:
@@ -997,7 +1001,6 @@ mod tests {
         let n = points.len();
         FitData {
             points,
-            curve_index: (0..n).collect(),
             basis: cov_basis,
             basis_index: (0..n).collect(),
             lines: [None; 3],
