@@ -160,14 +160,26 @@ impl bag2mat::shared::plot::Figure for Curves<'_> {
 
 /// Writes the four plot files into `dir` (the workspace's PNG+SVG writer, the two sensors in
 /// parallel); returns their paths.
-pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+pub fn write_plots(
+    outputs: &bag2mat::shared::output::Outputs,
+    an: &Analysis,
+    name: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, Error> {
     use rayon::prelude::*;
     let jobs = [("allan_gyr", 0), ("allan_acc", 3)];
     let files: Vec<[PathBuf; 2]> = jobs
         .par_iter()
         .filter(|(_, base)| an.present(*base))
         .map(|&(stem, base)| {
-            bag2mat::shared::plot::write_png_svg(&curves(an, name, base), dir, stem, SIZE, SIZE)
+            bag2mat::shared::plot::write_png_svg(
+                outputs,
+                &curves(an, name, base),
+                dir,
+                stem,
+                SIZE,
+                SIZE,
+            )
         })
         .collect::<Result<_, _>>()?;
     Ok(files.into_iter().flatten().collect())

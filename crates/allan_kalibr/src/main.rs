@@ -16,7 +16,7 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
-    front::finish(TOOL, &config.common, || {
-        allan_kalibr::run::sections(&config)
+    front::finish(TOOL, &config.common, |outputs| {
+        allan_kalibr::run::sections(&config, outputs)
     })
 }

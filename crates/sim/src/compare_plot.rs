@@ -235,7 +235,13 @@ impl bag2mat::shared::plot::Figure for Compare<'_> {
 
 /// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison `root`
 /// (the presets' folders under it; `rate` and `duration` of the bags for the title).
-pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result<Vec<PathBuf>> {
+pub fn plot(
+    outputs: &bag2mat::shared::output::Outputs,
+    root: &Path,
+    presets: &[Preset],
+    rate: f64,
+    duration: f64,
+) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for (sensor, column, axes, unit) in [
         ("gyro", "gyro_avg", ["gx", "gy", "gz"], "rad/s"),
@@ -275,6 +281,7 @@ pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result
             rate, duration
         );
         files.extend(bag2mat::shared::plot::write_png_svg(
+            outputs,
             &Compare {
                 title: &title,
                 unit,

@@ -241,6 +241,7 @@ where
 
 /// Draw `stem.png` and `stem.svg` (the workspace's PNG+SVG writer, atomically).
 pub fn plot_integration(
+    outputs: &bag2mat::shared::output::Outputs,
     stem: &Path,
     title: &str,
     truth: &[PoseRow],
@@ -255,6 +256,7 @@ pub fn plot_integration(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     bag2mat::shared::plot::write_png_svg(
+        outputs,
         &Integration {
             title,
             truth,

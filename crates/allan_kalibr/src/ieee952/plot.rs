@@ -78,6 +78,7 @@ pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
 /// writer) and, where the analysis has PSDs, the PSD chart beside it
 /// ([`super::psd_plot`]), the two rendered in parallel; returns the paths.
 pub fn write_chart(
+    outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     title: &str,
     truth: Option<&Truth>,
@@ -93,6 +94,7 @@ pub fn write_chart(
     let (allan, psd) = rayon::join(
         || {
             bag2mat::shared::plot::write_png_svg(
+                outputs,
                 &Chart { a, title, truth },
                 dir,
                 &format!("{prefix}{STEM}"),
@@ -100,7 +102,7 @@ pub fn write_chart(
                 psize,
             )
         },
-        || super::psd_plot::write_psd_chart(a, title, dir, prefix),
+        || super::psd_plot::write_psd_chart(outputs, a, title, dir, prefix),
     );
     let mut out = allan?.to_vec();
     out.extend(psd?.into_iter().flatten());

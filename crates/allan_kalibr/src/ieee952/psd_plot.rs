@@ -29,6 +29,7 @@ pub const STEM: &str = "ieee952_psd";
 /// Draws `<dir>/<prefix>ieee952_psd.{png,svg}`; `None` when no axis has a PSD (a curve
 /// given without its samples).
 pub(crate) fn write_psd_chart(
+    outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     title: &str,
     dir: &Path,
@@ -44,6 +45,7 @@ pub(crate) fn write_psd_chart(
         (size.1 as f64 * PNG_SCALE) as u32,
     );
     bag2mat::shared::plot::write_png_svg(
+        outputs,
         &PsdChart { a, title },
         dir,
         &format!("{prefix}{STEM}"),

@@ -73,8 +73,9 @@ pub trait Figure {
 }
 
 /// Writes `<dir>/<stem>.png` (`png_size` pixels) and `<dir>/<stem>.svg` (`svg_size` user
-/// units) of `fig`, each atomically; returns `[png, svg]`.
+/// units) of `fig`, each atomically among the run's `outputs`; returns `[png, svg]`.
 pub fn write_png_svg(
+    outputs: &crate::shared::output::Outputs,
     fig: &impl Figure,
     dir: &std::path::Path,
     stem: &str,
@@ -95,9 +96,9 @@ pub fn write_png_svg(
                 what,
             })?;
     }
-    crate::shared::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
+    outputs.write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
     let scale = png_size.0 as f64 / svg_size.0.max(1) as f64;
-    png_atomic(&png, png_size, |root| {
+    png_atomic(outputs, &png, png_size, |root| {
         fig.draw(&root, scale)?;
         present(&root)
     })?;
@@ -109,6 +110,7 @@ pub fn write_png_svg(
 /// ([`crate::shared::output::TempPath`]), which is put in place only after a successful
 /// encode (and removed otherwise, on a signal too).
 pub fn png_atomic<F>(
+    outputs: &crate::shared::output::Outputs,
     target: &std::path::Path,
     size: (u32, u32),
     draw: F,
@@ -120,7 +122,7 @@ where
 {
     use plotters::prelude::{BitMapBackend, IntoDrawingArea};
     register_font();
-    let tmp = crate::shared::output::TempPath::beside(target, ".tmp.png")?;
+    let tmp = crate::shared::output::TempPath::beside(outputs, target, ".tmp.png")?;
     let plot_err = |what: String| crate::Error::Plot {
         path: target.to_path_buf(),
         what,
