@@ -121,7 +121,7 @@ impl bag2mat::shared::plot::Figure for Chart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -135,7 +135,7 @@ fn draw<DB: DrawingBackend>(
     truth: Option<&Truth>,
     root: &DrawingArea<DB, Shift>,
     scale: f64,
-) -> Result<(), String>
+) -> Result<(), bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
@@ -147,7 +147,7 @@ where
     )?;
     for (i, ax) in a.axes.iter().enumerate() {
         let t = truth.and_then(|t| t.get(i)).map(|v| v.as_slice());
-        panel(ax, t, &panels[i], scale).map_err(|e| e.to_string())?;
+        panel(ax, t, &panels[i], scale)?;
     }
     Ok(())
 }

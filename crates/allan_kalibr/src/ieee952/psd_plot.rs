@@ -65,7 +65,7 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -79,7 +79,7 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
             scale,
         )?;
         for (i, ax) in self.a.axes.iter().enumerate() {
-            panel(ax, &panels[i], scale).map_err(|e| e.to_string())?;
+            panel(ax, &panels[i], scale)?;
         }
         Ok(())
     }

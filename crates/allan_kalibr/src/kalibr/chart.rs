@@ -62,11 +62,11 @@ impl bag2mat::shared::plot::Figure for Chart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
-        draw(self, root, scale).map_err(|e| e.to_string())
+        Ok(draw(self, root, scale)?)
     }
 }
 
