@@ -70,12 +70,4 @@ pub enum Error {
         /// The cause.
         cause: std::io::Error,
     },
-    /// Drawing a plot failed.
-    #[error("plot {path}: {what}")]
-    Plot {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        what: String,
-    },
 }

@@ -18,5 +18,7 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
-    finish_job(TOOL, &config.common, || allan_imu_utils::sections(&config))
+    finish_job(TOOL, &config.common, |outputs| {
+        allan_imu_utils::sections(&config, outputs)
+    })
 }

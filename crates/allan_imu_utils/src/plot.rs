@@ -75,11 +75,14 @@ fn log_points(taus: &[f64], values: &[f64]) -> Vec<(f64, f64)> {
 }
 
 /// One sensor's chart: each axis' data as circles and its fit as a line, legend top right.
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, c: &Curves<'_>) -> Result<(), String>
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    c: &Curves<'_>,
+) -> Result<(), bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE)?;
     let (lo, hi) = value_range(c);
     let (tlo, thi) = tau_range(c);
     let mut chart = ChartBuilder::on(root)
@@ -87,8 +90,7 @@ where
         .margin(20)
         .x_label_area_size(55)
         .y_label_area_size(90)
-        .build_cartesian_2d((tlo..thi).log_scale(), (lo / 1.5..hi * 1.5).log_scale())
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d((tlo..thi).log_scale(), (lo / 1.5..hi * 1.5).log_scale())?;
     chart
         .configure_mesh()
         .x_desc("cluster time τ (s)")
@@ -98,20 +100,17 @@ where
         .label_style(("sans-serif", 16))
         .axis_desc_style(("sans-serif", 18))
         .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
         let col = COLORS[k];
         let pts = log_points(c.taus, &c.data[k]);
         chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.stroke_width(1))))
-            .map_err(|e| e.to_string())?
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.stroke_width(1))))?
             .label(format!("{axis} data"))
             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
         let line = log_points(c.taus, &c.fit[k]);
         chart
-            .draw_series(LineSeries::new(line, col.stroke_width(2)))
-            .map_err(|e| e.to_string())?
+            .draw_series(LineSeries::new(line, col.stroke_width(2)))?
             .label(format!("{axis} fit"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
     }
@@ -121,8 +120,7 @@ where
         .border_style(BLACK)
         .label_font(("sans-serif", 16))
         .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
+        .draw()?;
     bag2mat::shared::plot::present(root)
 }
 
@@ -150,7 +148,7 @@ impl bag2mat::shared::plot::Figure for Curves<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         _scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -160,14 +158,26 @@ impl bag2mat::shared::plot::Figure for Curves<'_> {
 
 /// Writes the four plot files into `dir` (the workspace's PNG+SVG writer, the two sensors in
 /// parallel); returns their paths.
-pub fn write_plots(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+pub fn write_plots(
+    outputs: &bag2mat::shared::output::Outputs,
+    an: &Analysis,
+    name: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, Error> {
     use rayon::prelude::*;
     let jobs = [("allan_gyr", 0), ("allan_acc", 3)];
     let files: Vec<[PathBuf; 2]> = jobs
         .par_iter()
         .filter(|(_, base)| an.present(*base))
         .map(|&(stem, base)| {
-            bag2mat::shared::plot::write_png_svg(&curves(an, name, base), dir, stem, SIZE, SIZE)
+            bag2mat::shared::plot::write_png_svg(
+                outputs,
+                &curves(an, name, base),
+                dir,
+                stem,
+                SIZE,
+                SIZE,
+            )
         })
         .collect::<Result<_, _>>()?;
     Ok(files.into_iter().flatten().collect())

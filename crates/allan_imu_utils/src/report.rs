@@ -14,6 +14,7 @@ use crate::analysis::{AXIS_NAMES, Analysis};
 use crate::error::Error;
 use crate::fit::{SECONDS_PER_HOUR, find_min_index};
 use bag2mat::shared::cfmt::{g, g6};
+use bag2mat::shared::output::Outputs;
 
 /// Upstream's fit headers (capital X only; trailing space).
 const FIT_HEADERS: [&str; 6] = [
@@ -180,20 +181,26 @@ pub fn curve_files(an: &Analysis, name: &str) -> Vec<(String, String)> {
     files
 }
 
-/// Writes one text file atomically.
-pub fn write_text(path: &Path, text: &str) -> Result<(), Error> {
-    bag2mat::shared::output::write_atomic(path, |w| w.write_all(text.as_bytes()))
+/// Writes one text file atomically among the run's `outputs`.
+pub fn write_text(outputs: &Outputs, path: &Path, text: &str) -> Result<(), Error> {
+    outputs
+        .write_atomic(path, |w| w.write_all(text.as_bytes()))
         .map_err(Error::from)
 }
 
 /// Writes the curve files into `dir`; returns their paths.
-pub fn write_curve_files(an: &Analysis, name: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+pub fn write_curve_files(
+    outputs: &Outputs,
+    an: &Analysis,
+    name: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, Error> {
     use rayon::prelude::*;
     curve_files(an, name)
         .into_par_iter()
         .map(|(file, text)| {
             let p = dir.join(file);
-            write_text(&p, &text).map(|()| p)
+            write_text(outputs, &p, &text).map(|()| p)
         })
         .collect()
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use bag2mat::shared::note::Note;
+use bag2mat::shared::output::Outputs;
 use rayon::prelude::*;
 
 use allan_kalibr::{
@@ -138,10 +139,10 @@ pub struct CurvesOutcome {
 }
 
 /// The whole job as the binary says it: [`run`] or [`run_curves`], each result an
-/// [`allan_kalibr::Section`].
-pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::Section>, Error> {
+/// [`allan_kalibr::Section`]; every file among `outputs`.
+pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<allan_kalibr::Section>, Error> {
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
-        let o = run_curves(config)?;
+        let o = run_curves(config, outputs)?;
         return Ok(vec![allan_kalibr::Section {
             notes: o.notes,
             text: o.stdout + &o.ieee952_text,
@@ -149,7 +150,7 @@ pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::Section>, Error> {
             ..Default::default()
         }]);
     }
-    Ok(run(config)?
+    Ok(run(config, outputs)?
         .into_iter()
         .map(|o| allan_kalibr::Section {
             topic: Some(o.topic),
@@ -168,8 +169,8 @@ pub fn sections(config: &Config) -> Result<Vec<allan_kalibr::Section>, Error> {
 
 /// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
 /// selected topic is read in one pass and analysed on its own. With one topic the outputs go
-/// into `out_dir`; with several, into `out_dir/<topic folder>`.
-pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
+/// into `out_dir`; with several, into `out_dir/<topic folder>`; every file among `outputs`.
+pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<Outcome>, Error> {
     let t0 = Instant::now();
     let read = bag2mat::read_imu_topics_with(
         config.common.samples_path(),
@@ -190,7 +191,7 @@ pub fn run(config: &Config) -> Result<Vec<Outcome>, Error> {
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        outs.push(run_series(&c, series, read_time)?);
+        outs.push(run_series(&c, series, read_time, outputs)?);
     }
     Ok(outs)
 }
@@ -200,6 +201,7 @@ fn run_series(
     config: &Config,
     mut series: bag2mat::ImuSeries,
     read_time: Duration,
+    outputs: &Outputs,
 ) -> Result<Outcome, Error> {
     let mut timings = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
@@ -240,7 +242,7 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    let files = write_outputs(&analysis, ieee.as_ref(), config, &topic)?;
+    let files = write_outputs(outputs, &analysis, ieee.as_ref(), config, &topic)?;
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee
         .as_ref()
@@ -423,38 +425,51 @@ fn section(
 
 /// imu_utils' files (curves, both yaml modes, plots) and the section's.
 fn write_outputs(
+    outputs: &Outputs,
     analysis: &Analysis,
     ieee: Option<&ImuAnalysis>,
     config: &Config,
     topic: &str,
 ) -> Result<Vec<PathBuf>, Error> {
-    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
-    let mut files = report::write_curve_files(analysis, &config.name, &config.common.out_dir)?;
+    outputs.ensure_dir(&config.common.out_dir)?;
+    let mut files =
+        report::write_curve_files(outputs, analysis, &config.name, &config.common.out_dir)?;
     for mode in [YamlMode::Compat, YamlMode::Continuous] {
         let p = config.common.out_dir.join(mode.file_name(&config.name));
-        report::write_text(&p, &opencv_yaml::yaml_text(analysis, &config.name, mode))?;
+        report::write_text(
+            outputs,
+            &p,
+            &opencv_yaml::yaml_text(analysis, &config.name, mode),
+        )?;
         files.push(p);
     }
     if config.plots {
         files.extend(plot::write_plots(
+            outputs,
             analysis,
             &config.name,
             &config.common.out_dir,
         )?);
     }
     if let Some(an) = ieee {
-        files.extend(write_ieee952(an, config, topic)?);
+        files.extend(write_ieee952(outputs, an, config, topic)?);
     }
     Ok(files)
 }
 
 /// The section's files (prefixed `<name>_`) and chart.
-fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Vec<PathBuf>, Error> {
+fn write_ieee952(
+    outputs: &Outputs,
+    an: &ImuAnalysis,
+    config: &Config,
+    rostopic: &str,
+) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = write_ieee952_files(an, &config.common.out_dir, &prefix, rostopic)?;
+    let mut out = write_ieee952_files(outputs, an, &config.common.out_dir, &prefix, rostopic)?;
     if config.plots {
         let truth = allan_kalibr::find_truth(config.common.samples_path(), an);
         out.extend(allan_kalibr::write_ieee952_chart(
+            outputs,
             an,
             &config.name,
             truth.as_ref(),
@@ -468,7 +483,7 @@ fn write_ieee952(an: &ImuAnalysis, config: &Config, rostopic: &str) -> Result<Ve
 /// `--curves`: imu_utils' own fit and yaml files when the curves are an imu_utils data
 /// directory (its `*_n` needs the rate, taken as 1/first τ as the files imply), and the
 /// IEEE 952 section on any format.
-pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
+pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, Error> {
     let allan_kalibr::Input::Curves(input) = &config.common.input else {
         return Err(Error::Config("no --curves given".into()));
     };
@@ -476,7 +491,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
-    bag2mat::shared::output::ensure_dir(&config.common.out_dir)?;
+    outputs.ensure_dir(&config.common.out_dir)?;
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {
         let freq = 1.0 / raw.gyr_t[0];
@@ -492,7 +507,11 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
         stdout.push_str(&report::fit_text(&an));
         for mode in [YamlMode::Compat, YamlMode::Continuous] {
             let p = config.common.out_dir.join(mode.file_name(&config.name));
-            report::write_text(&p, &opencv_yaml::yaml_text(&an, &config.name, mode))?;
+            report::write_text(
+                outputs,
+                &p,
+                &opencv_yaml::yaml_text(&an, &config.name, mode),
+            )?;
             files.push(p);
         }
         analysis = Some(an);
@@ -511,7 +530,7 @@ pub fn run_curves(config: &Config) -> Result<CurvesOutcome, Error> {
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let rostopic = config.common.named_topic();
-    files.extend(write_ieee952(&an, config, rostopic)?);
+    files.extend(write_ieee952(outputs, &an, config, rostopic)?);
     Ok(CurvesOutcome {
         stdout,
         ieee952_text: ieee952_summary_text(&an),

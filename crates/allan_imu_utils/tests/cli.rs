@@ -60,7 +60,12 @@ fn write_noise_bag(
     scale: f64,
     nan_at: Option<usize>,
 ) {
-    let mut w = BagWriter::create(path, bag2mat::Compression::None).unwrap();
+    let mut w = BagWriter::create(
+        &bag2mat::shared::output::Outputs::direct(),
+        path,
+        bag2mat::Compression::None,
+    )
+    .unwrap();
     let conn = w.add_imu_connection("/imu");
     let mut state = SEED;
     let mut next = || {

@@ -86,9 +86,12 @@ fn issue18_7_header_and_record_clocks_are_cross_checked() {
     let yaml = std::fs::read_to_string(tmp.path().join("u/x_kalibr_imu_ieee952.yaml")).unwrap();
     assert!(yaml.contains("# RECORD CHECK: clock mismatch"), "{yaml}");
     // allan_kalibr, on the record time, says the same the other way round
-    let k = allan_kalibr::run(&kalibr_config(&bag, "imu", &tmp.path().join("k")))
-        .unwrap()
-        .remove(0);
+    let k = allan_kalibr::run(
+        &kalibr_config(&bag, "imu", &tmp.path().join("k")),
+        &bag2mat::shared::output::Outputs::direct(),
+    )
+    .unwrap()
+    .remove(0);
     let f: Vec<&Finding> = k
         .findings
         .iter()
@@ -118,9 +121,12 @@ fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
         g[0].clone()
     };
     // allan_kalibr (record time), through its library
-    let k = allan_kalibr::run(&kalibr_config(&bag, "imu", &tmp.path().join("k")))
-        .unwrap()
-        .remove(0);
+    let k = allan_kalibr::run(
+        &kalibr_config(&bag, "imu", &tmp.path().join("k")),
+        &bag2mat::shared::output::Outputs::direct(),
+    )
+    .unwrap()
+    .remove(0);
     let gk = gaps(&k.findings);
     assert_eq!(gk.size, Some(lost));
     // the same line, the longest gap's place included

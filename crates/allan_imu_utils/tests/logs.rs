@@ -31,7 +31,11 @@ fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        allan_imu_utils::run(&args.try_into().unwrap()).unwrap();
+        allan_imu_utils::run(
+            &args.try_into().unwrap(),
+            &bag2mat::shared::output::Outputs::direct(),
+        )
+        .unwrap();
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (
             read("p3_imu_param.yaml"),

@@ -35,7 +35,7 @@ fn run_case(case: &Case, out: &std::path::Path) -> Outcome {
     // Parity of the compat outputs; the IEEE 952 section is checked in allan_kalibr and in
     // cli.rs.
     config.common.ieee952 = false;
-    run(&config)
+    run(&config, &bag2mat::shared::output::Outputs::direct())
         .unwrap_or_else(|e| panic!("{}: run failed: {e}", case.dir))
         .remove(0)
 }

@@ -13,7 +13,7 @@ use crate::common::{CASES, imu_utils_config, kalibr_config};
 fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let mut c: Config = imu_utils_config(bag, topic, out);
     c.common.ieee952 = false;
-    let o = allan_imu_utils::run(&c)
+    let o = allan_imu_utils::run(&c, &bag2mat::shared::output::Outputs::direct())
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);
     let yaml = std::fs::read_to_string(out.join("x_imu_param.yaml")).unwrap();
@@ -23,7 +23,7 @@ fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
 fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let mut c = kalibr_config(bag, topic, out);
     c.common.ieee952 = false;
-    let o = allan_kalibr::run(&c)
+    let o = allan_kalibr::run(&c, &bag2mat::shared::output::Outputs::direct())
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);
     let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();

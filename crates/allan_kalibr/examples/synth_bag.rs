@@ -55,7 +55,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rng = Rng(SEED);
     let mut bias = [0.0; 6];
     let mut writer = match &bag {
-        Some(p) if p.to_string_lossy() != "-" => Some(BagWriter::create(p, Compression::None)?),
+        Some(p) if p.to_string_lossy() != "-" => Some(BagWriter::create(
+            &bag2mat::shared::output::Outputs::direct(),
+            p,
+            Compression::None,
+        )?),
         _ => None,
     };
     let conn = writer.as_mut().map(|w| w.add_imu_connection("imu"));
@@ -87,7 +91,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         w.finish()?;
     }
     if let (Some(p), Some(d)) = (mat, data) {
-        write_data_imu(&p, &d)?;
+        write_data_imu(&bag2mat::shared::output::Outputs::direct(), &p, &d)?;
     }
     eprintln!("{n} samples at {rate} Hz ({hours} h)");
     Ok(())

@@ -45,12 +45,4 @@ pub enum Error {
     /// `--curves` input that cannot be read.
     #[error(transparent)]
     Curves(#[from] crate::ieee952::curves_in::CurvesError),
-    /// Drawing a plot failed.
-    #[error("plot {path}: {what}")]
-    Plot {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        what: String,
-    },
 }

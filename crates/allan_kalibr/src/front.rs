@@ -341,25 +341,26 @@ pub fn parse<A: clap::Parser, C>(
     resolve(args).map_err(|e| cli::usage(tool, &e))
 }
 
-/// Runs `job` with every output staged (all of them or none are put in place), then says
+/// Runs `job` with its outputs staged (all of them or none are put in place, never over an
+/// input: [`output::Outputs::staged`]), then says
 /// what it found: per section its notes (warnings always, information without --quiet),
 /// the record check's findings, the results on stdout, the files written and the timings.
 /// The exit code: 0, or 1 with the error said once.
 pub fn finish<E: std::fmt::Display>(
     tool: &str,
     common: &Common,
-    job: impl FnOnce() -> Result<Vec<Section>, E>,
+    job: impl FnOnce(&output::Outputs) -> Result<Vec<Section>, E>,
 ) -> ExitCode {
+    let mut outputs = output::Outputs::staged();
     for p in common.input.paths() {
-        output::protect_input(p);
+        outputs.protect_input(p);
     }
     let started = std::time::Instant::now();
-    let staging = output::Staging::begin();
-    let sections = match job() {
+    let sections = match job(&outputs) {
         Ok(s) => s,
         Err(e) => return cli::fail(tool, &e),
     };
-    if let Err(e) = staging.commit() {
+    if let Err(e) = outputs.commit() {
         return cli::fail(tool, &e);
     }
     let several = sections.iter().filter(|s| s.topic.is_some()).count() > 1;

@@ -15,5 +15,5 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
-    finish_job(TOOL, &config.common, || sections(&config))
+    finish_job(TOOL, &config.common, |outputs| sections(&config, outputs))
 }

@@ -16,6 +16,7 @@ use crate::kalibr::grid::TauGrid;
 use crate::kalibr::report;
 use crate::yaml::ImuYaml;
 use bag2mat::shared::note::Note;
+use bag2mat::shared::output::Outputs;
 
 /// What the program runs with (resolved from the command line in `cli`).
 #[derive(Debug, Clone, PartialEq)]
@@ -134,9 +135,10 @@ impl std::fmt::Display for Timings {
 
 /// The whole job as the binary says it: [`run`] or `run_curves`, each result a
 /// [`crate::front::Section`] (the topic, notes, findings, text, files and timings).
-pub fn sections(config: &Config) -> Result<Vec<crate::front::Section>, Error> {
+/// Every file goes among `outputs`.
+pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<crate::front::Section>, Error> {
     if let crate::front::Input::Curves(curves) = &config.common.input {
-        let out = run_curves(config, curves)?;
+        let out = run_curves(config, curves, outputs)?;
         return Ok(vec![crate::front::Section {
             notes: out.notes,
             text: out.text,
@@ -144,7 +146,7 @@ pub fn sections(config: &Config) -> Result<Vec<crate::front::Section>, Error> {
             ..Default::default()
         }]);
     }
-    Ok(run(config)?
+    Ok(run(config, outputs)?
         .into_iter()
         .map(|out| crate::front::Section {
             topic: out.topic,
@@ -158,8 +160,9 @@ pub fn sections(config: &Config) -> Result<Vec<crate::front::Section>, Error> {
 }
 
 /// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
-/// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`.
-pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
+/// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`;
+/// every file among `outputs`.
+pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> {
     let start = Instant::now();
     let datas = input::load_all(
         config.common.samples_path(),
@@ -182,7 +185,7 @@ pub fn run(config: &Config) -> Result<Vec<RunOutput>, Error> {
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        let mut out = run_on(&c, data)?;
+        let mut out = run_on(&c, data, outputs)?;
         out.timings.load = load;
         outs.push(out);
     }
@@ -196,7 +199,7 @@ fn section_series(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
 
 /// [`run`] on samples already in memory: the record checked, the rate chosen, both
 /// analyses side by side, then every output rendered and written.
-pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
+pub fn run_on(config: &Config, mut data: ImuData, outputs: &Outputs) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
@@ -244,7 +247,14 @@ pub fn run_on(config: &Config, mut data: ImuData) -> Result<RunOutput, Error> {
     let ieee_s = curves_s + (fits_s - analyse_s).max(0.0);
     let start = Instant::now();
     let text = report::full_text_of(&analysis.accel, &analysis.gyro, absent);
-    let written = write_outputs(config, &analysis, ieee.as_ref(), c.rate.used, &topic)?;
+    let written = write_outputs(
+        outputs,
+        config,
+        &analysis,
+        ieee.as_ref(),
+        c.rate.used,
+        &topic,
+    )?;
     let timings = Timings {
         load: 0.0,
         analyse: analyse_s,
@@ -437,6 +447,7 @@ fn compat_axes(data: ImuData) -> [Vec<f64>; 6] {
 /// Renders the yaml and the curves' CSV (before the output folder is touched), then writes
 /// them, the compat charts and the section's files and chart; returns the paths written.
 fn write_outputs(
+    outputs: &Outputs,
     config: &Config,
     analysis: &Analysis,
     ieee: Option<&crate::ieee952::imu::ImuAnalysis>,
@@ -472,13 +483,13 @@ fn write_outputs(
     .map_err(|e| bag2mat::Error::io("allan_curves.csv", e))?;
 
     let dir = &config.common.out_dir;
-    bag2mat::shared::output::ensure_dir(dir)?;
+    outputs.ensure_dir(dir)?;
     let mut written = Vec::new();
     let yaml_path = dir.join("imu.yaml");
-    bag2mat::shared::output::write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
+    outputs.write_atomic(&yaml_path, |w| w.write_all(yaml.as_bytes()))?;
     written.push(yaml_path);
     let csv_path = dir.join("allan_curves.csv");
-    bag2mat::shared::output::write_atomic(&csv_path, |w| w.write_all(&csv))?;
+    outputs.write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
     // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
     let title = if config.title.is_empty() {
@@ -494,14 +505,15 @@ fn write_outputs(
     };
     // The charts are rendered in parallel (each is one thread's work).
     let (compat_plots, section_files) = rayon::join(
-        || write_plots(analysis, &title, dir),
+        || write_plots(outputs, analysis, &title, dir),
         || -> Result<Vec<PathBuf>, Error> {
             let Some(an) = ieee else {
                 return Ok(Vec::new());
             };
-            let mut w = crate::ieee952::files::write_outputs(an, dir, "", topic)?;
+            let mut w = crate::ieee952::files::write_outputs(outputs, an, dir, "", topic)?;
             let truth = crate::ieee952::plot::find_truth(config.common.samples_path(), an);
             w.extend(crate::ieee952::plot::write_chart(
+                outputs,
                 an,
                 &title,
                 truth.as_ref(),
@@ -541,6 +553,7 @@ pub struct CurvesOutput {
 pub fn run_curves(
     config: &Config,
     curves: &crate::front::CurvesInput,
+    outputs: &Outputs,
 ) -> Result<CurvesOutput, Error> {
     let mut opts = curves.options.clone();
     if opts.rate.is_none() {
@@ -557,7 +570,7 @@ pub fn run_curves(
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let dir = &config.common.out_dir;
-    bag2mat::shared::output::ensure_dir(dir)?;
+    outputs.ensure_dir(dir)?;
     let title = if config.title.is_empty() {
         config
             .common
@@ -570,9 +583,9 @@ pub fn run_curves(
         config.title.clone()
     };
     let rostopic = config.common.named_topic();
-    let mut written = crate::ieee952::files::write_outputs(&an, dir, "", rostopic)?;
+    let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic)?;
     written.extend(crate::ieee952::plot::write_chart(
-        &an, &title, None, dir, "",
+        outputs, &an, &title, None, dir, "",
     )?);
     Ok(CurvesOutput {
         text: crate::ieee952::imu::summary_text(&an),
@@ -582,7 +595,12 @@ pub fn run_curves(
 }
 
 /// Writes `allan_accel.{png,svg}` and `allan_gyro.{png,svg}` into `dir`.
-pub(crate) fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+pub(crate) fn write_plots(
+    outputs: &Outputs,
+    a: &Analysis,
+    title: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, Error> {
     let join = |name: &str| {
         if title.is_empty() {
             name.to_owned()
@@ -612,10 +630,10 @@ pub(crate) fn write_plots(a: &Analysis, title: &str, dir: &Path) -> Result<Vec<P
     };
     let mut out = Vec::new();
     if a.absent != Some(bag2mat::Sensor::Acc) {
-        out.extend(chart::write_chart(&accel, dir, "allan_accel")?);
+        out.extend(chart::write_chart(outputs, &accel, dir, "allan_accel")?);
     }
     if a.absent != Some(bag2mat::Sensor::Gyro) {
-        out.extend(chart::write_chart(&gyro, dir, "allan_gyro")?);
+        out.extend(chart::write_chart(outputs, &gyro, dir, "allan_gyro")?);
     }
     Ok(out)
 }

@@ -176,7 +176,7 @@ fn mat_input_matches_bag_input() {
             d.axes[5][i],
         ]);
     }
-    write_data_imu(&mat, &m).unwrap();
+    write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &m).unwrap();
     // Default output folder: <stem>_allan_kalibr/ beside the input (issue 21: never the data
     // folder itself).
     let o = run(&[
@@ -292,7 +292,7 @@ fn empty_and_too_short_inputs_are_clear_errors() {
         for i in 0..n {
             m.push([i as f64 * 0.005, 0.1, 0.2, 9.8, 0.01, 0.02, 0.03]);
         }
-        write_data_imu(&mat, &m).unwrap();
+        write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &m).unwrap();
         let o = run(&[
             mat.to_str().unwrap(),
             "--update-rate",
@@ -322,7 +322,7 @@ fn empty_and_too_short_inputs_are_clear_errors() {
             0.03 * i as f64,
         ]);
     }
-    write_data_imu(&mat, &m).unwrap();
+    write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &m).unwrap();
     let o = run(&[mat.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(o.status.success(), "n=3: {}", s(&o.stderr));
 }
@@ -337,7 +337,7 @@ fn non_finite_samples_are_a_clear_error() {
         let wy = if i == 41 { f64::NAN } else { 0.02 };
         m.push([i as f64 * 0.01, 0.1, 0.2, 9.8, 0.01, wy, 0.03]);
     }
-    write_data_imu(&mat, &m).unwrap();
+    write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &m).unwrap();
     let o = run(&[mat.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(
@@ -374,7 +374,7 @@ pub fn noise_mat_seeded(path: &Path, n: usize, seed: u64) {
             next() * 1e-3,
         ]);
     }
-    write_data_imu(path, &d).unwrap();
+    write_data_imu(&bag2mat::shared::output::Outputs::direct(), path, &d).unwrap();
 }
 
 #[test]
@@ -528,7 +528,7 @@ fn mat_at(path: &Path, t: &[f64], scale: f64) {
             next() * 1e-3,
         ]);
     }
-    write_data_imu(path, &d).unwrap();
+    write_data_imu(&bag2mat::shared::output::Outputs::direct(), path, &d).unwrap();
 }
 
 #[test]

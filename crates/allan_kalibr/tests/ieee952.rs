@@ -149,7 +149,12 @@ fn axes() -> Vec<(&'static str, &'static str, f64)> {
 fn curves_files_of_a_mat_run_give_the_same_terms() {
     let tmp = tempfile::tempdir().unwrap();
     let mat = tmp.path().join("rec.mat");
-    write_data_imu(&mat, &simulate(1, None, None)).unwrap();
+    write_data_imu(
+        &bag2mat::shared::output::Outputs::direct(),
+        &mat,
+        &simulate(1, None, None),
+    )
+    .unwrap();
     let first = tmp.path().join("first");
     let text = ok(&run(&[
         mat.to_str().unwrap(),
@@ -361,7 +366,12 @@ fn warm_up_is_reported_and_skip_start_drops_it() {
     let tmp = tempfile::tempdir().unwrap();
     let mat = tmp.path().join("warm.mat");
     // 0.02 rad/s settling in 300 s: far beyond the noise of a minute's mean (1.3e-4 rad/s)
-    write_data_imu(&mat, &simulate(2, Some((0.02, 300.0)), None)).unwrap();
+    write_data_imu(
+        &bag2mat::shared::output::Outputs::direct(),
+        &mat,
+        &simulate(2, Some((0.02, 300.0)), None),
+    )
+    .unwrap();
     // on stderr, with --quiet too, and named in the section
     let out = run(&[
         mat.to_str().unwrap(),
@@ -419,7 +429,12 @@ fn warm_up_is_reported_and_skip_start_drops_it() {
 fn gaps_in_the_stamps_are_reported() {
     let tmp = tempfile::tempdir().unwrap();
     let mat = tmp.path().join("gap.mat");
-    write_data_imu(&mat, &simulate(3, None, Some((3000.0, 20.0)))).unwrap();
+    write_data_imu(
+        &bag2mat::shared::output::Outputs::direct(),
+        &mat,
+        &simulate(3, None, Some((3000.0, 20.0))),
+    )
+    .unwrap();
     let out = run(&[
         mat.to_str().unwrap(),
         "-o",

@@ -205,7 +205,7 @@ fn sim_ellipse_bag(path: &Path) {
         unreachable!()
     };
     let cfg = sim::BagConfig::try_from(*a).unwrap();
-    sim::run_bag(&cfg).unwrap();
+    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
 }
 
 #[test]

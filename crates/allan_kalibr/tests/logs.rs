@@ -36,7 +36,11 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
     else {
         panic!("not a bag command")
     };
-    sim::run_bag(&sim::BagConfig::try_from(*a).unwrap()).unwrap();
+    sim::run_bag(
+        &sim::BagConfig::try_from(*a).unwrap(),
+        &bag2mat::shared::output::Outputs::direct(),
+    )
+    .unwrap();
     let root = bag2mat::test_tools::euroc_dataset_from_bag(
         &bag,
         "imu",
@@ -55,9 +59,12 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
             out.to_str().unwrap(),
         ])
         .unwrap();
-        let run = allan_kalibr::run(&args.try_into().unwrap())
-            .unwrap()
-            .remove(0);
+        let run = allan_kalibr::run(
+            &args.try_into().unwrap(),
+            &bag2mat::shared::output::Outputs::direct(),
+        )
+        .unwrap()
+        .remove(0);
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (
             read("ieee952_terms.csv"),

@@ -212,7 +212,8 @@ fn status(i: u32) -> Vec<u8> {
 }
 
 fn write_ros1(path: &Path, c: Compression) {
-    let mut w = BagWriter::create(path, c).expect("create bag");
+    let mut w = BagWriter::create(&bag2mat::shared::output::Outputs::direct(), path, c)
+        .expect("create bag");
     w.set_chunk_threshold(CHUNK_BYTES);
     let ci = w.add_imu_connection("imu");
     let cs = test_tools::add_string_connection(&mut w, "/status");
@@ -228,7 +229,8 @@ fn write_ros1(path: &Path, c: Compression) {
 }
 
 fn write_ros2(dir: &Path, storage: Storage) {
-    let mut w = Ros2BagWriter::create(dir, storage).expect("create bag");
+    let mut w = Ros2BagWriter::create(&bag2mat::shared::output::Outputs::direct(), dir, storage)
+        .expect("create bag");
     w.set_mcap_chunk_size(CHUNK_BYTES);
     let ti = w.add_imu_topic("imu").expect("topic");
     let ts = w

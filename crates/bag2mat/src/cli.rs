@@ -126,7 +126,7 @@ pub fn run(a: Args) -> Result<Option<String>, Invocation> {
                 quiet: a.quiet,
                 input: a.input.options(a.rate),
             };
-            crate::convert::run(&cfg)
+            crate::convert::run(&cfg, crate::shared::output::Outputs::staged())
                 .map(|_| None)
                 .map_err(Invocation::Failed)
         }

@@ -16,7 +16,7 @@ use crate::mat::{self, COLS, DataImu};
 use crate::series::{
     ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, topic_folder_names,
 };
-use crate::shared::output::write_atomic;
+use crate::shared::output::Outputs;
 use crate::time::RosTime;
 
 /// Output file formats.
@@ -210,8 +210,9 @@ pub fn encode(w: &mut dyn Write, data: &DataImu, format: Format) -> std::io::Res
     }
 }
 
-/// Writes the matrix in `format` to `out` (atomically; `-` is standard output).
-pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
+/// Writes the matrix in `format` to `out` (atomically among the run's `outputs`; `-` is
+/// standard output).
+pub fn write(outputs: &Outputs, out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
     if format == Format::Mat {
         mat::check_size(out, data)?;
     }
@@ -220,7 +221,7 @@ pub fn write(out: &Path, data: &DataImu, format: Format) -> Result<(), Error> {
             .map(|_| ())
             .map_err(|e| Error::io("standard output", e));
     }
-    write_atomic(out, |w| encode(w, data, format))
+    outputs.write_atomic(out, |w| encode(w, data, format))
 }
 
 /// What the `bag2mat` conversion runs with.
@@ -271,20 +272,10 @@ pub fn output_paths(cfg: &Config, topics: &[&str]) -> Vec<PathBuf> {
 }
 
 /// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet, its outputs
-/// all or none ([`crate::shared::output::Staging`], one at a time per process: the binary's
-/// way). Returns each output path with its number of rows.
-pub fn run(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
-    convert(cfg, true)
-}
-
-/// [`run`] without the process-wide staging, each output still written atomically: for a
-/// caller that runs beside other conversions or analyses in one process (tests), whose
-/// outputs another's staging would otherwise take in.
-pub fn run_unstaged(cfg: &Config) -> Result<Vec<(PathBuf, usize)>, Error> {
-    convert(cfg, false)
-}
-
-fn convert(cfg: &Config, staged: bool) -> Result<Vec<(PathBuf, usize)>, Error> {
+/// written among `outputs` and committed before the last line (the binary's are staged: all
+/// files or none; the input is protected here). Returns each output path with its number of
+/// rows.
+pub fn run(cfg: &Config, mut outputs: Outputs) -> Result<Vec<(PathBuf, usize)>, Error> {
     let log = |s: &str| {
         if !cfg.quiet {
             eprintln!("{s}");
@@ -301,7 +292,7 @@ fn convert(cfg: &Config, staged: bool) -> Result<Vec<(PathBuf, usize)>, Error> {
         ));
     }
     log("Reading in rosbag file...");
-    crate::shared::output::protect_input(&cfg.bag);
+    outputs.protect_input(&cfg.bag);
     let read = crate::series::read_imu_topics_with(
         &cfg.bag,
         &cfg.topics,
@@ -317,8 +308,6 @@ fn convert(cfg: &Config, staged: bool) -> Result<Vec<(PathBuf, usize)>, Error> {
             ),
         });
     }
-    // Several topics: all files or none.
-    let staging = staged.then(crate::shared::output::Staging::begin);
     let names: Vec<String> = read.series.iter().map(|s| s.topic.clone()).collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let outs = output_paths(cfg, &names);
@@ -345,14 +334,12 @@ fn convert(cfg: &Config, staged: bool) -> Result<Vec<(PathBuf, usize)>, Error> {
             && !single
             && !dir.as_os_str().is_empty()
         {
-            crate::shared::output::ensure_dir(dir)?;
+            outputs.ensure_dir(dir)?;
         }
-        write(&out, &data, cfg.format)?;
+        write(&outputs, &out, &data, cfg.format)?;
         written.push((out, data.rows()));
     }
-    if let Some(s) = staging {
-        s.commit()?;
-    }
+    outputs.commit()?;
     log("Done processing IMU data");
     Ok(written)
 }

@@ -146,7 +146,7 @@ pub enum Error {
         /// The output file.
         path: PathBuf,
         /// The backend's message.
-        what: String,
+        what: crate::shared::plot::DrawError,
     },
     /// A `.mat` file could not be read or written as an N×7 `data_imu`.
     #[error("{path}: {what}")]

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use crate::cursor::Le;
 use crate::error::Error;
-use crate::shared::output::write_atomic;
+use crate::shared::output::Outputs;
 
 /// The variable name bagconvert writes.
 pub const VAR_NAME: &str = "data_imu";
@@ -67,10 +67,11 @@ impl DataImu {
     }
 }
 
-/// Writes `data` as the variable `data_imu` into a v5 MAT file, atomically.
-pub fn write_data_imu(path: &Path, data: &DataImu) -> Result<(), Error> {
+/// Writes `data` as the variable `data_imu` into a v5 MAT file, atomically among the run's
+/// `outputs`.
+pub fn write_data_imu(outputs: &Outputs, path: &Path, data: &DataImu) -> Result<(), Error> {
     check_size(path, data)?;
-    write_atomic(path, |w| encode_data_imu(w, data))
+    outputs.write_atomic(path, |w| encode_data_imu(w, data))
 }
 
 /// Fails when the matrix is too large for a MAT v5 variable.
@@ -543,7 +544,7 @@ mod tests {
         for n in [0, 1, 7, 1000] {
             let p = dir.path().join(format!("m{n}.mat"));
             let d = sample(n);
-            write_data_imu(&p, &d).unwrap();
+            write_data_imu(&crate::shared::output::Outputs::direct(), &p, &d).unwrap();
             assert_eq!(std::fs::metadata(&p).unwrap().len(), 192 + 56 * n as u64);
             assert_eq!(read_data_imu(&p).unwrap(), d, "n = {n}");
         }
@@ -556,7 +557,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("long.mat");
         let d = sample(2 * VALUES_PER_READ + 3);
-        write_data_imu(&p, &d).unwrap();
+        write_data_imu(&crate::shared::output::Outputs::direct(), &p, &d).unwrap();
         assert_eq!(read_data_imu(&p).unwrap(), d);
         let good = std::fs::read(&p).unwrap();
         for len in [200, good.len() / 2, good.len() - 9] {
@@ -572,7 +573,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("v5.mat");
         let d = sample(5);
-        write_data_imu(&p, &d).unwrap();
+        write_data_imu(&crate::shared::output::Outputs::direct(), &p, &d).unwrap();
         let v5 = std::fs::read(&p).unwrap();
         let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
         z.write_all(&v5[128..]).unwrap();
@@ -591,7 +592,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("g.mat");
         let d = sample(3);
-        write_data_imu(&p, &d).unwrap();
+        write_data_imu(&crate::shared::output::Outputs::direct(), &p, &d).unwrap();
         let good = std::fs::read(&p).unwrap();
         for len in [0, 10, 128, 136, 150, 191, good.len() - 1] {
             std::fs::write(&p, &good[..len]).unwrap();

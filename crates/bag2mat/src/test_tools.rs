@@ -464,8 +464,7 @@ pub fn euroc_dataset_from_bag(
         quiet: true,
         input: Default::default(),
     };
-    // unstaged: tests run beside each other in one process
-    crate::convert::run_unstaged(&cfg).expect("bag2mat -o x.csv");
+    crate::convert::run(&cfg, crate::shared::output::Outputs::direct()).expect("bag2mat -o x.csv");
     let root = dir.join("dataset");
     euroc_from_bag2mat_csv(&csv, &root);
     root
@@ -615,7 +614,12 @@ pub fn euroc_pairing(log: &Path, gyro: &str, acc: &str, dir: &Path) -> PathBuf {
 pub fn retopic(src: &Path, topic: &str, dst: &Path, topics: &[&str]) {
     let s = crate::read_imu_series(src, topic, &crate::ReadOptions { quiet: true })
         .expect("read the source bag");
-    let mut w = crate::bag::BagWriter::create(dst, crate::Compression::None).expect("create");
+    let mut w = crate::bag::BagWriter::create(
+        &crate::shared::output::Outputs::direct(),
+        dst,
+        crate::Compression::None,
+    )
+    .expect("create");
     let conns: Vec<_> = topics.iter().map(|t| w.add_imu_connection(t)).collect();
     for i in 0..s.len() {
         let m = crate::imu_msg::Imu {

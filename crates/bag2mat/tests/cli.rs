@@ -152,7 +152,12 @@ fn the_only_imu_topic_is_the_default_and_several_must_be_named() {
     assert_eq!(bag2mat::mat::read_data_imu(&mat).unwrap().rows(), 300);
     let two = dir.path().join("two.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(&two, Compression::None).unwrap();
+        let mut w = bag2mat::bag::BagWriter::create(
+            &bag2mat::shared::output::Outputs::direct(),
+            &two,
+            Compression::None,
+        )
+        .unwrap();
         let a = w.add_imu_connection("/imu0");
         let b = w.add_imu_connection("/imu1");
         for i in 0..10 {

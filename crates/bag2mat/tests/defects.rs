@@ -525,7 +525,12 @@ fn defect_08_failed_outputs_leave_no_temp_files() {
     // temp file, and (all or none) no file of the other topic either.
     let two = dir.path().join("two.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(&two, Compression::None).unwrap();
+        let mut w = bag2mat::bag::BagWriter::create(
+            &bag2mat::shared::output::Outputs::direct(),
+            &two,
+            Compression::None,
+        )
+        .unwrap();
         let a = w.add_imu_connection("/imu0");
         let b = w.add_imu_connection("/imu1");
         for i in 0..100 {
@@ -635,7 +640,12 @@ fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("mixed.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(&bag, Compression::None).unwrap();
+        let mut w = bag2mat::bag::BagWriter::create(
+            &bag2mat::shared::output::Outputs::direct(),
+            &bag,
+            Compression::None,
+        )
+        .unwrap();
         let imu = w.add_imu_connection("imu");
         let other = bag2mat::test_tools::add_string_connection(&mut w, "imu");
         for i in 0..500 {

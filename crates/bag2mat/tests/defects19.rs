@@ -25,7 +25,8 @@ const N: u32 = 3000;
 /// A ROS 2 bag directory `dir` with `N` synthetic Imu messages on `imu` and a
 /// `std_msgs/String` message on `/status` every 100; returns its storage file.
 fn ros2_bag(dir: &Path, storage: Storage) -> PathBuf {
-    let mut w = Ros2BagWriter::create(dir, storage).unwrap();
+    let mut w =
+        Ros2BagWriter::create(&bag2mat::shared::output::Outputs::direct(), dir, storage).unwrap();
     w.set_mcap_chunk_size(8 * 1024);
     let t = w.add_imu_topic("imu").unwrap();
     let s = w

@@ -93,7 +93,13 @@ fn octave_and_scipy_load_our_mat() {
     let s = read_imu_series(&bag, "imu", &ReadOptions { quiet: true }).unwrap();
     let d = data_imu_from_series(&s, TimeColumn::Record);
     let mat = dir.path().join("m.mat");
-    write(&mat, &d, Format::Mat).unwrap();
+    write(
+        &bag2mat::shared::output::Outputs::direct(),
+        &mat,
+        &d,
+        Format::Mat,
+    )
+    .unwrap();
     // Octave prints the size, the first time at full precision, and the sum of each column.
     let script = format!(
         "load('{}'); printf('%d %d %.17g %.17g %.17g\\n', size(data_imu), data_imu(1,1), data_imu(end,7), data_imu(400,4));",
@@ -125,7 +131,13 @@ fn octave_and_scipy_load_our_mat() {
 
     // An empty matrix (0×7) loads too.
     let empty = dir.path().join("e.mat");
-    write(&empty, &bag2mat::mat::DataImu::default(), Format::Mat).unwrap();
+    write(
+        &bag2mat::shared::output::Outputs::direct(),
+        &empty,
+        &bag2mat::mat::DataImu::default(),
+        Format::Mat,
+    )
+    .unwrap();
     let (ok, out, err) = run(Command::new("octave")
         .args(["--no-gui", "--quiet", "--eval"])
         .arg(format!("load('{}'); disp(size(data_imu))", empty.display())));
@@ -174,8 +186,20 @@ fn numpy_loads_our_npy_and_csv() {
     }
     let npy = dir.path().join("d.npy");
     let csv = dir.path().join("d.csv");
-    write(&npy, &d, Format::Npy).unwrap();
-    write(&csv, &d, Format::Csv).unwrap();
+    write(
+        &bag2mat::shared::output::Outputs::direct(),
+        &npy,
+        &d,
+        Format::Npy,
+    )
+    .unwrap();
+    write(
+        &bag2mat::shared::output::Outputs::direct(),
+        &csv,
+        &d,
+        Format::Csv,
+    )
+    .unwrap();
     let code = format!(
         "import numpy as np; a = np.load('{}'); b = np.loadtxt('{}', delimiter=',', skiprows=1); print(a.shape, a.dtype, bool((a == b).all()), repr(float(a[49, 6])))",
         npy.display(),

@@ -409,6 +409,7 @@ fn damaged_mcap_and_db3_never_panic() {
     // other chunks are read and the loss is named.
     let ours_dir = dir.path().join("ours");
     let mut w = bag2mat::Ros2BagWriter::create(
+        &bag2mat::shared::output::Outputs::direct(),
         &ours_dir,
         bag2mat::Storage::Mcap(bag2mat::mcap::ChunkCompression::None),
     )

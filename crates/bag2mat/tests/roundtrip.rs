@@ -155,7 +155,12 @@ fn missing_topic_lists_every_topic() {
 fn out_of_order_record_times_come_out_sorted() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("ooo.bag");
-    let mut w = BagWriter::create(&path, Compression::None).unwrap();
+    let mut w = BagWriter::create(
+        &bag2mat::shared::output::Outputs::direct(),
+        &path,
+        Compression::None,
+    )
+    .unwrap();
     let c = w.add_imu_connection("imu");
     let order = [0u32, 2, 1, 4, 3, 5];
     for &i in &order {
@@ -246,7 +251,12 @@ fn unfinished_writer_leaves_nothing_behind() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("never.bag");
     {
-        let mut w = BagWriter::create(&path, Compression::Lz4).unwrap();
+        let mut w = BagWriter::create(
+            &bag2mat::shared::output::Outputs::direct(),
+            &path,
+            Compression::Lz4,
+        )
+        .unwrap();
         let c = w.add_imu_connection("imu");
         for i in 0..5000 {
             let (t, imu) = synthetic(i);
@@ -276,7 +286,12 @@ fn matrix_routes_agree_and_sort() {
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("ooo.bag");
-    let mut w = BagWriter::create(&path, Compression::None).unwrap();
+    let mut w = BagWriter::create(
+        &bag2mat::shared::output::Outputs::direct(),
+        &path,
+        Compression::None,
+    )
+    .unwrap();
     let c = w.add_imu_connection("imu");
     for i in [0u32, 2, 1, 4, 3, 5] {
         let (t, imu) = synthetic(i);

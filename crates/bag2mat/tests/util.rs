@@ -44,7 +44,12 @@ pub fn synthetic(i: u32) -> (RosTime, Imu) {
 
 /// Writes `n` synthetic messages on `topic` (plus an optional second, non-Imu topic).
 pub fn write_synthetic(path: &Path, topic: &str, n: u32, compression: Compression, extra: bool) {
-    let mut w = BagWriter::create(path, compression).unwrap();
+    let mut w = BagWriter::create(
+        &bag2mat::shared::output::Outputs::direct(),
+        path,
+        compression,
+    )
+    .unwrap();
     let c = w.add_imu_connection(topic);
     let s = extra.then(|| bag2mat::test_tools::add_string_connection(&mut w, "/status"));
     for i in 0..n {

@@ -21,6 +21,7 @@ use bag2mat::bag::BagWriter;
 use bag2mat::bag::write::ConnId;
 use bag2mat::imu_msg::Imu;
 use bag2mat::mcap::ChunkCompression;
+use bag2mat::shared::output::Outputs;
 use bag2mat::{Compression, RosTime};
 use bag2mat::{Ros2BagWriter, Storage, TopicId};
 use std::path::{Path, PathBuf};
@@ -110,16 +111,18 @@ pub struct ImuBagSink {
 impl ImuBagSink {
     /// Create the bag (a temp file until [`ImuBagSink::finish`]) with one Imu topic.
     pub fn create(
+        outputs: &Outputs,
         path: &std::path::Path,
         compression: Compression,
         topic: &str,
         frame_id: &str,
     ) -> Result<Self> {
-        Self::create_format(path, BagFormat::Ros1, compression, topic, frame_id)
+        Self::create_format(outputs, path, BagFormat::Ros1, compression, topic, frame_id)
     }
 
     /// Create a bag of the given format (a ROS 2 bag is a directory) with one Imu topic.
     pub fn create_format(
+        outputs: &Outputs,
         path: &std::path::Path,
         format: BagFormat,
         compression: Compression,
@@ -128,17 +131,17 @@ impl ImuBagSink {
     ) -> Result<Self> {
         let writer = match format {
             BagFormat::Ros1 => {
-                let mut w = BagWriter::create(path, compression)?;
+                let mut w = BagWriter::create(outputs, path, compression)?;
                 let c = w.add_imu_connection(topic);
                 SinkWriter::Ros1(w, c)
             }
             BagFormat::Mcap(c) => {
-                let mut w = Ros2BagWriter::create(path, Storage::Mcap(c))?;
+                let mut w = Ros2BagWriter::create(outputs, path, Storage::Mcap(c))?;
                 let t = w.add_imu_topic(topic)?;
                 SinkWriter::Ros2(Box::new(w), t)
             }
             BagFormat::Sqlite3 => {
-                let mut w = Ros2BagWriter::create(path, Storage::Sqlite3)?;
+                let mut w = Ros2BagWriter::create(outputs, path, Storage::Sqlite3)?;
                 let t = w.add_imu_topic(topic)?;
                 SinkWriter::Ros2(Box::new(w), t)
             }
@@ -303,14 +306,15 @@ pub fn message_count(rate: f64, duration: f64) -> u64 {
     Grid::AccumulatedF64.times(duration, rate).count() as u64
 }
 
-/// Write the bag.
-pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
+/// Write the bag (and its truth files) among `outputs`.
+pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
     validate(cfg)?;
     check_disk(cfg)?;
     let n = message_count(cfg.rate, cfg.duration);
     let pb = bag2mat::shared::progress::bar(n, cfg.quiet, "msgs");
     pb.set_message("writing");
     let mut sink = ImuBagSink::create_format(
+        outputs,
         &cfg.out,
         cfg.format,
         cfg.compression,
@@ -366,17 +370,20 @@ pub fn run(cfg: &BagConfig) -> Result<BagSummary> {
     pb.set_message("indexing");
     let mut s = sink.finish()?;
     pb.set_message("truth");
-    s.truth = crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {
-        bag: &cfg.out,
-        model: &cfg.model,
-        rate: cfg.rate,
-        samples: n as usize,
-        seed: cfg.seed,
-        motion: match cfg.motion {
-            Motion::Static => "static",
-            Motion::Ellipse => "ellipse",
+    s.truth = crate::noise::truth_file::write(
+        outputs,
+        &crate::noise::truth_file::TruthInfo {
+            bag: &cfg.out,
+            model: &cfg.model,
+            rate: cfg.rate,
+            samples: n as usize,
+            seed: cfg.seed,
+            motion: match cfg.motion {
+                Motion::Static => "static",
+                Motion::Ellipse => "ellipse",
+            },
         },
-    })?
+    )?
     .to_vec();
     pb.finish_and_clear();
     Ok(s)

@@ -3,6 +3,8 @@
 
 use std::process::ExitCode;
 
+use bag2mat::shared::output::Outputs;
+
 use crate::cli::{BagArgs, Cli, Command, SplineArgs, TrajArgs};
 
 /// Standard output through the workspace's one writer: a closed pipe (`| head`) ends the
@@ -16,12 +18,15 @@ fn out(text: &str) -> anyhow::Result<()> {
 /// Runs the command the user typed and says what it did (stderr) and found (stdout); the
 /// exit code is a failed `--check` or self-check's, errors come back once to the binary.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    // Each file is put in place when complete: a bag is one file (or one directory's
+    // rename), and the other commands' files stand alone.
+    let outputs = Outputs::direct();
     match cli.command {
-        Command::Bag(a) => run_bag(*a)?,
-        Command::Traj(a) => run_traj(a)?,
+        Command::Bag(a) => run_bag(*a, &outputs)?,
+        Command::Traj(a) => run_traj(a, &outputs)?,
         Command::Integrate(a) => {
             let cfg = crate::integrate::IntegrateConfig::try_from(a)?;
-            let (table, files) = crate::integrate::run(&cfg)?;
+            let (table, files) = crate::integrate::run(&cfg, &outputs)?;
             out(&crate::integrate::format_table(&table))?;
             for f in files {
                 eprintln!("wrote {}", f.display());
@@ -29,7 +34,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Command::Compare(a) => {
             let cfg = crate::compare::CompareConfig::try_from(a)?;
-            let (text, pass) = crate::compare::run(&cfg)?;
+            let (text, pass) = crate::compare::run(&cfg, &outputs)?;
             out(&text)?;
             if !pass {
                 return Ok(ExitCode::FAILURE);
@@ -43,14 +48,14 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 out(&crate::noise::profiles::listing(a.rate))?;
             }
         }
-        Command::Spline(a) => return run_spline(a),
+        Command::Spline(a) => return run_spline(a, &outputs),
     }
     Ok(ExitCode::SUCCESS)
 }
 
 /// `sim bag`: refused before any work when it cannot fit, its size said up front, then the
 /// run and what it wrote (stderr, unless quiet).
-fn run_bag(a: BagArgs) -> anyhow::Result<()> {
+fn run_bag(a: BagArgs, outputs: &Outputs) -> anyhow::Result<()> {
     let cfg = crate::bag_sim::BagConfig::try_from(a)?;
     crate::bag_sim::validate(&cfg)?;
     crate::bag_sim::check_disk(&cfg)?;
@@ -66,7 +71,7 @@ fn run_bag(a: BagArgs) -> anyhow::Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let s = crate::bag_sim::run(&cfg)?;
+    let s = crate::bag_sim::run(&cfg, outputs)?;
     if !cfg.quiet {
         eprintln!("{}", crate::report::bag_done(&cfg, &s));
     }
@@ -74,10 +79,10 @@ fn run_bag(a: BagArgs) -> anyhow::Result<()> {
 }
 
 /// `sim traj`: the noise model, the run, and what it wrote (stderr).
-fn run_traj(a: TrajArgs) -> anyhow::Result<()> {
+fn run_traj(a: TrajArgs, outputs: &Outputs) -> anyhow::Result<()> {
     let cfg = crate::traj::TrajConfig::try_from(a)?;
     eprintln!("{}", cfg.noise.describe(cfg.rate));
-    let s = crate::traj::run(&cfg)?;
+    let s = crate::traj::run(&cfg, outputs)?;
     eprintln!(
         "wrote {} files into {} ({} IMU samples, {} camera frames, {} landmarks)",
         s.files,
@@ -90,7 +95,7 @@ fn run_traj(a: TrajArgs) -> anyhow::Result<()> {
 }
 
 /// `sim spline`: the self-check (its verdict is the exit code), or the run and its summary.
-fn run_spline(a: SplineArgs) -> anyhow::Result<ExitCode> {
+fn run_spline(a: SplineArgs, outputs: &Outputs) -> anyhow::Result<ExitCode> {
     if a.self_check {
         let (text, pass) = crate::report::spline_self_check(a.pose_rate)?;
         out(&text)?;
@@ -104,7 +109,7 @@ fn run_spline(a: SplineArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = &cfg.noise {
         eprintln!("{}", n.describe(cfg.rate));
     }
-    let s = crate::spline_sim::run(&cfg)?;
+    let s = crate::spline_sim::run(&cfg, outputs)?;
     out(&crate::report::spline_summary(&s))?;
     Ok(ExitCode::SUCCESS)
 }

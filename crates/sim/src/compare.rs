@@ -99,12 +99,15 @@ pub struct CompareConfig {
 /// `sim compare`: writes the tables and plots; with `check`, prints every failed assertion
 /// on stderr. Returns what goes to standard output (the tables, and the checks' count) and
 /// false when a check failed.
-pub fn run(cfg: &CompareConfig) -> Result<(String, bool)> {
+pub fn run(
+    cfg: &CompareConfig,
+    outputs: &bag2mat::shared::output::Outputs,
+) -> Result<(String, bool)> {
     let c = compare(cfg)?;
     let md = markdown(&c);
-    bag2mat::shared::output::write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
+    outputs.write_atomic(&cfg.output, |w| w.write_all(md.as_bytes()))?;
     eprintln!("wrote {}", cfg.output.display());
-    for f in crate::compare_plot::plot(&cfg.root, &cfg.presets, cfg.rate, cfg.duration)? {
+    for f in crate::compare_plot::plot(outputs, &cfg.root, &cfg.presets, cfg.rate, cfg.duration)? {
         eprintln!("wrote {}", f.display());
     }
     if !cfg.check {

@@ -138,12 +138,11 @@ fn draw<DB: DrawingBackend>(
     title: &str,
     unit: &str,
     curves: &[Curves],
-) -> std::result::Result<(), String>
+) -> std::result::Result<(), bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: &dyn std::fmt::Display| x.to_string();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
+    root.fill(&WHITE)?;
     let Some((t0, t1, y0, y1)) = tool_bounds(curves) else {
         return Err("no curve points to draw".into());
     };
@@ -152,8 +151,7 @@ where
         .margin(20)
         .x_label_area_size(60)
         .y_label_area_size(100)
-        .build_cartesian_2d((t0..t1).log_scale(), (y0 / 1.5..y1 * 1.5).log_scale())
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d((t0..t1).log_scale(), (y0 / 1.5..y1 * 1.5).log_scale())?;
     chart
         .configure_mesh()
         .x_desc("τ [s]")
@@ -162,16 +160,13 @@ where
         .axis_desc_style(("sans-serif", 22))
         .x_label_formatter(&|v| format!("{v:.0e}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     // The truth first, under the tools' curves.
     for (i, c) in curves.iter().enumerate() {
-        let truth = chart
-            .draw_series(LineSeries::new(
-                truth_points(c, t0, t1),
-                BLACK.stroke_width(2),
-            ))
-            .map_err(|x| e(&x))?;
+        let truth = chart.draw_series(LineSeries::new(
+            truth_points(c, t0, t1),
+            BLACK.stroke_width(2),
+        ))?;
         if i == 0 {
             truth.label(truth_label(c)).legend(|(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
@@ -187,16 +182,14 @@ where
                 c.ieee
                     .iter()
                     .map(|&p| Circle::new(p, 4, col.stroke_width(1))),
-            )
-            .map_err(|x| e(&x))?
+            )?
             .label(format!("{}: IEEE 952 overlapping (mean of axes)", c.preset))
             .legend(move |(x, y)| Circle::new((x + 10, y), 4, col.stroke_width(1)));
         chart
             .draw_series(LineSeries::new(
                 c.kalibr.iter().copied(),
                 col.mix(0.8).stroke_width(2),
-            ))
-            .map_err(|x| e(&x))?
+            ))?
             .label(format!("{}: kalibr_allan (non-overlapping, avg)", c.preset))
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], col.mix(0.8).stroke_width(3))
@@ -208,8 +201,7 @@ where
         .label_font(("sans-serif", 16))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .draw()?;
     bag2mat::shared::plot::present(&root)
 }
 
@@ -225,7 +217,7 @@ impl bag2mat::shared::plot::Figure for Compare<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         _scale: f64,
-    ) -> std::result::Result<(), String>
+    ) -> std::result::Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -235,7 +227,13 @@ impl bag2mat::shared::plot::Figure for Compare<'_> {
 
 /// Writes `compare_gyro.{png,svg}` and `compare_acc.{png,svg}` into the comparison `root`
 /// (the presets' folders under it; `rate` and `duration` of the bags for the title).
-pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result<Vec<PathBuf>> {
+pub fn plot(
+    outputs: &bag2mat::shared::output::Outputs,
+    root: &Path,
+    presets: &[Preset],
+    rate: f64,
+    duration: f64,
+) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for (sensor, column, axes, unit) in [
         ("gyro", "gyro_avg", ["gx", "gy", "gz"], "rad/s"),
@@ -275,6 +273,7 @@ pub fn plot(root: &Path, presets: &[Preset], rate: f64, duration: f64) -> Result
             rate, duration
         );
         files.extend(bag2mat::shared::plot::write_png_svg(
+            outputs,
             &Compare {
                 title: &title,
                 unit,

@@ -31,14 +31,6 @@ pub enum SimError {
     /// The spline cannot be built from the given poses.
     #[error("spline: {0}")]
     Spline(String),
-    /// Drawing a plot failed.
-    #[error("plot {path}: {msg}")]
-    Plot {
-        /// The output file.
-        path: PathBuf,
-        /// The backend's message.
-        msg: String,
-    },
     /// A tool output read by `sim compare` is missing or malformed.
     #[error("comparison input: {0}")]
     Input(String),

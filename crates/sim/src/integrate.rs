@@ -292,7 +292,11 @@ fn init_state(cfg: &IntegrateConfig, rows: &[PoseRow]) -> crate::Result<State> {
 
 /// Run `sim integrate`: integrate, write `imu_int_pose*.txt`, plot. Returns the table rows
 /// and the files written.
-pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)> {
+/// Every file goes among `outputs`.
+pub fn run(
+    cfg: &IntegrateConfig,
+    outputs: &bag2mat::shared::output::Outputs,
+) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)> {
     use crate::textio::{NumFormat, format_int_rows, write_string};
     if !(cfg.dt.is_finite() && cfg.dt > 0.0) {
         return Err(crate::SimError::InvalidArgument(format!(
@@ -322,6 +326,7 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
             };
             let path = cfg.out_dir.join(format!("imu_int_pose{suffix}.txt"));
             write_string(
+                outputs,
                 &path,
                 &format_int_rows(&int_rows(rows, &states), NumFormat::CppG),
             )?;
@@ -346,7 +351,7 @@ pub fn run(cfg: &IntegrateConfig) -> crate::Result<(Vec<TableRow>, Vec<PathBuf>)
                 rows.len(),
                 cfg.dt
             );
-            crate::plot::plot_integration(&stem, &title, rows, &t)?;
+            crate::plot::plot_integration(outputs, &stem, &title, rows, &t)?;
             files.push(stem.with_extension("png"));
             files.push(stem.with_extension("svg"));
         }

@@ -223,24 +223,24 @@ fn draw<DB: DrawingBackend>(
     title: &str,
     truth: &[PoseRow],
     tracks: &[Track],
-) -> std::result::Result<(), String>
+) -> std::result::Result<(), bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: &dyn std::fmt::Display| x.to_string();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let root = root.titled(title, ("sans-serif", 28)).map_err(|x| e(&x))?;
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 28))?;
     let panels = root.split_evenly((1, 3));
     let (t0, t1) = range(truth.iter().map(|r| r.t));
-    top_view(&panels[0], truth, tracks).map_err(|x| e(&x))?;
-    z_over_time(&panels[1], truth, tracks, (t0, t1)).map_err(|x| e(&x))?;
-    position_error(&panels[2], truth, tracks, (t0, t1)).map_err(|x| e(&x))?;
+    top_view(&panels[0], truth, tracks)?;
+    z_over_time(&panels[1], truth, tracks, (t0, t1))?;
+    position_error(&panels[2], truth, tracks, (t0, t1))?;
     bag2mat::shared::plot::present(&root)?;
     Ok(())
 }
 
 /// Draw `stem.png` and `stem.svg` (the workspace's PNG+SVG writer, atomically).
 pub fn plot_integration(
+    outputs: &bag2mat::shared::output::Outputs,
     stem: &Path,
     title: &str,
     truth: &[PoseRow],
@@ -255,6 +255,7 @@ pub fn plot_integration(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     bag2mat::shared::plot::write_png_svg(
+        outputs,
         &Integration {
             title,
             truth,
@@ -280,7 +281,7 @@ impl bag2mat::shared::plot::Figure for Integration<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         _scale: f64,
-    ) -> std::result::Result<(), String>
+    ) -> std::result::Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {

@@ -10,6 +10,7 @@ use crate::noise::{ContinuousNoise, NoiseGenerator};
 use crate::rotation::quat_from_matrix;
 use crate::spline::{Fit, FitReport, Pose, SplitSpline, knots_from_poses, model_poses};
 use crate::textio::{NumFormat, PoseRow, format_pose_rows, format_tum, read_tum, write_string};
+use bag2mat::shared::output::Outputs;
 use bag2mat::{Compression, RosTime};
 use std::path::{Path, PathBuf};
 
@@ -93,7 +94,8 @@ pub struct SplineSummary {
 pub const TRIM_KNOTS: i64 = 10;
 
 /// Run `sim spline`: checks, fit, emission, text files, bag, truth.
-pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
+/// Every file goes among `outputs`.
+pub fn run(cfg: &SplineConfig, outputs: &Outputs) -> Result<SplineSummary> {
     if !(cfg.rate.is_finite() && cfg.rate > 0.0) {
         return Err(SimError::InvalidArgument(format!(
             "--rate must be positive, got {}",
@@ -114,9 +116,9 @@ pub fn run(cfg: &SplineConfig) -> Result<SplineSummary> {
     let (dir, bag_path) = output_paths(&cfg.out);
     std::fs::create_dir_all(&dir).map_err(|e| SimError::io(&dir, e))?;
     let emitted = emit(cfg, &spline, t_start, t_end);
-    let mut files = write_text_files(cfg, &dir, &emitted, &poses)?;
-    let bag = write_bag(cfg, &bag_path, &emitted.noisy, t_start)?;
-    let truth = write_truth(cfg, &bag_path, emitted.noisy.len())?;
+    let mut files = write_text_files(outputs, cfg, &dir, &emitted, &poses)?;
+    let bag = write_bag(outputs, cfg, &bag_path, &emitted.noisy, t_start)?;
+    let truth = write_truth(outputs, cfg, &bag_path, emitted.noisy.len())?;
     files.push(bag_path);
     files.extend(truth);
     Ok(SplineSummary {
@@ -242,6 +244,7 @@ fn emit(cfg: &SplineConfig, spline: &SplitSpline, t_start: i64, t_end: i64) -> E
 
 /// `imu_pose.txt`, `imu_pose_noise.txt` and with `--from-model` `model_poses.tum` into `dir`.
 fn write_text_files(
+    outputs: &Outputs,
     cfg: &SplineConfig,
     dir: &Path,
     emitted: &Emitted,
@@ -249,10 +252,18 @@ fn write_text_files(
 ) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let p = dir.join("imu_pose.txt");
-    write_string(&p, &format_pose_rows(&emitted.clean, NumFormat::Full))?;
+    write_string(
+        outputs,
+        &p,
+        &format_pose_rows(&emitted.clean, NumFormat::Full),
+    )?;
     files.push(p);
     let p = dir.join("imu_pose_noise.txt");
-    write_string(&p, &format_pose_rows(&emitted.noisy, NumFormat::Full))?;
+    write_string(
+        outputs,
+        &p,
+        &format_pose_rows(&emitted.noisy, NumFormat::Full),
+    )?;
     files.push(p);
     if let PoseSource::Model { .. } = cfg.source {
         let p = dir.join("model_poses.tum");
@@ -260,7 +271,7 @@ fn write_text_files(
             .iter()
             .map(|q| (q.t_ns as f64 * 1e-9, q.p, quat_from_matrix(&q.r)))
             .collect();
-        write_string(&p, &format_tum(&rows, 9, 9))?;
+        write_string(outputs, &p, &format_tum(&rows, 9, 9))?;
         files.push(p);
     }
     Ok(files)
@@ -269,6 +280,7 @@ fn write_text_files(
 /// The bag of the noisy IMU, record time = stamp: sample i at t_start + round(i·1e9/rate),
 /// shifted to `--start-time`, kept if already absolute (≥ 1e9 s), else to now.
 fn write_bag(
+    outputs: &Outputs,
     cfg: &SplineConfig,
     bag_path: &Path,
     noisy: &[PoseRow],
@@ -280,7 +292,13 @@ fn write_bag(
         None => now_ns() as i64 - t_start,
     };
     let pb = bag2mat::shared::progress::bar(noisy.len() as u64, cfg.quiet, "msgs");
-    let mut sink = ImuBagSink::create(bag_path, cfg.compression, &cfg.topic, &cfg.frame_id)?;
+    let mut sink = ImuBagSink::create(
+        outputs,
+        bag_path,
+        cfg.compression,
+        &cfg.topic,
+        &cfg.frame_id,
+    )?;
     for (i, r) in noisy.iter().enumerate() {
         let t_ns = t_start + (i as f64 * 1e9 / cfg.rate).round() as i64 + offset;
         if t_ns < 0 {
@@ -302,7 +320,12 @@ fn write_bag(
 }
 
 /// The truth beside the bag: the noise model (zero with --no-noise) and its Allan deviation.
-fn write_truth(cfg: &SplineConfig, bag_path: &Path, samples: usize) -> Result<[PathBuf; 2]> {
+fn write_truth(
+    outputs: &Outputs,
+    cfg: &SplineConfig,
+    bag_path: &Path,
+    samples: usize,
+) -> Result<[PathBuf; 2]> {
     let model = crate::noise::model::ImuModel::from_continuous(
         if cfg.noise.is_some() {
             "spline"
@@ -311,14 +334,17 @@ fn write_truth(cfg: &SplineConfig, bag_path: &Path, samples: usize) -> Result<[P
         },
         &cfg.noise.unwrap_or(ContinuousNoise::ZERO),
     );
-    crate::noise::truth_file::write(&crate::noise::truth_file::TruthInfo {
-        bag: bag_path,
-        model: &model,
-        rate: cfg.rate,
-        samples,
-        seed: cfg.seed,
-        motion: "spline",
-    })
+    crate::noise::truth_file::write(
+        outputs,
+        &crate::noise::truth_file::TruthInfo {
+            bag: bag_path,
+            model: &model,
+            rate: cfg.rate,
+            samples,
+            seed: cfg.seed,
+            motion: "spline",
+        },
+    )
 }
 
 #[cfg(test)]
@@ -337,7 +363,7 @@ mod tests {
             .map(|p| (p.t_ns as f64 * 1e-9, p.p, quat_from_matrix(&p.r)))
             .collect();
         let path = d.path().join("m.tum");
-        write_string(&path, &format_tum(&rows, 9, 9)).unwrap();
+        write_string(&Outputs::direct(), &path, &format_tum(&rows, 9, 9)).unwrap();
         let cfg = SplineConfig {
             source: PoseSource::Tum(path),
             knot_dt_ns: None,
@@ -355,7 +381,7 @@ mod tests {
             gravity: crate::spline::GRAVITY,
             quiet: true,
         };
-        let s = run(&cfg).unwrap();
+        let s = run(&cfg, &Outputs::direct()).unwrap();
         assert_eq!(s.samples, 8001);
         let clean = crate::textio::read_pose_rows(&d.path().join("out/imu_pose.txt")).unwrap();
         let (mut mg, mut ma) = (0.0f64, 0.0f64);

@@ -6,6 +6,7 @@ use crate::error::{Result, SimError};
 use crate::rotation::matrix_from_quat;
 use crate::spline::Pose;
 use bag2mat::shared::cfmt::push_g;
+use bag2mat::shared::output::Outputs;
 use nalgebra::Vector3;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -43,9 +44,9 @@ pub struct PoseRow {
     pub acc: Vector3<f64>,
 }
 
-/// Write a file atomically from a string.
-pub fn write_string(path: &Path, s: &str) -> Result<()> {
-    bag2mat::shared::output::write_atomic(path, |w| w.write_all(s.as_bytes()))?;
+/// Write a file atomically from a string, among the run's `outputs`.
+pub fn write_string(outputs: &Outputs, path: &Path, s: &str) -> Result<()> {
+    outputs.write_atomic(path, |w| w.write_all(s.as_bytes()))?;
     Ok(())
 }
 
@@ -266,7 +267,12 @@ mod tests {
         ];
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("x.txt");
-        write_string(&p, &format_pose_rows(&rows, NumFormat::Full)).unwrap();
+        write_string(
+            &Outputs::direct(),
+            &p,
+            &format_pose_rows(&rows, NumFormat::Full),
+        )
+        .unwrap();
         assert_eq!(read_pose_rows(&p).unwrap(), rows);
         let g = format_pose_rows(&rows[..1], NumFormat::CppG);
         assert_eq!(

@@ -17,6 +17,7 @@ use crate::noise::{ContinuousNoise, NoiseGenerator};
 use crate::rotation::quat_from_matrix;
 use crate::textio::{NumFormat, PoseRow, format_pose_rows, format_tum, write_string};
 use bag2mat::shared::cfmt::push_g;
+use bag2mat::shared::output::Outputs;
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 
@@ -214,7 +215,8 @@ fn frame_lines_text(f: &CamFrame, lines: &[Segment]) -> String {
 
 /// Write every file of `sim traj` into `cfg.out_dir`: the upstream `master` file writer top
 /// to bottom, one block per file.
-pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
+/// Every file goes among `outputs`.
+pub fn run(cfg: &TrajConfig, outputs: &Outputs) -> Result<TrajSummary> {
     if !(cfg.duration > 0.0 && cfg.rate > 0.0 && cfg.cam_rate > 0.0) {
         return Err(SimError::InvalidArgument(
             "duration, rate and cam-rate must be positive".into(),
@@ -226,7 +228,7 @@ pub fn run(cfg: &TrajConfig) -> Result<TrajSummary> {
     let mut files = 0;
     let mut write = |name: &Path, s: &str| -> Result<()> {
         files += 1;
-        write_string(name, s)
+        write_string(outputs, name, s)
     };
 
     // Landmarks.

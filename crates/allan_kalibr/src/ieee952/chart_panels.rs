@@ -12,19 +12,18 @@ pub(super) fn titled_panels<DB: DrawingBackend>(
     title: &str,
     axes: usize,
     scale: f64,
-) -> Result<Vec<DrawingArea<DB, Shift>>, String>
+) -> Result<Vec<DrawingArea<DB, Shift>>, bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
     let px = |v: f64| (v * scale).round() as u32;
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE)?;
     let (top, body) = root.split_vertically(px(40.0));
     top.draw(&Text::new(
         title.to_string(),
         (px(12.0) as i32, px(10.0) as i32),
         ("sans-serif", px(18.0)),
-    ))
-    .map_err(|e| e.to_string())?;
+    ))?;
     Ok(body.split_evenly((axes.div_ceil(3).max(1), 3)))
 }
 

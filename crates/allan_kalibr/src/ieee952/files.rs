@@ -153,8 +153,9 @@ pub(crate) fn stated_samples(text: &str) -> Option<usize> {
 }
 
 /// Writes the terms and curves CSVs and the three configuration files into `dir`, each name
-/// prefixed with `prefix`; returns the paths.
+/// prefixed with `prefix`, among the run's `outputs`; returns the paths.
 pub fn write_outputs(
+    outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     dir: &Path,
     prefix: &str,
@@ -163,7 +164,7 @@ pub fn write_outputs(
     let mut files = Vec::new();
     let mut put = |name: &str, text: String| -> Result<(), bag2mat::Error> {
         let p = dir.join(format!("{prefix}{name}"));
-        bag2mat::shared::output::write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
+        outputs.write_atomic(&p, |w| w.write_all(text.as_bytes()))?;
         files.push(p);
         Ok(())
     };

@@ -78,6 +78,7 @@ pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
 /// writer) and, where the analysis has PSDs, the PSD chart beside it
 /// (`psd_plot`), the two rendered in parallel; returns the paths.
 pub fn write_chart(
+    outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     title: &str,
     truth: Option<&Truth>,
@@ -93,6 +94,7 @@ pub fn write_chart(
     let (allan, psd) = rayon::join(
         || {
             bag2mat::shared::plot::write_png_svg(
+                outputs,
                 &Chart { a, title, truth },
                 dir,
                 &format!("{prefix}{STEM}"),
@@ -100,7 +102,7 @@ pub fn write_chart(
                 psize,
             )
         },
-        || super::psd_plot::write_psd_chart(a, title, dir, prefix),
+        || super::psd_plot::write_psd_chart(outputs, a, title, dir, prefix),
     );
     let mut out = allan?.to_vec();
     out.extend(psd?.into_iter().flatten());
@@ -119,7 +121,7 @@ impl bag2mat::shared::plot::Figure for Chart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -133,7 +135,7 @@ fn draw<DB: DrawingBackend>(
     truth: Option<&Truth>,
     root: &DrawingArea<DB, Shift>,
     scale: f64,
-) -> Result<(), String>
+) -> Result<(), bag2mat::shared::plot::DrawError>
 where
     DB::ErrorType: 'static,
 {
@@ -145,7 +147,7 @@ where
     )?;
     for (i, ax) in a.axes.iter().enumerate() {
         let t = truth.and_then(|t| t.get(i)).map(|v| v.as_slice());
-        panel(ax, t, &panels[i], scale).map_err(|e| e.to_string())?;
+        panel(ax, t, &panels[i], scale)?;
     }
     Ok(())
 }

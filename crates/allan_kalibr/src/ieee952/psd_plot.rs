@@ -29,6 +29,7 @@ pub const STEM: &str = "ieee952_psd";
 /// Draws `<dir>/<prefix>ieee952_psd.{png,svg}`; `None` when no axis has a PSD (a curve
 /// given without its samples).
 pub(crate) fn write_psd_chart(
+    outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     title: &str,
     dir: &Path,
@@ -44,6 +45,7 @@ pub(crate) fn write_psd_chart(
         (size.1 as f64 * PNG_SCALE) as u32,
     );
     bag2mat::shared::plot::write_png_svg(
+        outputs,
         &PsdChart { a, title },
         dir,
         &format!("{prefix}{STEM}"),
@@ -63,7 +65,7 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
@@ -77,7 +79,7 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
             scale,
         )?;
         for (i, ax) in self.a.axes.iter().enumerate() {
-            panel(ax, &panels[i], scale).map_err(|e| e.to_string())?;
+            panel(ax, &panels[i], scale)?;
         }
         Ok(())
     }

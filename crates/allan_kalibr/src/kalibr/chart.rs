@@ -46,9 +46,14 @@ pub struct Chart<'a> {
 
 /// Draws `chart` into `<stem>.png` and `<stem>.svg` under `dir` (the workspace's PNG+SVG
 /// writer); returns the two paths.
-pub(crate) fn write_chart(chart: &Chart, dir: &Path, stem: &str) -> Result<[PathBuf; 2], Error> {
+pub(crate) fn write_chart(
+    outputs: &bag2mat::shared::output::Outputs,
+    chart: &Chart,
+    dir: &Path,
+    stem: &str,
+) -> Result<[PathBuf; 2], Error> {
     Ok(bag2mat::shared::plot::write_png_svg(
-        chart, dir, stem, SVG_SIZE, PNG_SIZE,
+        outputs, chart, dir, stem, SVG_SIZE, PNG_SIZE,
     )?)
 }
 
@@ -57,11 +62,11 @@ impl bag2mat::shared::plot::Figure for Chart<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), bag2mat::shared::plot::DrawError>
     where
         DB::ErrorType: 'static,
     {
-        draw(self, root, scale).map_err(|e| e.to_string())
+        Ok(draw(self, root, scale)?)
     }
 }
 

@@ -165,13 +165,15 @@ fn mat_cases() -> Vec<Outcome> {
     }
     let dir = tempfile::tempdir().expect("temp dir");
     let mat = dir.path().join("bmi088_like.mat");
-    bag2mat::mat::write_data_imu(&mat, &data).expect("write .mat");
+    bag2mat::mat::write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &data)
+        .expect("write .mat");
     drop(data);
     let out = dir.path().join("out");
     let mut config = allan_kalibr::Config::new(allan_kalibr::Input::Samples(mat), out.clone());
     config.common.topics = bag2mat::TopicSelector::one("/imu0");
     config.title = "bmi088-like".into();
-    allan_kalibr::run(&config).expect("allan_kalibr run on the .mat");
+    allan_kalibr::run(&config, &bag2mat::shared::output::Outputs::direct())
+        .expect("allan_kalibr run on the .mat");
     let rows = crate::ieee952::terms(&out);
     let mut out_cases = Vec::new();
     for (s, sname) in [

@@ -17,7 +17,7 @@ use super::Compression;
 use super::record::{self, ChunkInfo, Connection, MAGIC};
 use crate::error::Error;
 use crate::imu_msg::{self, Imu};
-use crate::shared::output::AtomicFile;
+use crate::shared::output::{AtomicFile, Outputs};
 use crate::time::RosTime;
 
 /// rosbag's default chunk threshold: a chunk is closed once its body reaches 768 KiB.
@@ -160,9 +160,14 @@ pub struct BagWriter {
 }
 
 impl BagWriter {
-    /// Starts a bag at `path` (written as a temporary file until [`BagWriter::finish`]).
-    pub fn create(path: &Path, compression: Compression) -> Result<BagWriter, Error> {
-        let mut out = AtomicFile::create(path)?;
+    /// Starts a bag at `path` among the run's `outputs` (written as a temporary file until
+    /// [`BagWriter::finish`]).
+    pub fn create(
+        outputs: &Outputs,
+        path: &Path,
+        compression: Compression,
+    ) -> Result<BagWriter, Error> {
+        let mut out = AtomicFile::create(outputs, path)?;
         let header = record::bag_header(0, 0, 0);
         let w = out.writer();
         w.write_all(MAGIC)

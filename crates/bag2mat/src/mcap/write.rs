@@ -12,7 +12,7 @@ use super::record::{
     self, ChunkHeader, ChunkIndex, MAGIC, MessageIndex, MessageRef, Op, Put, Schema, Statistics,
 };
 use crate::error::Error;
-use crate::shared::output::AtomicFile;
+use crate::shared::output::{AtomicFile, Outputs};
 
 /// Chunks are closed once their records reach this size (rosbag2's MCAP default, 768 KiB).
 pub const DEFAULT_CHUNK_SIZE: usize = 768 * 1024;
@@ -63,11 +63,12 @@ pub struct McapWriter {
 impl McapWriter {
     /// Starts a file at `path` with the given profile (`ros2` for ROS 2 bags).
     pub fn create(
+        outputs: &Outputs,
         path: &Path,
         profile: &str,
         compression: ChunkCompression,
     ) -> Result<McapWriter, Error> {
-        let out = AtomicFile::create(path)?;
+        let out = AtomicFile::create(outputs, path)?;
         let mut w = McapWriter {
             out,
             path: path.to_path_buf(),

@@ -21,7 +21,7 @@ use crate::cdr;
 use crate::error::Error;
 use crate::imu_msg::Imu;
 use crate::mcap::{ChunkCompression, McapReader, McapWriter};
-use crate::shared::output::AtomicDir;
+use crate::shared::output::{AtomicDir, Outputs};
 use crate::source::{self, Channel, InputKind, Loss, MessageSink, PartRead, Source};
 use crate::zstd::Decompressed;
 use metadata::{BagInfo, OFFERED_QOS_PROFILES, WrittenBag, WrittenTopic};
@@ -331,9 +331,9 @@ pub struct Ros2BagWriter {
 }
 
 impl Ros2BagWriter {
-    /// Starts the bag directory `dir` (which must not exist yet).
-    pub fn create(dir: &Path, storage: Storage) -> Result<Ros2BagWriter, Error> {
-        let d = AtomicDir::create(dir)?;
+    /// Starts the bag directory `dir` (which must not exist yet) among the run's `outputs`.
+    pub fn create(outputs: &Outputs, dir: &Path, storage: Storage) -> Result<Ros2BagWriter, Error> {
+        let d = AtomicDir::create(outputs, dir)?;
         let stem = dir
             .file_name()
             .map(|s| s.to_string_lossy().into_owned())
@@ -346,7 +346,7 @@ impl Ros2BagWriter {
             }
             Storage::Mcap(c) => {
                 let f = format!("{stem}_0.mcap");
-                let w = McapWriter::create(&d.path().join(&f), "ros2", c)?;
+                let w = McapWriter::create(&Outputs::direct(), &d.path().join(&f), "ros2", c)?;
                 (f, StorageWriter::Mcap(Box::new(w)))
             }
         };
@@ -459,7 +459,8 @@ impl Ros2BagWriter {
             StorageWriter::Sqlite3(w) => w.finish(&yaml)?,
             StorageWriter::Mcap(w) => w.finish()?,
         }
-        crate::shared::output::write_atomic(&self.dir.path().join("metadata.yaml"), |w| {
+        // Files inside the bag's temporary directory go in place with it (its one rename).
+        Outputs::direct().write_atomic(&self.dir.path().join("metadata.yaml"), |w| {
             w.write_all(yaml.as_bytes())
         })?;
         self.dir.commit()

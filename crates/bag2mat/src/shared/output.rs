@@ -8,37 +8,105 @@
 //! * A symlink is followed: its target is written, the link stays.
 //! * A target that exists and is not a regular file (`/dev/null`, `/dev/stdout`, a FIFO) is
 //!   written through, never replaced; a directory is refused.
-//! * An input of the run ([`protect_input`]) is never an output (same device and inode).
-//! * [`Staging`] ([`super::staging`]): a run that writes several files commits them
-//!   together, all or none, also across concurrent runs and a kill during the commit.
+//! * An input of the run ([`Outputs::protect_input`]) is never an output (same device and
+//!   inode).
+//! * A staged run ([`Outputs::staged`], [`super::staging`]) that writes several files
+//!   commits them together, all or none, also across concurrent runs and a kill during the
+//!   commit.
+//!
+//! Every writer takes the run's [`Outputs`]: which files are staged and which inputs are
+//! protected is the caller's explicit choice, never a process-wide switch, so runs in one
+//! process (tests, a library caller) do not take in each other's outputs.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
-use super::live::{lock, register, remove, unique, unregister};
+use super::live::{register, remove, unique, unregister};
+use super::staging::{Stage, Staging};
 use crate::error::Error;
 
-/// Inputs of this run, as (device, inode, path).
-static INPUTS: Mutex<Vec<(u64, u64, PathBuf)>> = Mutex::new(Vec::new());
-/// Declares `path` an input of this run: no output may be it (nor, for a directory, one of
-/// the files in it).
-pub fn protect_input(path: &Path) {
-    let mut v = lock(&INPUTS);
-    let mut add = |p: &Path| {
-        if let Ok(m) = std::fs::metadata(p) {
-            v.push((m.dev(), m.ino(), p.to_path_buf()));
+/// Where a run's outputs go, handed to every writer: each file put in place as soon as it
+/// is complete ([`Outputs::direct`]) or all of them together at [`Outputs::commit`]
+/// ([`Outputs::staged`]), and never over one of the run's inputs.
+#[derive(Debug)]
+pub struct Outputs {
+    /// The stage of a staged run.
+    staging: Option<Staging>,
+    /// Inputs of the run, as (device, inode, path).
+    inputs: Vec<(u64, u64, PathBuf)>,
+}
+
+impl Outputs {
+    /// Outputs put in place one by one, each when it is complete.
+    pub fn direct() -> Outputs {
+        Outputs {
+            staging: None,
+            inputs: Vec::new(),
         }
-    };
-    add(path);
-    if path.is_dir()
-        && let Ok(rd) = std::fs::read_dir(path)
+    }
+
+    /// Outputs that wait in a stage until [`Outputs::commit`] puts them all in place;
+    /// dropped uncommitted, none is left (see [`super::staging`]).
+    pub fn staged() -> Outputs {
+        Outputs {
+            staging: Some(Staging::begin()),
+            inputs: Vec::new(),
+        }
+    }
+
+    /// Declares `path` an input of the run: no output may be it (nor, for a directory, one
+    /// of the files in it).
+    pub fn protect_input(&mut self, path: &Path) {
+        let mut add = |p: &Path| {
+            if let Ok(m) = std::fs::metadata(p) {
+                self.inputs.push((m.dev(), m.ino(), p.to_path_buf()));
+            }
+        };
+        add(path);
+        if path.is_dir()
+            && let Ok(rd) = std::fs::read_dir(path)
+        {
+            for e in rd.flatten() {
+                add(&e.path());
+            }
+        }
+    }
+
+    /// Writes a whole file atomically with `fill`.
+    pub fn write_atomic<F>(&self, target: &Path, fill: F) -> Result<(), Error>
+    where
+        F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
     {
-        for e in rd.flatten() {
-            add(&e.path());
+        let mut f = AtomicFile::create(self, target)?;
+        fill(f.writer()).map_err(|e| Error::io(target, e))?;
+        f.commit()
+    }
+
+    /// Makes sure the output directory `dir` can take outputs: in a staged run nothing is
+    /// created (its commit makes the directory, so a failed run leaves none); otherwise the
+    /// directory and its parents are created.
+    pub fn ensure_dir(&self, dir: &Path) -> Result<(), Error> {
+        if let Some(stage) = self.stage()
+            && super::staging::may_create(stage, dir)
+        {
+            return Ok(());
         }
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))
+    }
+
+    /// Puts a staged run's outputs in place (a direct run's are already). If that fails,
+    /// what was not yet in place is removed and the error names the first failure.
+    pub fn commit(self) -> Result<(), Error> {
+        match self.staging {
+            Some(s) => s.commit(),
+            None => Ok(()),
+        }
+    }
+
+    fn stage(&self) -> Option<&Stage> {
+        self.staging.as_ref().map(Staging::stage)
     }
 }
 
@@ -73,11 +141,11 @@ fn resolve(target: &Path) -> Result<PathBuf, Error> {
 }
 
 /// Refuses an output that is an input of the run.
-fn check_not_input(target: &Path, real: &Path) -> Result<(), Error> {
+fn check_not_input(outputs: &Outputs, target: &Path, real: &Path) -> Result<(), Error> {
     let Ok(m) = std::fs::metadata(real) else {
         return Ok(());
     };
-    for (dev, ino, input) in lock(&INPUTS).iter() {
+    for (dev, ino, input) in outputs.inputs.iter() {
         if m.dev() == *dev && m.ino() == *ino {
             return Err(Error::Output {
                 path: target.to_path_buf(),
@@ -91,50 +159,60 @@ fn check_not_input(target: &Path, real: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-/// A temporary path for a file that is renamed into place on commit (or, while a
-/// [`Staging`] is active, written in its stage), and removed otherwise.
+/// A temporary path for a file that is renamed into place on commit (or, in a staged run,
+/// written in its stage), and removed otherwise.
 pub struct TempPath {
     tmp: PathBuf,
     target: PathBuf,
     done: bool,
     /// A file (staged with its directory), not a directory.
     file: bool,
+    /// The stage of a staged run, where the commit hands the path.
+    stage: Option<Stage>,
 }
 
 impl TempPath {
     /// Where to write `target` (after its symlinks) until it is committed: a fresh
-    /// `.<name>.<pid>.<n><suffix>` beside it, or its place in the active [`Staging`]'s
-    /// stage; registered for removal on SIGINT/SIGTERM. Nothing is created but a stage.
-    pub fn beside(target: &Path, suffix: &str) -> Result<TempPath, Error> {
+    /// `.<name>.<pid>.<n><suffix>` beside it, or its place in a staged run's stage;
+    /// registered for removal on SIGINT/SIGTERM. Nothing is created but a stage.
+    pub fn beside(outputs: &Outputs, target: &Path, suffix: &str) -> Result<TempPath, Error> {
         let real = resolve(target)?;
-        check_not_input(target, &real)?;
+        check_not_input(outputs, target, &real)?;
         if real.is_dir() {
             return Err(Error::Output {
                 path: target.to_path_buf(),
                 what: "it is a directory (name a file)".into(),
             });
         }
-        if let Some(tmp) = super::staging::file_path(&real)? {
+        if let Some(stage) = outputs.stage()
+            && let Some(tmp) = super::staging::file_path(stage, &real)?
+        {
             return Ok(TempPath {
                 tmp,
                 target: real,
                 done: false,
                 file: true,
+                stage: Some(stage.clone()),
             });
         }
-        let mut t = Self::beside_path(target, &real, suffix)?;
+        let mut t = Self::beside_path(outputs, target, &real, suffix)?;
         t.file = true;
         Ok(t)
     }
 
     /// A fresh temporary name beside `target` for a directory.
-    fn beside_dir(target: &Path) -> Result<TempPath, Error> {
+    fn beside_dir(outputs: &Outputs, target: &Path) -> Result<TempPath, Error> {
         let real = resolve(target)?;
-        check_not_input(target, &real)?;
-        Self::beside_path(target, &real, ".tmp")
+        check_not_input(outputs, target, &real)?;
+        Self::beside_path(outputs, target, &real, ".tmp")
     }
 
-    fn beside_path(target: &Path, real: &Path, suffix: &str) -> Result<TempPath, Error> {
+    fn beside_path(
+        outputs: &Outputs,
+        target: &Path,
+        real: &Path,
+        suffix: &str,
+    ) -> Result<TempPath, Error> {
         if real.is_dir() {
             return Err(Error::Output {
                 path: target.to_path_buf(),
@@ -156,6 +234,7 @@ impl TempPath {
             target: real.to_path_buf(),
             done: false,
             file: false,
+            stage: outputs.stage().cloned(),
         })
     }
 
@@ -164,11 +243,13 @@ impl TempPath {
         &self.tmp
     }
 
-    /// Renames the temporary path into place, or hands it to the active [`Staging`]. On
-    /// failure the temporary path is removed and the error names the target.
+    /// Renames the temporary path into place, or hands it to its run's stage. On failure
+    /// the temporary path is removed and the error names the target.
     pub fn commit(mut self) -> Result<(), Error> {
         self.done = true;
-        if super::staging::record(&self.tmp, &self.target, self.file) {
+        if let Some(stage) = &self.stage
+            && super::staging::record(stage, &self.tmp, &self.target, self.file)
+        {
             return Ok(());
         }
         let r = std::fs::rename(&self.tmp, &self.target);
@@ -207,8 +288,8 @@ pub struct AtomicFile {
 
 impl AtomicFile {
     /// Starts writing `target` (see the module doc for symlinks, devices and inputs).
-    pub fn create(target: &Path) -> Result<AtomicFile, Error> {
-        check_not_input(target, target)?;
+    pub fn create(outputs: &Outputs, target: &Path) -> Result<AtomicFile, Error> {
+        check_not_input(outputs, target, target)?;
         // Devices and FIFOs (also behind /dev/stdout's links into /proc) are opened as named.
         let through = std::fs::metadata(target)
             .map(|m| !m.is_file() && !m.is_dir())
@@ -221,7 +302,7 @@ impl AtomicFile {
                 .map_err(|e| Error::io(target, e))?;
             (Dest::Through, f)
         } else {
-            let t = TempPath::beside(target, ".tmp")?;
+            let t = TempPath::beside(outputs, target, ".tmp")?;
             let f = File::create(t.path()).map_err(|e| Error::io(target, e))?;
             (Dest::Temp(t), f)
         };
@@ -259,28 +340,6 @@ impl AtomicFile {
     }
 }
 
-/// Writes a whole file atomically with `fill`.
-pub fn write_atomic<F>(target: &Path, fill: F) -> Result<(), Error>
-where
-    F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
-{
-    let mut f = AtomicFile::create(target)?;
-    fill(f.writer()).map_err(|e| Error::io(target, e))?;
-    f.commit()
-}
-
-pub use super::staging::Staging;
-
-/// Makes sure the output directory `dir` can take outputs: while a [`Staging`] is active
-/// nothing is created (its commit makes the directory, so a failed run leaves none);
-/// otherwise the directory and its parents are created.
-pub fn ensure_dir(dir: &Path) -> Result<(), Error> {
-    if super::staging::may_create(dir) {
-        return Ok(());
-    }
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))
-}
-
 /// A directory being filled under a temporary name beside the target; [`AtomicDir::commit`]
 /// renames it into place. Dropped without a commit, it is removed with everything in it.
 /// The target must not exist (a bag directory is never merged into or replaced, as
@@ -292,14 +351,14 @@ pub struct AtomicDir {
 
 impl AtomicDir {
     /// Creates the temporary directory; fails when `target` already exists.
-    pub fn create(target: &Path) -> Result<AtomicDir, Error> {
+    pub fn create(outputs: &Outputs, target: &Path) -> Result<AtomicDir, Error> {
         if target.exists() {
             return Err(Error::Output {
                 path: target.to_path_buf(),
                 what: "it already exists (remove it or choose another output)".into(),
             });
         }
-        let tmp = TempPath::beside_dir(target)?;
+        let tmp = TempPath::beside_dir(outputs, target)?;
         std::fs::create_dir(tmp.path()).map_err(|e| Error::io(target, e))?;
         Ok(AtomicDir {
             tmp,
@@ -327,9 +386,6 @@ impl AtomicDir {
 mod tests {
     use super::*;
 
-    /// Staging is process-wide: the tests that write files take turns.
-    static SERIAL: Mutex<()> = Mutex::new(());
-
     fn names(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
@@ -341,29 +397,30 @@ mod tests {
 
     #[test]
     fn failed_write_leaves_nothing_behind() {
-        let _turn = lock(&SERIAL);
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.txt");
-        let r = write_atomic(&target, |w| {
+        let out = Outputs::direct();
+        let r = out.write_atomic(&target, |w| {
             w.write_all(b"partial")?;
             Err(std::io::Error::other("boom"))
         });
         assert!(r.is_err());
         assert!(names(dir.path()).is_empty());
-        write_atomic(&target, |w| w.write_all(b"whole")).unwrap();
+        out.write_atomic(&target, |w| w.write_all(b"whole"))
+            .unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
         assert_eq!(names(dir.path()), vec!["out.txt"]);
     }
 
     #[test]
     fn symlinks_are_followed_and_devices_written_through() {
-        let _turn = lock(&SERIAL);
         let dir = tempfile::tempdir().unwrap();
         let real = dir.path().join("real.txt");
         std::fs::write(&real, b"old").unwrap();
         let link = dir.path().join("link.txt");
         std::os::unix::fs::symlink("real.txt", &link).unwrap();
-        write_atomic(&link, |w| w.write_all(b"new")).unwrap();
+        let out = Outputs::direct();
+        out.write_atomic(&link, |w| w.write_all(b"new")).unwrap();
         assert!(
             std::fs::symlink_metadata(&link)
                 .unwrap()
@@ -371,26 +428,26 @@ mod tests {
                 .is_symlink()
         );
         assert_eq!(std::fs::read(&real).unwrap(), b"new");
-        write_atomic(Path::new("/dev/null"), |w| w.write_all(b"x")).unwrap();
+        out.write_atomic(Path::new("/dev/null"), |w| w.write_all(b"x"))
+            .unwrap();
         assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
     }
 
     #[test]
     fn staging_commits_all_or_none() {
-        let _turn = lock(&SERIAL);
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a"), dir.path().join("b"));
         {
-            let _s = Staging::begin();
-            write_atomic(&a, |w| w.write_all(b"a")).unwrap();
-            write_atomic(&b, |w| w.write_all(b"b")).unwrap();
+            let out = Outputs::staged();
+            out.write_atomic(&a, |w| w.write_all(b"a")).unwrap();
+            out.write_atomic(&b, |w| w.write_all(b"b")).unwrap();
             assert!(!a.exists() && !b.exists());
         }
         assert!(names(dir.path()).is_empty(), "dropped staging left files");
-        let s = Staging::begin();
-        write_atomic(&a, |w| w.write_all(b"a")).unwrap();
-        write_atomic(&b, |w| w.write_all(b"b")).unwrap();
-        s.commit().unwrap();
+        let out = Outputs::staged();
+        out.write_atomic(&a, |w| w.write_all(b"a")).unwrap();
+        out.write_atomic(&b, |w| w.write_all(b"b")).unwrap();
+        out.commit().unwrap();
         assert_eq!(names(dir.path()), vec!["a", "b"]);
     }
 }

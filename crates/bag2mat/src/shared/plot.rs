@@ -26,6 +26,33 @@ pub fn register_font() {
     });
 }
 
+/// A chart that could not be drawn, said in words: plotters' errors are generic over the
+/// backend, so each becomes its text where it arises (a failed write as every tool says an
+/// I/O error: [`present`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct DrawError(String);
+
+impl<E: std::error::Error + Send + Sync> From<plotters::drawing::DrawingAreaErrorKind<E>>
+    for DrawError
+{
+    fn from(e: plotters::drawing::DrawingAreaErrorKind<E>) -> DrawError {
+        DrawError(e.to_string())
+    }
+}
+
+impl From<Box<dyn std::error::Error>> for DrawError {
+    fn from(e: Box<dyn std::error::Error>) -> DrawError {
+        DrawError(e.to_string())
+    }
+}
+
+impl From<&str> for DrawError {
+    fn from(what: &str) -> DrawError {
+        DrawError(what.to_owned())
+    }
+}
+
 /// The bitmap backend's error type (plotters does not name it).
 type BitmapError =
     <plotters::prelude::BitMapBackend<'static> as plotters::prelude::DrawingBackend>::ErrorType;
@@ -35,7 +62,7 @@ type BitmapError =
 /// the device"), not as the backend's debug text.
 pub fn present<DB>(
     root: &plotters::drawing::DrawingArea<DB, plotters::coord::Shift>,
-) -> Result<(), String>
+) -> Result<(), DrawError>
 where
     DB: plotters::prelude::DrawingBackend,
     DB::ErrorType: 'static,
@@ -47,15 +74,17 @@ where
             && let Some(b) = (inner as &dyn std::any::Any).downcast_ref::<BitmapError>()
         {
             match *b {
-                BitmapError::IOError(ref io) => return crate::shared::output::describe(io),
+                BitmapError::IOError(ref io) => {
+                    return DrawError(crate::shared::output::describe(io));
+                }
                 // The encoder's I/O error, as its text (the image crate keeps no source).
                 BitmapError::ImageError(ref ie) => {
-                    return crate::shared::output::without_errno(&ie.to_string());
+                    return DrawError(crate::shared::output::without_errno(&ie.to_string()));
                 }
                 _ => {}
             }
         }
-        e.to_string()
+        DrawError::from(e)
     })
 }
 
@@ -67,14 +96,15 @@ pub trait Figure {
         &self,
         root: &plotters::drawing::DrawingArea<DB, plotters::coord::Shift>,
         scale: f64,
-    ) -> Result<(), String>
+    ) -> Result<(), DrawError>
     where
         DB::ErrorType: 'static;
 }
 
 /// Writes `<dir>/<stem>.png` (`png_size` pixels) and `<dir>/<stem>.svg` (`svg_size` user
-/// units) of `fig`, each atomically; returns `[png, svg]`.
+/// units) of `fig`, each atomically among the run's `outputs`; returns `[png, svg]`.
 pub fn write_png_svg(
+    outputs: &crate::shared::output::Outputs,
     fig: &impl Figure,
     dir: &std::path::Path,
     stem: &str,
@@ -95,9 +125,9 @@ pub fn write_png_svg(
                 what,
             })?;
     }
-    crate::shared::output::write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
+    outputs.write_atomic(&svg, |w| w.write_all(text.as_bytes()))?;
     let scale = png_size.0 as f64 / svg_size.0.max(1) as f64;
-    png_atomic(&png, png_size, |root| {
+    png_atomic(outputs, &png, png_size, |root| {
         fig.draw(&root, scale)?;
         present(&root)
     })?;
@@ -109,6 +139,7 @@ pub fn write_png_svg(
 /// ([`crate::shared::output::TempPath`]), which is put in place only after a successful
 /// encode (and removed otherwise, on a signal too).
 pub fn png_atomic<F>(
+    outputs: &crate::shared::output::Outputs,
     target: &std::path::Path,
     size: (u32, u32),
     draw: F,
@@ -116,12 +147,12 @@ pub fn png_atomic<F>(
 where
     F: FnOnce(
         plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend<'_>, plotters::coord::Shift>,
-    ) -> Result<(), String>,
+    ) -> Result<(), DrawError>,
 {
     use plotters::prelude::{BitMapBackend, IntoDrawingArea};
     register_font();
-    let tmp = crate::shared::output::TempPath::beside(target, ".tmp.png")?;
-    let plot_err = |what: String| crate::Error::Plot {
+    let tmp = crate::shared::output::TempPath::beside(outputs, target, ".tmp.png")?;
+    let plot_err = |what: DrawError| crate::Error::Plot {
         path: target.to_path_buf(),
         what,
     };

@@ -1,8 +1,8 @@
 //! Several outputs committed together, all or none — also across concurrent runs into one
 //! directory and a kill during the commit.
 //!
-//! While a [`Staging`] is active, every file the atomic outputs of [`super::output`] write
-//! waits in a stage:
+//! Every file the atomic outputs of [`super::output`] write through a staged
+//! [`super::output::Outputs`] (which holds a [`Staging`]) waits in a stage:
 //!
 //! * for a directory that does not exist yet: a hidden directory beside it
 //!   (`.<name>.<pid>.<n>.tmp`) that one rename turns into it;
@@ -24,7 +24,7 @@
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use super::live::{lock, register, remove, unique, unregister};
 use crate::error::Error;
@@ -68,12 +68,15 @@ struct Staged {
     creatable: Vec<PathBuf>,
 }
 
-static STAGED: Mutex<Option<Staged>> = Mutex::new(None);
+/// A run's stage, shared by its [`Staging`] and the temporary paths written in it (which
+/// record themselves at their commit); empty once the staging is committed or dropped.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Stage(Arc<Mutex<Option<Staged>>>);
 
-/// Declares `dir` an output directory the active [`Staging`]'s commit may create; false
-/// without one.
-pub(super) fn may_create(dir: &Path) -> bool {
-    match lock(&STAGED).as_mut() {
+/// Declares `dir` an output directory the stage's commit may create; false once the
+/// stage is gone.
+pub(super) fn may_create(stage: &Stage, dir: &Path) -> bool {
+    match lock(&stage.0).as_mut() {
         Some(s) => {
             s.creatable.push(dir.to_path_buf());
             true
@@ -83,10 +86,10 @@ pub(super) fn may_create(dir: &Path) -> bool {
 }
 
 /// The temporary path a staged file for `target` (a resolved path, not a directory) is
-/// written at: in its directory's stage, created on first use. `None` without an active
-/// [`Staging`].
-pub(super) fn file_path(target: &Path) -> Result<Option<PathBuf>, Error> {
-    let mut g = lock(&STAGED);
+/// written at: in its directory's stage, created on first use. `None` once the stage is
+/// gone.
+pub(super) fn file_path(stage: &Stage, target: &Path) -> Result<Option<PathBuf>, Error> {
+    let mut g = lock(&stage.0);
     let Some(staged) = g.as_mut() else {
         return Ok(None);
     };
@@ -132,9 +135,9 @@ pub(super) fn file_path(target: &Path) -> Result<Option<PathBuf>, Error> {
 }
 
 /// Records a committed staged file (`tmp` → `target`), or another temporary path to rename
-/// at the commit. Returns false without an active [`Staging`].
-pub(super) fn record(tmp: &Path, target: &Path, file: bool) -> bool {
-    let mut g = lock(&STAGED);
+/// at the commit. Returns false once the stage is gone.
+pub(super) fn record(stage: &Stage, tmp: &Path, target: &Path, file: bool) -> bool {
+    let mut g = lock(&stage.0);
     let Some(staged) = g.as_mut() else {
         return false;
     };
@@ -467,27 +470,34 @@ fn commit_in_place(a: &Area) -> Result<(), Error> {
     err.map_or(Ok(()), Err)
 }
 
-/// Several outputs committed together: while a `Staging` is active, every output of
-/// [`super::output`] (files, plots, directories) waits in a stage; [`Staging::commit`] puts
-/// them all in place (see the module doc), and dropping it uncommitted removes them all. A
-/// run that fails half way therefore leaves none of its outputs — not even the output
-/// directory it would have made — and never a mix of old and new ones.
-pub struct Staging {
-    done: bool,
+/// Several outputs committed together: every output written through a staged
+/// [`super::output::Outputs`] (files, plots, directories) waits in its stage;
+/// [`Staging::commit`] puts them all in place (see the module doc), and dropping it
+/// uncommitted removes them all. A run that fails half way therefore leaves none of its
+/// outputs — not even the output directory it would have made — and never a mix of old
+/// and new ones. Stagings are independent: runs in one process stage apart.
+#[derive(Debug)]
+pub(super) struct Staging {
+    stage: Stage,
 }
 
 impl Staging {
-    /// Starts staging (one at a time per process).
-    pub fn begin() -> Staging {
-        *lock(&STAGED) = Some(Staged::default());
-        Staging { done: false }
+    /// Starts a stage.
+    pub(super) fn begin() -> Staging {
+        Staging {
+            stage: Stage(Arc::new(Mutex::new(Some(Staged::default())))),
+        }
+    }
+
+    /// The stage the temporary paths written in it record themselves in.
+    pub(super) fn stage(&self) -> &Stage {
+        &self.stage
     }
 
     /// Puts every staged output in place. If that fails, what was not yet in place is
     /// removed and the error names the first failure.
-    pub fn commit(mut self) -> Result<(), Error> {
-        self.done = true;
-        let staged = lock(&STAGED).take().unwrap_or_default();
+    pub(super) fn commit(self) -> Result<(), Error> {
+        let staged = lock(&self.stage.0).take().unwrap_or_default();
         let mut err = None;
         for (tmp, target) in &staged.pairs {
             if err.is_none()
@@ -529,9 +539,7 @@ fn discard(a: &Area) {
 
 impl Drop for Staging {
     fn drop(&mut self) {
-        if !self.done
-            && let Some(staged) = lock(&STAGED).take()
-        {
+        if let Some(staged) = lock(&self.stage.0).take() {
             for (tmp, _) in &staged.pairs {
                 remove(tmp);
                 unregister(tmp);

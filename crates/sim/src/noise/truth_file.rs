@@ -548,13 +548,17 @@ pub fn widrow_warnings(model: &ImuModel, rate: f64, samples: usize) -> Result<Ve
     Ok(out)
 }
 
-/// Writes both files atomically beside the bag; returns their paths.
-pub fn write(info: &TruthInfo<'_>) -> Result<[PathBuf; 2]> {
+/// Writes both files atomically beside the bag, among the run's `outputs`; returns their
+/// paths.
+pub fn write(
+    outputs: &bag2mat::shared::output::Outputs,
+    info: &TruthInfo<'_>,
+) -> Result<[PathBuf; 2]> {
     let (yp, cp) = paths(info.bag);
     let y = yaml_text(info)?;
     let c = csv_text(info)?;
-    bag2mat::shared::output::write_atomic(&yp, |w| w.write_all(y.as_bytes()))?;
-    bag2mat::shared::output::write_atomic(&cp, |w| w.write_all(c.as_bytes()))?;
+    outputs.write_atomic(&yp, |w| w.write_all(y.as_bytes()))?;
+    outputs.write_atomic(&cp, |w| w.write_all(c.as_bytes()))?;
     Ok([yp, cp])
 }
 
