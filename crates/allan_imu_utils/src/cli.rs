@@ -85,15 +85,18 @@ impl Config {
 
 /// A positive whole number: "must be positive" for 0 and negatives (clap would otherwise
 /// call "-1" an unexpected argument).
-fn positive_int<T: std::str::FromStr + TryFrom<u64>>(s: &str) -> Result<T, String> {
+fn positive_int<T: std::str::FromStr + TryFrom<u64>>(
+    s: &str,
+) -> Result<T, bag2mat::shared::cli::UsageError> {
+    use bag2mat::shared::cli::UsageError;
     let t = s.trim();
     if t.starts_with('-') || t.parse::<f64>().is_ok_and(|v| v <= 0.0) {
-        return Err(format!("{s} must be positive"));
+        return Err(UsageError(format!("{s} must be positive")));
     }
     let v: u64 = t
         .parse()
-        .map_err(|_| format!("'{s}' is not a whole number"))?;
-    T::try_from(v).map_err(|_| format!("{s} is too large"))
+        .map_err(|_| UsageError(format!("'{s}' is not a whole number")))?;
+    T::try_from(v).map_err(|_| UsageError(format!("{s} is too large")))
 }
 
 fn from_launch(lp: Option<&LaunchParams>, param: &str) -> Result<Option<String>, Error> {
@@ -129,7 +132,7 @@ impl TryFrom<Args> for Config {
         // for any other input it would do nothing (imu_utils uses the stamps)
         a.common
             .curve_flags_need_curves(&[])
-            .map_err(Error::Config)?;
+            .map_err(|e| Error::Config(e.0))?;
         let text_rate = allan_kalibr::rate_for_text(a.common.input.as_deref(), a.common.rate);
         if let (Some(input), Some(rate), None) = (&a.common.input, a.common.rate, text_rate) {
             let kind = bag2mat::input_kind(input)

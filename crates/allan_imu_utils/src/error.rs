@@ -56,7 +56,7 @@ pub enum Error {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        what: String,
+        what: crate::launch::LaunchSyntax,
     },
     /// A setting is missing or invalid.
     #[error("{0}")]

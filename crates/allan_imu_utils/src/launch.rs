@@ -87,8 +87,13 @@ fn unescape(s: &str) -> String {
         .replace("&amp;", "&")
 }
 
+/// What makes a launch file unreadable as one (said after its path).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct LaunchSyntax(pub String);
+
 /// Parses `key = "value"` attributes of one tag body.
-fn attributes(body: &str) -> Result<Vec<(String, String)>, String> {
+fn attributes(body: &str) -> Result<Vec<(String, String)>, LaunchSyntax> {
     let mut out = Vec::new();
     let b = body.as_bytes();
     let mut i = 0;
@@ -108,14 +113,16 @@ fn attributes(body: &str) -> Result<Vec<(String, String)>, String> {
             i += 1;
         }
         if i >= b.len() || b[i] != b'=' {
-            return Err(format!("attribute '{key}' has no value"));
+            return Err(LaunchSyntax(format!("attribute '{key}' has no value")));
         }
         i += 1;
         while i < b.len() && b[i].is_ascii_whitespace() {
             i += 1;
         }
         if i >= b.len() || (b[i] != b'"' && b[i] != b'\'') {
-            return Err(format!("attribute '{key}' value is not quoted"));
+            return Err(LaunchSyntax(format!(
+                "attribute '{key}' value is not quoted"
+            )));
         }
         let q = b[i];
         i += 1;
@@ -124,7 +131,9 @@ fn attributes(body: &str) -> Result<Vec<(String, String)>, String> {
             i += 1;
         }
         if i >= b.len() {
-            return Err(format!("attribute '{key}' value is not closed"));
+            return Err(LaunchSyntax(format!(
+                "attribute '{key}' value is not closed"
+            )));
         }
         out.push((key.to_string(), unescape(&body[vstart..i])));
         i += 1;
@@ -133,10 +142,12 @@ fn attributes(body: &str) -> Result<Vec<(String, String)>, String> {
 }
 
 /// Parses launch-file text.
-pub(crate) fn parse(text: &str) -> Result<LaunchParams, String> {
+pub(crate) fn parse(text: &str) -> Result<LaunchParams, LaunchSyntax> {
     let text = strip_comments(text);
     if !text.contains("<launch") {
-        return Err("not a roslaunch file (no <launch> element)".into());
+        return Err(LaunchSyntax(
+            "not a roslaunch file (no <launch> element)".into(),
+        ));
     }
     let mut params = Vec::new();
     let mut rest = text.as_str();
@@ -160,7 +171,7 @@ pub(crate) fn parse(text: &str) -> Result<LaunchParams, String> {
                 _ => {}
             }
         }
-        let end = end.ok_or("unterminated <param> tag")?;
+        let end = end.ok_or_else(|| LaunchSyntax("unterminated <param> tag".into()))?;
         let attrs = attributes(&after[..end])?;
         rest = &after[end + 1..];
         let get = |k: &str| attrs.iter().find(|(a, _)| a == k).map(|(_, v)| v.clone());
@@ -171,10 +182,10 @@ pub(crate) fn parse(text: &str) -> Result<LaunchParams, String> {
             continue;
         }
         let Some(value) = get("value") else {
-            return Err(format!(
+            return Err(LaunchSyntax(format!(
                 "<param name=\"{name}\"> has no value attribute (command/textfile need ROS); give {} instead",
                 flag_for(&short)
-            ));
+            )));
         };
         let value = if value.contains("$(") {
             LaunchValue::Unresolved(value)
@@ -184,7 +195,7 @@ pub(crate) fn parse(text: &str) -> Result<LaunchParams, String> {
         params.push((short, value));
     }
     if params.is_empty() {
-        return Err("no imu_utils <param> (imu_topic, imu_name, data_save_path, max_time_min, max_cluster) found".into());
+        return Err(LaunchSyntax("no imu_utils <param> (imu_topic, imu_name, data_save_path, max_time_min, max_cluster) found".into()));
     }
     Ok(LaunchParams { params })
 }
@@ -226,6 +237,7 @@ mod tests {
         assert!(
             parse("<launch></launch>")
                 .unwrap_err()
+                .0
                 .contains("no imu_utils")
         );
         assert!(parse("<launch><param name=\"imu_topic\" value=\"/a></launch>").is_err());

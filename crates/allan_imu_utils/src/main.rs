@@ -12,9 +12,7 @@ static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOn
 
 fn main() -> ExitCode {
     bag2mat::shared::alloc::start_threads(TOOL);
-    let config = match parse_args::<Args, Config>(TOOL, |a| {
-        Config::try_from(a).map_err(|e| e.to_string())
-    }) {
+    let config = match parse_args::<Args, Config, _>(TOOL, Config::try_from) {
         Ok(c) => c,
         Err(code) => return code,
     };

@@ -45,9 +45,9 @@ pub struct Args {
 pub const TOOL: &str = "allan_kalibr";
 
 impl TryFrom<Args> for Config {
-    type Error = String;
+    type Error = bag2mat::shared::cli::UsageError;
 
-    fn try_from(a: Args) -> Result<Config, String> {
+    fn try_from(a: Args) -> Result<Config, Self::Error> {
         a.common.curve_flags_need_curves(&[])?;
         // a text log without a time column is sampled at --rate
         let text_rate = crate::front::rate_for_text(a.common.input.as_deref(), a.common.rate);

@@ -91,12 +91,12 @@ pub struct CommonArgs {
 }
 
 /// `--rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
-fn rate_hz(s: &str) -> Result<f64, String> {
+fn rate_hz(s: &str) -> Result<f64, cli::UsageError> {
     let v = cli::positive_f64(s)?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
-        return Err(format!(
+        return Err(cli::UsageError(format!(
             "{s} Hz is outside {MIN_RATE_HZ} .. {MAX_RATE_HZ:e} Hz"
-        ));
+        )));
     }
     Ok(v)
 }
@@ -234,7 +234,7 @@ pub(crate) fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
 impl CommonArgs {
     /// --units, --duration, --samples (and `more`) describe Allan curves: without --curves
     /// they would be ignored in silence.
-    pub fn curve_flags_need_curves(&self, more: &[(&str, bool)]) -> Result<(), String> {
+    pub fn curve_flags_need_curves(&self, more: &[(&str, bool)]) -> Result<(), cli::UsageError> {
         let mut flags = vec![
             ("--units", !self.units.is_empty()),
             ("--duration", self.duration.is_some()),
@@ -326,9 +326,9 @@ pub struct Section {
 
 /// Parses the tool's arguments into its settings: `--help`/`--version` print and exit 0,
 /// a command line that cannot be run is a usage error (exit 2).
-pub fn parse<A: clap::Parser, C>(
+pub fn parse<A: clap::Parser, C, E: std::fmt::Display>(
     tool: &str,
-    resolve: impl FnOnce(A) -> Result<C, String>,
+    resolve: impl FnOnce(A) -> Result<C, E>,
 ) -> Result<C, ExitCode> {
     let args = match A::try_parse() {
         Ok(a) => a,
@@ -338,7 +338,7 @@ pub fn parse<A: clap::Parser, C>(
         }
         Err(e) => return Err(cli::usage(tool, &e.render().to_string())),
     };
-    resolve(args).map_err(|e| cli::usage(tool, &e))
+    resolve(args).map_err(|e| cli::usage(tool, &e.to_string()))
 }
 
 /// Runs `job` with its outputs staged (all of them or none are put in place, never over an

@@ -11,7 +11,7 @@ static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOn
 
 fn main() -> ExitCode {
     bag2mat::shared::alloc::start_threads(TOOL);
-    let config = match parse_args::<Args, Config>(TOOL, Config::try_from) {
+    let config = match parse_args::<Args, Config, _>(TOOL, Config::try_from) {
         Ok(c) => c,
         Err(code) => return code,
     };

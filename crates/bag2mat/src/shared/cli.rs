@@ -28,12 +28,17 @@ pub fn to_stdout(
     }
 }
 
-/// Writes `text` to standard output ([`to_stdout`]); other failures come back described
-/// plainly (no "os error N").
-pub fn print(text: &str) -> Result<bool, String> {
-    to_stdout(|w| w.write_all(text.as_bytes()))
-        .map_err(|e| format!("standard output: {}", crate::shared::output::describe(&e)))
+/// Writes `text` to standard output ([`to_stdout`]); other failures come back as the I/O
+/// error of "standard output", described plainly (no "os error N").
+pub fn print(text: &str) -> Result<bool, crate::Error> {
+    to_stdout(|w| w.write_all(text.as_bytes())).map_err(|e| crate::Error::io("standard output", e))
 }
+
+/// A command line that cannot be run as given (exit status [`EXIT_USAGE`]): what is wrong
+/// and what to give instead.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
 
 /// Prints a failure the one way, and returns exit status 1.
 pub fn fail(tool: &str, what: &dyn std::fmt::Display) -> ExitCode {
@@ -53,29 +58,29 @@ pub fn usage(tool: &str, rendered: &str) -> ExitCode {
 /// A value parser for numbers that must be finite and positive: "must be positive" (not
 /// the parser's "unexpected argument '-1'", which the binaries avoid by accepting negative
 /// numbers as values).
-pub fn positive_f64(s: &str) -> Result<f64, String> {
+pub fn positive_f64(s: &str) -> Result<f64, UsageError> {
     let v: f64 = s
         .trim()
         .parse()
-        .map_err(|_| format!("'{s}' is not a number"))?;
+        .map_err(|_| UsageError(format!("'{s}' is not a number")))?;
     if !v.is_finite() || v <= 0.0 {
-        return Err(format!("{s} must be positive (and finite)"));
+        return Err(UsageError(format!("{s} must be positive (and finite)")));
     }
     Ok(v)
 }
 
 /// Flags that only apply with another one: a usage error naming those given without it
 /// (clap's `requires` does not see an empty repeatable flag as absent here).
-pub fn only_with(needed: &str, present: bool, flags: &[(&str, bool)]) -> Result<(), String> {
+pub fn only_with(needed: &str, present: bool, flags: &[(&str, bool)]) -> Result<(), UsageError> {
     let given: Vec<&str> = flags.iter().filter(|f| f.1).map(|f| f.0).collect();
     if present || given.is_empty() {
         return Ok(());
     }
-    Err(format!(
+    Err(UsageError(format!(
         "{} only appl{} with {needed}, which was not given",
         given.join(", "),
         if given.len() == 1 { "ies" } else { "y" }
-    ))
+    )))
 }
 
 #[cfg(test)]
@@ -85,13 +90,24 @@ mod tests {
     #[test]
     fn positive_numbers() {
         assert_eq!(positive_f64("200"), Ok(200.0));
-        assert!(positive_f64("-1").unwrap_err().contains("must be positive"));
-        assert!(positive_f64("0").unwrap_err().contains("must be positive"));
+        assert!(
+            positive_f64("-1")
+                .unwrap_err()
+                .0
+                .contains("must be positive")
+        );
+        assert!(
+            positive_f64("0")
+                .unwrap_err()
+                .0
+                .contains("must be positive")
+        );
         assert!(
             positive_f64("nan")
                 .unwrap_err()
+                .0
                 .contains("must be positive")
         );
-        assert!(positive_f64("abc").unwrap_err().contains("not a number"));
+        assert!(positive_f64("abc").unwrap_err().0.contains("not a number"));
     }
 }
