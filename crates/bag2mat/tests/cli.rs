@@ -4,7 +4,7 @@ use std::process::Command;
 
 use bag2mat::Compression;
 
-use crate::util::{case_bag, run, synthetic, write_synthetic};
+use crate::common::{case_bag, run, synthetic, write_synthetic};
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))

@@ -8,7 +8,7 @@ use std::process::Command;
 use bag2mat::bag::record::{Header, Op, raw_record, read_u32};
 use bag2mat::{Compression, ReadOptions, read_imu_series};
 
-use crate::util::{run, synthetic, write_synthetic};
+use crate::common::{run, synthetic, write_synthetic};
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))

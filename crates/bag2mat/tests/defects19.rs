@@ -13,7 +13,7 @@ use bag2mat::test_tools::{
 };
 use bag2mat::{Ros2BagWriter, Storage};
 
-use crate::util::{run, synthetic};
+use crate::common::{run, synthetic};
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))

@@ -9,7 +9,7 @@ use std::process::Command;
 use bag2mat::test_tools::{run_ok, venv_python, workspace};
 use bag2mat::{ImuSeries, ReadOptions, TopicSelector, read_imu_topics};
 
-use crate::util::run;
+use crate::common::run;
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))
@@ -435,7 +435,7 @@ fn damaged_text_lines_are_counted_with_their_line_numbers_and_stamps_checked() {
 #[test]
 fn npy_from_bag2mat_reads_back_bit_for_bit_and_unknown_files_name_every_format() {
     let dir = tempfile::tempdir().unwrap();
-    let bag = crate::util::case_bag("p3_short_61s");
+    let bag = crate::common::case_bag("p3_short_61s");
     let npy = dir.path().join("x.npy");
     let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&npy).arg("-q"));
     assert!(ok, "{err}");
@@ -555,7 +555,7 @@ fn damaged_logs_of_every_format_never_panic() {
     bag2mat::formats::dataflash::write::imu_log(f, 3.0, 200.0, 1).unwrap();
     let csv = write_euroc(&d.join("e"), 400);
     let (ok, _, err) = run(bag2mat()
-        .arg(crate::util::case_bag("p3_short_61s"))
+        .arg(crate::common::case_bag("p3_short_61s"))
         .args(["imu", "-q", "-o"])
         .arg(d.join("a.npy")));
     assert!(ok, "{err}");

@@ -3,6 +3,7 @@
 //! what we write, and the command line as a user runs it.
 
 mod cli;
+mod common;
 mod defects;
 mod defects19;
 mod issue18;
@@ -11,4 +12,3 @@ mod real_tools;
 mod reference;
 mod ros2;
 mod roundtrip;
-mod util;

@@ -8,7 +8,7 @@ use bag2mat::Compression;
 use bag2mat::convert::{Format, data_imu_from_series, write};
 use bag2mat::{ReadOptions, TimeColumn, read_imu_series};
 
-use crate::util::{run, synthetic, write_synthetic};
+use crate::common::{run, synthetic, write_synthetic};
 
 /// Debian's interpreter: the one that sees python3-rosbag and python3-scipy.
 const PYTHON: &str = "/usr/bin/python3";

@@ -4,7 +4,7 @@
 
 use sha2::{Digest, Sha256};
 
-use crate::util::{CASES, case_bag, testdata};
+use crate::common::{CASES, case_bag, testdata};
 use bag2mat::convert::bag_to_data_imu;
 
 /// The first quoted string after `"key":`.

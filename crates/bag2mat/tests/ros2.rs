@@ -14,7 +14,7 @@ use bag2mat::test_tools::{ROS2_MODES, rosbags_convert, run_ok, venv_python};
 use bag2mat::{Compression, ReadOptions, TimeColumn, TopicSelector, read_imu_topics};
 use sha2::{Digest, Sha256};
 
-use crate::util::{CASES, case_bag, run, testdata, write_synthetic};
+use crate::common::{CASES, case_bag, run, testdata, write_synthetic};
 
 fn sha(d: &DataImu) -> String {
     let mut h = Sha256::new();
@@ -394,7 +394,7 @@ fn damaged_mcap_and_db3_never_panic() {
     for (k, seq) in s.stamp.iter().enumerate() {
         assert_eq!(
             seq.as_nanos(),
-            crate::util::synthetic(k as u32).1.stamp.as_nanos()
+            crate::common::synthetic(k as u32).1.stamp.as_nanos()
         );
     }
     // Summary damaged but data intact: everything is read, with a note.
@@ -416,7 +416,7 @@ fn damaged_mcap_and_db3_never_panic() {
     .unwrap();
     let t = w.add_imu_topic("imu").unwrap();
     for i in 0..6000 {
-        let (rt, imu) = crate::util::synthetic(i);
+        let (rt, imu) = crate::common::synthetic(i);
         w.write_imu(t, rt.as_nanos(), &imu).unwrap();
     }
     w.finish().unwrap();

@@ -5,7 +5,7 @@ use bag2mat::imu_msg::{self, Imu};
 use bag2mat::{Compression, Error, ReadOptions, RosTime, read_imu_series};
 use md5::{Digest, Md5};
 
-use crate::util::{synthetic, write_synthetic};
+use crate::common::{synthetic, write_synthetic};
 
 const COMPRESSIONS: [Compression; 3] = [Compression::None, Compression::Bz2, Compression::Lz4];
 
@@ -276,7 +276,7 @@ fn unfinished_writer_leaves_nothing_behind() {
 #[test]
 fn matrix_routes_agree_and_sort() {
     use bag2mat::convert::{bag_to_data_imu, data_imu_from_series};
-    let p2 = crate::util::case_bag("p2_medium_100hz");
+    let p2 = crate::common::case_bag("p2_medium_100hz");
     let planned = bag_to_data_imu(&p2, "/imu/data", true).unwrap().data;
     let streamed = data_imu_from_series(
         &read_imu_series(&p2, "/imu/data", &ReadOptions { quiet: true }).unwrap(),

@@ -1,6 +1,6 @@
 //! The binary as a user runs it: determinism, counts, defaults, errors, files.
 
-use crate::util::{SEED, START, ok, run_in};
+use crate::common::{SEED, START, ok, run_in};
 use bag2mat::{ReadOptions, read_imu_series};
 use sim::{NoiseGenerator, Preset};
 
@@ -278,7 +278,7 @@ fn spline_self_check_passes_and_from_model_writes_bag_and_text() {
 fn defect_12_time_range_and_size_are_checked_up_front() {
     let d = tempfile::tempdir().unwrap();
     // The last stamp would pass 2^32 s (and saturate, jumping back): refused, exit 2.
-    let out = crate::util::sim()
+    let out = crate::common::sim()
         .current_dir(d.path())
         .args([
             "bag",
@@ -298,7 +298,7 @@ fn defect_12_time_range_and_size_are_checked_up_front() {
     assert!(!d.path().join("a.bag").exists());
     // A job larger than the disk is refused before any work, with its size.
     let t = std::time::Instant::now();
-    let out = crate::util::sim()
+    let out = crate::common::sim()
         .current_dir(d.path())
         .args([
             "bag",
@@ -343,7 +343,7 @@ fn defect_14_one_error_convention() {
         (&[], 2, "sim: error: "),
     ];
     for (args, code, start) in cases {
-        let out = crate::util::sim()
+        let out = crate::common::sim()
             .current_dir(d.path())
             .args(args)
             .output()
@@ -366,7 +366,7 @@ use bag2mat::test_tools::temp_files_in as temps;
 fn defect_08_sigterm_and_sigint_remove_temp_files() {
     let d = tempfile::tempdir().unwrap();
     for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGINT, 130)] {
-        let mut child = crate::util::sim()
+        let mut child = crate::common::sim()
             .current_dir(d.path())
             .args(["bag", "-o", "long.bag", "--duration", "36000", "-q"])
             .spawn()
@@ -399,7 +399,7 @@ fn a_failing_standard_output_is_an_error_not_a_panic() {
         .write(true)
         .open("/dev/full")
         .expect("/dev/full");
-    let o = crate::util::sim()
+    let o = crate::common::sim()
         .args(["sensors"])
         .stdout(full)
         .output()

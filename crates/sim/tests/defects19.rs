@@ -3,7 +3,7 @@
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-use crate::util::sim;
+use crate::common::sim;
 
 /// Longer than any refusal takes; a run still going then spins.
 const REFUSAL_TIMEOUT: Duration = Duration::from_secs(20);

@@ -3,7 +3,7 @@
 //! (scripts/test.sh installs them).
 
 mod cli;
+mod common;
 mod defects19;
 mod real_sensors;
 mod real_tools;
-mod util;

@@ -1,7 +1,7 @@
 //! Issue 9 from the command line: profiles, `--noise-spec`, flags over the spec, the truth
 //! files beside the bag (read back by PyYAML and by sim itself), `sim sensors`, bad specs.
 
-use crate::util::{SEED, START, ok, run_in};
+use crate::common::{SEED, START, ok, run_in};
 use bag2mat::{ReadOptions, read_imu_series};
 use std::process::Command;
 

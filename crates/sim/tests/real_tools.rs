@@ -1,7 +1,7 @@
 //! `sim bag` output read by Debian's tools: `rosbag info --yaml`, `rosbag check`, and every
 //! message through the python rosbag API, compared exactly with an in-process replay.
 
-use crate::util::{SEED, START, ok};
+use crate::common::{SEED, START, ok};
 use sim::Motion;
 use sim::quat_from_matrix;
 use sim::{NoiseGenerator, Preset};

@@ -1,4 +1,4 @@
-//! Helpers: run the binary, temp dirs.
+//! The test support of sim's tests (each crate's is `tests/common.rs`): run the binary, temp dirs.
 
 use std::path::Path;
 use std::process::{Command, Output};
