@@ -112,7 +112,8 @@ pub fn run(a: Args) -> Result<Option<String>, Invocation> {
                 FormatArg::Csv => Format::Csv,
                 FormatArg::Npy => Format::Npy,
             });
-            let format = resolve_format(given, a.output.as_deref()).map_err(Invocation::Usage)?;
+            let format =
+                resolve_format(given, a.output.as_deref()).map_err(|e| Invocation::Usage(e.0))?;
             let cfg = Config {
                 bag,
                 topics: TopicSelector {

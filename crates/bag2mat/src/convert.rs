@@ -148,17 +148,20 @@ pub fn format_of(path: &Path) -> Option<Format> {
 /// The format to write: `--format` when given, else the output's extension, else MAT. A
 /// `--format` that contradicts the output's extension is refused (the file would be
 /// misnamed), with the message for the user.
-pub fn resolve_format(given: Option<Format>, output: Option<&Path>) -> Result<Format, String> {
+pub fn resolve_format(
+    given: Option<Format>,
+    output: Option<&Path>,
+) -> Result<Format, crate::shared::cli::UsageError> {
     let implied = output
         .filter(|o| *o != Path::new(STDOUT))
         .and_then(format_of);
     match (given, implied) {
-        (Some(g), Some(i)) if g != i => Err(format!(
+        (Some(g), Some(i)) if g != i => Err(crate::shared::cli::UsageError(format!(
             "--format {} contradicts the output name {} (.{}); give one or make them agree",
             g.extension(),
             output.map(|o| o.display().to_string()).unwrap_or_default(),
             i.extension()
-        )),
+        ))),
         (Some(g), _) => Ok(g),
         (None, Some(i)) => Ok(i),
         (None, None) => Ok(Format::Mat),

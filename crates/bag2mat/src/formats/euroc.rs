@@ -62,11 +62,23 @@ impl Stated {
     }
 }
 
-/// The `sensor.yaml` beside `data_csv`, if there is one that parses.
-pub(crate) fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, String>> {
+/// A `sensor.yaml` that does not parse: its path and the parser's message.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", .path.display())]
+pub(crate) struct SensorYamlError {
+    path: std::path::PathBuf,
+    source: serde_saphyr::Error,
+}
+
+/// The `sensor.yaml` beside `data_csv`, if there is one: its figures, or why they cannot be
+/// read.
+pub(crate) fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, SensorYamlError>> {
     let p = data_csv.parent()?.join("sensor.yaml");
     let text = std::fs::read_to_string(&p).ok()?;
-    Some(serde_saphyr::from_str::<Stated>(&text).map_err(|e| format!("{}: {e}", p.display())))
+    Some(
+        serde_saphyr::from_str::<Stated>(&text)
+            .map_err(|source| SensorYamlError { path: p, source }),
+    )
 }
 
 /// The figures the `sensor.yaml` of topic `topic` of the input at `path` states (for the

@@ -51,9 +51,14 @@ struct MetadataFile {
     rosbag2_bagfile_information: BagInfo,
 }
 
+/// Why a `metadata.yaml` is no bag's metadata: the YAML parser's message.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct MetadataError(String);
+
 impl BagInfo {
     /// Parses the text of a `metadata.yaml`.
-    pub(crate) fn parse(text: &str) -> Result<BagInfo, String> {
+    pub(crate) fn parse(text: &str) -> Result<BagInfo, MetadataError> {
         // The parser's message: its first line (the excerpt after it is the file's text),
         // without its own "error: ".
         serde_saphyr::from_str::<MetadataFile>(text)
@@ -61,7 +66,7 @@ impl BagInfo {
             .map_err(|e| {
                 let s = e.to_string();
                 let first = s.lines().next().unwrap_or("").trim();
-                first.strip_prefix("error: ").unwrap_or(first).to_string()
+                MetadataError(first.strip_prefix("error: ").unwrap_or(first).to_string())
             })
     }
 

@@ -120,34 +120,35 @@ pub(super) fn row_of<'f>(
     lay: &Layout,
     n_fields: usize,
     get: impl Fn(usize) -> Option<&'f [u8]>,
-) -> Result<Row, String> {
+) -> Result<Row, BadRow> {
     let t = match lay.time {
         Some(i) => {
-            let f =
-                get(i).ok_or_else(|| format!("{n_fields} fields, the time is field {}", i + 1))?;
+            let f = get(i)
+                .ok_or_else(|| BadRow(format!("{n_fields} fields, the time is field {}", i + 1)))?;
             parse_time_ns(f, lay.time_unit).ok_or_else(|| {
-                format!(
+                BadRow(format!(
                     "time '{}' is not a non-negative number",
                     String::from_utf8_lossy(f)
-                )
+                ))
             })?
         }
         None => 0,
     };
-    let three = |cols: Option<[usize; 3]>, si: f64| -> Result<[f64; 3], String> {
+    let three = |cols: Option<[usize; 3]>, si: f64| -> Result<[f64; 3], BadRow> {
         let Some(c) = cols else {
             return Ok([f64::NAN; 3]);
         };
         let mut v = [0.0; 3];
         for a in 0..3 {
-            let f = get(c[a])
-                .ok_or_else(|| format!("{n_fields} fields, expected at least {}", c[a] + 1))?;
+            let f = get(c[a]).ok_or_else(|| {
+                BadRow(format!("{n_fields} fields, expected at least {}", c[a] + 1))
+            })?;
             v[a] = num(f).ok_or_else(|| {
-                format!(
+                BadRow(format!(
                     "field {} '{}' is not a number",
                     c[a] + 1,
                     String::from_utf8_lossy(f)
-                )
+                ))
             })? * si;
         }
         Ok(v)
@@ -161,8 +162,12 @@ pub(super) fn row_of<'f>(
     })
 }
 
+/// Why a line is no row (counted, and the first one said with its line number).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct BadRow(pub(super) String);
+
 impl Chunk<'_> {
-    pub(super) fn take(&mut self, line: u64, r: Result<Row, String>) {
+    pub(super) fn take(&mut self, line: u64, r: Result<Row, BadRow>) {
         match r {
             Ok(row) if self.got.filled < self.slot.cap() => {
                 self.slot.set_row(self.got.filled, row.stamp, &row);
@@ -171,11 +176,13 @@ impl Chunk<'_> {
             }
             Ok(_) => self.take(
                 line,
-                Err("more rows than lines in a range (a reader defect)".into()),
+                Err(BadRow(
+                    "more rows than lines in a range (a reader defect)".into(),
+                )),
             ),
             Err(why) => {
                 self.got.bad += 1;
-                self.got.first_bad.get_or_insert((line, why));
+                self.got.first_bad.get_or_insert((line, why.0));
             }
         }
     }

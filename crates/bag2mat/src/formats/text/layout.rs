@@ -598,7 +598,7 @@ fn resolve_unit<U: Copy + PartialEq>(
     what: &str,
     flag: Option<U>,
     header: &[String],
-    parse: fn(&str) -> Result<U, String>,
+    parse: fn(&str) -> Result<U, super::units::UnknownUnit>,
     known: Option<U>,
     name: fn(U) -> &'static str,
 ) -> Result<Option<U>, Error> {

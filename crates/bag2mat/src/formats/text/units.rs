@@ -36,16 +36,24 @@ impl TimeUnit {
         }
     }
     /// From a flag or header text.
-    pub(crate) fn parse(s: &str) -> Result<TimeUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<TimeUnit, UnknownUnit> {
         match unit_key(s).as_str() {
             "s" | "sec" | "secs" | "second" | "seconds" => Ok(TimeUnit::S),
             "ms" | "msec" => Ok(TimeUnit::Ms),
             "us" | "µs" | "usec" => Ok(TimeUnit::Us),
             "ns" | "nsec" => Ok(TimeUnit::Ns),
-            _ => Err(format!("'{s}' is not a time unit (s, ms, us, ns)")),
+            _ => Err(UnknownUnit(format!(
+                "'{s}' is not a time unit (s, ms, us, ns)"
+            ))),
         }
     }
 }
+
+/// Unit text that names none of the units a column can be in (what was given, and the
+/// units there are).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub(crate) struct UnknownUnit(String);
 
 /// Unit of the gyroscope columns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,11 +80,13 @@ impl GyroUnit {
         }
     }
     /// From a flag or header text.
-    pub(crate) fn parse(s: &str) -> Result<GyroUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<GyroUnit, UnknownUnit> {
         match unit_key(s).as_str() {
             "rad/s" | "rads^-1" | "rad*s^-1" | "rads-1" | "radps" => Ok(GyroUnit::RadS),
             "deg/s" | "°/s" | "dps" | "degs^-1" | "degps" => Ok(GyroUnit::DegS),
-            _ => Err(format!("'{s}' is not a gyroscope unit (rad/s, deg/s)")),
+            _ => Err(UnknownUnit(format!(
+                "'{s}' is not a gyroscope unit (rad/s, deg/s)"
+            ))),
         }
     }
 }
@@ -110,12 +120,14 @@ impl AccUnit {
         }
     }
     /// From a flag or header text.
-    pub(crate) fn parse(s: &str) -> Result<AccUnit, String> {
+    pub(crate) fn parse(s: &str) -> Result<AccUnit, UnknownUnit> {
         match unit_key(s).as_str() {
             "m/s^2" | "m/s2" | "ms^-2" | "m*s^-2" | "ms-2" | "m/s/s" | "mps2" => Ok(AccUnit::Ms2),
             "g" => Ok(AccUnit::G),
             "mg" => Ok(AccUnit::Mg),
-            _ => Err(format!("'{s}' is not an accelerometer unit (m/s^2, g, mg)")),
+            _ => Err(UnknownUnit(format!(
+                "'{s}' is not an accelerometer unit (m/s^2, g, mg)"
+            ))),
         }
     }
 }
