@@ -491,18 +491,7 @@ fn write_outputs(
     let csv_path = dir.join("allan_curves.csv");
     outputs.write_atomic(&csv_path, |w| w.write_all(&csv))?;
     written.push(csv_path);
-    // Upstream hard-codes titlestr; without --title the input's file stem names the charts.
-    let title = if config.title.is_empty() {
-        config
-            .common
-            .input
-            .first()
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    } else {
-        config.title.clone()
-    };
+    let title = chart_title(config);
     // The charts are rendered in parallel (each is one thread's work).
     let (compat_plots, section_files) = rayon::join(
         || write_plots(outputs, analysis, &title, dir),
@@ -571,17 +560,7 @@ pub fn run_curves(
     an.notes.extend(c.notes.iter().cloned());
     let dir = &config.common.out_dir;
     outputs.ensure_dir(dir)?;
-    let title = if config.title.is_empty() {
-        config
-            .common
-            .input
-            .first()
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    } else {
-        config.title.clone()
-    };
+    let title = chart_title(config);
     let rostopic = config.common.named_topic();
     let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic)?;
     written.extend(crate::ieee952::plot::write_chart(
@@ -592,6 +571,22 @@ pub fn run_curves(
         notes: Vec::new(),
         written,
     })
+}
+
+/// The charts' title: `--title`, else the input's file stem (upstream hard-codes its
+/// `titlestr`).
+fn chart_title(config: &Config) -> String {
+    if config.title.is_empty() {
+        config
+            .common
+            .input
+            .first()
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    } else {
+        config.title.clone()
+    }
 }
 
 /// Writes `allan_accel.{png,svg}` and `allan_gyro.{png,svg}` into `dir`.

@@ -321,14 +321,7 @@ pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
         &cfg.topic,
         &cfg.frame_id,
     )?;
-    // The presets' model is vio_data_simulation's: keep its generator (byte-identical bags).
-    let mut noise = match cfg.model.legacy(cfg.rate) {
-        Some(c) => Noise::Legacy(Box::new(NoiseGenerator::new(
-            c.discretize(1.0 / cfg.rate),
-            cfg.seed,
-        ))),
-        None => Noise::Real(Box::new(ImuNoise::new(&cfg.model, cfg.rate, cfg.seed)?)),
-    };
+    let mut noise = Noise::of(cfg)?;
     // The static model does not depend on t (upstream calls MotionModel(0)): compute it once.
     let fixed = (cfg.motion == Motion::Static).then(|| cfg.motion.sample(0.0));
     let to_xyzw = |q: [f64; 4]| [q[1], q[2], q[3], q[0]];
@@ -393,6 +386,20 @@ pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
 enum Noise {
     Legacy(Box<NoiseGenerator>),
     Real(Box<ImuNoise>),
+}
+
+impl Noise {
+    /// The generator of `cfg`'s model: the presets' model is vio_data_simulation's, so it
+    /// keeps that generator (byte-identical bags).
+    fn of(cfg: &BagConfig) -> Result<Noise> {
+        Ok(match cfg.model.legacy(cfg.rate) {
+            Some(c) => Noise::Legacy(Box::new(NoiseGenerator::new(
+                c.discretize(1.0 / cfg.rate),
+                cfg.seed,
+            ))),
+            None => Noise::Real(Box::new(ImuNoise::new(&cfg.model, cfg.rate, cfg.seed)?)),
+        })
+    }
 }
 
 impl Noise {
