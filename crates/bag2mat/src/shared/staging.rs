@@ -70,7 +70,7 @@ struct Staged {
 
 /// A run's stage, shared by its [`Staging`] and the temporary paths written in it (which
 /// record themselves at their commit); empty once the staging is committed or dropped.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub(super) struct Stage(Arc<Mutex<Option<Staged>>>);
 
 /// Declares `dir` an output directory the stage's commit may create; false once the
