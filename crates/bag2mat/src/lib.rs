@@ -61,13 +61,30 @@ mod time;
 pub mod timing;
 mod zstd;
 
-pub use bag::Compression;
+pub use bag::write::ConnId;
+pub use bag::{BagReader, BagWriter, Compression};
 pub use cli::{Args, Invocation, run};
+pub use convert::{
+    Converted, Format as OutputFormat, bag_to_data_imu, data_imu_from_series, into_data_imu,
+    write as write_matrix,
+};
 pub use detect::input_kind;
 pub use error::{Error, TopicSummary};
+pub use formats::euroc::{Stated as SensorYaml, stated_for as sensor_yaml_for};
+pub use formats::text::STANDARD_GRAVITY;
+pub use formats::{AccUnit, GyroUnit, InputArgs, InputOptions, TimeUnit};
+pub use imu_msg::{Imu, MD5 as IMU_MD5, definition as imu_definition};
 pub use info::{InfoReport, TopicInfo, info, info_with};
 pub use input::open as open_input;
+pub use mat::{DataImu, read_data_imu, write_data_imu};
+pub use mcap::{ChunkCompression, MAGIC as MCAP_MAGIC};
 pub use printable::escape as escape_printable;
+pub use record_check::warmup::{Fit as WarmupFit, find as find_warmup};
+pub use record_check::{
+    Check as RecordCheck, Finding, Keep as KeepRows, Kind as FindingKind, Level as FindingLevel,
+    Options as CheckOptions, RATE_ARGUMENT_REL, Record as CheckInput, check as check_record,
+    checked_skip, drop_absent, rate_argument,
+};
 pub use rosbag2::{Ros2BagWriter, Storage, TopicId};
 pub use rows::{ROW_LEN, Row, Rows, permute};
 pub use sensor::Sensor;
@@ -77,3 +94,4 @@ pub use series::{
 };
 pub use source::{ACCEPTED, InputKind, Source};
 pub use time::RosTime;
+pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};
