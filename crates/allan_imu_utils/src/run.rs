@@ -32,7 +32,7 @@ pub struct Outcome {
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
     pub ieee952_text: Option<String>,
     /// What the record check found (stderr, always).
-    pub findings: Vec<bag2mat::record_check::Finding>,
+    pub findings: Vec<bag2mat::Finding>,
     /// Things to say on stderr (end of bag, topic fallback, …).
     pub notes: Vec<Note>,
     /// Files written.
@@ -80,25 +80,21 @@ pub fn ieee952_curve(a: &AxisAllan, gyro: bool, tau0: f64) -> CurveData {
 
 /// The record check of the first `n` messages of `series` on the chosen clock, the other
 /// cross-checked.
-fn check_record(
-    series: &bag2mat::ImuSeries,
-    n: usize,
-    config: &Config,
-) -> bag2mat::record_check::Check {
+fn check_record(series: &bag2mat::ImuSeries, n: usize, config: &Config) -> bag2mat::RecordCheck {
     let (used, other) = match config.common.time {
         bag2mat::TimeColumn::Header => (&series.stamp, &series.record_time),
         bag2mat::TimeColumn::Record => (&series.record_time, &series.stamp),
     };
-    let t = bag2mat::timing::ns_of_times(&used[..n]);
-    let o = bag2mat::timing::ns_of_times(&other[..n]);
-    let mut rec = bag2mat::record_check::Record::of_series(series, config.common.time, &t, &o);
+    let t = bag2mat::ns_of_times(&used[..n]);
+    let o = bag2mat::ns_of_times(&other[..n]);
+    let mut rec = bag2mat::CheckInput::of_series(series, config.common.time, &t, &o);
     rec.storage_order = rec.storage_order.map(|s| &s[..n]);
     for v in rec.values.iter_mut() {
         *v = &v[..n];
     }
-    bag2mat::record_check::check(
+    bag2mat::check_record(
         &rec,
-        &bag2mat::record_check::Options {
+        &bag2mat::CheckOptions {
             drop_outliers: config.common.drop_outliers,
         },
     )
@@ -111,7 +107,7 @@ fn skip_start(
     seconds: f64,
 ) -> Result<(usize, Option<String>), Error> {
     let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
-    let (k, warning) = bag2mat::record_check::checked_skip(&t, seconds).map_err(Error::Config)?;
+    let (k, warning) = bag2mat::checked_skip(&t, seconds).map_err(Error::Config)?;
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);
@@ -209,14 +205,14 @@ fn run_series(
     let absent = stand_in_and_skip(config, &mut series, &mut notes)?;
     let collected = collect::collect(&series, config.max_time_min, config.common.time);
     notes.extend(end_of_bag_note(&collected, config));
-    // The record check (bag2mat::record_check) on the collected messages: duplicates, a
+    // The record check (bag2mat::check_record) on the collected messages: duplicates, a
     // clock that steps back and a record that is not one continuous stretch are cut, spikes
     // dropped when asked; what the record breaks of the analysis' assumptions is found.
     let (n, stop) = (collected.len(), collected.stop);
     drop(collected);
     let t1 = Instant::now();
     let mut check = check_record(&series, n, config);
-    bag2mat::record_check::drop_absent(&mut check.findings, absent);
+    bag2mat::drop_absent(&mut check.findings, absent);
     timings.push(("record_check", t1.elapsed()));
     let series = kept_series(series, &check, n, absent);
     let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
@@ -301,7 +297,7 @@ fn end_of_bag_note(collected: &collect::Collected, config: &Config) -> Option<No
 /// present sensor's samples then stand in for the absent one's.
 fn kept_series(
     series: bag2mat::ImuSeries,
-    check: &bag2mat::record_check::Check,
+    check: &bag2mat::RecordCheck,
     n: usize,
     absent: Option<bag2mat::Sensor>,
 ) -> bag2mat::ImuSeries {
@@ -323,7 +319,7 @@ fn kept_series(
 /// record check's findings; not on a record that breaks its assumptions (said in `notes`).
 fn ieee952_section(
     config: &Config,
-    check: &bag2mat::record_check::Check,
+    check: &bag2mat::RecordCheck,
     axes: &[AxisAllan],
     collected: &collect::Collected,
     absent: Option<Sensor>,
@@ -388,7 +384,7 @@ fn section(
     collected: &collect::Collected,
     absent: Option<Sensor>,
     section_rate: f64,
-    findings: &[bag2mat::record_check::Finding],
+    findings: &[bag2mat::Finding],
 ) -> ImuAnalysis {
     let curves: Vec<CurveData> = axes
         .par_iter()

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use bag2mat::BagWriter;
+use bag2mat::Imu;
 use bag2mat::RosTime;
-use bag2mat::bag::BagWriter;
-use bag2mat::imu_msg::Imu;
 
 use crate::common::CASES;
 

@@ -7,8 +7,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use bag2mat::record_check::{Finding, Kind};
 use bag2mat::test_tools::{OddRecord, OddWriter, odd_record, warnings};
+use bag2mat::{Finding, FindingKind};
 
 use crate::common::kalibr_config;
 
@@ -95,7 +95,7 @@ fn issue18_7_header_and_record_clocks_are_cross_checked() {
     let f: Vec<&Finding> = k
         .findings
         .iter()
-        .filter(|f| f.kind == Kind::ClockMismatch)
+        .filter(|f| f.kind == FindingKind::ClockMismatch)
         .collect();
     assert!(f.len() == 1 && f[0].size == Some(200.0), "{f:?}");
 }
@@ -116,7 +116,7 @@ fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
         "{err}"
     );
     let gaps = |fs: &[Finding]| -> Finding {
-        let g: Vec<&Finding> = fs.iter().filter(|f| f.kind == Kind::Gaps).collect();
+        let g: Vec<&Finding> = fs.iter().filter(|f| f.kind == FindingKind::Gaps).collect();
         assert_eq!(g.len(), 1, "{fs:?}");
         g[0].clone()
     };

@@ -24,7 +24,7 @@ fn cpu_seconds() -> f64 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     if std::env::var("PSD").is_ok() {
         let a: Vec<String> = std::env::args().collect();
-        let d = bag2mat::mat::read_data_imu(std::path::Path::new(&a[1]))?;
+        let d = bag2mat::read_data_imu(std::path::Path::new(&a[1]))?;
         let t = Instant::now();
         let n: usize = d.columns[1..]
             .par_iter()
@@ -43,7 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Ok(());
     }
     let a: Vec<String> = std::env::args().collect();
-    let d = bag2mat::mat::read_data_imu(std::path::Path::new(&a[1]))?;
+    let d = bag2mat::read_data_imu(std::path::Path::new(&a[1]))?;
     let rate: f64 = a[2].parse()?;
     let cols: Vec<&Vec<f64>> = d.columns[1..].iter().collect();
     let all = GridSpec::default().cluster_sizes(cols[0].len());

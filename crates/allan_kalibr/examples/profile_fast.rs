@@ -6,7 +6,7 @@ use allan_kalibr::{TauGrid, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
-    let d = bag2mat::mat::read_data_imu(std::path::Path::new(&a[1]))?;
+    let d = bag2mat::read_data_imu(std::path::Path::new(&a[1]))?;
     let rate: f64 = a[2].parse()?;
     let [_, mut x, mut y, ..] = d.columns;
     let t = Instant::now();

@@ -8,10 +8,10 @@
 
 use std::path::PathBuf;
 
-use bag2mat::bag::BagWriter;
-use bag2mat::imu_msg::Imu;
-use bag2mat::mat::{DataImu, write_data_imu};
+use bag2mat::BagWriter;
+use bag2mat::Imu;
 use bag2mat::{Compression, RosTime};
+use bag2mat::{DataImu, write_data_imu};
 
 /// Seed of the generator (fixed: the benchmark input is reproducible).
 const SEED: u64 = 0x4a11_ba9c;

@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bag2mat::record_check::Finding;
+use bag2mat::Finding;
 use bag2mat::shared::note::Note;
 use bag2mat::shared::{cli, output};
 
@@ -87,7 +87,7 @@ pub struct CommonArgs {
     #[arg(long)]
     pub compat_only: bool,
     #[command(flatten)]
-    pub input_args: bag2mat::formats::InputArgs,
+    pub input_args: bag2mat::InputArgs,
 }
 
 /// `--rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
@@ -159,7 +159,7 @@ pub struct Common {
     pub ieee952: bool,
     /// What the user said about a log whose content does not say it all (a text log's
     /// columns, units and, without a time column, its rate).
-    pub input_options: bag2mat::formats::InputOptions,
+    pub input_options: bag2mat::InputOptions,
 }
 
 impl Common {

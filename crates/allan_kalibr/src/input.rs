@@ -3,8 +3,8 @@
 //!
 //! Upstream never looks at the timestamps except to count them (kalibr_allan.md §2): the
 //! user types the rate into the script. Here the rate is the stamps' nominal rate
-//! (`bag2mat::timing`: lost samples do not change it) when not given; a given rate the stamps
-//! contradict (`bag2mat::record_check::rate_argument`) still drives the upstream-compatible
+//! (`bag2mat::analyse_timing`: lost samples do not change it) when not given; a given rate the stamps
+//! contradict (`bag2mat::rate_argument`) still drives the upstream-compatible
 //! grid, as upstream, and the IEEE 952 section uses the measured one.
 
 use std::path::Path;
@@ -34,7 +34,7 @@ pub struct ImuData {
     pub absent: Option<bag2mat::Sensor>,
 }
 
-/// The clock side of [`ImuData`], for `bag2mat::record_check`: the time column in exact
+/// The clock side of [`ImuData`], for `bag2mat::check_record`: the time column in exact
 /// nanoseconds (a bag's stamps; a `.mat`'s seconds as they are), the other clock of a bag,
 /// the storage order when the reader sorted, and the container's promised count.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -74,12 +74,12 @@ impl ImuData {
         };
         let clock = Clock {
             time,
-            t_ns: bag2mat::timing::ns_of_times(used),
-            other_ns: Some(bag2mat::timing::ns_of_times(other)),
+            t_ns: bag2mat::ns_of_times(used),
+            other_ns: Some(bag2mat::ns_of_times(other)),
             storage_order: s.storage_order.take(),
             promised: s.report.promised.map(|p| (p, s.report.delivered)),
         };
-        let [t, ax, ay, az, wx, wy, wz] = bag2mat::convert::into_data_imu(s, time).columns;
+        let [t, ax, ay, az, wx, wy, wz] = bag2mat::into_data_imu(s, time).columns;
         ImuData {
             t,
             axes: [ax, ay, az, wx, wy, wz],
@@ -91,7 +91,7 @@ impl ImuData {
     }
 
     /// The samples `keep` names (all of them: unchanged).
-    pub(crate) fn select(self, keep: &bag2mat::record_check::Keep) -> ImuData {
+    pub(crate) fn select(self, keep: &bag2mat::KeepRows) -> ImuData {
         if keep.is_all() {
             return self;
         }
@@ -129,9 +129,9 @@ impl ImuData {
     }
 
     /// The record the check reads: gyro x y z, then acc x y z, with the clock.
-    pub(crate) fn record(&self) -> bag2mat::record_check::Record<'_> {
+    pub(crate) fn record(&self) -> bag2mat::CheckInput<'_> {
         let a = &self.axes;
-        bag2mat::record_check::Record {
+        bag2mat::CheckInput {
             time: self.clock.time,
             t: &self.clock.t_ns,
             other: self.clock.other_ns.as_deref(),
@@ -180,7 +180,7 @@ fn is_mat(path: &Path) -> bool {
 /// Reads one topic of a bag (any format bag2mat reads) or a `.mat` (variable `data_imu`).
 pub fn load(path: &Path, topic: &str, quiet: bool) -> Result<ImuData, Error> {
     let sel = bag2mat::TopicSelector::one(topic);
-    let opts = bag2mat::formats::InputOptions::default();
+    let opts = bag2mat::InputOptions::default();
     Ok(load_all(path, &sel, bag2mat::TimeColumn::Record, quiet, &opts)?.remove(0))
 }
 
@@ -190,7 +190,7 @@ pub(crate) fn load_all(
     sel: &bag2mat::TopicSelector,
     time: bag2mat::TimeColumn,
     quiet: bool,
-    opts: &bag2mat::formats::InputOptions,
+    opts: &bag2mat::InputOptions,
 ) -> Result<Vec<ImuData>, Error> {
     if is_mat(path) {
         return Ok(vec![load_mat(path)?]);
@@ -209,11 +209,11 @@ pub(crate) fn load_all(
 }
 
 fn load_mat(path: &Path) -> Result<ImuData, Error> {
-    let d = bag2mat::mat::read_data_imu(path)?;
+    let d = bag2mat::read_data_imu(path)?;
     let [t, ax, ay, az, wx, wy, wz] = d.columns;
     let clock = Clock {
         time: bag2mat::TimeColumn::Record,
-        t_ns: bag2mat::timing::ns_of_seconds(&t),
+        t_ns: bag2mat::ns_of_seconds(&t),
         ..Clock::default()
     };
     Ok(ImuData {
@@ -340,16 +340,16 @@ fn value_problem_slow(axis: &str, col: &[f64]) -> Option<(bool, String)> {
 pub struct RateChoice {
     /// Hz, drives the τ grid of the upstream-compatible part.
     pub used: f64,
-    /// The nominal rate of the analysed stamps (`bag2mat::timing`), when they allow one.
+    /// The nominal rate of the analysed stamps (`bag2mat::analyse_timing`), when they allow one.
     pub measured: Option<f64>,
     /// The rate the IEEE 952 section uses: the stamps' (snapped as [`snap_rate`]), unless
-    /// the given rate agrees with them (`bag2mat::record_check::RATE_ARGUMENT_REL`) or they
+    /// the given rate agrees with them (`bag2mat::RATE_ARGUMENT_REL`) or they
     /// give none.
     pub section: f64,
     /// An info line (estimated), for stderr.
     pub message: Option<String>,
     /// A given rate the stamps contradict.
-    pub finding: Option<bag2mat::record_check::Finding>,
+    pub finding: Option<bag2mat::Finding>,
 }
 
 /// A measured rate within this fraction of a rate with at most [`RATE_ROUND_DECIMALS`]
@@ -385,7 +385,7 @@ pub(crate) fn measured_rate(t: &[f64]) -> Option<f64> {
 }
 
 /// Chooses the update rate from the given one and the stamps' nominal rate `measured`
-/// (`bag2mat::timing`: lost samples do not change it): the given one for the
+/// (`bag2mat::analyse_timing`: lost samples do not change it): the given one for the
 /// upstream-compatible grid (as upstream), the measured one, snapped to an integer within
 /// [`RATE_SNAP_REL`], otherwise and for the IEEE 952 section.
 pub(crate) fn choose_rate(
@@ -398,7 +398,7 @@ pub(crate) fn choose_rate(
             if !(rate.is_finite() && rate > 0.0) {
                 return Err(Error::BadRate(rate));
             }
-            let finding = measured.and_then(|m| bag2mat::record_check::rate_argument(rate, m));
+            let finding = measured.and_then(|m| bag2mat::rate_argument(rate, m));
             let section = match (measured, &finding) {
                 (Some(m), Some(_)) => snap_rate(m),
                 _ => rate,
@@ -449,7 +449,7 @@ mod tests {
 
     /// The nominal rate of `t`, as the run measures it.
     fn nominal(t: &[f64]) -> Option<f64> {
-        bag2mat::timing::analyse(&bag2mat::timing::ns_of_seconds(t)).nominal_rate()
+        bag2mat::analyse_timing(&bag2mat::ns_of_seconds(t)).nominal_rate()
     }
 
     #[test]

@@ -31,7 +31,7 @@
 //!   [`Verdict`]), the IEEE 952 region readings as cross-check and fallback
 //!   (`ieee952::region`, [`Reading`]); record-length advice (`ieee952::advisor`,
 //!   [`advise`]); the record check's findings named in the verdicts
-//!   (`bag2mat::record_check`: clocks, gaps, outliers, warm-up, motion);
+//!   (`bag2mat::check_record`: clocks, gaps, outliers, warm-up, motion);
 //!   other tools' Allan curves (`--curves`, `ieee952::curves_in`: [`read_curves`]); the
 //!   section's text (`ieee952::imu`: [`ieee952_summary_text`]), its files (terms and curves
 //!   CSV, Kalibr/VINS/ORB-SLAM3 yaml, with named columns `sim compare` reads:

@@ -97,7 +97,7 @@ pub struct RunOutput {
     /// The IEEE 952 section printed after it (when enabled and the data allow it).
     pub ieee952_text: Option<String>,
     /// What the record check found (stderr, always).
-    pub findings: Vec<bag2mat::record_check::Finding>,
+    pub findings: Vec<bag2mat::Finding>,
     /// Notes and warnings (stderr), in order.
     pub notes: Vec<Note>,
     /// Files written.
@@ -119,7 +119,7 @@ pub struct Timings {
     pub ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
     pub output: f64,
-    /// The record check (`bag2mat::record_check`).
+    /// The record check (`bag2mat::check_record`).
     pub checks: f64,
 }
 
@@ -281,12 +281,12 @@ pub fn run_on(config: &Config, mut data: ImuData, outputs: &Outputs) -> Result<R
 /// the section's curves made beside the checks (see [`check_record`]).
 struct Checked {
     data: ImuData,
-    findings: Vec<bag2mat::record_check::Finding>,
+    findings: Vec<bag2mat::Finding>,
     rate: RateChoice,
     /// The check kept every sample.
     whole: bool,
     /// What makes the record unfit for the IEEE 952 section, if anything.
-    refusal: Option<bag2mat::record_check::Finding>,
+    refusal: Option<bag2mat::Finding>,
     /// The section's curves made beside the check (taken by [`section_curves`]).
     early: Option<EarlyCurves>,
     checks_s: f64,
@@ -297,7 +297,7 @@ struct Checked {
 type EarlyCurves = (f64, Option<crate::ieee952::imu::ImuCurves>, Vec<Note>, f64);
 
 /// The finiteness and value checks of each column, then the record check
-/// (bag2mat::record_check): duplicates, a clock that steps back and a record that is not
+/// (bag2mat::check_record): duplicates, a clock that steps back and a record that is not
 /// one continuous stretch are cut, spikes dropped when asked, and what the record breaks of
 /// the analysis' assumptions is found; then the rate.
 fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result<Checked, Error> {
@@ -322,9 +322,9 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
     let ((check, checks_s), early) = rayon::join(
         || {
             let start = Instant::now();
-            let check = bag2mat::record_check::check(
+            let check = bag2mat::check_record(
                 &data.record(),
-                &bag2mat::record_check::Options {
+                &bag2mat::CheckOptions {
                     drop_outliers: config.common.drop_outliers,
                 },
             );
@@ -345,7 +345,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
         },
     );
     let mut findings = check.findings.clone();
-    bag2mat::record_check::drop_absent(&mut findings, absent);
+    bag2mat::drop_absent(&mut findings, absent);
     notes.extend(absent.map(bag2mat::absent_warning));
     let whole = check.keep.is_all();
     let data = data.select(&check.keep);
@@ -520,8 +520,8 @@ fn write_outputs(
 /// Drops the samples of the first `seconds` of the record; returns how many, and a
 /// warning when that is most of it.
 fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
-    let (k, warning) = bag2mat::record_check::checked_skip(&data.t, seconds)
-        .map_err(|what| Error::BadData { what })?;
+    let (k, warning) =
+        bag2mat::checked_skip(&data.t, seconds).map_err(|what| Error::BadData { what })?;
     data.drop_first(k);
     Ok((k, warning))
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use allan_kalibr::load_input;
-use bag2mat::mat::{DataImu, write_data_imu};
+use bag2mat::{DataImu, write_data_imu};
 
 use crate::common::{CASES, final_full, process_lines, rel_err};
 

@@ -335,7 +335,7 @@ fn defect_19_10_skip_start_and_curve_flags_are_checked() {
 fn defect_19_9_warnings_go_to_stderr_in_lowercase() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("w.mat");
-    bag2mat::mat::write_data_imu(
+    bag2mat::write_data_imu(
         &bag2mat::shared::output::Outputs::direct(),
         &mat,
         &crate::ieee952::simulate(4, Some((0.02, 300.0)), Some((3000.0, 20.0))),

@@ -11,7 +11,7 @@ use allan_kalibr::{
     COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_SENSOR,
     COL_TERM, COL_VALUE, COL_VERDICT, CURVES_FILE, TERMS_FILE,
 };
-use bag2mat::mat::{DataImu, write_data_imu};
+use bag2mat::{DataImu, write_data_imu};
 
 /// Sample rate of the simulated records, Hz.
 const RATE: f64 = 50.0;

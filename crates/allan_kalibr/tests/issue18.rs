@@ -278,7 +278,7 @@ fn issue18_6_a_clock_step_and_duplicates_are_found_not_sorted_in() {
     assert!(
         t.findings
             .iter()
-            .any(|f| f.kind == bag2mat::record_check::Kind::Duplicates),
+            .any(|f| f.kind == bag2mat::FindingKind::Duplicates),
         "{t:?}"
     );
 }

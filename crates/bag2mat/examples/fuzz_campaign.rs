@@ -49,11 +49,11 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use bag2mat::bag::BagWriter;
-use bag2mat::bag::record::{Header, Op, raw_record};
-use bag2mat::imu_msg::Imu;
-use bag2mat::mcap::ChunkCompression;
+use bag2mat::BagWriter;
+use bag2mat::ChunkCompression;
+use bag2mat::Imu;
 use bag2mat::test_tools::{self, btree_pages, mcap_records, reported_losses, rowid_fields};
+use bag2mat::test_tools::{BagOp, BagRecordHeader, raw_bag_record};
 use bag2mat::{Compression, RosTime};
 use bag2mat::{Ros2BagWriter, Storage};
 
@@ -260,20 +260,22 @@ fn ros1_regions(b: &[u8]) -> Vec<Region> {
     let mut out = Vec::new();
     let mut pos = 13;
     let mut first = true;
-    while let Some(r) = raw_record(b, pos) {
+    while let Some(r) = raw_bag_record(b, pos) {
         let hs = pos + 4;
         let ds = hs + r.header.len() + 4;
-        let op = Header::parse(r.header).ok().and_then(|h| h.op().ok());
+        let op = BagRecordHeader::parse(r.header)
+            .ok()
+            .and_then(|h| h.op().ok());
         let mut push = |kind, range, index| out.push(Region { kind, range, index });
         match op {
-            Some(Op::BagHeader) if first => push("header", pos..ds, true),
-            Some(Op::Chunk) => {
+            Some(BagOp::BagHeader) if first => push("header", pos..ds, true),
+            Some(BagOp::Chunk) => {
                 push("chunk header", pos..ds, true);
                 push("chunk data", ds..r.end, false);
             }
-            Some(Op::IndexData) => push("index data", pos..r.end, true),
-            Some(Op::Connection) => push("connection", pos..r.end, false),
-            Some(Op::ChunkInfo) => push("chunk info", pos..r.end, true),
+            Some(BagOp::IndexData) => push("index data", pos..r.end, true),
+            Some(BagOp::Connection) => push("connection", pos..r.end, false),
+            Some(BagOp::ChunkInfo) => push("chunk info", pos..r.end, true),
             _ => {}
         }
         first = false;
@@ -420,7 +422,7 @@ fn source_units(path: &Path) -> Vec<(usize, Vec<u32>)> {
 /// and data length; MCAP: after its header fields): a file cut before that holds none of
 /// its messages.
 fn data_start(b: &[u8], at: usize) -> usize {
-    if b.starts_with(bag2mat::mcap::MAGIC) {
+    if b.starts_with(bag2mat::MCAP_MAGIC) {
         if b.get(at) != Some(&0x06) {
             return at;
         }

@@ -1,5 +1,5 @@
 //! Writes the synthetic logs the cross-checks and `scripts/bench.sh` read:
-//! `write_logs ulog OUT SECONDS RATE` (PX4 IMU topics, bag2mat::formats::ulog::write),
+//! `write_logs ulog OUT SECONDS RATE` (PX4 IMU topics, bag2mat::test_tools::ulog_imu_log),
 //! `write_logs ulog-fifo OUT SECONDS RATE` (PX4's raw FIFO topics, 6 samples a message),
 //! `write_logs dataflash OUT SECONDS RATE` (IMU and ISBH/ISBD, formats::dataflash::write),
 //! `write_logs euroc DIR SECONDS RATE` (DIR/mav0/imu0/data.csv, EuRoC/ASL header).
@@ -15,20 +15,17 @@ fn main() -> anyhow::Result<()> {
     let (out, seconds, rate) = (std::path::Path::new(&a[2]), a[3].parse()?, a[4].parse()?);
     match a[1].as_str() {
         "ulog" => {
-            let spec = bag2mat::formats::ulog::write::ImuLogSpec {
+            let spec = bag2mat::test_tools::UlogImuSpec {
                 seconds,
                 rate,
                 instances: 2,
                 dropout_ms: Some(40),
                 seed: 20,
             };
-            bag2mat::formats::ulog::write::imu_log(
-                BufWriter::new(std::fs::File::create(out)?),
-                &spec,
-            )?;
+            bag2mat::test_tools::ulog_imu_log(BufWriter::new(std::fs::File::create(out)?), &spec)?;
         }
         "ulog-fifo" => {
-            bag2mat::formats::ulog::write::fifo_log(
+            bag2mat::test_tools::ulog_fifo_log(
                 BufWriter::new(std::fs::File::create(out)?),
                 seconds,
                 rate,
@@ -37,7 +34,7 @@ fn main() -> anyhow::Result<()> {
             )?;
         }
         "dataflash" => {
-            bag2mat::formats::dataflash::write::imu_log(
+            bag2mat::test_tools::dataflash_imu_log(
                 BufWriter::new(std::fs::File::create(out)?),
                 seconds,
                 rate,
@@ -63,7 +60,7 @@ fn euroc(path: &std::path::Path, seconds: f64, rate: f64) -> anyhow::Result<()> 
         "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"
     )?;
     let mut st = 20u64;
-    let mut next = || bag2mat::formats::synthetic_noise(&mut st);
+    let mut next = || bag2mat::test_tools::synthetic_noise(&mut st);
     let n = (seconds * rate) as u64;
     let dt = (1e9 / rate).round() as u64;
     for i in 0..n {

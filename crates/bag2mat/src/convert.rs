@@ -17,7 +17,6 @@ use crate::series::{
     ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, topic_folder_names,
 };
 use crate::shared::output::Outputs;
-use crate::time::RosTime;
 
 /// Output file formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -58,19 +57,6 @@ pub fn default_output(bag: &Path, format: Format) -> PathBuf {
     }
 }
 
-/// bagconvert's row for one message: `[record time (s), acc x y z, gyro x y z]`.
-pub fn bagconvert_row(record_time: RosTime, acc: [f64; 3], gyro: [f64; 3]) -> [f64; COLS] {
-    [
-        record_time.to_sec(),
-        acc[0],
-        acc[1],
-        acc[2],
-        gyro[0],
-        gyro[1],
-        gyro[2],
-    ]
-}
-
 /// The matrix of one Imu series with the chosen time column.
 pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
     let t = s.time(time).iter().map(|r| r.to_sec()).collect();
@@ -83,7 +69,8 @@ pub fn data_imu_from_series(s: &ImuSeries, time: TimeColumn) -> DataImu {
 
 /// The matrix of one Imu series, consuming it: the six value columns are moved, not copied,
 /// and only the time column is computed (peak memory stays near the size of the matrix).
-/// The values are bagconvert's row ([`bagconvert_row`]) column by column.
+/// The values are bagconvert's row (`[record time (s), acc x y z, gyro x y z]`) column by
+/// column.
 pub fn into_data_imu(s: ImuSeries, time: TimeColumn) -> DataImu {
     let ImuSeries {
         record_time,

@@ -88,11 +88,6 @@ impl Stream {
         }
     }
 
-    /// True when empty.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Record time of message `i`, ns.
     pub(crate) fn record(&self, i: usize) -> u64 {
         if self.imu {
@@ -102,8 +97,9 @@ impl Stream {
         }
     }
 
-    /// Row `i` of an Imu topic.
-    pub fn row(&self, i: usize) -> Row {
+    /// Row `i` of an Imu topic (the unit tests').
+    #[cfg(test)]
+    pub(crate) fn row(&self, i: usize) -> Row {
         self.rows.row(i)
     }
 }

@@ -34,13 +34,13 @@ pub struct TopicInfo {
     pub span: Option<(u64, u64)>,
     /// Nominal rate of the record times (span over the sample periods it holds, so lost
     /// and duplicated messages do not change it), Hz; for an Imu topic, of the samples the
-    /// analysers keep ([`crate::record_check`]).
+    /// analysers keep ([`crate::check_record`]).
     pub rate: Option<f64>,
     /// Median interval between consecutive messages, s.
     pub median_period: Option<f64>,
     /// Standard deviation of the intervals over their mean (relative jitter).
     pub jitter: Option<f64>,
-    /// Gaps (intervals with at least one message missing), by [`crate::timing`]'s rule.
+    /// Gaps (intervals with at least one message missing), by [`crate::analyse_timing`]'s rule.
     pub gaps: u64,
     /// Messages missing in them.
     pub missing: u64,

@@ -22,15 +22,15 @@ pub enum InputKind {
     Rosbag2Dir,
     /// A zstd frame: a FILE-mode compressed `.mcap.zstd` or `.db3.zstd`.
     Zstd,
-    /// Delimited text (CSV, TSV, whitespace; EuRoC/ASL `data.csv`): [`crate::formats::text`].
+    /// Delimited text (CSV, TSV, whitespace; EuRoC/ASL `data.csv`): `formats::text`.
     Text,
-    /// An EuRoC/ASL dataset folder: [`crate::formats::euroc`].
+    /// An EuRoC/ASL dataset folder: `formats::euroc`.
     EurocDir,
-    /// `\x93NUMPY`: [`crate::formats::npy`].
+    /// `\x93NUMPY`: `formats::npy`.
     Npy,
-    /// `ULog\x01\x12\x35`: a PX4 log, [`crate::formats::ulog`].
+    /// `ULog\x01\x12\x35`: a PX4 log, `formats::ulog`.
     Ulog,
-    /// `\xA3\x95\x80`: an ArduPilot DataFlash log, [`crate::formats::dataflash`].
+    /// `\xA3\x95\x80`: an ArduPilot DataFlash log, `formats::dataflash`.
     DataFlash,
 }
 

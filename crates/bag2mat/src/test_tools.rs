@@ -6,6 +6,20 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+// The raw record helpers of ROS 1 bags and the synthetic-log writers, for the tests and
+// benchmarks that build or damage files byte by byte.
+pub use crate::bag::record::{
+    Header as BagRecordHeader, Op as BagOp, RawRecord as RawBagRecord,
+    raw_record as raw_bag_record, read_u32,
+};
+pub use crate::formats::dataflash::write::imu_log as dataflash_imu_log;
+pub use crate::formats::synthetic_noise;
+pub use crate::formats::ulog::write::{
+    ImuLogSpec as UlogImuSpec, SENSOR_COMBINED as ULOG_SENSOR_COMBINED,
+    VEHICLE_IMU as ULOG_VEHICLE_IMU, Writer as UlogWriter, fifo_log as ulog_fifo_log,
+    imu_log as ulog_imu_log,
+};
+
 /// The workspace root.
 pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -546,7 +560,7 @@ pub fn warnings<'a>(stderr: &'a str, kind: &str) -> Vec<&'a str> {
 }
 
 /// A PX4 ULog of `seconds` at `rate` Hz (two `sensor_gyro`/`sensor_accel` instances,
-/// `sensor_combined`, `vehicle_imu`; [`crate::formats::ulog::write::imu_log`]) as pyulog's
+/// `sensor_combined`, `vehicle_imu`; [`ulog_imu_log`]) as pyulog's
 /// own writer lays it out (`ULog.write_ulog`, an independent writer): `dir/pyulog.ulg`.
 pub fn pyulog_imu_log(dir: &Path, seconds: f64, rate: f64) -> PathBuf {
     let ours = dir.join("ours.ulg");

@@ -117,7 +117,7 @@ impl Timing {
     }
 
     /// True when an Allan variance over the whole series is meaningful: no rate change and
-    /// long gaps adding up to at most [`MAX_GAP_FRACTION`] of the span.
+    /// long gaps adding up to at most `MAX_GAP_FRACTION` of the span.
     pub fn is_continuous(&self) -> bool {
         self.rate_changes.is_empty()
             && (self.span <= 0.0 || self.long_gap_time() <= MAX_GAP_FRACTION * self.span)

@@ -21,7 +21,7 @@ fn default_output_goes_beside_the_bag() {
         err.contains("BAG Path is:") && err.contains("Done processing IMU data"),
         "{err}"
     );
-    let d = bag2mat::mat::read_data_imu(&dir.path().join("rec.2024.mat")).unwrap();
+    let d = bag2mat::read_data_imu(&dir.path().join("rec.2024.mat")).unwrap();
     assert_eq!(d.rows(), 12200);
 }
 
@@ -149,10 +149,10 @@ fn the_only_imu_topic_is_the_default_and_several_must_be_named() {
         err.contains("no topic named: reading '/imu0', the only sensor_msgs/Imu topic"),
         "{err}"
     );
-    assert_eq!(bag2mat::mat::read_data_imu(&mat).unwrap().rows(), 300);
+    assert_eq!(bag2mat::read_data_imu(&mat).unwrap().rows(), 300);
     let two = dir.path().join("two.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(
+        let mut w = bag2mat::BagWriter::create(
             &bag2mat::shared::output::Outputs::direct(),
             &two,
             Compression::None,

@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use bag2mat::bag::BagWriter;
-use bag2mat::imu_msg::Imu;
+use bag2mat::BagWriter;
+use bag2mat::Imu;
 use bag2mat::{Compression, RosTime};
 
 /// The workspace's `testdata/` folder.

@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use bag2mat::bag::record::{Header, Op, raw_record, read_u32};
+use bag2mat::test_tools::{BagOp, BagRecordHeader, raw_bag_record, read_u32};
 use bag2mat::{Compression, ReadOptions, read_imu_series};
 
 use crate::common::{run, synthetic, write_synthetic};
@@ -24,7 +24,7 @@ type ByteEdit<'a> = Box<dyn Fn(&mut Vec<u8>) + 'a>;
 #[derive(Debug, Clone)]
 pub(crate) struct Rec {
     pub(crate) pos: usize,
-    pub(crate) op: Op,
+    pub(crate) op: BagOp,
     pub(crate) header: std::ops::Range<usize>,
     pub(crate) data: std::ops::Range<usize>,
 }
@@ -33,9 +33,9 @@ pub(crate) struct Rec {
 pub(crate) fn records(bytes: &[u8]) -> Vec<Rec> {
     let mut pos = 13;
     let mut out = Vec::new();
-    while let Some(r) = raw_record(bytes, pos) {
+    while let Some(r) = raw_bag_record(bytes, pos) {
         let hstart = pos + 4;
-        let h = Header::parse(r.header).unwrap();
+        let h = BagRecordHeader::parse(r.header).unwrap();
         let dstart = hstart + r.header.len() + 4;
         out.push(Rec {
             pos,
@@ -114,8 +114,8 @@ fn defect_01_flipped_chunk_info_is_reported_or_read() {
         write_synthetic(&path, "imu", N, c, false);
         let good = std::fs::read(&path).unwrap();
         let recs = records(&good);
-        let infos: Vec<&Rec> = recs.iter().filter(|r| r.op == Op::ChunkInfo).collect();
-        let chunks: Vec<&Rec> = recs.iter().filter(|r| r.op == Op::Chunk).collect();
+        let infos: Vec<&Rec> = recs.iter().filter(|r| r.op == BagOp::ChunkInfo).collect();
+        let chunks: Vec<&Rec> = recs.iter().filter(|r| r.op == BagOp::Chunk).collect();
         assert!(infos.len() >= 5, "{} chunk infos", infos.len());
         let info = infos[1];
         let edits: Vec<(&str, ByteEdit)> = vec![
@@ -162,12 +162,12 @@ fn defect_01_flipped_chunk_info_is_reported_or_read() {
 fn message_header(bytes: &[u8], k: usize) -> std::ops::Range<usize> {
     let recs = records(bytes);
     let mut seen = 0;
-    for ch in recs.iter().filter(|r| r.op == Op::Chunk) {
+    for ch in recs.iter().filter(|r| r.op == BagOp::Chunk) {
         let mut pos = ch.data.start;
         while pos < ch.data.end {
-            let r = raw_record(bytes, pos).unwrap();
-            let h = Header::parse(r.header).unwrap();
-            if h.op().unwrap() == Op::MessageData {
+            let r = raw_bag_record(bytes, pos).unwrap();
+            let h = BagRecordHeader::parse(r.header).unwrap();
+            if h.op().unwrap() == BagOp::MessageData {
                 if seen == k {
                     return pos + 4..pos + 4 + r.header.len();
                 }
@@ -291,11 +291,11 @@ fn defect_04_bad_index_byte_still_reads_every_chunk() {
         let recs = records(&good);
         let first_index = recs
             .iter()
-            .position(|r| r.op == Op::ChunkInfo)
+            .position(|r| r.op == BagOp::ChunkInfo)
             .map(|i| {
                 // The index section starts with the connection records before the infos.
                 let mut j = i;
-                while j > 0 && recs[j - 1].op == Op::Connection {
+                while j > 0 && recs[j - 1].op == BagOp::Connection {
                     j -= 1;
                 }
                 j
@@ -307,7 +307,7 @@ fn defect_04_bad_index_byte_still_reads_every_chunk() {
             ("index connection op", field(&good, &index[0].header, "op")),
             (
                 "chunk info header length",
-                index.iter().find(|r| r.op == Op::ChunkInfo).unwrap().pos + 2,
+                index.iter().find(|r| r.op == BagOp::ChunkInfo).unwrap().pos + 2,
             ),
             ("last chunk info data", index.last().unwrap().data.start + 1),
         ];
@@ -340,7 +340,11 @@ fn defect_05_counts_never_size_memory() {
     write_synthetic(&path, "imu", N, Compression::None, false);
     let good = std::fs::read(&path).unwrap();
     let recs = records(&good);
-    let info = recs.iter().find(|r| r.op == Op::ChunkInfo).unwrap().clone();
+    let info = recs
+        .iter()
+        .find(|r| r.op == BagOp::ChunkInfo)
+        .unwrap()
+        .clone();
     // 12,000 rows are 1 MB of matrix; the limit leaves room for threads and buffers only.
     const LIMIT_MIB: u64 = 600;
     for count in [0xFFFF_FFFFu32, 0x0800_0000] {
@@ -359,7 +363,7 @@ fn defect_05_counts_never_size_memory() {
         );
         assert!(ok, "count {count:#x}: {err}");
         assert_eq!(
-            bag2mat::mat::read_data_imu(&out).unwrap().rows(),
+            bag2mat::read_data_imu(&out).unwrap().rows(),
             N as usize,
             "count {count:#x}"
         );
@@ -525,7 +529,7 @@ fn defect_08_failed_outputs_leave_no_temp_files() {
     // temp file, and (all or none) no file of the other topic either.
     let two = dir.path().join("two.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(
+        let mut w = bag2mat::BagWriter::create(
             &bag2mat::shared::output::Outputs::direct(),
             &two,
             Compression::None,
@@ -640,7 +644,7 @@ fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("mixed.bag");
     {
-        let mut w = bag2mat::bag::BagWriter::create(
+        let mut w = bag2mat::BagWriter::create(
             &bag2mat::shared::output::Outputs::direct(),
             &bag,
             Compression::None,

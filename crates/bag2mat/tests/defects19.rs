@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use bag2mat::mcap::ChunkCompression;
+use bag2mat::ChunkCompression;
 use bag2mat::test_tools::{
     BtreePage, McapRecord, btree_pages, mcap_chunk_records, mcap_records, reported_losses,
     rowid_fields,

@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use bag2mat::bag::record::Op;
-use bag2mat::record_check::{Finding, Kind};
+use bag2mat::test_tools::BagOp;
 use bag2mat::test_tools::{OddWriter, ROS2_MODES, odd_record, rosbags_convert};
+use bag2mat::{Finding, FindingKind};
 
 use crate::defects::{field, records};
 
@@ -15,7 +15,7 @@ use crate::defects::{field, records};
 const N: usize = 60_000;
 
 /// `bag2mat info`'s Imu topic: its rate, and its findings of `kind`.
-fn imu_topic(path: &Path, kind: Kind) -> (f64, Vec<Finding>) {
+fn imu_topic(path: &Path, kind: FindingKind) -> (f64, Vec<Finding>) {
     let info = bag2mat::info(path, true).unwrap();
     let t = info.topics.iter().find(|t| t.imu).expect("an Imu topic");
     let f = t
@@ -31,10 +31,10 @@ fn imu_topic(path: &Path, kind: Kind) -> (f64, Vec<Finding>) {
 fn record_last_chunk_twice(bag: &Path) -> usize {
     let bytes = std::fs::read(bag).unwrap();
     let recs = records(&bytes);
-    let last = recs.iter().rposition(|r| r.op == Op::Chunk).unwrap();
+    let last = recs.iter().rposition(|r| r.op == BagOp::Chunk).unwrap();
     let end = recs[last + 1..]
         .iter()
-        .find(|r| r.op != Op::IndexData)
+        .find(|r| r.op != BagOp::IndexData)
         .expect("the index section")
         .pos;
     let copy = bytes[recs[last].pos..end].to_vec();
@@ -42,7 +42,7 @@ fn record_last_chunk_twice(bag: &Path) -> usize {
     out.extend_from_slice(&copy);
     out.extend_from_slice(&bytes[end..]);
     // the index section moved by the copy's length
-    let head = recs.iter().find(|r| r.op == Op::BagHeader).unwrap();
+    let head = recs.iter().find(|r| r.op == BagOp::BagHeader).unwrap();
     let at = field(&out, &head.header, "index_pos");
     let pos = u64::from_le_bytes(out[at..at + 8].try_into().unwrap()) + copy.len() as u64;
     out[at..at + 8].copy_from_slice(&pos.to_le_bytes());
@@ -50,7 +50,7 @@ fn record_last_chunk_twice(bag: &Path) -> usize {
     // messages in the copied chunk: its index records count them
     recs[last + 1..]
         .iter()
-        .take_while(|r| r.op == Op::IndexData)
+        .take_while(|r| r.op == BagOp::IndexData)
         .map(|r| {
             let c = field(&bytes, &r.header, "count");
             u32::from_le_bytes(bytes[c..c + 4].try_into().unwrap()) as usize
@@ -67,7 +67,7 @@ fn issue18_6_rows_stored_twice_are_more_than_the_container_promises() {
     assert!(extra > 0);
     // the reader reads the chunk the index does not list (and says so); its rows are the
     // duplicates (before: nothing said, the copy's rows analysed twice)
-    let (rate, d) = imu_topic(&bag, Kind::Duplicates);
+    let (rate, d) = imu_topic(&bag, FindingKind::Duplicates);
     assert!(
         d.len() == 1 && d[0].size == Some(extra as f64),
         "{extra} rows stored twice: {d:?}"
@@ -84,9 +84,9 @@ fn issue18_6_rows_stored_twice_are_more_than_the_container_promises() {
     let listed = "  - twice.mcap\n";
     assert!(text.contains(listed), "{text}");
     std::fs::write(&meta, text.replace(listed, &listed.repeat(2))).unwrap();
-    let (rate, f) = imu_topic(&dir, Kind::ExtraRows);
+    let (rate, f) = imu_topic(&dir, FindingKind::ExtraRows);
     assert!(f.len() == 1 && f[0].size == Some(N as f64), "{f:?}");
-    let (_, d) = imu_topic(&dir, Kind::Duplicates);
+    let (_, d) = imu_topic(&dir, FindingKind::Duplicates);
     assert!(d.len() == 1 && d[0].size == Some(N as f64), "{d:?}");
     assert!((rate - 200.0).abs() < 1e-6, "{rate}");
 }

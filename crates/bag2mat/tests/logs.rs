@@ -85,7 +85,7 @@ fn assert_same_rows(path: &Path, theirs: &[Theirs]) -> Vec<ImuSeries> {
 }
 
 fn write_ulog(path: &Path, seconds: f64, dropout: Option<u16>) {
-    let spec = bag2mat::formats::ulog::write::ImuLogSpec {
+    let spec = bag2mat::test_tools::UlogImuSpec {
         seconds,
         rate: 250.0,
         instances: 2,
@@ -93,7 +93,7 @@ fn write_ulog(path: &Path, seconds: f64, dropout: Option<u16>) {
         seed: 7,
     };
     let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    bag2mat::formats::ulog::write::imu_log(f, &spec).unwrap();
+    bag2mat::test_tools::ulog_imu_log(f, &spec).unwrap();
 }
 
 #[test]
@@ -125,7 +125,7 @@ fn ulog_topics_match_pyulog_bit_for_bit_also_on_pyulogs_own_rewrite() {
             f.display()
         );
         // the gap it leaves is found where the analysers look for gaps
-        let tm = bag2mat::timing::analyse(&bag2mat::timing::ns_of_times(&series[0].record_time));
+        let tm = bag2mat::analyse_timing(&bag2mat::ns_of_times(&series[0].record_time));
         assert_eq!(tm.gaps.len(), 1, "{tm:?}");
     }
 }
@@ -140,7 +140,7 @@ fn defect_20_2_ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() 
     let dir = tempfile::tempdir().unwrap();
     let ours = dir.path().join("fifo.ulg");
     let f = std::io::BufWriter::new(std::fs::File::create(&ours).unwrap());
-    bag2mat::formats::ulog::write::fifo_log(f, 20.0, 800.0, 6, 3).unwrap();
+    bag2mat::test_tools::ulog_fifo_log(f, 20.0, 800.0, 6, 3).unwrap();
     let rewritten = dir.path().join("rewritten.ulg");
     let _ = independent(&[
         "ulog-rewrite",
@@ -159,7 +159,7 @@ fn defect_20_2_ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() 
         for s in &series {
             // every sample of the 20 s at 800 Hz, none lost, evenly spaced
             assert_eq!(s.len(), 16_000, "{}", s.topic);
-            let tm = bag2mat::timing::analyse(&bag2mat::timing::ns_of_times(&s.stamp));
+            let tm = bag2mat::analyse_timing(&bag2mat::ns_of_times(&s.stamp));
             assert!(tm.gaps.is_empty(), "{}: {tm:?}", s.topic);
             let rate = tm.nominal_rate().unwrap();
             assert!((rate - 800.0).abs() < 0.01, "{}: {rate}", s.topic);
@@ -215,7 +215,7 @@ fn dataflash_imu_and_batches_match_pymavlink_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("00000042.BIN");
     let f = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
-    bag2mat::formats::dataflash::write::imu_log(f, 12.0, 200.0, 3).unwrap();
+    bag2mat::test_tools::dataflash_imu_log(f, 12.0, 200.0, 3).unwrap();
     let (theirs, _) = independent(&["dataflash", log.to_str().unwrap()]);
     let names: Vec<&str> = theirs.iter().map(|t| t.topic.as_str()).collect();
     assert_eq!(names, ["IMU:0", "IMU:1", "ISB_ACC", "ISB_GYR"]);
@@ -335,7 +335,7 @@ fn text_logs_name_columns_and_units_or_say_what_to_add() {
     std::fs::write(&p, &tsv).unwrap();
     let s = bag2mat::read_imu_series(&p, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.gyro_at(3), [1f64.to_radians(), 0.0, -(1f64.to_radians())]);
-    assert_eq!(s.acc_at(3)[2], bag2mat::formats::text::STANDARD_GRAVITY);
+    assert_eq!(s.acc_at(3)[2], bag2mat::STANDARD_GRAVITY);
     assert_eq!(s.record_time[100].as_nanos(), 1_000_000_000);
     // no header: --columns, whitespace, raw counts with a scale
     let raw = rows(&|i| format!("  {}   164  -164 0  2048 0   0\n", 1000 * i));
@@ -439,12 +439,8 @@ fn npy_from_bag2mat_reads_back_bit_for_bit_and_unknown_files_name_every_format()
     let npy = dir.path().join("x.npy");
     let (ok, _, err) = run(bag2mat().arg(&bag).arg("imu").arg("-o").arg(&npy).arg("-q"));
     assert!(ok, "{err}");
-    let from_bag = bag2mat::convert::bag_to_data_imu(&bag, "imu", true)
-        .unwrap()
-        .data;
-    let back = bag2mat::convert::bag_to_data_imu(&npy, "imu", true)
-        .unwrap()
-        .data;
+    let from_bag = bag2mat::bag_to_data_imu(&bag, "imu", true).unwrap().data;
+    let back = bag2mat::bag_to_data_imu(&npy, "imu", true).unwrap().data;
     assert_eq!(back.rows(), from_bag.rows());
     for c in 0..7 {
         for (a, b) in back.columns[c].iter().zip(&from_bag.columns[c]) {
@@ -469,12 +465,12 @@ fn npy_from_bag2mat_reads_back_bit_for_bit_and_unknown_files_name_every_format()
 
 #[test]
 fn a_damaged_ulog_says_what_it_lost_and_keeps_the_rest() {
-    use bag2mat::formats::ulog::write::{SENSOR_COMBINED, VEHICLE_IMU, Writer};
+    use bag2mat::test_tools::{ULOG_SENSOR_COMBINED, ULOG_VEHICLE_IMU, UlogWriter};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("damaged.ulg");
-    let mut u = Writer::new(Vec::new(), 0).unwrap();
-    u.format(SENSOR_COMBINED).unwrap();
-    u.format(VEHICLE_IMU).unwrap();
+    let mut u = UlogWriter::new(Vec::new(), 0).unwrap();
+    u.format(ULOG_SENSOR_COMBINED).unwrap();
+    u.format(ULOG_VEHICLE_IMU).unwrap();
     u.add(0, 0, "sensor_combined").unwrap();
     u.add(0, 1, "vehicle_imu").unwrap();
     let combined = |t: u64| {
@@ -505,7 +501,7 @@ fn a_damaged_ulog_says_what_it_lost_and_keeps_the_rest() {
     let mut bytes = u.finish().unwrap();
     // garbage, then the logger's sync marker and more data, then a message cut short
     bytes.extend([0xEE; 37]);
-    let mut u = Writer::new(Vec::new(), 0).unwrap();
+    let mut u = UlogWriter::new(Vec::new(), 0).unwrap();
     u.sync().unwrap();
     for i in 100..150u64 {
         u.data(0, &combined(1_000_000 + 5_000 * i)).unwrap();
@@ -552,7 +548,7 @@ fn damaged_logs_of_every_format_never_panic() {
     let d = dir.path();
     write_ulog(&d.join("a.ulg"), 3.0, Some(20));
     let f = std::io::BufWriter::new(std::fs::File::create(d.join("a.bin")).unwrap());
-    bag2mat::formats::dataflash::write::imu_log(f, 3.0, 200.0, 1).unwrap();
+    bag2mat::test_tools::dataflash_imu_log(f, 3.0, 200.0, 1).unwrap();
     let csv = write_euroc(&d.join("e"), 400);
     let (ok, _, err) = run(bag2mat()
         .arg(crate::common::case_bag("p3_short_61s"))

@@ -5,7 +5,7 @@
 use std::process::Command;
 
 use bag2mat::Compression;
-use bag2mat::convert::{Format, data_imu_from_series, write};
+use bag2mat::{OutputFormat, data_imu_from_series, write_matrix};
 use bag2mat::{ReadOptions, TimeColumn, read_imu_series};
 
 use crate::common::{run, synthetic, write_synthetic};
@@ -77,7 +77,7 @@ fn rosbag_info_check_and_python_read_our_bags() {
                 imu.seq,
                 imu.stamp.as_nanos(),
                 imu.frame_id,
-                bag2mat::imu_msg::MD5,
+                bag2mat::IMU_MD5,
                 doubles.join(" ")
             );
             assert_eq!(*line, want, "{c:?}: message {i}");
@@ -93,11 +93,11 @@ fn octave_and_scipy_load_our_mat() {
     let s = read_imu_series(&bag, "imu", &ReadOptions { quiet: true }).unwrap();
     let d = data_imu_from_series(&s, TimeColumn::Record);
     let mat = dir.path().join("m.mat");
-    write(
+    write_matrix(
         &bag2mat::shared::output::Outputs::direct(),
         &mat,
         &d,
-        Format::Mat,
+        OutputFormat::Mat,
     )
     .unwrap();
     // Octave prints the size, the first time at full precision, and the sum of each column.
@@ -131,11 +131,11 @@ fn octave_and_scipy_load_our_mat() {
 
     // An empty matrix (0×7) loads too.
     let empty = dir.path().join("e.mat");
-    write(
+    write_matrix(
         &bag2mat::shared::output::Outputs::direct(),
         &empty,
-        &bag2mat::mat::DataImu::default(),
-        Format::Mat,
+        &bag2mat::DataImu::default(),
+        OutputFormat::Mat,
     )
     .unwrap();
     let (ok, out, err) = run(Command::new("octave")
@@ -160,7 +160,7 @@ fn octave_v7_compressed_mat_reads_back() {
         .args(["--no-gui", "--quiet", "--eval"])
         .arg(&script));
     assert!(ok, "octave failed: {err}");
-    let d = bag2mat::mat::read_data_imu(&mat).unwrap();
+    let d = bag2mat::read_data_imu(&mat).unwrap();
     assert_eq!(d.rows(), 100);
     assert_eq!(d.row(0)[0], 1_600_000_000.0);
     assert_eq!(d.row(99)[0], 1_600_000_000.0 + 99.0 * 0.005);
@@ -178,7 +178,7 @@ fn octave_v7_compressed_mat_reads_back() {
 #[test]
 fn numpy_loads_our_npy_and_csv() {
     let dir = tempfile::tempdir().unwrap();
-    let mut d = bag2mat::mat::DataImu::default();
+    let mut d = bag2mat::DataImu::default();
     for i in 0..50 {
         let (t, imu) = synthetic(i);
         let (a, g) = (imu.linear_acceleration, imu.angular_velocity);
@@ -186,18 +186,18 @@ fn numpy_loads_our_npy_and_csv() {
     }
     let npy = dir.path().join("d.npy");
     let csv = dir.path().join("d.csv");
-    write(
+    write_matrix(
         &bag2mat::shared::output::Outputs::direct(),
         &npy,
         &d,
-        Format::Npy,
+        OutputFormat::Npy,
     )
     .unwrap();
-    write(
+    write_matrix(
         &bag2mat::shared::output::Outputs::direct(),
         &csv,
         &d,
-        Format::Csv,
+        OutputFormat::Csv,
     )
     .unwrap();
     let code = format!(

@@ -5,7 +5,7 @@
 use sha2::{Digest, Sha256};
 
 use crate::common::{CASES, case_bag, testdata};
-use bag2mat::convert::bag_to_data_imu;
+use bag2mat::bag_to_data_imu;
 
 /// The first quoted string after `"key":`.
 fn first_quoted_after<'a>(json: &'a str, key: &str) -> &'a str {
@@ -58,7 +58,7 @@ fn matrix_equals_bagconvert_bit_for_bit() {
 
 #[test]
 fn other_topics_are_ignored_and_counted() {
-    let bag = bag2mat::bag::BagReader::open(&case_bag("p2_medium_100hz")).unwrap();
+    let bag = bag2mat::BagReader::open(&case_bag("p2_medium_100hz")).unwrap();
     let topics = bag.topics();
     let find = |t: &str| topics.iter().find(|s| s.topic == t).unwrap().count;
     assert_eq!(find("/imu/data"), 72000);

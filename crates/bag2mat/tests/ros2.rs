@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::thread;
 
-use bag2mat::convert::{bag_to_data_imu, data_imu_from_series};
-use bag2mat::mat::DataImu;
+use bag2mat::DataImu;
 use bag2mat::test_tools::{ROS2_MODES, rosbags_convert, run_ok, venv_python};
 use bag2mat::{Compression, ReadOptions, TimeColumn, TopicSelector, read_imu_topics};
+use bag2mat::{bag_to_data_imu, data_imu_from_series};
 use sha2::{Digest, Sha256};
 
 use crate::common::{CASES, case_bag, run, testdata, write_synthetic};
@@ -164,7 +164,7 @@ fn two_imu_topics_and_another_in_one_pass() {
             .arg("-q"));
         assert!(ok, "{mode}: {err}");
         for (i, t) in ["imu0", "imu1"].iter().enumerate() {
-            let ours = bag2mat::mat::read_data_imu(&out.join(t).join(format!("rig_{mode}.mat")))
+            let ours = bag2mat::read_data_imu(&out.join(t).join(format!("rig_{mode}.mat")))
                 .unwrap_or_else(|e| panic!("{mode} {t}: {e}"));
             let ros1 = bag_to_data_imu(&sources[i], &format!("/{t}"), true).unwrap();
             assert_eq!(sha(&ours), sha(&ros1.data), "{mode} {t}");
@@ -411,7 +411,7 @@ fn damaged_mcap_and_db3_never_panic() {
     let mut w = bag2mat::Ros2BagWriter::create(
         &bag2mat::shared::output::Outputs::direct(),
         &ours_dir,
-        bag2mat::Storage::Mcap(bag2mat::mcap::ChunkCompression::None),
+        bag2mat::Storage::Mcap(bag2mat::ChunkCompression::None),
     )
     .unwrap();
     let t = w.add_imu_topic("imu").unwrap();

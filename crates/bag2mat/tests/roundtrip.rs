@@ -1,8 +1,8 @@
 //! Our writer and reader against each other and against genpy's golden bytes; broken bags.
 
-use bag2mat::bag::{BagReader, BagWriter};
-use bag2mat::imu_msg::{self, Imu};
+use bag2mat::{BagReader, BagWriter};
 use bag2mat::{Compression, Error, ReadOptions, RosTime, read_imu_series};
+use bag2mat::{IMU_MD5, Imu, imu_definition};
 use md5::{Digest, Md5};
 
 use crate::common::{synthetic, write_synthetic};
@@ -40,8 +40,8 @@ fn imu_bytes_equal_genpy() {
 #[test]
 fn definition_equals_genpy_full_text() {
     let golden = include_str!("fixtures/imu_full_text.txt");
-    assert_eq!(imu_msg::definition().len(), 2571);
-    assert_eq!(imu_msg::definition(), golden);
+    assert_eq!(imu_definition().len(), 2571);
+    assert_eq!(imu_definition(), golden);
 }
 
 /// The ROS 1 md5 recipe (rust_stack.md §5.2) applied to the vendored .msg files.
@@ -77,7 +77,7 @@ fn md5_recomputed_from_msg_files() {
         ("Vector3".into(), vec3),
     ];
     let deps: Vec<(&str, String)> = deps.iter().map(|(a, b)| (a.as_str(), b.clone())).collect();
-    assert_eq!(hash_text(&read("sensor_msgs_Imu.msg"), &deps), imu_msg::MD5);
+    assert_eq!(hash_text(&read("sensor_msgs_Imu.msg"), &deps), IMU_MD5);
 }
 
 #[test]
@@ -275,7 +275,7 @@ fn unfinished_writer_leaves_nothing_behind() {
 /// conversion of the same series agree exactly, and an out-of-order bag comes out sorted.
 #[test]
 fn matrix_routes_agree_and_sort() {
-    use bag2mat::convert::{bag_to_data_imu, data_imu_from_series};
+    use bag2mat::{bag_to_data_imu, data_imu_from_series};
     let p2 = crate::common::case_bag("p2_medium_100hz");
     let planned = bag_to_data_imu(&p2, "/imu/data", true).unwrap().data;
     let streamed = data_imu_from_series(

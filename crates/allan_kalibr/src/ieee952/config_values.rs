@@ -81,7 +81,7 @@ pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
     for (name, x) in names.iter().zip([v.acc_n, v.acc_w, v.gyr_n, v.gyr_w]) {
         comments.extend(note(name, x));
     }
-    // what the record breaks of the analysis' assumptions (bag2mat::record_check)
+    // what the record breaks of the analysis' assumptions (bag2mat::check_record)
     for f in a.warnings() {
         comments.push(format!(
             "RECORD CHECK: {}; the values above carry it (the tool's warning says what to do).",

@@ -14,7 +14,7 @@
 //!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
 //!   are left out (with a comment) rather than written as a number. Every warning of the
-//!   record check (`bag2mat::record_check`: warm-up, spike, gaps, clocks) is a caveat.
+//!   record check (`bag2mat::check_record`: warm-up, spike, gaps, clocks) is a caveat.
 //! * OpenVINS' `kalibr_imu_chain.yaml` and Basalt's calibration noise fields:
 //!   [`super::vio_files`].
 

@@ -1,7 +1,7 @@
 //! The IEEE 952 analysis of a whole IMU, as both analysers run it next to their compat
 //! outputs: up to six axes (gyro x y z, accelerometer x y z) from samples or from another
 //! tool's curves, the record-length advice per axis, the record check's findings
-//! (`bag2mat::record_check`, named in the verdicts), and the printed section. The files it writes are in [`super::files`].
+//! (`bag2mat::check_record`, named in the verdicts), and the printed section. The files it writes are in [`super::files`].
 //!
 //! One value per sensor goes into the configuration files: the largest of the three axes
 //! (the conservative choice, as allan_variance_ros writes), and never a number the data do
@@ -16,7 +16,7 @@ use super::{
     Analysis, AxisVerdict, Config, CovBasis, CurveData, Ieee952Error, Term, Verdict, analyse_curve,
     short,
 };
-use bag2mat::record_check::{Finding, Level};
+use bag2mat::{Finding, FindingLevel};
 
 /// τ/T_lo from which a flicker floor with lower corner T_lo is within 2 % of 0.664·B in
 /// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
@@ -175,7 +175,7 @@ impl ImuCurves {
     }
 
     /// The fits and the advice; `checks` are the record check's findings on the series
-    /// (`bag2mat::record_check`, which the caller has run to cut the record), named by the
+    /// (`bag2mat::check_record`, which the caller has run to cut the record), named by the
     /// section and the files.
     pub fn finish(&self, checks: Vec<Finding>, cfg: &Config) -> ImuAnalysis {
         let mut an = analyse_curves(&self.sensors, self.rate, cfg);
@@ -300,7 +300,7 @@ impl ImuAnalysis {
         axis: usize,
     ) -> impl Iterator<Item = &Finding> {
         self.checks.iter().filter(move |f| {
-            f.level >= Level::Warning
+            f.level >= FindingLevel::Warning
                 && f.axis
                     .is_some_and(|x| x.sensor == sensor && x.index == axis)
         })
@@ -308,7 +308,9 @@ impl ImuAnalysis {
 
     /// The record check's warnings, for the files' caveats.
     pub(crate) fn warnings(&self) -> impl Iterator<Item = &Finding> {
-        self.checks.iter().filter(|f| f.level >= Level::Warning)
+        self.checks
+            .iter()
+            .filter(|f| f.level >= FindingLevel::Warning)
     }
 
     /// Axes without a reliable fit, as `gyro y` labels.
@@ -701,7 +703,7 @@ pub(crate) fn checks_text(a: &ImuAnalysis) -> String {
     for f in a
         .checks
         .iter()
-        .filter(|f| f.axis.is_none() && f.level >= Level::Warning)
+        .filter(|f| f.axis.is_none() && f.level >= FindingLevel::Warning)
     {
         let _ = writeln!(s, "record check: {} (see the warning on stderr)", f.short());
     }

@@ -1,5 +1,5 @@
 //! The figures a dataset states for its own IMU (an EuRoC/ASL `sensor.yaml`, read by
-//! [`bag2mat::formats::euroc`]) printed beside the IEEE 952 values measured here, so a user
+//! [`bag2mat::sensor_yaml_for`]) printed beside the IEEE 952 values measured here, so a user
 //! sees whether the dataset's numbers hold. Both are continuous-time (Kalibr's convention).
 
 use std::fmt::Write as _;
@@ -16,7 +16,7 @@ pub fn section_text(a: &ImuAnalysis, input: &Path, topic: &str) -> String {
 /// The lines printed after the IEEE 952 section when `input`'s topic `topic` has a
 /// `sensor.yaml` stating figures; empty otherwise.
 pub fn beside_ours(a: &ImuAnalysis, input: &Path, topic: &str) -> String {
-    let Some(st) = bag2mat::formats::euroc::stated_for(input, topic) else {
+    let Some(st) = bag2mat::sensor_yaml_for(input, topic) else {
         return String::new();
     };
     let mut s = format!(

@@ -158,14 +158,14 @@ fn mat_cases() -> Vec<Outcome> {
             axis_series(&m, s, a, RATE, n, SEED + 100 + i as u64, 0.0).expect("series")
         })
         .collect();
-    let mut data = bag2mat::mat::DataImu::with_capacity(n);
+    let mut data = bag2mat::DataImu::with_capacity(n);
     data.columns[0] = (0..n).map(|i| i as f64 / RATE).collect();
     for (c, col) in cols.into_iter().enumerate() {
         data.columns[1 + c] = col;
     }
     let dir = tempfile::tempdir().expect("temp dir");
     let mat = dir.path().join("bmi088_like.mat");
-    bag2mat::mat::write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &data)
+    bag2mat::write_data_imu(&bag2mat::shared::output::Outputs::direct(), &mat, &data)
         .expect("write .mat");
     drop(data);
     let out = dir.path().join("out");

@@ -85,7 +85,7 @@ fn analyse_as_user(y: &[f64], tau0: f64, cfg: &Ieee952Config) -> (Ieee952Analysi
         let basis = data.basis(cfg.fit.per_octave);
         analyse_curve(&data, cfg, basis.as_ref())
     };
-    match bag2mat::record_check::warmup::find(y, tau0) {
+    match bag2mat::find_warmup(y, tau0) {
         Some(w) => {
             let skip = w.skip.ceil();
             let k = ((skip / tau0).round() as usize).min(y.len() / 2);

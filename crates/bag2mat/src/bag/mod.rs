@@ -12,11 +12,11 @@
 //! Times are [`RosTime`] (module `time`): unsigned seconds and nanoseconds since the UNIX
 //! epoch.
 
-pub mod read;
-pub mod record;
-pub mod write;
+pub(crate) mod read;
+pub(crate) mod record;
+pub(crate) mod write;
 
-pub use read::{BagIndex, BagReader, ConnectionSummary};
+pub use read::BagReader;
 pub use write::BagWriter;
 
 /// How chunk bodies are stored.

@@ -263,6 +263,7 @@ impl<'a> Header<'a> {
 }
 
 /// Little-endian u32 at `pos`, if the bytes are there.
+#[cfg(any(test, feature = "test-support"))]
 pub fn read_u32(buf: &[u8], pos: usize) -> Option<u32> {
     let mut c = Cursor::new(buf);
     c.skip(pos, "record").ok()?;

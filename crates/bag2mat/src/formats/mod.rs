@@ -13,11 +13,11 @@
 //! What the content cannot say (a text log's columns and units, a rate without a time
 //! column) comes from [`InputOptions`], the flags every tool shares ([`InputArgs`]).
 
-pub mod dataflash;
-pub mod euroc;
-pub mod npy;
-pub mod text;
-pub mod ulog;
+pub(crate) mod dataflash;
+pub(crate) mod euroc;
+pub(crate) mod npy;
+pub(crate) mod text;
+pub(crate) mod ulog;
 
 use std::path::Path;
 
@@ -109,6 +109,7 @@ pub(crate) fn instance_topics<'a>(topics: impl Iterator<Item = &'a mut String>) 
 
 /// Bell-shaped deterministic noise (SplitMix64, a sum of four uniforms, variance 1/3) for
 /// the synthetic logs the test and benchmark writers make.
+#[cfg(any(test, feature = "test-support"))]
 pub fn synthetic_noise(state: &mut u64) -> f64 {
     let mut s = 0.0;
     for _ in 0..4 {
@@ -121,9 +122,6 @@ pub fn synthetic_noise(state: &mut u64) -> f64 {
     }
     s
 }
-
-/// The formats of this module as [`crate::source::ACCEPTED`] lists them.
-pub const ACCEPTED: &str = "a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root), a CSV/TSV/whitespace text log, a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin), or a NumPy .npy (N x 7, bag2mat's layout)";
 
 /// The first bytes of a ULog file.
 pub const ULOG_MAGIC: &[u8] = b"ULog\x01\x12\x35";

@@ -7,9 +7,9 @@
 //!   chunks `none`/`lz4`/`zstd` read in parallel as [`crate::source::Source`] parts.
 //! * [`write`]: [`McapWriter`] — chunked files with message indexes, summary and CRCs.
 
-pub mod read;
-pub mod record;
-pub mod write;
+pub(crate) mod read;
+pub(crate) mod record;
+pub(crate) mod write;
 
 pub use read::McapReader;
 pub use record::MAGIC;

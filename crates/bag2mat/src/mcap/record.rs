@@ -340,17 +340,6 @@ pub struct MessageRef<'a> {
 }
 
 impl<'a> MessageRef<'a> {
-    /// Parses the content.
-    pub fn decode(c: &'a [u8]) -> Result<MessageRef<'a>, CursorError> {
-        let mut c = Cursor::new(c);
-        Ok(MessageRef {
-            channel_id: c.le::<u16>("channel_id")?,
-            sequence: c.le::<u32>("sequence")?,
-            log_time: c.le::<u64>("log_time")?,
-            publish_time: c.le::<u64>("publish_time")?,
-            data: c.rest(),
-        })
-    }
     /// Appends the record.
     pub fn encode(&self, out: &mut Vec<u8>) {
         out.push(Op::Message as u8);
@@ -419,14 +408,6 @@ pub struct MessageIndex {
 }
 
 impl MessageIndex {
-    /// Channel id and message count, read from the first 6 bytes of the content.
-    pub fn count(c: &[u8]) -> Result<(u16, u64), CursorError> {
-        let mut c = Cursor::new(c);
-        Ok((
-            c.le::<u16>("channel_id")?,
-            c.le::<u32>("records length")? as u64 / 16,
-        ))
-    }
     /// Appends the record.
     pub fn encode(&self, out: &mut Vec<u8>) {
         push_record(out, Op::MessageIndex, |o| {
@@ -556,14 +537,6 @@ pub fn encode_summary_offset(out: &mut Vec<u8>, group_opcode: Op, start: u64, le
         o.push(group_opcode as u8);
         o.put_u64(start);
         o.put_u64(length);
-    });
-}
-
-/// Appends a Metadata record.
-pub fn encode_metadata(out: &mut Vec<u8>, name: &str, map: &[(String, String)]) {
-    push_record(out, Op::Metadata, |o| {
-        o.put_str(name);
-        o.put_string_map(map);
     });
 }
 

@@ -20,10 +20,10 @@
 //! Its findings are typed ([`Finding`]: level, kind, axis, time, size), printed on stderr by
 //! every tool (also with `--quiet`), and named by the IEEE 952 section and its yaml files.
 
-pub mod clock;
-pub mod motion;
-pub mod outliers;
-pub mod warmup;
+pub(crate) mod clock;
+pub(crate) mod motion;
+pub(crate) mod outliers;
+pub(crate) mod warmup;
 
 use std::borrow::Cow;
 use std::fmt;
@@ -515,8 +515,8 @@ pub const SKIP_MIN_SAMPLES_LEFT: usize = 1000;
 /// mistaken number, not a warm-up).
 pub const SKIP_MIN_FRACTION_LEFT: f64 = 0.1;
 
-/// The `--skip-start` cut of `t` ([`skip_index`]), checked: an error when it leaves too
-/// little of the record to analyse ([`SKIP_MIN_SAMPLES_LEFT`], [`SKIP_MIN_FRACTION_LEFT`]);
+/// The `--skip-start` cut of `t` (`skip_index`), checked: an error when it leaves too
+/// little of the record to analyse (`SKIP_MIN_SAMPLES_LEFT`, `SKIP_MIN_FRACTION_LEFT`);
 /// else the index and, when it drops more than half of the record, a warning to print.
 pub fn checked_skip(t: &[f64], seconds: f64) -> Result<(usize, Option<String>), String> {
     if !(seconds >= 0.0 && seconds.is_finite()) {

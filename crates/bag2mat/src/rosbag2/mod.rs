@@ -8,8 +8,8 @@
 //!   [`crate::source::Source`], with channels merged across files by topic and type.
 //! * [`Ros2BagWriter`]: a bag directory with one storage file, Imu as CDR.
 
-pub mod metadata;
-pub mod sqlite;
+pub(crate) mod metadata;
+pub(crate) mod sqlite;
 mod table_walk;
 
 pub use sqlite::{Sqlite3Reader, Sqlite3Writer};

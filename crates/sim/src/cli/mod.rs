@@ -150,7 +150,7 @@ pub enum BagFormatArg {
 /// The container and compression of `sim bag`, checked together.
 fn bag_format(f: BagFormatArg, c: CompressionArg) -> Result<crate::bag_sim::BagFormat> {
     use crate::bag_sim::BagFormat;
-    use bag2mat::mcap::ChunkCompression;
+    use bag2mat::ChunkCompression;
     Ok(match (f, c) {
         (BagFormatArg::Ros1, CompressionArg::Zstd) => {
             return Err(SimError::InvalidArgument(

@@ -96,9 +96,6 @@ pub struct BagIndex {
     pub indexed: bool,
 }
 
-/// One topic of a bag as [`BagReader::topics`] lists it.
-pub type ConnectionSummary = TopicSummary;
-
 /// An open bag.
 pub struct BagReader {
     path: PathBuf,

@@ -13,7 +13,9 @@
 //! message are skipped to the next header and reported; batch data without its header, and
 //! batches with fewer samples than their header promises, are losses.
 
-pub mod write;
+// The synthetic-log writers of the tests and benchmarks (re-exported by `test_tools`).
+#[cfg(any(test, feature = "test-support"))]
+pub(crate) mod write;
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -93,8 +93,6 @@ pub struct Parsed {
     pub streams: Vec<Stream>,
     /// Notes (units assumed, stamps out of order, malformed lines).
     pub notes: Vec<String>,
-    /// True when the header is EuRoC/ASL's.
-    pub euroc: bool,
 }
 
 /// Parses the text log at `path` into a stream named `topic`.
@@ -146,7 +144,6 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     Ok(Parsed {
         streams: vec![Stream::of_rows(topic, msg_type, rows)],
         notes,
-        euroc: lay.euroc,
     })
 }
 

@@ -31,7 +31,9 @@
 
 mod decoder;
 mod format;
-pub mod write;
+// The synthetic-log writers of the tests and benchmarks (re-exported by `test_tools`).
+#[cfg(any(test, feature = "test-support"))]
+pub(crate) mod write;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -42,7 +44,7 @@ use crate::rows::Row;
 use crate::source::{InputKind, Loss};
 
 use decoder::{Decoder, fifo_offset_ns};
-pub use format::Field;
+
 use format::{Formats, Slot, parse_format};
 
 /// The file's first 7 bytes (then a version byte and the start time, µs).

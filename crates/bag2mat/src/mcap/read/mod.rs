@@ -477,11 +477,6 @@ impl McapReader {
             }
         }
     }
-
-    /// The file's length.
-    pub fn file_len(&self) -> u64 {
-        self.len
-    }
 }
 
 impl Source for McapReader {
