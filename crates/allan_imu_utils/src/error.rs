@@ -9,6 +9,9 @@ pub enum Error {
     /// Reading the bag failed (includes "no such topic", whose message lists the bag's topics).
     #[error(transparent)]
     Bag(#[from] bag2mat::Error),
+    /// A `--skip-start` that leaves too little of the record, or is not a span.
+    #[error(transparent)]
+    Skip(#[from] bag2mat::SkipError),
     /// Too few samples for a 5-parameter fit.
     #[error(
         "too few samples on topic '{topic}': {n} messages give {valid} Allan points with data, the 5-term fit needs at least {needed} (record longer)"

@@ -107,7 +107,7 @@ fn skip_start(
     seconds: f64,
 ) -> Result<(usize, Option<String>), Error> {
     let t: Vec<f64> = series.stamp.iter().map(|s| s.to_sec()).collect();
-    let (k, warning) = bag2mat::checked_skip(&t, seconds).map_err(Error::Config)?;
+    let (k, warning) = bag2mat::checked_skip(&t, seconds)?;
     series.stamp.drain(..k);
     series.record_time.drain(..k);
     series.seq.drain(..k);

@@ -6,6 +6,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
+    /// A `--skip-start` that leaves too little of the record, or is not a span.
+    #[error(transparent)]
+    Skip(#[from] bag2mat::SkipError),
     /// The update rate is not a finite positive number of Hz.
     #[error("update rate must be a finite positive number of Hz, got {0}")]
     BadRate(f64),

@@ -520,8 +520,7 @@ fn write_outputs(
 /// Drops the samples of the first `seconds` of the record; returns how many, and a
 /// warning when that is most of it.
 fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
-    let (k, warning) =
-        bag2mat::checked_skip(&data.t, seconds).map_err(|what| Error::BadData { what })?;
+    let (k, warning) = bag2mat::checked_skip(&data.t, seconds)?;
     data.drop_first(k);
     Ok((k, warning))
 }

@@ -93,7 +93,7 @@ pub use record_check::warmup::{Fit as WarmupFit, find as find_warmup};
 pub use record_check::{
     Check as RecordCheck, Finding, Keep as KeepRows, Kind as FindingKind, Level as FindingLevel,
     Options as CheckOptions, RATE_ARGUMENT_REL, Record as CheckInput, check as check_record,
-    checked_skip, drop_absent, rate_argument,
+    checked_skip, drop_absent, rate_argument, SkipError,
 };
 pub use rosbag2::{Ros2BagWriter, Storage, TopicId};
 pub use rows::{ROW_LEN, Row, Rows, permute};

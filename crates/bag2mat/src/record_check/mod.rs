@@ -515,26 +515,51 @@ pub const SKIP_MIN_SAMPLES_LEFT: usize = 1000;
 /// mistaken number, not a warm-up).
 pub const SKIP_MIN_FRACTION_LEFT: f64 = 0.1;
 
+/// A `--skip-start` that cannot be applied.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SkipError {
+    /// Negative, NaN or infinite.
+    #[error("--skip-start must be a non-negative number of seconds, got {seconds}")]
+    NotASpan {
+        /// The value given.
+        seconds: f64,
+    },
+    /// Leaves less than `SKIP_MIN_SAMPLES_LEFT` samples or `SKIP_MIN_FRACTION_LEFT` of the
+    /// record.
+    #[error(
+        "--skip-start {seconds} leaves {left} of {total} samples ({:.1} s of a {span:.1} s record): too little for an Allan analysis (at least {SKIP_MIN_SAMPLES_LEFT} samples and {:.0} % of the record)",
+        (.span - .seconds).max(0.0),
+        100.0 * SKIP_MIN_FRACTION_LEFT
+    )]
+    TooLittleLeft {
+        /// The value given.
+        seconds: f64,
+        /// Samples left after the cut.
+        left: usize,
+        /// Samples in the record.
+        total: usize,
+        /// The record's span in seconds.
+        span: f64,
+    },
+}
+
 /// The `--skip-start` cut of `t` (`skip_index`), checked: an error when it leaves too
 /// little of the record to analyse (`SKIP_MIN_SAMPLES_LEFT`, `SKIP_MIN_FRACTION_LEFT`);
 /// else the index and, when it drops more than half of the record, a warning to print.
-pub fn checked_skip(t: &[f64], seconds: f64) -> Result<(usize, Option<String>), String> {
+pub fn checked_skip(t: &[f64], seconds: f64) -> Result<(usize, Option<String>), SkipError> {
     if !(seconds >= 0.0 && seconds.is_finite()) {
-        return Err(format!(
-            "--skip-start must be a non-negative number of seconds, got {seconds}"
-        ));
+        return Err(SkipError::NotASpan { seconds });
     }
     let k = skip_index(t, seconds);
     let left = t.len() - k;
     let span = t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a);
     if left < SKIP_MIN_SAMPLES_LEFT || (left as f64) < SKIP_MIN_FRACTION_LEFT * t.len() as f64 {
-        return Err(format!(
-            "--skip-start {seconds} leaves {left} of {} samples ({:.1} s of a {:.1} s record): too little for an Allan analysis (at least {SKIP_MIN_SAMPLES_LEFT} samples and {:.0} % of the record)",
-            t.len(),
-            (span - seconds).max(0.0),
+        return Err(SkipError::TooLittleLeft {
+            seconds,
+            left,
+            total: t.len(),
             span,
-            100.0 * SKIP_MIN_FRACTION_LEFT
-        ));
+        });
     }
     let warning = (2 * k > t.len()).then(|| {
         format!(
