@@ -9,7 +9,7 @@ use bag2mat::shared::output::Outputs;
 use rayon::prelude::*;
 
 use allan_kalibr::{
-    CurveData, CurvePoint, ImuAnalysis, Overlap, analyse_imu_curves, ieee952_summary_text,
+    CurveData, CurvePoint, ImuAnalysis, Overlap, Section, analyse_imu_curves, ieee952_summary_text,
     read_curves, write_ieee952_files,
 };
 use bag2mat::Sensor;
@@ -22,27 +22,17 @@ use crate::fit::{AxisFit, IMU_UTILS_DEG_PER_RAD, SECONDS_PER_HOUR};
 use crate::opencv_yaml::{self, YamlMode};
 use crate::{plot, report};
 
-/// What a run produced for one topic; the binary prints `stdout` and `notes`.
+/// What a run produced for one topic: what the binary says, and the numbers behind it.
 #[derive(Debug)]
 pub struct Outcome {
-    /// The topic, as named in the bag.
-    pub topic: String,
-    /// Upstream's terminal output.
-    pub stdout: String,
-    /// The IEEE 952 section printed after it (when enabled and the data allow it).
-    pub ieee952_text: Option<String>,
-    /// What the record check found (stderr, always).
-    pub findings: Vec<bag2mat::Finding>,
-    /// Things to say on stderr (end of bag, topic fallback, …).
-    pub notes: Vec<Note>,
-    /// Files written.
-    pub files: Vec<PathBuf>,
+    /// The topic, upstream's terminal output, the IEEE 952 section, the record check's
+    /// findings, the notes (end of bag, topic fallback, …), the files written and the
+    /// phase timings.
+    pub section: Section,
     /// The analysis itself.
     pub analysis: Analysis,
     /// The IEEE 952 analysis.
     pub ieee952: Option<ImuAnalysis>,
-    /// (phase, wall time).
-    pub timings: Vec<(&'static str, Duration)>,
 }
 
 /// The IEEE 952 curve of one axis from imu_utils' own Allan variances: the same overlapping
@@ -117,50 +107,38 @@ fn skip_start(
     Ok((k, warning))
 }
 
-/// What `--curves` produced.
+/// What `--curves` produced: what the binary says, and the numbers behind it.
 #[derive(Debug)]
 pub struct CurvesOutcome {
-    /// imu_utils' fit blocks (imu_utils data directories only), then nothing else.
-    pub stdout: String,
-    /// The IEEE 952 section.
-    pub ieee952_text: String,
-    /// Things to say on stderr.
-    pub notes: Vec<Note>,
-    /// Files written.
-    pub files: Vec<PathBuf>,
+    /// imu_utils' fit blocks (imu_utils data directories only), the IEEE 952 section, the
+    /// notes and the files written.
+    pub section: Section,
     /// imu_utils' analysis of an imu_utils data directory.
     pub analysis: Option<Analysis>,
     /// The IEEE 952 analysis.
     pub ieee952: ImuAnalysis,
 }
 
-/// The whole job as the binary says it: [`run`] or [`run_curves`], each result an
-/// [`allan_kalibr::Section`]; every file among `outputs`.
-pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<allan_kalibr::Section>, Error> {
+/// The whole job as the binary says it: [`run`] or [`run_curves`], one [`Section`] per
+/// topic (or for the curves read); every file among `outputs`.
+pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Error> {
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
-        let o = run_curves(config, outputs)?;
-        return Ok(vec![allan_kalibr::Section {
-            notes: o.notes,
-            text: o.stdout + &o.ieee952_text,
-            written: o.files,
-            ..Default::default()
-        }]);
+        return Ok(vec![run_curves(config, outputs)?.section]);
     }
     Ok(run(config, outputs)?
         .into_iter()
-        .map(|o| allan_kalibr::Section {
-            topic: Some(o.topic),
-            notes: o.notes,
-            findings: o.findings,
-            text: o.stdout + o.ieee952_text.as_deref().unwrap_or(""),
-            written: o.files,
-            timings: o
-                .timings
-                .iter()
-                .map(|(phase, d)| format!("timing {phase} {:.3} s", d.as_secs_f64()))
-                .collect(),
-        })
+        .map(|o| o.section)
         .collect())
+}
+
+impl allan_kalibr::Job for Config {
+    type Error = Error;
+    fn common(&self) -> &allan_kalibr::Common {
+        &self.common
+    }
+    fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
+        sections(self, outputs)
+    }
 }
 
 /// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
@@ -199,7 +177,7 @@ fn run_series(
     read_time: Duration,
     outputs: &Outputs,
 ) -> Result<Outcome, Error> {
-    let mut timings = vec![("read_bag", read_time)];
+    let mut timings: Vec<(&str, Duration)> = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
     let mut notes = bag2mat::shared::note::warnings(&series.notes);
     let absent = stand_in_and_skip(config, &mut series, &mut notes)?;
@@ -243,16 +221,22 @@ fn run_series(
     let ieee952_text = ieee
         .as_ref()
         .map(|a| allan_kalibr::ieee952_section_text(a, config.common.samples_path(), &topic));
-    Ok(Outcome {
-        topic,
-        stdout: report::stdout_text(&analysis),
-        ieee952_text,
-        findings: check.findings,
+    let section = Section {
+        topic: Some(topic),
         notes,
-        files,
+        findings: check.findings,
+        text: report::stdout_text(&analysis),
+        ieee952_text,
+        written: files,
+        timings: timings
+            .iter()
+            .map(|(phase, d)| format!("timing {phase} {:.3} s", d.as_secs_f64()))
+            .collect(),
+    };
+    Ok(Outcome {
+        section,
         analysis,
         ieee952: ieee,
-        timings,
     })
 }
 
@@ -527,11 +511,15 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
     an.notes.extend(c.notes.iter().cloned());
     let rostopic = config.common.named_topic();
     files.extend(write_ieee952(outputs, &an, config, rostopic)?);
-    Ok(CurvesOutcome {
-        stdout,
-        ieee952_text: ieee952_summary_text(&an),
+    let section = Section {
         notes,
-        files,
+        text: stdout,
+        ieee952_text: Some(ieee952_summary_text(&an)),
+        written: files,
+        ..Default::default()
+    };
+    Ok(CurvesOutcome {
+        section,
         analysis,
         ieee952: an,
     })

@@ -93,6 +93,7 @@ fn issue18_7_header_and_record_clocks_are_cross_checked() {
     .unwrap()
     .remove(0);
     let f: Vec<&Finding> = k
+        .section
         .findings
         .iter()
         .filter(|f| f.kind == FindingKind::ClockMismatch)
@@ -127,7 +128,7 @@ fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
     )
     .unwrap()
     .remove(0);
-    let gk = gaps(&k.findings);
+    let gk = gaps(&k.section.findings);
     assert_eq!(gk.size, Some(lost));
     // the same line, the longest gap's place included
     assert_eq!(w[0], gk.to_string());

@@ -310,7 +310,7 @@ fn reference_cases_end_to_end() {
         // stdout: line by line; fit-dependent lines compared number by number.
         let theirs = case.read("stdout.txt");
         let (o, t): (Vec<&str>, Vec<&str>) =
-            (out.stdout.lines().collect(), theirs.lines().collect());
+            (out.section.text.lines().collect(), theirs.lines().collect());
         if o.len() != t.len() {
             fail(format!(
                 "{c} stdout: expected {} lines, actual {}",
@@ -372,7 +372,7 @@ fn reference_cases_end_to_end() {
 
         // stderr: upstream's reference run printed only the end-of-bag warning (p3).
         let stderr_ref = case.read("stderr.txt");
-        let ours_err: String = out.notes.iter().map(|n| format!("{n}\n")).collect();
+        let ours_err: String = out.section.notes.iter().map(|n| format!("{n}\n")).collect();
         if ours_err != stderr_ref {
             fail(format!(
                 "{c} stderr: expected {stderr_ref:?}, actual {ours_err:?}"

@@ -17,7 +17,10 @@ fn imu_utils(bag: &Path, topic: &str, out: &Path) -> (String, String) {
         .unwrap_or_else(|e| panic!("{}: {e}", bag.display()))
         .remove(0);
     let yaml = std::fs::read_to_string(out.join("x_imu_param.yaml")).unwrap();
-    (o.stdout + o.ieee952_text.as_deref().unwrap_or(""), yaml)
+    (
+        o.section.text + o.section.ieee952_text.as_deref().unwrap_or(""),
+        yaml,
+    )
 }
 
 fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
@@ -29,7 +32,10 @@ fn kalibr(bag: &Path, topic: &str, out: &Path) -> (String, String) {
     let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
     // imu.yaml names its source file; the rest must be identical.
     let yaml: String = yaml.lines().filter(|l| !l.starts_with('#')).collect();
-    (o.text + o.ieee952_text.as_deref().unwrap_or(""), yaml)
+    (
+        o.section.text + o.section.ieee952_text.as_deref().unwrap_or(""),
+        yaml,
+    )
 }
 
 #[test]

@@ -316,17 +316,46 @@ pub struct Section {
     pub notes: Vec<Note>,
     /// What the record check found (always said).
     pub findings: Vec<Finding>,
-    /// The results (stdout).
+    /// The results (stdout): the reproduced tool's text.
     pub text: String,
+    /// The IEEE 952 section printed after it (when enabled and the data allow it).
+    pub ieee952_text: Option<String>,
     /// Files written (a "wrote" line each, without --quiet).
     pub written: Vec<PathBuf>,
     /// Phase timings, one line each (with --timings).
     pub timings: Vec<String>,
 }
 
+/// A tool's settings as the front end runs them: the shared part, and the job that turns
+/// them into sections.
+pub trait Job {
+    /// The job's error (said once by [`finish`]).
+    type Error: std::fmt::Display;
+    /// The settings both analysers share.
+    fn common(&self) -> &Common;
+    /// The whole job, every file among `outputs`.
+    fn sections(&self, outputs: &output::Outputs) -> Result<Vec<Section>, Self::Error>;
+}
+
+/// A tool's whole `main`: the worker threads started, the arguments `A` parsed and resolved
+/// into the settings `C`, the job run inside its output stage and said ([`finish`]).
+pub fn main<A, C>(tool: &str) -> ExitCode
+where
+    A: clap::Parser,
+    C: Job + TryFrom<A>,
+    <C as TryFrom<A>>::Error: std::fmt::Display,
+{
+    bag2mat::shared::alloc::start_threads(tool);
+    let config = match parse::<A, C, _>(tool, C::try_from) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    finish(tool, config.common(), |outputs| config.sections(outputs))
+}
+
 /// Parses the tool's arguments into its settings: `--help`/`--version` print and exit 0,
 /// a command line that cannot be run is a usage error (exit 2).
-pub fn parse<A: clap::Parser, C, E: std::fmt::Display>(
+fn parse<A: clap::Parser, C, E: std::fmt::Display>(
     tool: &str,
     resolve: impl FnOnce(A) -> Result<C, E>,
 ) -> Result<C, ExitCode> {
@@ -346,7 +375,7 @@ pub fn parse<A: clap::Parser, C, E: std::fmt::Display>(
 /// what it found: per section its notes (warnings always, information without --quiet),
 /// the record check's findings, the results on stdout, the files written and the timings.
 /// The exit code: 0, or 1 with the error said once.
-pub fn finish<E: std::fmt::Display>(
+fn finish<E: std::fmt::Display>(
     tool: &str,
     common: &Common,
     job: impl FnOnce(&output::Outputs) -> Result<Vec<Section>, E>,
@@ -381,6 +410,7 @@ pub fn finish<E: std::fmt::Display>(
                 text.push_str(&format!("===== topic {t} =====\n"));
             }
             text.push_str(&s.text);
+            text.push_str(s.ieee952_text.as_deref().unwrap_or(""));
             match cli::print(&text) {
                 Ok(more) => printing = more,
                 Err(e) => return cli::fail(tool, &e),

@@ -68,11 +68,12 @@ mod yaml;
 
 pub use cli::{Args, TOOL};
 pub use error::Error;
-pub use front::{
-    Common, CommonArgs, Input, Section, finish as finish_job, parse as parse_args, rate_for_text,
-};
+pub use front::CurvesInput;
+pub use front::{Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text};
 pub use ieee952::advisor::advise;
+pub use ieee952::advisor::{Advice, TermAdvice};
 pub use ieee952::ci::chi2_interval;
+pub use ieee952::curves_in::{Curves, Format as CurvesFormat, SensorCurves};
 pub use ieee952::curves_in::{
     CurvesError, ImuUtilsRaw, Options as CurvesOptions, read as read_curves,
 };
@@ -83,22 +84,28 @@ pub use ieee952::files::{
     CURVES_FILE, TERMS_FILE, write_outputs as write_ieee952_files,
 };
 pub use ieee952::fit::GM;
+pub use ieee952::imu::SensorValue;
 pub use ieee952::imu::{
     AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
     summary_text as ieee952_summary_text,
 };
 pub use ieee952::lines::{resonance_avar, resonance_poles, sinusoid_avar};
 pub use ieee952::noise_id::{NoiseId, identify, identify_on};
+pub use ieee952::oadev::AvarPoint;
 pub use ieee952::oadev::{second_diff_sum, second_diff_sums};
 pub use ieee952::plot::{find_truth, write_chart as write_ieee952_chart};
 pub use ieee952::psd::{BUMP_X, find_lines, welch};
+pub use ieee952::psd::{Line as PsdLine, Psd};
+pub use ieee952::region::Readings;
 pub use ieee952::region::{B_FLOOR_FACTOR, Reading, ReadingKind};
 pub use ieee952::stated::section_text as ieee952_section_text;
 pub use ieee952::{
-    Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CurveData, CurvePoint,
-    FitConfig, GridSpec, IdMethod, Overlap, Phase, Term, Verdict, analyse as analyse_ieee952,
-    analyse_curve, short,
+    AlphaSource, Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CovBasis,
+    CurveData, CurvePoint, FitConfig, FitSummary, GridSpec, IdMethod, Ieee952Error, LineShape,
+    LineTerm, Overlap, Phase, Point as CurveFitPoint, Shapes, Term, Terms, Verdict,
+    analyse as analyse_ieee952, analyse_curve, short,
 };
+pub use input::{Clock, RateChoice};
 pub use input::{ImuData, load as load_input, snap_rate, value_problem};
 pub use kalibr::chart_fit::{ChartFit, gen_chart};
 pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};

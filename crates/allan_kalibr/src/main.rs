@@ -3,17 +3,12 @@
 
 use std::process::ExitCode;
 
-use allan_kalibr::{Args, Config, TOOL, finish_job, parse_args, sections};
+use allan_kalibr::{Args, Config, TOOL};
 
 /// Out of memory is reported as an error, not an abort.
 #[global_allocator]
 static ALLOC: bag2mat::shared::alloc::ExitOnOom = bag2mat::shared::alloc::ExitOnOom::new(TOOL);
 
 fn main() -> ExitCode {
-    bag2mat::shared::alloc::start_threads(TOOL);
-    let config = match parse_args::<Args, Config, _>(TOOL, Config::try_from) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
-    finish_job(TOOL, &config.common, |outputs| sections(&config, outputs))
+    allan_kalibr::analyser_main::<Args, Config>(TOOL)
 }

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Error;
+use crate::front::Section;
 use crate::input::{self, ImuData, RateChoice};
 use crate::kalibr::chart::{self, Chart};
 use crate::kalibr::chart_fit::{ChartFit, gen_chart};
@@ -83,44 +84,33 @@ pub fn analyse(
     })
 }
 
-/// Result of [`run`]: the printed text, the messages for stderr and the files written.
+/// Result of [`run`] for one topic: what the binary says, and the numbers behind it.
 #[derive(Debug)]
 pub struct RunOutput {
-    /// The topic the samples came from (None for a `.mat`).
-    pub topic: Option<String>,
+    /// The topic (None for a `.mat`), upstream's text, the IEEE 952 section, the record
+    /// check's findings, the notes, the files written and the phase timings.
+    pub section: Section,
     /// The numbers.
     pub analysis: Analysis,
     /// How the update rate was chosen.
     pub rate: RateChoice,
-    /// Upstream's printed text (stdout).
-    pub text: String,
-    /// The IEEE 952 section printed after it (when enabled and the data allow it).
-    pub ieee952_text: Option<String>,
-    /// What the record check found (stderr, always).
-    pub findings: Vec<bag2mat::Finding>,
-    /// Notes and warnings (stderr), in order.
-    pub notes: Vec<Note>,
-    /// Files written.
-    pub written: Vec<PathBuf>,
-    /// Wall time of each phase.
-    pub timings: Timings,
 }
 
-/// Wall-clock seconds per phase of [`run`].
+/// Wall-clock seconds per phase of [`run`] (said as one line with --timings).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Timings {
+struct Timings {
     /// Reading the bag or .mat.
-    pub load: f64,
+    load: f64,
     /// τ grid, sig2 curves and both fits.
-    pub analyse: f64,
+    analyse: f64,
     /// The IEEE 952 analysis (0 when disabled): its curves (made beside the record check
     /// when it keeps the record whole, so the phases then overlap), and the part of its
     /// fits that outlasted the compat path they run beside.
-    pub ieee952: f64,
+    ieee952: f64,
     /// Rendering and writing yaml, CSV and plots.
-    pub output: f64,
+    output: f64,
     /// The record check (`bag2mat::check_record`).
-    pub checks: f64,
+    checks: f64,
 }
 
 impl std::fmt::Display for Timings {
@@ -133,30 +123,26 @@ impl std::fmt::Display for Timings {
     }
 }
 
-/// The whole job as the binary says it: [`run`] or `run_curves`, each result a
-/// [`crate::front::Section`] (the topic, notes, findings, text, files and timings).
-/// Every file goes among `outputs`.
-pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<crate::front::Section>, Error> {
+/// The whole job as the binary says it: [`run`] or `run_curves`, one [`Section`] per
+/// topic (or for the curves read). Every file goes among `outputs`.
+pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Error> {
     if let crate::front::Input::Curves(curves) = &config.common.input {
-        let out = run_curves(config, curves, outputs)?;
-        return Ok(vec![crate::front::Section {
-            notes: out.notes,
-            text: out.text,
-            written: out.written,
-            ..Default::default()
-        }]);
+        return Ok(vec![run_curves(config, curves, outputs)?]);
     }
     Ok(run(config, outputs)?
         .into_iter()
-        .map(|out| crate::front::Section {
-            topic: out.topic,
-            notes: out.notes,
-            findings: out.findings,
-            text: out.text + out.ieee952_text.as_deref().unwrap_or(""),
-            written: out.written,
-            timings: vec![out.timings.to_string()],
-        })
+        .map(|out| out.section)
         .collect())
+}
+
+impl crate::front::Job for Config {
+    type Error = Error;
+    fn common(&self) -> &crate::front::Common {
+        &self.common
+    }
+    fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
+        sections(self, outputs)
+    }
 }
 
 /// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
@@ -185,9 +171,7 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> 
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        let mut out = run_on(&c, data, outputs)?;
-        out.timings.load = load;
-        outs.push(out);
+        outs.push(run_on(&c, data, load, outputs)?);
     }
     Ok(outs)
 }
@@ -197,9 +181,14 @@ fn section_series(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
     [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]]
 }
 
-/// [`run`] on samples already in memory: the record checked, the rate chosen, both
-/// analyses side by side, then every output rendered and written.
-pub fn run_on(config: &Config, mut data: ImuData, outputs: &Outputs) -> Result<RunOutput, Error> {
+/// [`run`] on samples already in memory (read in `load` seconds): the record checked, the
+/// rate chosen, both analyses side by side, then every output rendered and written.
+fn run_on(
+    config: &Config,
+    mut data: ImuData,
+    load: f64,
+    outputs: &Outputs,
+) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
@@ -256,24 +245,27 @@ pub fn run_on(config: &Config, mut data: ImuData, outputs: &Outputs) -> Result<R
         &topic,
     )?;
     let timings = Timings {
-        load: 0.0,
+        load,
         analyse: analyse_s,
         ieee952: ieee_s,
         output: start.elapsed().as_secs_f64(),
         checks: c.checks_s,
     };
-    Ok(RunOutput {
+    let section = Section {
         topic: data_topic,
-        analysis,
-        rate: c.rate,
+        notes,
+        findings: c.findings,
         text,
         ieee952_text: ieee
             .as_ref()
             .map(|a| crate::ieee952::stated::section_text(a, config.common.samples_path(), &topic)),
-        findings: c.findings,
-        notes,
         written,
-        timings,
+        timings: vec![timings.to_string()],
+    };
+    Ok(RunOutput {
+        section,
+        analysis,
+        rate: c.rate,
     })
 }
 
@@ -525,24 +517,13 @@ fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>
     Ok((k, warning))
 }
 
-/// Result of [`run_curves`].
-#[derive(Debug)]
-pub struct CurvesOutput {
-    /// The IEEE 952 section.
-    pub text: String,
-    /// Notes (how the sample count was found, …).
-    pub notes: Vec<Note>,
-    /// Files written.
-    pub written: Vec<PathBuf>,
-}
-
 /// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat
 /// outputs), with the same files and chart as from a bag.
 pub fn run_curves(
     config: &Config,
     curves: &crate::front::CurvesInput,
     outputs: &Outputs,
-) -> Result<CurvesOutput, Error> {
+) -> Result<Section, Error> {
     let mut opts = curves.options.clone();
     if opts.rate.is_none() {
         opts.rate = config.common.rate;
@@ -565,10 +546,10 @@ pub fn run_curves(
     written.extend(crate::ieee952::plot::write_chart(
         outputs, &an, &title, None, dir, "",
     )?);
-    Ok(CurvesOutput {
+    Ok(Section {
         text: crate::ieee952::imu::summary_text(&an),
-        notes: Vec::new(),
         written,
+        ..Default::default()
     })
 }
 

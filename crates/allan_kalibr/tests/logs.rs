@@ -70,7 +70,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
             read("ieee952_terms.csv"),
             values(&read("imu.yaml")),
             read("basalt_imu_noise_ieee952.json"),
-            run.ieee952_text.unwrap_or_default(),
+            run.section.ieee952_text.unwrap_or_default(),
         )
     };
     let from_bag = analyse(&bag, "imu", "bag");

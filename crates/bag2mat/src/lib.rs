@@ -71,9 +71,12 @@ mod time;
 mod timing;
 mod zstd;
 
+pub use bag::read::BagIndex;
+pub use bag::record::Connection as BagConnection;
 pub use bag::write::ConnId;
 pub use bag::{BagReader, BagWriter, Compression};
 pub use cli::{Args, Invocation, run};
+pub use cli::{Command, FormatArg};
 pub use convert::{
     Converted, Format as OutputFormat, bag_to_data_imu, data_imu_from_series, into_data_imu,
     write as write_matrix,
@@ -83,17 +86,19 @@ pub use error::{Error, TopicSummary};
 pub use formats::euroc::{Stated as SensorYaml, stated_for as sensor_yaml_for};
 pub use formats::text::STANDARD_GRAVITY;
 pub use formats::{AccUnit, GyroUnit, InputArgs, InputOptions, TimeUnit};
+pub use imu_msg::BadMessage;
 pub use imu_msg::{Imu, MD5 as IMU_MD5, definition as imu_definition};
 pub use info::{InfoReport, TopicInfo, info, info_with};
 pub use input::open as open_input;
 pub use mat::{DataImu, read_data_imu, write_data_imu};
 pub use mcap::{ChunkCompression, MAGIC as MCAP_MAGIC};
 pub use printable::escape as escape_printable;
+pub use record_check::Axis as FindingAxis;
 pub use record_check::warmup::{Fit as WarmupFit, find as find_warmup};
 pub use record_check::{
     Check as RecordCheck, Finding, Keep as KeepRows, Kind as FindingKind, Level as FindingLevel,
-    Options as CheckOptions, RATE_ARGUMENT_REL, Record as CheckInput, check as check_record,
-    checked_skip, drop_absent, rate_argument, SkipError,
+    Options as CheckOptions, RATE_ARGUMENT_REL, Record as CheckInput, SkipError,
+    check as check_record, checked_skip, drop_absent, rate_argument,
 };
 pub use rosbag2::{Ros2BagWriter, Storage, TopicId};
 pub use rows::{ROW_LEN, Row, Rows, permute};
@@ -103,5 +108,10 @@ pub use series::{
     absent_warning, read_imu_series, read_imu_topics, read_imu_topics_with, topic_folder_names,
 };
 pub use source::{ACCEPTED, InputKind, Source};
+pub use source::{
+    Channel as SourceChannel, Contents as SourceContents, Encoding as MessageEncoding,
+    Loss as SourceLoss, Part as SourcePart, PartRead,
+};
 pub use time::RosTime;
+pub use timing::{Gap as TimingGap, Segment as TimingSegment};
 pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};

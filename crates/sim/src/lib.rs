@@ -62,14 +62,24 @@ mod traj;
 // What the binary, the tests and the other crates' tests use; everything else is the
 // crate's own.
 pub use bag_sim::{BagConfig, message_count, run as run_bag};
+pub use bag_sim::{BagFormat, BagSummary};
+pub use cli::{
+    BagArgs, BagFormatArg, CompareArgs, CompressionArg, FitArg, GridArg, InitArg, IntegrateArgs,
+    MethodArg, ModelArgs, MotionArg, NoiseArgs, PresetArg, SensorArg, SensorsArgs, SplineArgs,
+    TrajArgs,
+};
 pub use cli::{Cli, Command};
 pub use command::run;
 pub use error::{Result, SimError};
+pub use motion::MotionSample;
 pub use motion::{Motion, ellipse};
+pub use noise::DiscreteNoise;
 pub use noise::generate::axis_series;
 pub use noise::model::{AxisModel, Chain, Filter, ImuModel, Line, Sensor, SensorModel};
+pub use noise::model::{BiasInstability, GaussMarkov, ResolvedChain, Warmup};
 pub use noise::profiles::Profile;
 pub use noise::truth::AxisTruth;
+pub use noise::truth::{FilteredWhite, TermAvar};
 pub use noise::truth_file::read_model;
 pub use noise::{ContinuousNoise, NoiseGenerator, Preset, white_rw_axis};
 pub use rotation::quat_from_matrix;

@@ -115,6 +115,7 @@ mod tests_real;
 pub use avar_cov::CovBasis;
 pub use fit::FitConfig;
 pub use input_error::Ieee952Error;
+pub use model::{LineShape, Shapes};
 pub use noise_id::IdMethod;
 pub use oadev::{Overlap, Phase};
 pub use tau_grid::GridSpec;

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 mod model_args;
 mod noise_args;
 
-pub use model_args::{ModelArgs, SPEC_EXAMPLE, SensorsArgs};
+pub use model_args::{ModelArgs, SPEC_EXAMPLE, SensorArg, SensorsArgs};
 pub use noise_args::{NoiseArgs, PresetArg};
 
 /// IMU data simulator (after HeYijia/vio_data_simulation) and Spline-Fusion IMU synthesis.
