@@ -75,11 +75,14 @@ def main():
             st['pub_mod'] += len(re.findall(r'^\s*pub\s+mod\s', t, re.M))
             st['rs'] += len(re.findall(r'Result<[^;{]*,\s*String>', t))
             for name, ln, at in fns(t):
+                st.setdefault('all', []).append((ln, f'{rel}:{name}'))
                 if ln > LONG:
                     head = '\n'.join(t.split('\n')[max(0, at - 6):at])
                     st['long'].append((ln, f'{rel}:{name}', 'reason' if re.search(r'(?im)^\s*//.*\b(long because|long:|long on purpose|over 80 lines)', head) else ''))
     st['long'].sort(reverse=True)
     print(f"## {crate}: pub fn {st['pub_fn']}, pub(crate|super) fn {st['crate_fn']}, pub mod {st['pub_mod']}, Result<_, String> {st['rs']}, files>1000 {st['big']}")
+    top = sorted(st.get('all', []), reverse=True)[:3]
+    print("   longest: " + ', '.join(f'{n} {l}' for n, l in top))
     print(f"   fn > {LONG} lines ({len(st['long'])}): " + ', '.join(f'{n} {l}{" ["+r+"]" if r else ""}' for l, n, r in [(b, a, c) for a, b, c in st['long']]))
 
 if __name__ == '__main__':

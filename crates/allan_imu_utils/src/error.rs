@@ -59,7 +59,7 @@ pub enum Error {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        what: crate::launch::LaunchSyntax,
+        what: LaunchSyntax,
     },
     /// A setting is missing or invalid.
     #[error("{0}")]
@@ -74,3 +74,8 @@ pub enum Error {
         cause: std::io::Error,
     },
 }
+
+/// What makes a launch file unreadable as one (said after its path).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct LaunchSyntax(pub String);

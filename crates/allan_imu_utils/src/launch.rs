@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::error::Error;
+use crate::error::{Error, LaunchSyntax};
 
 /// The imu_utils parameters and the flag that replaces each.
 pub const PARAMS: [(&str, &str); 5] = [
@@ -86,11 +86,6 @@ fn unescape(s: &str) -> String {
         .replace("&gt;", ">")
         .replace("&amp;", "&")
 }
-
-/// What makes a launch file unreadable as one (said after its path).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct LaunchSyntax(pub String);
 
 /// Parses `key = "value"` attributes of one tag body.
 fn attributes(body: &str) -> Result<Vec<(String, String)>, LaunchSyntax> {

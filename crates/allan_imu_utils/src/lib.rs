@@ -48,10 +48,9 @@ mod run;
 // What the binary, the tests and the benchmark use; everything else is the crate's own.
 pub use analysis::{Analysis, AxisAllan};
 pub use cli::{Args, Config, TOOL};
-pub use error::Error;
+pub use error::{Error, LaunchSyntax};
 pub use estimator::{allan_variance, mean_period, thetas};
 pub use factors::factors;
 pub use fit::dogleg::{Summary as DoglegSummary, Termination as DoglegTermination};
 pub use fit::{AxisFit, Sensor};
-pub use launch::LaunchSyntax;
 pub use run::{CurvesOutcome, Outcome, run, run_curves, sections};

@@ -193,12 +193,7 @@ fn run_on(
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
     if let Some(skip) = config.common.skip_start {
-        let (k, warning) = skip_start(&mut data, skip)?;
-        notes.extend(warning.map(Note::warning));
-        notes.push(Note::info(format!(
-            "--skip-start {skip}: dropped the first {k} samples ({} left)",
-            data.len()
-        )));
+        skip_start(&mut data, skip, &mut notes)?;
     }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
@@ -509,12 +504,17 @@ fn write_outputs(
     Ok(written)
 }
 
-/// Drops the samples of the first `seconds` of the record; returns how many, and a
-/// warning when that is most of it.
-fn skip_start(data: &mut ImuData, seconds: f64) -> Result<(usize, Option<String>), Error> {
+/// `--skip-start`: drops the samples of the first `seconds` of the record, said in `notes`
+/// (a warning when that is most of it).
+fn skip_start(data: &mut ImuData, seconds: f64, notes: &mut Vec<Note>) -> Result<(), Error> {
     let (k, warning) = bag2mat::checked_skip(&data.t, seconds)?;
     data.drop_first(k);
-    Ok((k, warning))
+    notes.extend(warning.map(Note::warning));
+    notes.push(Note::info(format!(
+        "--skip-start {seconds}: dropped the first {k} samples ({} left)",
+        data.len()
+    )));
+    Ok(())
 }
 
 /// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat

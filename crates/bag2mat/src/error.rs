@@ -146,7 +146,7 @@ pub enum Error {
         /// The output file.
         path: PathBuf,
         /// The backend's message.
-        what: crate::shared::plot::DrawError,
+        what: DrawError,
     },
     /// A `.mat` file could not be read or written as an N×7 `data_imu`.
     #[error("{path}: {what}")]
@@ -264,5 +264,32 @@ pub(crate) fn without_errno(s: &str) -> String {
     match s.find(" (os error") {
         Some(i) => s[..i].to_string(),
         None => s.to_string(),
+    }
+}
+
+/// A chart that could not be drawn, said in words: plotters' errors are generic over the
+/// backend, so each becomes its text where it arises (a failed write as every tool says an
+/// I/O error: `shared::plot::present`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct DrawError(pub(crate) String);
+
+impl<E: std::error::Error + Send + Sync> From<plotters::drawing::DrawingAreaErrorKind<E>>
+    for DrawError
+{
+    fn from(e: plotters::drawing::DrawingAreaErrorKind<E>) -> DrawError {
+        DrawError(e.to_string())
+    }
+}
+
+impl From<Box<dyn std::error::Error>> for DrawError {
+    fn from(e: Box<dyn std::error::Error>) -> DrawError {
+        DrawError(e.to_string())
+    }
+}
+
+impl From<&str> for DrawError {
+    fn from(what: &str) -> DrawError {
+        DrawError(what.to_owned())
     }
 }

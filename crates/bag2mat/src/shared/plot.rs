@@ -26,32 +26,7 @@ pub fn register_font() {
     });
 }
 
-/// A chart that could not be drawn, said in words: plotters' errors are generic over the
-/// backend, so each becomes its text where it arises (a failed write as every tool says an
-/// I/O error: [`present`]).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct DrawError(String);
-
-impl<E: std::error::Error + Send + Sync> From<plotters::drawing::DrawingAreaErrorKind<E>>
-    for DrawError
-{
-    fn from(e: plotters::drawing::DrawingAreaErrorKind<E>) -> DrawError {
-        DrawError(e.to_string())
-    }
-}
-
-impl From<Box<dyn std::error::Error>> for DrawError {
-    fn from(e: Box<dyn std::error::Error>) -> DrawError {
-        DrawError(e.to_string())
-    }
-}
-
-impl From<&str> for DrawError {
-    fn from(what: &str) -> DrawError {
-        DrawError(what.to_owned())
-    }
-}
+pub use crate::error::DrawError;
 
 /// The bitmap backend's error type (plotters does not name it).
 type BitmapError =
