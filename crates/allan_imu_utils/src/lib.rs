@@ -51,6 +51,6 @@ pub use cli::{Args, Config, TOOL};
 pub use error::{Error, LaunchSyntax};
 pub use estimator::{allan_variance, mean_period, thetas};
 pub use factors::factors;
+pub use fit::AxisFit;
 pub use fit::dogleg::{Summary as DoglegSummary, Termination as DoglegTermination};
-pub use fit::{AxisFit, Sensor};
 pub use run::{CurvesOutcome, Outcome, run, run_curves, sections};

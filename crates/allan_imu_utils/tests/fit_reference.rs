@@ -3,7 +3,8 @@
 //! (`ref_dump_summary.txt`, full precision) within the spec's §8 tolerances.
 
 use crate::common::{CASES, rel_err};
-use allan_imu_utils::{AxisFit, Sensor};
+use allan_imu_utils::AxisFit;
+use bag2mat::Sensor;
 
 /// yaml values: 1e-3 relative on every axis (imu_utils.md §8).
 pub const YAML_REL_TOL: f64 = 1e-3;

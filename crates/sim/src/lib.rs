@@ -75,7 +75,7 @@ pub use motion::MotionSample;
 pub use motion::{Motion, ellipse};
 pub use noise::DiscreteNoise;
 pub use noise::generate::axis_series;
-pub use noise::model::{AxisModel, Chain, Filter, ImuModel, Line, Sensor, SensorModel};
+pub use noise::model::{AxisModel, Chain, Filter, ImuModel, Line, SensorModel};
 pub use noise::model::{BiasInstability, GaussMarkov, ResolvedChain, Warmup};
 pub use noise::profiles::Profile;
 pub use noise::truth::AxisTruth;

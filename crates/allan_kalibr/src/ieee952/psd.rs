@@ -754,8 +754,8 @@ mod tests {
     /// within [`RESONANCE_BW_REL_TOL`], and its standard error is stated.
     #[test]
     fn issue_17_resonance_bandwidth_fitted_with_its_own_floor() {
+        use bag2mat::Sensor;
         use sim::Profile;
-        use sim::Sensor;
         use sim::axis_series;
         let (rate, n) = (200.0, 4 * 3600 * 200);
         let model = Profile::Vibration.model();

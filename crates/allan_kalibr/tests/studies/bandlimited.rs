@@ -11,11 +11,12 @@
 //! their column names.
 
 use allan_kalibr::{CurveData, Ieee952Config, Verdict, analyse_curve};
+use bag2mat::Sensor;
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
 use sim::axis_series;
-use sim::{AxisModel, Chain, Filter, ImuModel, Sensor as SimSensor, SensorModel};
+use sim::{AxisModel, Chain, Filter, ImuModel, SensorModel};
 
 /// Output rate, Hz.
 const RATE: f64 = 400.0;
@@ -65,7 +66,7 @@ fn model(frac: f64) -> ImuModel {
 }
 
 /// (N as the data show it, K) of one axis.
-fn truth(m: &ImuModel, s: SimSensor, axis: usize, n: usize) -> (f64, f64) {
+fn truth(m: &ImuModel, s: Sensor, axis: usize, n: usize) -> (f64, f64) {
     let sm = m.sensor(s);
     let chain = sm.chain.resolve(s, RATE).expect("chain");
     let a = &sm.axes[axis];
@@ -114,9 +115,9 @@ fn print(o: &Outcome) {
 fn in_memory_cases() -> Vec<Outcome> {
     let n = (DURATION * RATE) as usize;
     let cfg = Ieee952Config::default();
-    let jobs: Vec<(f64, SimSensor)> = CORNERS
+    let jobs: Vec<(f64, Sensor)> = CORNERS
         .iter()
-        .flat_map(|&f| [SimSensor::Gyro, SimSensor::Acc].map(|s| (f, s)))
+        .flat_map(|&f| [Sensor::Gyro, Sensor::Acc].map(|s| (f, s)))
         .collect();
     jobs.par_iter()
         .enumerate()
@@ -147,7 +148,7 @@ fn in_memory_cases() -> Vec<Outcome> {
 fn mat_cases() -> Vec<Outcome> {
     let n = (DURATION * RATE) as usize;
     let m = model(MAT_CORNER);
-    let jobs: Vec<(SimSensor, usize)> = [SimSensor::Acc, SimSensor::Gyro]
+    let jobs: Vec<(Sensor, usize)> = [Sensor::Acc, Sensor::Gyro]
         .into_iter()
         .flat_map(|s| (0..3).map(move |a| (s, a)))
         .collect();
@@ -176,10 +177,7 @@ fn mat_cases() -> Vec<Outcome> {
         .expect("allan_kalibr run on the .mat");
     let rows = crate::ieee952::terms(&out);
     let mut out_cases = Vec::new();
-    for (s, sname) in [
-        (SimSensor::Gyro, "gyroscope"),
-        (SimSensor::Acc, "accelerometer"),
-    ] {
+    for (s, sname) in [(Sensor::Gyro, "gyroscope"), (Sensor::Acc, "accelerometer")] {
         for (a, aname) in ["x", "y", "z"].iter().enumerate() {
             let find = |t: &str| crate::ieee952::term(&rows, sname, aname, t);
             let (nr, kr) = (find("N"), find("K"));

@@ -9,11 +9,12 @@
 use allan_kalibr::{
     BUMP_X, CurveData, Ieee952Analysis, Ieee952Config, Verdict, analyse_curve, sinusoid_avar,
 };
+use bag2mat::Sensor;
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
 use sim::axis_series;
-use sim::{AxisModel, ImuModel, Line, Sensor as SimSensor, SensorModel};
+use sim::{AxisModel, ImuModel, Line, SensorModel};
 
 /// Output rate, Hz.
 const RATE: f64 = 200.0;
@@ -100,13 +101,13 @@ fn run_case(frac: f64, k: f64, seed: u64, duration: f64) -> Case {
         bandwidth: 0.0,
     };
     let m = model_with(line);
-    let y = axis_series(&m, SimSensor::Gyro, 0, RATE, n, seed, 0.0).expect("series");
+    let y = axis_series(&m, Sensor::Gyro, 0, RATE, n, seed, 0.0).expect("series");
     let cfg = Ieee952Config::default();
     let data = CurveData::from_samples(&y, 1.0 / RATE, &cfg).expect("curve");
     let basis = data.basis(cfg.fit.per_octave);
     let an = analyse_curve(&data, &cfg, basis.as_ref());
-    let sm = m.sensor(SimSensor::Gyro);
-    let chain = sm.chain.resolve(SimSensor::Gyro, RATE).expect("chain");
+    let sm = m.sensor(Sensor::Gyro);
+    let chain = sm.chain.resolve(Sensor::Gyro, RATE).expect("chain");
     let at = AxisTruth::new(&sm.axes[0], &chain, 1.0 / RATE, n);
     let n_eff = ((at.white().s0() + at.resolution_variance()) / RATE).sqrt();
     let b_true = a.bias_instability.map_or(0.0, |b| b.b);
@@ -214,7 +215,7 @@ fn issue17_2_a_short_tau_line_is_named_not_called_band_limited() {
         },
         acc: SensorModel::uniform(AxisModel::default()),
     };
-    let y = axis_series(&model, SimSensor::Gyro, 0, RATE, n, 0x17_02, 0.0).expect("series");
+    let y = axis_series(&model, Sensor::Gyro, 0, RATE, n, 0x17_02, 0.0).expect("series");
     let cfg = Ieee952Config::default();
     let data = CurveData::from_samples(&y, 1.0 / RATE, &cfg).expect("curve");
     let basis = data.basis(cfg.fit.per_octave);
@@ -293,7 +294,7 @@ fn lines_study() {
     let over: Vec<String> = cases
         .iter()
         .flat_map(|c| {
-            super::profiles::yaml_over_bounds(&c.label, &[(bag2mat::Sensor::Gyro, 0, &c.analysis)])
+            super::profiles::yaml_over_bounds(&c.label, &[(Sensor::Gyro, 0, &c.analysis)])
         })
         .collect();
     assert!(over.is_empty(), "{over:?}");
@@ -339,7 +340,7 @@ fn issue18_5_clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
     let cfg = Ieee952Config::default();
     let mut jobs = Vec::new();
     for seed in [0x18_05u64, 0x18_06, 0x18_07] {
-        for s in [SimSensor::Gyro, SimSensor::Acc] {
+        for s in [Sensor::Gyro, Sensor::Acc] {
             for axis in 0..3 {
                 jobs.push((seed, s, axis));
             }
@@ -353,8 +354,8 @@ fn issue18_5_clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
             let basis = data.basis(cfg.fit.per_octave);
             let a = analyse_curve(&data, &cfg, basis.as_ref());
             let k_true = match s {
-                SimSensor::Gyro => c.gyro_bias_rw,
-                SimSensor::Acc => c.acc_bias_rw,
+                Sensor::Gyro => c.gyro_bias_rw,
+                Sensor::Acc => c.acc_bias_rw,
             };
             let (r, k) = (a.terms.r, a.terms.k);
             let k_ok = match k.verdict {

@@ -10,10 +10,10 @@
 //! included, √(S₀·Δt + LSB²/12·Δt)); B, K, Q, R are the model's own figures.
 
 use allan_kalibr::{CurveData, GM, Ieee952Analysis, Ieee952Config, Term, Verdict, analyse_curve};
+use bag2mat::Sensor;
 use rayon::prelude::*;
 use sim::AxisTruth;
 use sim::Profile;
-use sim::Sensor as SimSensor;
 use sim::axis_series;
 
 /// Seeds of the study (one simulation stream per profile, seed and axis).
@@ -52,7 +52,7 @@ pub(super) struct Case {
 
 fn truth_of(
     model: &sim::ImuModel,
-    s: SimSensor,
+    s: Sensor,
     axis: usize,
     rate: f64,
     n: usize,
@@ -103,7 +103,7 @@ pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64)
     if std::env::var("NO_GM").is_ok() {
         cfg.fit.terms[GM] = false;
     }
-    let jobs: Vec<(SimSensor, usize)> = [SimSensor::Gyro, SimSensor::Acc]
+    let jobs: Vec<(Sensor, usize)> = [Sensor::Gyro, Sensor::Acc]
         .into_iter()
         .flat_map(|s| (0..3).map(move |a| (s, a)))
         .collect();
@@ -275,7 +275,7 @@ pub(super) fn b_dominates_a_decade(at: &AxisTruth, b: f64, rate: f64, n: usize) 
 /// record's (sensor, axis, analysis); returns the breaches.
 pub(super) fn yaml_over_bounds(
     label: &str,
-    axes: &[(bag2mat::Sensor, usize, &Ieee952Analysis)],
+    axes: &[(Sensor, usize, &Ieee952Analysis)],
 ) -> Vec<String> {
     use allan_kalibr::{AxisResult, ImuAnalysis};
     let imu = ImuAnalysis {
@@ -398,8 +398,8 @@ pub(super) fn score(cases: &[Case], rate: f64) -> Scores {
             .expect("profile")
             .model();
         let (sens, axis) = match c.label.as_str() {
-            l if l.starts_with("gyro") => (SimSensor::Gyro, l),
-            l => (SimSensor::Acc, l),
+            l if l.starts_with("gyro") => (Sensor::Gyro, l),
+            l => (Sensor::Acc, l),
         };
         let ax = "xyz".find(axis.chars().last().unwrap_or('x')).unwrap_or(0);
         let n = a.n.unwrap_or(0);
@@ -510,13 +510,13 @@ fn profiles_study() {
     let over: Vec<String> = cases
         .chunks(6)
         .flat_map(|rec| {
-            let axes: Vec<(bag2mat::Sensor, usize, &Ieee952Analysis)> = rec
+            let axes: Vec<(Sensor, usize, &Ieee952Analysis)> = rec
                 .iter()
                 .map(|c| {
                     let s = if c.label.starts_with("gyro") {
-                        bag2mat::Sensor::Gyro
+                        Sensor::Gyro
                     } else {
-                        bag2mat::Sensor::Acc
+                        Sensor::Acc
                     };
                     let axis = "xyz".find(c.label.chars().last().unwrap_or('x'));
                     (s, axis.unwrap_or(0), &c.analysis)
