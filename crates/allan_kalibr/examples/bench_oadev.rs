@@ -1,6 +1,7 @@
 //! Timing of the IEEE 952 overlapping Allan sweep on six axes of a .mat (development aid):
 //! wall and CPU seconds of the phase integration and of the sweep, best of 5.
 //! `cargo run --release -p allan_kalibr --example bench_oadev -- FILE.mat RATE`
+//! (a long input: `sim bag --duration 14400 -o x.bag`, then `bag2mat x.bag -o x.mat`)
 use std::time::Instant;
 
 use allan_kalibr::{GridSpec, Phase};

@@ -1,5 +1,6 @@
 //! Phase timings of the fast path on a .mat (development aid for the benchmark).
 //! `cargo run --release -p allan_kalibr --example profile_fast -- FILE.mat RATE`
+//! (a long input: `sim bag --duration 14400 -o x.bag`, then `bag2mat x.bag -o x.mat`)
 use std::time::Instant;
 
 use allan_kalibr::{TauGrid, prefix_in_place, sig2_prefix_fused, sig2_tiled};
