@@ -8,7 +8,8 @@ use crate::collect::Collected;
 use crate::error::Error;
 use crate::estimator;
 use crate::factors;
-use crate::fit::{AxisFit, Sensor};
+use crate::fit::AxisFit;
+use bag2mat::Sensor;
 
 /// Upstream's accumulator names, in creation order.
 pub const AXIS_NAMES: [&str; 6] = ["gyr x", "gyr y", "gyr z", "acc x", "acc y", "acc z"];

@@ -209,7 +209,8 @@ pub fn write_curve_files(
 mod tests {
     use super::*;
     use crate::analysis::AxisAllan;
-    use crate::fit::{AxisFit, Sensor};
+    use crate::fit::AxisFit;
+    use bag2mat::Sensor;
 
     /// A small synthetic analysis: white noise only; axis y gets its own taus to expose
     /// which taus the files use.

@@ -475,13 +475,13 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
     let mut analysis = None;
     if let Some(raw) = &c.imu_utils {
         let freq = 1.0 / raw.gyr_t[0];
-        let fit = |sensor: crate::fit::Sensor, t: &[f64], dev: &[f64]| {
+        let fit = |sensor: bag2mat::Sensor, t: &[f64], dev: &[f64]| {
             let var: Vec<f64> = dev.iter().map(|d| d * d).collect();
             AxisFit::fit(sensor, t, &var, freq)
         };
         let fits: Vec<AxisFit> = (0..3)
-            .map(|k| fit(crate::fit::Sensor::Gyro, &raw.gyr_t, &raw.gyr[k]))
-            .chain((0..3).map(|k| fit(crate::fit::Sensor::Acc, &raw.acc_t, &raw.acc[k])))
+            .map(|k| fit(bag2mat::Sensor::Gyro, &raw.gyr_t, &raw.gyr[k]))
+            .chain((0..3).map(|k| fit(bag2mat::Sensor::Acc, &raw.acc_t, &raw.acc[k])))
             .collect();
         let an = Analysis::from_curves(raw, fits, freq);
         stdout.push_str(&report::fit_text(&an));

@@ -23,7 +23,7 @@ use crate::noise::{
 };
 
 /// The two sensors (the workspace's one sensor type).
-pub(crate) use bag2mat::Sensor;
+use bag2mat::Sensor;
 
 /// The two quantities users need.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

@@ -245,9 +245,9 @@ pub fn plot(
             let t = p.params();
             let (_, csv) = crate::noise::truth_file::paths(&root.join(p.name()).join("imu.bag"));
             let sensor_kind = if sensor == "gyro" {
-                crate::noise::model::Sensor::Gyro
+                bag2mat::Sensor::Gyro
             } else {
-                crate::noise::model::Sensor::Acc
+                bag2mat::Sensor::Acc
             };
             let truth_curve = if csv.exists() {
                 let tc = crate::noise::truth_file::read_curves(&csv)?;

@@ -18,7 +18,8 @@
 //! bags stay byte-identical.
 
 use crate::noise::filter::{Biquad, impulse_response};
-use crate::noise::model::{Filter, ImuModel, ResolvedChain, Sensor};
+use crate::noise::model::{Filter, ImuModel, ResolvedChain};
+use bag2mat::Sensor;
 
 use crate::error::Result;
 

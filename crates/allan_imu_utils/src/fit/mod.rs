@@ -20,7 +20,7 @@ pub const IMU_UTILS_MIN_START: f64 = 1000.0;
 /// Which of upstream's two twin fit classes: `FitAllanGyr` (`Sensor::Gyro`: values in
 /// pseudo-deg/h, no point filter) or `FitAllanAcc` (`Sensor::Acc`: values in m/s², the
 /// `checkData` filter) — the workspace's one sensor type.
-pub(crate) use bag2mat::Sensor;
+use bag2mat::Sensor;
 
 /// Mirrors imu_utils `2cdda91` `FitAllanAcc::checkData` (imu_utils.md §4.1, quirk 6): among
 /// τ < 1 s points, each one that sets a new running maximum of σ² (starting from 0) is

@@ -2,7 +2,8 @@
 //! ORB-SLAM3 in [`super::files`]; OpenVINS, Basalt in [`super::vio_files`]): one value per
 //! sensor and term, and the comments saying where each is not a plain fitted value.
 
-use super::imu::{ImuAnalysis, Sensor, SensorValue};
+use super::imu::{ImuAnalysis, SensorValue};
+use bag2mat::Sensor;
 
 fn note(name: &str, v: Option<SensorValue>) -> Option<String> {
     let v = v?;

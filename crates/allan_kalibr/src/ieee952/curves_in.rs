@@ -20,10 +20,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::imu::Sensor;
 use super::oadev::Overlap;
 use super::{CurveData, CurvePoint, IdMethod};
 use crate::ieee952::files;
+use bag2mat::Sensor;
 
 mod imu_utils;
 use imu_utils::{imu_utils_name, read_imu_utils};

@@ -22,7 +22,7 @@ use bag2mat::{Finding, FindingLevel};
 /// deviation (ψ(40) = 0.965: [`super::fit::flicker_band`]).
 const BAND_FLOOR_X: f64 = 40.0;
 
-pub(crate) use bag2mat::Sensor;
+use bag2mat::Sensor;
 
 /// One analysed axis.
 #[derive(Debug, Clone)]

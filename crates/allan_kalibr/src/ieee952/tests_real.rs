@@ -3,8 +3,8 @@
 //! and so stays a unit test; the others are in `tests/studies/real.rs`.
 
 use super::curves_in::{self, Options};
-use super::imu::Sensor;
 use super::{Analysis, Config, analyse_curve};
+use bag2mat::Sensor;
 
 /// (folder, record length in s from its launch file, see the folder's README).
 const IMUS: [(&str, f64); 3] = [("A3", 7200.0), ("N3", 7200.0), ("BMI160", 12000.0)];

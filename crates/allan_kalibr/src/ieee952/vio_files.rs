@@ -24,8 +24,9 @@
 use std::fmt::Write as _;
 
 use super::config_values::{FileValues, file_values, inline_note};
-use super::imu::{ImuAnalysis, Sensor, SensorValue};
+use super::imu::{ImuAnalysis, SensorValue};
 use crate::yaml::yaml_float;
+use bag2mat::Sensor;
 
 /// OpenVINS file name (before the caller's prefix).
 pub const OPENVINS_FILE: &str = "openvins_kalibr_imu_chain_ieee952.yaml";

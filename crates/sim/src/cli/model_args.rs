@@ -1,6 +1,7 @@
 //! The real-sensor noise flags of `sim bag` (clap derive) and their resolution into an
 //! [`ImuModel`]: profile or preset, then `--noise-spec`, then explicit flags.
 
+use bag2mat::Sensor;
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
@@ -8,7 +9,7 @@ use clap::{Args, ValueEnum};
 use super::noise_args::{NoiseArgs, PresetArg};
 use crate::error::{Result, SimError};
 use crate::noise::model::{
-    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Sensor, Warmup,
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Warmup,
 };
 use crate::noise::profiles::Profile;
 

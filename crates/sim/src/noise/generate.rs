@@ -32,8 +32,9 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use super::filter::{Biquad, impulse_response};
-use super::model::{Filter, ImuModel, ResolvedChain, Sensor};
+use super::model::{Filter, ImuModel, ResolvedChain};
 use crate::error::Result;
+use bag2mat::Sensor;
 
 /// Output samples generated per block and axis.
 pub const BLOCK: usize = 8192;

@@ -30,7 +30,7 @@ use std::fmt::Write as _;
 use crate::error::{Result, SimError};
 
 /// The two sensors of an IMU (the workspace's one sensor type, with the units of each term).
-pub(crate) use bag2mat::Sensor;
+use bag2mat::Sensor;
 
 /// Axis names.
 pub const AXES: [&str; 3] = ["x", "y", "z"];

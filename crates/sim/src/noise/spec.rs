@@ -26,12 +26,12 @@
 //! drop a term). A `<bag>.truth.yaml` written by `sim bag` is also accepted: its `model`
 //! section is such a spec.
 
+use bag2mat::Sensor;
 use serde::Deserialize;
 use std::path::Path;
 
 use super::model::{
-    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, Sensor, SensorModel,
-    Warmup,
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, SensorModel, Warmup,
 };
 use super::profiles::Profile;
 use crate::error::{Result, SimError, SpecError};

@@ -19,12 +19,12 @@
 //! a little strict rather than loose). Seeds are fixed: the outcome is deterministic.
 
 use allan_kalibr::{Overlap, Phase, chi2_interval, greenhall_edf};
+use bag2mat::Sensor;
 use statrs::distribution::{Binomial, DiscreteCDF};
 
 use super::generate::axis_series;
 use super::model::{
-    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, Sensor, SensorModel,
-    Warmup,
+    AxisModel, BiasInstability, Chain, Filter, GaussMarkov, ImuModel, Line, SensorModel, Warmup,
 };
 use super::profiles::Profile;
 use super::truth::{AxisTruth, FilteredWhite, TermAvar};

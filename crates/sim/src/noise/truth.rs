@@ -786,7 +786,7 @@ mod tests {
                 ..Default::default()
             };
             let chain = crate::noise::model::Chain::DIRECT
-                .resolve(crate::noise::model::Sensor::Gyro, 1.0 / dt)
+                .resolve(bag2mat::Sensor::Gyro, 1.0 / dt)
                 .unwrap();
             let tr = AxisTruth::new(&a, &chain, dt, 1_000_000);
             let (pa, pb) = allan_kalibr::resonance_poles(f0, bw, dt);
@@ -957,7 +957,7 @@ mod tests {
                 ..Default::default()
             };
             let chain = crate::noise::model::Chain::DIRECT
-                .resolve(crate::noise::model::Sensor::Gyro, 1.0 / dt)
+                .resolve(bag2mat::Sensor::Gyro, 1.0 / dt)
                 .unwrap();
             let tr = AxisTruth::new(&a, &chain, dt, usize::MAX / 4);
             let floor = crate::noise::flicker::FLOOR_PER_B * bi.b;

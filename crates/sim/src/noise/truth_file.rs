@@ -12,13 +12,12 @@
 //! (its own Allan deviation; the totals are the root-sum-square of these, plus the ramp ×
 //! warm-up cross term when both deterministic terms are on).
 
+use bag2mat::Sensor;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::filter::{Biquad, autocorrelation, enbw, impulse_response};
-use super::model::{
-    AXES, AxisModel, BiasInstability, Filter, ImuModel, ResolvedChain, Sensor, Warmup,
-};
+use super::model::{AXES, AxisModel, BiasInstability, Filter, ImuModel, ResolvedChain, Warmup};
 use super::truth::{AxisTruth, TERM_NAMES, TermAvar, WIDROW_MIN, tau_grid};
 use crate::error::{Result, SimError};
 

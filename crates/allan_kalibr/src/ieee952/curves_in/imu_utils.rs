@@ -4,12 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use super::super::imu::Sensor;
 use super::super::oadev::Overlap;
 use super::{
     Curves, CurvesError, Format, IMU_UTILS_PSEUDO_DEG_H, ImuUtilsRaw, Options, dedup_rows, given_n,
     io, sensor_curves,
 };
+use bag2mat::Sensor;
 
 /// `data_<name>_gyr_t.txt` → name.
 pub(super) fn imu_utils_name(fname: &str) -> Option<String> {
