@@ -20,8 +20,10 @@ use std::path::Path;
 use rayon::prelude::*;
 
 mod body;
+mod decimal;
 mod layout;
 mod units;
+mod wide;
 
 use super::InputOptions;
 use crate::RosTime;
