@@ -456,20 +456,8 @@ mod tests {
     /// pass does not take go to the csv crate.
     #[test]
     fn the_fast_path_reads_what_the_csv_crate_reads() {
-        let lay = |delim, time: Option<usize>| Layout {
-            delim,
-            time,
-            gyro: Some([1, 2, 3]),
-            acc: Some([5, 6, 7]),
-            time_unit: TimeUnit::Ns,
-            gyro_si: 0.5,
-            acc_si: 2.0,
-            gyro_stated: true,
-            acc_stated: true,
-            body: 0,
-            body_line: 1,
-            what: String::new(),
-            euroc: false,
+        let lay = |delim, time: Option<usize>| {
+            Layout::for_test(delim, time, ([1, 2, 3], [5, 6, 7]), (0.5, 2.0))
         };
         let csv = "1,0.5,-1e-3,3,temp,1.25e2,-0,7,extra\r\n2, 0.25 ,2,3,x,4,5,6\n# comment\n\n3,1,2,3,\"q\",4,5,6\n4,1,2\n5,1,2,3,x,4,5,nan";
         let ws = "  1   0.5 -1e-3\t3 t 1.25e2 -0 7\n2 1 2 3 x 4 5 6 9 9\n";

@@ -141,6 +141,33 @@ pub(super) struct Layout {
     pub(super) euroc: bool,
 }
 
+#[cfg(test)]
+impl Layout {
+    /// A test layout: the body from byte 0, nanosecond times, both units stated.
+    pub(super) fn for_test(
+        delim: Delim,
+        time: Option<usize>,
+        (gyro, acc): ([usize; 3], [usize; 3]),
+        (gyro_si, acc_si): (f64, f64),
+    ) -> Layout {
+        Layout {
+            delim,
+            time,
+            gyro: Some(gyro),
+            acc: Some(acc),
+            time_unit: TimeUnit::Ns,
+            gyro_si,
+            acc_si,
+            gyro_stated: true,
+            acc_stated: true,
+            body: 0,
+            body_line: 1,
+            what: String::new(),
+            euroc: false,
+        }
+    }
+}
+
 /// The header of bag2mat's own CSV output (t in s, m/s², rad/s).
 pub const BAG2MAT_CSV_HEADER: &str = "t,ax,ay,az,wx,wy,wz";
 

@@ -261,26 +261,11 @@ mod x86 {
 #[cfg(test)]
 mod tests {
     use super::super::body::{columns, fast_row};
-    use super::super::units::TimeUnit;
     use super::*;
 
     /// A layout of the given columns, delimiter and scale.
     fn layout(d: u8, time: Option<usize>, gyro: [usize; 3], acc: [usize; 3]) -> Layout {
-        Layout {
-            delim: Delim::Byte(d),
-            time,
-            gyro: Some(gyro),
-            acc: Some(acc),
-            time_unit: TimeUnit::Ns,
-            gyro_si: 0.5,
-            acc_si: 1.0,
-            gyro_stated: true,
-            acc_stated: true,
-            body: 0,
-            body_line: 1,
-            what: String::new(),
-            euroc: false,
-        }
+        Layout::for_test(Delim::Byte(d), time, (gyro, acc), (0.5, 1.0))
     }
 
     /// A seeded field: mostly plain decimals of every length, sometimes a form the scanner
