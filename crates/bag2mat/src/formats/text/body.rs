@@ -99,6 +99,7 @@ pub(super) struct Order {
 }
 
 impl Order {
+    #[inline]
     pub(super) fn next(&mut self, line: u64, t: u64) {
         match self.last {
             None => self.first = Some((t, line)),
@@ -169,6 +170,19 @@ pub(super) fn row_of<'f>(
 pub(super) struct BadRow(pub(super) String);
 
 impl Chunk<'_> {
+    /// Puts `row` (of line `line`) into the slot, or says there is no room (the caller then
+    /// hands the line to [`Chunk::take`], which reports it).
+    #[inline]
+    pub(super) fn push(&mut self, line: u64, row: &Row) -> bool {
+        if self.got.filled >= self.slot.cap() {
+            return false;
+        }
+        self.slot.set_row(self.got.filled, row.stamp, row);
+        self.got.filled += 1;
+        self.got.order.next(line, row.stamp);
+        true
+    }
+
     pub(super) fn take(&mut self, line: u64, r: Result<Row, BadRow>) {
         match r {
             Ok(row) if self.got.filled < self.slot.cap() => {
@@ -398,14 +412,15 @@ pub(super) fn parse_range<'a>(
     let mut pos = 0;
     let mut line = 0u64;
     while pos < text.len() {
+        if wide {
+            pos = wide::rows(text, pos, lay, &cols, &mut out, &mut line);
+            if pos >= text.len() {
+                break;
+            }
+        }
         line += 1;
         let rest = &text[pos..];
-        let got = if wide {
-            wide::row(text, pos, lay, &cols)
-        } else {
-            None
-        };
-        if let Some((row, took)) = got.or_else(|| fast_row(rest, lay, &cols)) {
+        if let Some((row, took)) = fast_row(rest, lay, &cols) {
             out.take(line, Ok(row));
             pos += took;
             continue;

@@ -2,14 +2,16 @@
 //! nearest f64, ties to even — the value every correct parser (fast-float2, Rust's `parse`)
 //! gives — for the SIMD row reader ([`super::wide`]), which has already found the digits.
 //!
-//! Three cases: an integer (`u64 as f64` rounds correctly); Clinger's fast path, where `w`
-//! and `10^k` are both exact in f64 (`w < 2^53`, `k ≤ 22`), so one IEEE division is the
-//! correctly rounded quotient; else the quotient from a 128-bit reciprocal of `10^k`
-//! (Lemire's method restricted to these exponents). The reciprocal is rounded up by less
-//! than one, so the top 128 bits of the product are the true quotient's floor or one above
-//! it: a true tie shows exactly as one half below the mantissa, and only then (or within a
-//! unit of a tie) is the rounding undecided: [`to_f64`] gives `None` and the caller parses
-//! the text with fast-float2.
+//! Three cases: Clinger's fast path, where `w` and `10^k` are both exact in f64 (`w < 2^53`,
+//! `k ≤ 22`), so one IEEE division is the correctly rounded quotient; an integer (`u64 as
+//! f64` rounds correctly); else the quotient from a 128-bit reciprocal of `10^k` (Lemire's
+//! method restricted to these exponents). The reciprocal is rounded up by less than one, so
+//! the top 128 bits of the product are the true quotient's floor or one above it: a true tie
+//! shows exactly as one half below the mantissa, and only then (or within a unit of a tie)
+//! is the rounding undecided: [`to_f64`] gives `None` and the caller parses the text with
+//! fast-float2. The round bit is as often set as not, so the tie test is one comparison,
+//! not a branch on it (a branch there mispredicted half the time: a third of the reader's
+//! time on EuRoC's 18-digit accelerometer values).
 
 /// The largest fraction length with a reciprocal (10^27 < 2^90 keeps the long division in
 /// u128).
@@ -20,17 +22,6 @@ const EXACT_POW10: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
-
-/// 10^i as integers, i ≤ 19.
-pub(super) const POW10: [u64; 20] = {
-    let mut t = [1u64; 20];
-    let mut i = 1;
-    while i < 20 {
-        t[i] = t[i - 1] * 10;
-        i += 1;
-    }
-    t
-};
 
 /// `(ceil(2^n / 10^k), n)` with `n` chosen so that the first lies in (2^127, 2^128), for
 /// k ≥ 1, by long division one bit at a time (compile time only).
@@ -51,11 +42,13 @@ const fn reciprocal(k: u32) -> (u128, u32) {
     (q + (rem != 0) as u128, n)
 }
 
-const RECIPROCALS: [(u128, u32); MAX_FRACTION_DIGITS + 1] = {
-    let mut t = [(0u128, 0u32); MAX_FRACTION_DIGITS + 1];
+/// The reciprocal of `10^k` as its high and low 64 bits, and its `n`.
+const RECIPROCALS: [(u64, u64, u32); MAX_FRACTION_DIGITS + 1] = {
+    let mut t = [(0u64, 0u64, 0u32); MAX_FRACTION_DIGITS + 1];
     let mut k = 1;
     while k <= MAX_FRACTION_DIGITS {
-        t[k] = reciprocal(k as u32);
+        let (r, n) = reciprocal(k as u32);
+        t[k] = ((r >> 64) as u64, r as u64, n);
         k += 1;
     }
     t
@@ -65,28 +58,31 @@ const RECIPROCALS: [(u128, u32); MAX_FRACTION_DIGITS + 1] = {
 /// (an exact half, or `k` past [`MAX_FRACTION_DIGITS`]).
 #[inline(always)]
 pub(super) fn to_f64(w: u64, k: usize, neg: bool) -> Option<f64> {
-    let v = if w == 0 {
-        0.0
-    } else if k == 0 {
+    let v = if w < (1u64 << 53) && k < EXACT_POW10.len() {
+        // w < 2^53 converts exactly, also through i64 (one instruction, where u64 takes a
+        // branch on its top bit)
+        w as i64 as f64 / EXACT_POW10[k]
+    } else if k == 0 || w == 0 {
         w as f64
-    } else if w < (1u64 << 53) && k < EXACT_POW10.len() {
-        w as f64 / EXACT_POW10[k]
     } else {
-        let &(r, n) = RECIPROCALS.get(k)?;
-        // w normalised to [2^63, 2^64) times r in (2^127, 2^128): the top 128 of its 192
-        // bits, in [2^126, 2^128)
+        let &(r_hi, r_lo, n) = RECIPROCALS.get(k)?;
+        // w normalised to [2^63, 2^64) times r in (2^127, 2^128): the top
+        // 128 of its 192 bits, in [2^126, 2^128)
         let lz = w.leading_zeros();
         let w = u128::from(w << lz);
-        let hi = w * (r >> 64) + ((w * (r as u64 as u128)) >> 64);
-        let shift = 128 - hi.leading_zeros() - 54;
-        let top54 = (hi >> shift) as u64;
-        let below = hi & ((1u128 << (shift + 1)) - 1);
-        let half = 1u128 << shift;
-        if below == half {
+        let p = w * u128::from(r_hi) + ((w * u128::from(r_lo)) >> 64);
+        let (hi, lo) = ((p >> 64) as u64, p as u64);
+        // the 54 bits from the top one (53 and the round bit) end 9 or 10 bits into `hi`
+        let s = 10 - hi.leading_zeros();
+        let top54 = hi >> s;
+        let round = top54 & 1;
+        let rest = (hi & ((1u64 << s) - 1)) | lo;
+        // round bit set and nothing below it: undecided (one comparison, see the module doc)
+        if (rest | (round ^ 1)) == 0 {
             return None;
         }
-        let mut m = (top54 >> 1) + u64::from(below > half);
-        let mut e = shift as i32 + 65 - n as i32 - lz as i32;
+        let mut m = (top54 >> 1) + round;
+        let mut e = (64 + s) as i32 + 65 - n as i32 - lz as i32;
         if m == 1u64 << 53 {
             m >>= 1;
             e += 1;
@@ -94,7 +90,8 @@ pub(super) fn to_f64(w: u64, k: usize, neg: bool) -> Option<f64> {
         // w < 2^64 and k ≤ 27: the value is a normal double, e + 1075 in 1..2047
         f64::from_bits(((e + 52 + 1023) as u64) << 52 | (m & ((1u64 << 52) - 1)))
     };
-    Some(if neg { -v } else { v })
+    // the sign as a bit: `-v` behind a branch on a random sign mispredicts
+    Some(f64::from_bits(v.to_bits() | u64::from(neg) << 63))
 }
 
 #[cfg(test)]
@@ -126,7 +123,7 @@ mod tests {
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             let digits = 1 + (st >> 59) as usize % 19;
-            let w = (st >> 3) % POW10[digits];
+            let w = (st >> 3) % 10u64.pow(digits as u32);
             let k = (st >> 40) as usize % (MAX_FRACTION_DIGITS + 1);
             let neg = st & 1 == 1;
             let text = format!("{}{w}e-{k}", if neg { "-" } else { "" });

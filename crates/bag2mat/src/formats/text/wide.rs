@@ -1,23 +1,27 @@
-//! The text reader's SIMD row scanner (x86-64 with AVX2, found at run time): the ends,
-//! digits and decimal points of a line's first 192 bytes as bit masks, in one pass, its
-//! digits turned into an integer sixteen at a time, and the value rounded by
-//! [`super::decimal`]. It takes only the plainest lines — a single-byte delimiter, every
-//! read field `-?digits[.digits]` with at most 19 digits, an integer time, the line ending
-//! straight after the last read column — and hands every other line to
-//! [`super::body::fast_row`], so it gives what `fast_row` gives, bit for bit, or nothing.
+//! The text reader's SIMD row scanner (x86-64 with AVX2, BMI1/2 and LZCNT, found at run
+//! time). Per field: one 32-byte load at its start classifies its bytes (digits, a point, a
+//! leading minus) and finds its end; a second load that ends where the field ends, with
+//! the bytes before the point moved up over it (one blend), turns its at most 19 digits
+//! into an integer in one multiply-add tree; [`super::decimal`] rounds it. It takes only
+//! the plainest lines — a single-byte delimiter, every read field `-?digits[.digits]` with
+//! at most 19 digits, an integer time, the line ending straight after the last read column
+//! — and hands every other line to [`super::body::fast_row`], so it gives what `fast_row`
+//! gives, bit for bit, or nothing. [`rows`] reads plain lines one after another straight
+//! into the range's slot, so the scanner's constants stay in registers.
 //! Why: issue 20's benchmark (a 4 h EuRoC CSV against pandas), where fast-float2's
 //! byte-at-a-time scan of 17-digit decimals was most of the time.
 
-use super::body::Col;
+use super::body::{Chunk, Col};
 use super::layout::{Delim, Layout};
+#[cfg(test)]
 use crate::rows::Row;
 
-/// Bytes of a line the scanner looks at, in 32-byte steps: its fields must end inside
-/// them, and a line nearer the end of its range is left to `fast_row`.
-const ROW_WINDOW: usize = 192;
-/// Bytes before a field's start a 16-byte digit window may reach back: a range's first row
-/// is left to `fast_row`.
-const READ_BEHIND: usize = 16;
+/// Bytes a field may take with its delimiter: one load holds it, and a line reads at most
+/// this per column from its start.
+const FIELD_WINDOW: usize = 32;
+/// Bytes before a field's end its right-aligned loads reach back (32, and one more for the
+/// bytes before the point): a range's first line is left to `fast_row`.
+const READ_BEHIND: usize = FIELD_WINDOW + 1;
 /// Digits one u64 holds whatever they are (10^19 < 2^64).
 const MAX_DIGITS: u32 = 19;
 
@@ -28,31 +32,33 @@ pub(super) fn usable(lay: &Layout) -> bool {
     };
     // a delimiter that can be part of a number or a quote would need the slow path anyway
     let plain = !(d.is_ascii_digit() || matches!(d, b'.' | b'-' | b'"' | b'\n' | b'\r'));
-    plain && avx2()
+    plain && simd()
 }
 
 #[cfg(target_arch = "x86_64")]
-fn avx2() -> bool {
+fn simd() -> bool {
     std::is_x86_feature_detected!("avx2")
         && std::is_x86_feature_detected!("bmi1")
+        && std::is_x86_feature_detected!("bmi2")
         && std::is_x86_feature_detected!("lzcnt")
 }
 
 #[cfg(not(target_arch = "x86_64"))]
-fn avx2() -> bool {
+fn simd() -> bool {
     false
 }
 
 /// The row of the line at `text[pos..]` and the bytes it took with its line end, or `None`
 /// (the line is for `fast_row`). Only where [`usable`] said so.
+#[cfg(test)]
 pub(super) fn row(text: &[u8], pos: usize, lay: &Layout, cols: &[Col]) -> Option<(Row, usize)> {
     #[cfg(target_arch = "x86_64")]
     {
         let Delim::Byte(d) = lay.delim else {
             return None;
         };
-        debug_assert!(avx2());
-        // SAFETY: `usable` found AVX2, BMI1 and LZCNT on this CPU
+        debug_assert!(simd());
+        // SAFETY: `usable` found the instructions on this CPU
         unsafe { x86::row(text, pos, lay, cols, d) }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -62,87 +68,154 @@ pub(super) fn row(text: &[u8], pos: usize, lay: &Layout, cols: &[Col]) -> Option
     }
 }
 
+/// Reads the lines from `text[pos..]` on while the scanner takes them, each into `out` as
+/// line `*line + 1` (counted on), and returns where it stopped: the start of the first line
+/// it leaves to `fast_row`, or the end of `text`. Only where [`usable`] said so.
+pub(super) fn rows(
+    text: &[u8],
+    pos: usize,
+    lay: &Layout,
+    cols: &[Col],
+    out: &mut Chunk,
+    line: &mut u64,
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let Delim::Byte(d) = lay.delim else {
+            return pos;
+        };
+        debug_assert!(simd());
+        // SAFETY: `usable` found the instructions on this CPU
+        unsafe { x86::rows(text, pos, lay, cols, d, out, line) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (text, lay, cols, out, line);
+        pos
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::*;
 
-    use super::super::body::Col;
-    use super::super::decimal::{POW10, to_f64};
+    use super::super::body::{Chunk, Col};
+    use super::super::decimal::to_f64;
     use super::super::layout::Layout;
-    use super::{MAX_DIGITS, READ_BEHIND, ROW_WINDOW};
+    use super::{FIELD_WINDOW, MAX_DIGITS, READ_BEHIND};
     use crate::rows::Row;
 
-    /// The value of the `n ≤ 16` digits that end just before `end`.
-    ///
-    /// # Safety
-    /// The 16 bytes before `end` are readable; the `n` before it are ASCII digits.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    unsafe fn digits16(end: *const u8, n: u32) -> u64 {
-        // SAFETY: the caller's contract
-        let x = unsafe { _mm_loadu_si128(end.sub(16).cast()) };
-        let v = _mm_sub_epi8(x, _mm_set1_epi8(b'0' as i8));
-        let lane = _mm_setr_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-        // keep the last n lanes: the bytes before the digits count as leading zeros
-        let v = _mm_and_si128(v, _mm_cmpgt_epi8(lane, _mm_set1_epi8(15 - n as i8)));
-        let pairs = _mm_maddubs_epi16(
-            v,
-            _mm_setr_epi8(10, 1, 10, 1, 10, 1, 10, 1, 10, 1, 10, 1, 10, 1, 10, 1),
-        );
-        let fours = _mm_madd_epi16(pairs, _mm_setr_epi16(100, 1, 100, 1, 100, 1, 100, 1));
-        let fours = _mm_packus_epi32(fours, fours);
-        let eights = _mm_madd_epi16(
-            fours,
-            _mm_setr_epi16(10000, 1, 10000, 1, 10000, 1, 10000, 1),
-        );
-        let hi = _mm_cvtsi128_si32(eights) as u32 as u64;
-        let lo = _mm_extract_epi32::<1>(eights) as u32 as u64;
-        hi * 100_000_000 + lo
-    }
-
-    /// The value of the `n ≤ 19` digits that end just before `end`.
-    ///
-    /// # Safety
-    /// As [`digits16`], and the `n` bytes before `end` are readable.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    unsafe fn digits(end: *const u8, n: u32) -> u64 {
-        // SAFETY: the caller's contract
-        unsafe {
-            if n <= 16 {
-                return digits16(end, n);
-            }
-            let mut high = 0u64;
-            for j in (17..=n as usize).rev() {
-                high = high * 10 + u64::from(*end.sub(j) - b'0');
-            }
-            high * POW10[16] + digits16(end, 16)
+    /// 32 zero bytes, then 32 of all ones: the 32 bytes from `TAIL[q]` keep the last `q`
+    /// lanes of a vector.
+    static TAIL: [u8; 64] = {
+        let mut t = [0u8; 64];
+        let mut i = 32;
+        while i < 64 {
+            t[i] = 0xff;
+            i += 1;
         }
+        t
+    };
+
+    /// A number field: its digits as an integer, the count of digits after its point, and
+    /// the rest of what the row needs of it.
+    struct Number {
+        w: u64,
+        frac: u32,
+        neg: bool,
+        point: bool,
+        /// Its bytes: the delimiter or line end follows.
+        len: usize,
     }
 
-    /// The masks of a row's first [`ROW_WINDOW`] bytes, bit i for byte i (one spare word
-    /// of zeros so that 64 bits can be read from any position in the window).
-    struct Masks {
-        ends: [u64; 4],
-        digits: [u64; 4],
-        dots: [u64; 4],
-        quotes: [u64; 4],
+    /// The last `q ≤ 32` lanes of an all-ones vector.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn tail(q: u32) -> __m256i {
+        // SAFETY: q ≤ 32, so the 32 bytes from TAIL[q] are in TAIL
+        unsafe { _mm256_loadu_si256(TAIL.as_ptr().add(q as usize).cast()) }
     }
 
-    /// The 64 bits of `m` from bit `s` (< ROW_WINDOW) on.
-    #[inline(always)]
-    fn bits(m: &[u64; 4], s: usize) -> u64 {
-        let w = s >> 6;
-        let pair = u128::from(m[w + 1]) << 64 | u128::from(m[w]);
-        (pair >> (s & 63)) as u64
+    /// The number that starts at `at`, or `None` (not `-?digits[.digits]` of at most
+    /// [`MAX_DIGITS`] digits followed by a byte that is none of them).
+    ///
+    /// # Safety
+    /// The 32 bytes from `at` and the [`READ_BEHIND`] bytes before it are readable.
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+    #[inline]
+    unsafe fn number(at: *const u8) -> Option<Number> {
+        let zero = _mm256_set1_epi8(b'0' as i8);
+        // SAFETY: the caller's contract
+        let x = unsafe { _mm256_loadu_si256(at.cast()) };
+        let y = _mm256_sub_epi8(x, zero);
+        let digit = _mm256_cmpeq_epi8(_mm256_min_epu8(y, _mm256_set1_epi8(9)), y);
+        let dot = _mm256_cmpeq_epi8(x, _mm256_set1_epi8(b'.' as i8));
+        // SAFETY: the caller's contract
+        let neg = u32::from(unsafe { *at } == b'-');
+        let num = _mm256_movemask_epi8(_mm256_or_si256(digit, dot)) as u32 | neg;
+        // the field's length: its first byte that is no digit, point or leading minus
+        let len = (!num).trailing_zeros();
+        let points = _bzhi_u32(_mm256_movemask_epi8(dot) as u32, len);
+        if points & points.wrapping_sub(1) != 0 {
+            return None;
+        }
+        let point = u32::from(points != 0);
+        // the sign and the point are lanes of their own, so this does not wrap; at most
+        // MAX_DIGITS digits also bounds len below 32
+        let digits = len - neg - point;
+        if digits.wrapping_sub(1) >= MAX_DIGITS {
+            return None;
+        }
+        let frac = if point == 1 {
+            len - 1 - points.trailing_zeros()
+        } else {
+            0
+        };
+        // SAFETY: the field ends inside the 32 bytes from `at`, and the 33 bytes before its
+        // end start at or after `at - READ_BEHIND`
+        let (x1, x2) = unsafe {
+            let end = at.add(len as usize);
+            (
+                _mm256_loadu_si256(end.sub(32).cast()),
+                _mm256_loadu_si256(end.sub(33).cast()),
+            )
+        };
+        // the field's digits right-aligned: the bytes after the point as they are, those
+        // before it one lane up (over the point), the rest zero
+        let after = tail(if point == 1 { frac } else { 32 });
+        let r = _mm256_sub_epi8(_mm256_blendv_epi8(x2, x1, after), zero);
+        let r = _mm256_and_si256(r, tail(digits));
+        Some(Number {
+            w: value(r),
+            frac,
+            neg: neg == 1,
+            point: point == 1,
+            len: len as usize,
+        })
+    }
+
+    /// The integer of 32 lanes of digit values (0–9), of which only the last 19 may be
+    /// non-zero.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn value(r: __m256i) -> u64 {
+        // pairs, then fours, then eights of digits: lanes 8–15, 16–23, 24–31
+        let twos = _mm256_maddubs_epi16(r, _mm256_set1_epi16(0x010a));
+        let fours = _mm256_madd_epi16(twos, _mm256_set1_epi32(0x0001_0064));
+        let fours = _mm256_packus_epi32(fours, fours);
+        let eights = _mm256_madd_epi16(fours, _mm256_set1_epi32(0x0001_2710));
+        let high = _mm256_extract_epi32::<1>(eights) as u32 as u64;
+        let low = _mm_cvtsi128_si64(_mm256_extracti128_si256::<1>(eights)) as u64;
+        (high * 100_000_000 + (low & 0xffff_ffff)) * 100_000_000 + (low >> 32)
     }
 
     /// See [`super::row`].
     ///
     /// # Safety
-    /// The CPU has AVX2, BMI1 and LZCNT.
-    // One body, like fast_row: the masks, the position and the row stay in registers.
-    #[target_feature(enable = "avx2,bmi1,lzcnt")]
+    /// The CPU has AVX2, BMI1, BMI2 and LZCNT.
+    // One body, like fast_row: the position and the row stay in registers.
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+    #[inline]
     pub(super) unsafe fn row(
         text: &[u8],
         pos: usize,
@@ -150,101 +223,59 @@ mod x86 {
         cols: &[Col],
         d: u8,
     ) -> Option<(Row, usize)> {
-        if pos < READ_BEHIND || pos + ROW_WINDOW + 1 > text.len() {
+        // every field starts within FIELD_WINDOW bytes of the one before
+        if pos < READ_BEHIND || pos + FIELD_WINDOW * cols.len() + 2 > text.len() {
             return None;
-        }
-        let mut m = Masks {
-            ends: [0; 4],
-            digits: [0; 4],
-            dots: [0; 4],
-            quotes: [0; 4],
-        };
-        // the whole window at once: its masks do not wait on the fields before
-        for j in 0..ROW_WINDOW / 32 {
-            // SAFETY: pos + ROW_WINDOW ≤ text.len()
-            let x = unsafe { _mm256_loadu_si256(text.as_ptr().add(pos + 32 * j).cast()) };
-            let is = |c: u8| _mm256_cmpeq_epi8(x, _mm256_set1_epi8(c as i8));
-            let ends = _mm256_or_si256(_mm256_or_si256(is(d), is(b'\n')), is(b'\r'));
-            let y = _mm256_sub_epi8(x, _mm256_set1_epi8(b'0' as i8));
-            let digit = _mm256_cmpeq_epi8(_mm256_min_epu8(y, _mm256_set1_epi8(9)), y);
-            let half = 32 * (j & 1);
-            let put = |v: __m256i| u64::from(_mm256_movemask_epi8(v) as u32) << half;
-            m.ends[j >> 1] |= put(ends);
-            m.digits[j >> 1] |= put(digit);
-            m.dots[j >> 1] |= put(is(b'.'));
-            m.quotes[j >> 1] |= put(is(b'"'));
         }
         let mut row = Row {
             stamp: 0,
             acc: [f64::NAN; 3],
             gyro: [f64::NAN; 3],
         };
-        // s: the field's start in the window
-        let mut s = 0;
+        let mut a = pos;
         for (k, col) in cols.iter().enumerate() {
-            if s >= ROW_WINDOW {
-                return None;
-            }
-            let ends = bits(&m.ends, s);
-            // the field is the window's s..s + e; a field of 32 bytes or more is fast_row's
-            let e = ends.trailing_zeros();
-            if e >= 32 {
-                return None;
-            }
-            let field = (1u64 << e) - 1;
-            if let Col::Skip = col {
-                if bits(&m.quotes, s) & field != 0 {
-                    return None;
-                }
-            } else {
-                // SAFETY: in the window
-                let at = unsafe { text.as_ptr().add(pos + s) };
-                let neg = u32::from(unsafe { *at } == b'-');
-                let body = field & !((1u64 << neg) - 1);
-                let dots = bits(&m.dots, s) & body;
-                if (bits(&m.digits, s) | dots) & body != body || dots & dots.wrapping_sub(1) != 0 {
-                    return None;
-                }
-                let point = if dots == 0 { e } else { dots.trailing_zeros() };
-                let int_len = point - neg;
-                let frac_len = if dots == 0 { 0 } else { e - point - 1 };
-                if int_len + frac_len == 0 || int_len + frac_len > MAX_DIGITS {
-                    return None;
-                }
-                // SAFETY: every digit run ends in the window, and pos ≥ READ_BEHIND: the 16
-                // bytes before either end are in `text`; the runs are digits (checked)
-                let w = unsafe {
-                    let end = at.add(e as usize);
-                    if dots == 0 {
-                        digits(end, int_len)
-                    } else {
-                        let int = match int_len {
-                            0 => 0,
-                            1 => u64::from(*at.add(point as usize - 1) - b'0'),
-                            n => digits(at.add(point as usize), n),
-                        };
-                        int * POW10[frac_len as usize] + digits(end, frac_len)
+            // SAFETY: a < pos + FIELD_WINDOW · k (each field took less than FIELD_WINDOW
+            // bytes), so the 32 bytes from it are in `text`; a ≥ pos ≥ READ_BEHIND
+            let at = unsafe { text.as_ptr().add(a) };
+            let len = match col {
+                Col::Skip => {
+                    // SAFETY: as above
+                    let x = unsafe { _mm256_loadu_si256(at.cast()) };
+                    let is = |c: u8| _mm256_cmpeq_epi8(x, _mm256_set1_epi8(c as i8));
+                    let ends = _mm256_or_si256(_mm256_or_si256(is(d), is(b'\n')), is(b'\r'));
+                    let len = (_mm256_movemask_epi8(ends) as u32).trailing_zeros();
+                    // a field of 32 bytes or more is fast_row's, and so is a quote
+                    if len >= 32 || _bzhi_u32(_mm256_movemask_epi8(is(b'"')) as u32, len) != 0 {
+                        return None;
                     }
-                };
-                match col {
-                    Col::Time if neg == 0 && dots == 0 => {
-                        row.stamp = w.checked_mul(lay.time_unit.nanos())?;
-                    }
-                    Col::Gyro(a) => {
-                        row.gyro[*a] = to_f64(w, frac_len as usize, neg == 1)? * lay.gyro_si
-                    }
-                    Col::Acc(a) => {
-                        row.acc[*a] = to_f64(w, frac_len as usize, neg == 1)? * lay.acc_si
-                    }
-                    _ => return None,
+                    len as usize
                 }
-            }
-            let end = pos + s + e as usize;
+                // SAFETY (each arm): as above
+                Col::Time => {
+                    let n = unsafe { number(at) }?;
+                    if n.neg || n.point {
+                        return None;
+                    }
+                    row.stamp = n.w.checked_mul(lay.time_unit.nanos())?;
+                    n.len
+                }
+                Col::Gyro(i) => {
+                    let n = unsafe { number(at) }?;
+                    row.gyro[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.gyro_si;
+                    n.len
+                }
+                Col::Acc(i) => {
+                    let n = unsafe { number(at) }?;
+                    row.acc[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.acc_si;
+                    n.len
+                }
+            };
+            let end = a + len;
             if k + 1 < cols.len() {
                 if text[end] != d {
                     return None;
                 }
-                s += e as usize + 1;
+                a = end + 1;
             } else {
                 // the line ends straight after the last column read, or fast_row reads it
                 return match (text[end], text[end + 1]) {
@@ -256,12 +287,40 @@ mod x86 {
         }
         None
     }
+
+    /// See [`super::rows`].
+    ///
+    /// # Safety
+    /// As [`row`].
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+    pub(super) unsafe fn rows(
+        text: &[u8],
+        mut pos: usize,
+        lay: &Layout,
+        cols: &[Col],
+        d: u8,
+        out: &mut Chunk,
+        line: &mut u64,
+    ) -> usize {
+        // SAFETY: the caller's contract
+        while let Some((r, took)) = unsafe { row(text, pos, lay, cols, d) } {
+            if !out.push(*line + 1, &r) {
+                break;
+            }
+            *line += 1;
+            pos += took;
+        }
+        pos
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::body::{columns, fast_row};
     use super::*;
+
+    /// Line ends after the test lines: room for the scanner's reads past a line's start.
+    const PAD: usize = 16 * FIELD_WINDOW;
 
     /// A layout of the given columns, delimiter and scale.
     fn layout(d: u8, time: Option<usize>, gyro: [usize; 3], acc: [usize; 3]) -> Layout {
@@ -299,7 +358,7 @@ mod tests {
     #[test]
     fn the_wide_scanner_reads_what_fast_row_reads() {
         const LINES: usize = 60_000;
-        if !avx2() {
+        if !simd() {
             eprintln!("no AVX2 here: the scanner is off and fast_row reads every line");
             return;
         }
@@ -332,10 +391,10 @@ mod tests {
                 text += &line.join(&d.to_string());
                 text += if i % 7 == 0 { "\r\n" } else { "\n" };
             }
-            text += &"\n".repeat(ROW_WINDOW);
+            text += &"\n".repeat(PAD);
             let b = text.as_bytes();
             let (mut pos, mut took_wide, mut lines) = (40, 0, 0);
-            while pos + ROW_WINDOW < b.len() {
+            while pos + PAD < b.len() {
                 let slow = fast_row(&b[pos..], lay, &cols);
                 let wide = row(b, pos, lay, &cols);
                 if let Some((r, n)) = wide {
@@ -360,7 +419,7 @@ mod tests {
     /// A EuRoC line, the benchmark's: taken by the scanner (not left to fast_row).
     #[test]
     fn the_wide_scanner_takes_euroc_lines() {
-        if !avx2() {
+        if !simd() {
             return;
         }
         let lay = layout(b',', Some(0), [1, 2, 3], [4, 5, 6]);
@@ -369,8 +428,8 @@ mod tests {
             "-0.00032156565656565,0.01234567890123456,-0.01999999999999999,",
             "9.81234567890123457\n"
         );
-        let text = format!("{}{line}{}", "#".repeat(16), "\n".repeat(ROW_WINDOW));
-        let (r, n) = row(text.as_bytes(), 16, &lay, &columns(&lay)).expect("taken");
+        let text = format!("{}{line}{}", "#".repeat(READ_BEHIND), "\n".repeat(PAD));
+        let (r, n) = row(text.as_bytes(), READ_BEHIND, &lay, &columns(&lay)).expect("taken");
         assert_eq!(n, line.len());
         assert_eq!(r.stamp, 1_403_636_579_758_555_392);
         assert_eq!(r.acc[2], "9.81234567890123457".parse::<f64>().unwrap());
