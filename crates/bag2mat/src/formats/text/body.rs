@@ -170,19 +170,6 @@ pub(super) fn row_of<'f>(
 pub(super) struct BadRow(pub(super) String);
 
 impl Chunk<'_> {
-    /// Puts `row` (of line `line`) into the slot, or says there is no room (the caller then
-    /// hands the line to [`Chunk::take`], which reports it).
-    #[inline]
-    pub(super) fn push(&mut self, line: u64, row: &Row) -> bool {
-        if self.got.filled >= self.slot.cap() {
-            return false;
-        }
-        self.slot.set_row(self.got.filled, row.stamp, row);
-        self.got.filled += 1;
-        self.got.order.next(line, row.stamp);
-        true
-    }
-
     pub(super) fn take(&mut self, line: u64, r: Result<Row, BadRow>) {
         match r {
             Ok(row) if self.got.filled < self.slot.cap() => {
@@ -407,8 +394,18 @@ pub(super) fn parse_range<'a>(
         out.got.lines = parse_csv(text, lay, 1, &mut out);
         return out;
     }
+    parse_lines(text, lay, wide::usable(lay), out)
+}
+
+/// [`parse_range`] of an unquoted range: runs of lines by the SIMD scanner where `wide`,
+/// each other line by [`fast_row`], else by the csv crate.
+pub(super) fn parse_lines<'a>(
+    text: &[u8],
+    lay: &Layout,
+    wide: bool,
+    mut out: Chunk<'a>,
+) -> Chunk<'a> {
     let cols = columns(lay);
-    let wide = wide::usable(lay);
     let mut pos = 0;
     let mut line = 0u64;
     while pos < text.len() {

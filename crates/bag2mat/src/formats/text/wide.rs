@@ -103,7 +103,9 @@ mod x86 {
     use super::super::decimal::to_f64;
     use super::super::layout::Layout;
     use super::{FIELD_WINDOW, MAX_DIGITS, READ_BEHIND};
+    #[cfg(test)]
     use crate::rows::Row;
+    use crate::time::RosTime;
 
     /// 32 zero bytes, then 32 of all ones: the 32 bytes from `TAIL[q]` keep the last `q`
     /// lanes of a vector.
@@ -209,29 +211,29 @@ mod x86 {
         (high * 100_000_000 + (low & 0xffff_ffff)) * 100_000_000 + (low >> 32)
     }
 
-    /// See [`super::row`].
+    /// The line at `text[pos..]`: each value read goes to `put(column, value)` (acc x y z
+    /// are columns 0–2, gyro x y z 3–5, in SI units) as it is read; its stamp and the bytes
+    /// it took with its line end, or `None` (the line is for `fast_row`; what `put` got of
+    /// it is to be dropped).
     ///
     /// # Safety
     /// The CPU has AVX2, BMI1, BMI2 and LZCNT.
-    // One body, like fast_row: the position and the row stay in registers.
+    // One body, like fast_row: the position and the values stay in registers.
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     #[inline]
-    pub(super) unsafe fn row(
+    unsafe fn line(
         text: &[u8],
         pos: usize,
         lay: &Layout,
         cols: &[Col],
         d: u8,
-    ) -> Option<(Row, usize)> {
+        mut put: impl FnMut(usize, f64),
+    ) -> Option<(u64, usize)> {
         // every field starts within FIELD_WINDOW bytes of the one before
         if pos < READ_BEHIND || pos + FIELD_WINDOW * cols.len() + 2 > text.len() {
             return None;
         }
-        let mut row = Row {
-            stamp: 0,
-            acc: [f64::NAN; 3],
-            gyro: [f64::NAN; 3],
-        };
+        let mut stamp = 0;
         let mut a = pos;
         for (k, col) in cols.iter().enumerate() {
             // SAFETY: a < pos + FIELD_WINDOW · k (each field took less than FIELD_WINDOW
@@ -256,17 +258,17 @@ mod x86 {
                     if n.neg || n.point {
                         return None;
                     }
-                    row.stamp = n.w.checked_mul(lay.time_unit.nanos())?;
+                    stamp = n.w.checked_mul(lay.time_unit.nanos())?;
                     n.len
                 }
                 Col::Gyro(i) => {
                     let n = unsafe { number(at) }?;
-                    row.gyro[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.gyro_si;
+                    put(3 + i, to_f64(n.w, n.frac as usize, n.neg)? * lay.gyro_si);
                     n.len
                 }
                 Col::Acc(i) => {
                     let n = unsafe { number(at) }?;
-                    row.acc[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.acc_si;
+                    put(*i, to_f64(n.w, n.frac as usize, n.neg)? * lay.acc_si);
                     n.len
                 }
             };
@@ -279,8 +281,8 @@ mod x86 {
             } else {
                 // the line ends straight after the last column read, or fast_row reads it
                 return match (text[end], text[end + 1]) {
-                    (b'\n', _) => Some((row, end + 1 - pos)),
-                    (b'\r', b'\n') => Some((row, end + 2 - pos)),
+                    (b'\n', _) => Some((stamp, end + 1 - pos)),
+                    (b'\r', b'\n') => Some((stamp, end + 2 - pos)),
                     _ => None,
                 };
             }
@@ -288,10 +290,34 @@ mod x86 {
         None
     }
 
-    /// See [`super::rows`].
+    /// See [`super::row`].
     ///
     /// # Safety
-    /// As [`row`].
+    /// As [`line`].
+    #[cfg(test)]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+    pub(super) unsafe fn row(
+        text: &[u8],
+        pos: usize,
+        lay: &Layout,
+        cols: &[Col],
+        d: u8,
+    ) -> Option<(Row, usize)> {
+        let mut v = [f64::NAN; 6];
+        // SAFETY: the caller's contract
+        let (stamp, took) = unsafe { line(text, pos, lay, cols, d, |c, x| v[c] = x) }?;
+        let row = Row {
+            stamp,
+            acc: [v[0], v[1], v[2]],
+            gyro: [v[3], v[4], v[5]],
+        };
+        Some((row, took))
+    }
+
+    /// See [`super::rows`]: each value goes straight into its column of the slot.
+    ///
+    /// # Safety
+    /// As [`line`].
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     pub(super) unsafe fn rows(
         text: &[u8],
@@ -300,14 +326,28 @@ mod x86 {
         cols: &[Col],
         d: u8,
         out: &mut Chunk,
-        line: &mut u64,
+        line_no: &mut u64,
     ) -> usize {
-        // SAFETY: the caller's contract
-        while let Some((r, took)) = unsafe { row(text, pos, lay, cols, d) } {
-            if !out.push(*line + 1, &r) {
+        let got = &mut out.got;
+        let slot = &mut out.slot;
+        while got.filled < slot.cap() {
+            let i = got.filled;
+            let mut v = [f64::NAN; 6];
+            // SAFETY: the caller's contract
+            let Some((stamp, took)) = (unsafe { line(text, pos, lay, cols, d, |c, x| v[c] = x) })
+            else {
                 break;
+            };
+            for c in 0..3 {
+                slot.acc[c][i] = v[c];
+                slot.gyro[c][i] = v[3 + c];
             }
-            *line += 1;
+            let t = RosTime::from_nanos(stamp);
+            slot.record_time[i] = t;
+            slot.stamp[i] = t;
+            got.filled += 1;
+            *line_no += 1;
+            got.order.next(*line_no, stamp);
             pos += took;
         }
         pos
@@ -316,8 +356,9 @@ mod x86 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::body::{columns, fast_row};
+    use super::super::body::{columns, fast_row, parse_lines, room};
     use super::*;
+    use crate::rows::Rows;
 
     /// Line ends after the test lines: room for the scanner's reads past a line's start.
     const PAD: usize = 16 * FIELD_WINDOW;
@@ -327,25 +368,26 @@ mod tests {
         Layout::for_test(Delim::Byte(d), time, (gyro, acc), (0.5, 1.0))
     }
 
-    /// A seeded field: mostly plain decimals of every length, sometimes a form the scanner
-    /// must leave to fast_row (exponent, blank, sign, too many digits, text, empty).
-    fn field(st: &mut u64) -> String {
+    /// A seeded field: a plain decimal of any length where `plain`, else mostly one and
+    /// sometimes a form the scanner must leave to fast_row (exponent, blank, sign, too many
+    /// digits, text, empty).
+    fn field(st: &mut u64, plain: bool) -> String {
         *st = st
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         let r = *st >> 33;
-        let digits: String = (0..1 + r % 22)
+        let digits: String = (0..1 + r % if plain { 19 } else { 22 })
             .map(|i| char::from(b'0' + ((r >> (i % 20)) as u8 ^ i as u8) % 10))
             .collect();
         let cut = (r >> 7) as usize % (digits.len() + 1);
         let (int, frac) = digits.split_at(cut);
         let sign = if r & 1 == 1 { "-" } else { "" };
         match (r >> 12) % 16 {
-            0 => format!("{sign}{int}e-{}", r % 30),
-            1 => format!(" {sign}{int}.{frac}"),
-            2 => format!("+{int}.{frac}"),
-            3 => "nan".into(),
-            4 => String::new(),
+            0 if !plain => format!("{sign}{int}e-{}", r % 30),
+            1 if !plain => format!(" {sign}{int}.{frac}"),
+            2 if !plain => format!("+{int}.{frac}"),
+            3 if !plain => "nan".into(),
+            4 if !plain => String::new(),
             5 => format!("{sign}{int}"),
             6 => format!("{sign}.{frac}"),
             7 => format!("{sign}{int}."),
@@ -353,8 +395,50 @@ mod tests {
         }
     }
 
+    /// `n` seeded lines of `lay`'s columns after a 40-byte preamble, then room for the
+    /// scanner's reads: every `odd`-th line of any fields (with now and then an extra
+    /// column, a fractional time, a quote or a CRLF end), the others of plain fields.
+    fn lines_text(lay: &Layout, st: &mut u64, n: usize, odd: usize) -> String {
+        let cols = columns(lay);
+        let mut text = "h\n".repeat(20);
+        let d = match lay.delim {
+            Delim::Byte(d) => char::from(d).to_string(),
+            Delim::Whitespace(_) => unreachable!(),
+        };
+        for i in 0..n {
+            let plain = i % odd != 0;
+            let extra = !plain && i % 17 == 0;
+            let mut line: Vec<String> = (0..cols.len() + usize::from(extra))
+                .map(|_| field(st, plain))
+                .collect();
+            if let Some(t) = lay.time {
+                line[t] = if !plain && i % 13 == 0 {
+                    format!("{i}.5")
+                } else {
+                    format!("{}", 1_403_636_579_758_555_392 + i as u64 * 5_000_000)
+                };
+            }
+            if !plain && i % 19 == 0 {
+                line[0] = "\"q\"".into();
+            }
+            text += &line.join(&d);
+            text += if i % 7 == 0 { "\r\n" } else { "\n" };
+        }
+        text + &"\n".repeat(PAD)
+    }
+
+    /// The layouts the tests read: time first, columns shuffled with one skipped, no time.
+    fn layouts() -> [Layout; 3] {
+        [
+            layout(b',', Some(0), [1, 2, 3], [4, 5, 6]),
+            layout(b';', Some(1), [4, 5, 6], [2, 7, 3]),
+            layout(b'\t', None, [0, 1, 2], [3, 4, 5]),
+        ]
+    }
+
     /// The scanner gives what fast_row gives on every line it takes, bit for bit, and takes
-    /// the plain ones (checked only where AVX2 is found: elsewhere it is never used).
+    /// the plain ones (checked only where the instructions are found: elsewhere it is never
+    /// used).
     #[test]
     fn the_wide_scanner_reads_what_fast_row_reads() {
         const LINES: usize = 60_000;
@@ -363,35 +447,9 @@ mod tests {
             return;
         }
         let mut st = 0x5EED_2026_u64;
-        let lays = [
-            layout(b',', Some(0), [1, 2, 3], [4, 5, 6]),
-            layout(b';', Some(1), [4, 5, 6], [2, 7, 3]),
-            layout(b'\t', None, [0, 1, 2], [3, 4, 5]),
-        ];
-        for lay in &lays {
+        for lay in &layouts() {
             let cols = columns(lay);
-            let mut text = "h\n".repeat(20);
-            let d = char::from(match lay.delim {
-                Delim::Byte(d) => d,
-                Delim::Whitespace(_) => unreachable!(),
-            });
-            for i in 0..LINES {
-                let n = cols.len() + usize::from(i % 17 == 0);
-                let mut line: Vec<String> = (0..n).map(|_| field(&mut st)).collect();
-                if let Some(t) = lay.time {
-                    line[t] = if i % 13 == 0 {
-                        format!("{i}.5")
-                    } else {
-                        format!("{}", 1_403_636_579_758_555_392 + i as u64 * 5_000_000)
-                    };
-                }
-                if i % 19 == 0 {
-                    line[0] = "\"q\"".into();
-                }
-                text += &line.join(&d.to_string());
-                text += if i % 7 == 0 { "\r\n" } else { "\n" };
-            }
-            text += &"\n".repeat(PAD);
+            let text = lines_text(lay, &mut st, LINES, 1);
             let b = text.as_bytes();
             let (mut pos, mut took_wide, mut lines) = (40, 0, 0);
             while pos + PAD < b.len() {
@@ -413,6 +471,66 @@ mod tests {
             assert!(lines >= LINES, "{lines}");
             // a line is plain when each of its read fields is (about 5 in 8 each)
             assert!(took_wide > 0, "no line taken by the scanner");
+        }
+    }
+
+    /// Runs of plain lines read straight into the slot ([`rows`]) between odd lines left to
+    /// fast_row and the csv crate fill the range as reading line by line without the
+    /// scanner does: the same rows bit for bit, line count, malformed lines and stamp order.
+    #[test]
+    fn runs_of_lines_fill_the_slot_as_reading_line_by_line_does() {
+        const LINES: usize = 40_000;
+        if !simd() {
+            return;
+        }
+        let mut st = 0x2026_1207_u64;
+        for lay in &layouts() {
+            for odd in [2, 9, 500] {
+                let text = lines_text(lay, &mut st, LINES, odd);
+                let n = room(text.as_bytes());
+                let (mut wide_rows, mut line_rows) = (Rows::zeroed(n), Rows::zeroed(n));
+                let read = |rows: &mut Rows, wide: bool| {
+                    let out = Chunk {
+                        slot: rows.split(&[n]).remove(0),
+                        ..Chunk::default()
+                    };
+                    parse_lines(text.as_bytes(), lay, wide, out).got
+                };
+                let (w, l) = (read(&mut wide_rows, true), read(&mut line_rows, false));
+                assert!(w.filled > LINES / 2, "{} rows", w.filled);
+                assert_eq!(
+                    (w.filled, w.lines, w.bad, &w.first_bad, w.quoted),
+                    (l.filled, l.lines, l.bad, &l.first_bad, l.quoted)
+                );
+                let (wo, lo) = (w.order, l.order);
+                assert_eq!(
+                    (
+                        wo.first,
+                        wo.last,
+                        wo.back,
+                        wo.first_back,
+                        wo.dup,
+                        wo.first_dup
+                    ),
+                    (
+                        lo.first,
+                        lo.last,
+                        lo.back,
+                        lo.first_back,
+                        lo.dup,
+                        lo.first_dup
+                    )
+                );
+                for i in 0..w.filled {
+                    let (a, b) = (wide_rows.row(i), line_rows.row(i));
+                    assert_eq!(a.stamp, b.stamp, "row {i}");
+                    for c in 0..3 {
+                        assert_eq!(a.acc[c].to_bits(), b.acc[c].to_bits(), "row {i}");
+                        assert_eq!(a.gyro[c].to_bits(), b.gyro[c].to_bits(), "row {i}");
+                    }
+                    assert_eq!(wide_rows.record_time[i], line_rows.record_time[i]);
+                }
+            }
         }
     }
 
