@@ -1,13 +1,15 @@
 //! The text reader's SIMD row scanner (x86-64 with AVX2, BMI1/2 and LZCNT, found at run
 //! time). Per field: one 32-byte load at its start classifies its bytes (digits, a point, a
-//! leading minus) and finds its end; a second load that ends where the field ends, with
-//! the bytes before the point moved up over it (one blend), turns its at most 19 digits
-//! into an integer in one multiply-add tree; [`super::decimal`] rounds it. It takes only
+//! leading minus) and finds its end; the 32 bytes that end where the field ends, with the
+//! bytes before the point moved up over it (a blend with the load one byte earlier), turn
+//! its at most 19 digits into an integer in one multiply-add tree; [`super::decimal`]
+//! rounds it. It takes only
 //! the plainest lines — a single-byte delimiter, every read field `-?digits[.digits]` with
 //! at most 19 digits, an integer time, the line ending straight after the last read column
 //! — and hands every other line to [`super::body::fast_row`], so it gives what `fast_row`
-//! gives, bit for bit, or nothing. [`rows`] reads plain lines one after another straight
-//! into the range's slot, so the scanner's constants stay in registers.
+//! gives, bit for bit, or nothing. [`rows`] reads plain lines one after another, each
+//! value straight into its column of the range's slot (no call and no row copied per
+//! line).
 //! Why: issue 20's benchmark (a 4 h EuRoC CSV against pandas), where fast-float2's
 //! byte-at-a-time scan of 17-digit decimals was most of the time.
 
@@ -103,9 +105,7 @@ mod x86 {
     use super::super::decimal::to_f64;
     use super::super::layout::Layout;
     use super::{FIELD_WINDOW, MAX_DIGITS, READ_BEHIND};
-    #[cfg(test)]
     use crate::rows::Row;
-    use crate::time::RosTime;
 
     /// 32 zero bytes, then 32 of all ones: the 32 bytes from `TAIL[q]` keep the last `q`
     /// lanes of a vector.
@@ -338,13 +338,12 @@ mod x86 {
             else {
                 break;
             };
-            for c in 0..3 {
-                slot.acc[c][i] = v[c];
-                slot.gyro[c][i] = v[3 + c];
-            }
-            let t = RosTime::from_nanos(stamp);
-            slot.record_time[i] = t;
-            slot.stamp[i] = t;
+            let row = Row {
+                stamp,
+                acc: [v[0], v[1], v[2]],
+                gyro: [v[3], v[4], v[5]],
+            };
+            slot.set_row(i, stamp, &row);
             got.filled += 1;
             *line_no += 1;
             got.order.next(*line_no, stamp);
