@@ -2,7 +2,9 @@
 # Issue 20's reading benchmarks (never run by the tests). Usage: scripts/bench_logs.sh [WORKDIR]
 #   * a 4 h, 200 Hz EuRoC/ASL data.csv (2,880,000 rows, ~410 MB) read through bag2mat's read
 #     path (examples/read_log) vs pandas.read_csv (C engine; timed inside Python, without the
-#     interpreter's start) and `wc -l` (targets: >= 3x faster than pandas, within 5x of wc -l);
+#     interpreter's start; pandas 3.1 uses both cores here, as bag2mat does: its CPU is about
+#     twice its wall time, and pinned to one core it took 0.96 s instead of 0.46 s) and
+#     `wc -l` (targets: >= 3x faster than pandas, within 5x of wc -l);
 #   * a 4 h ULog (sensor_combined, 2 x sensor_gyro/sensor_accel at 200 Hz, vehicle_imu,
 #     vehicle_status; ~800 MB) vs pyulog's ULog() (target: >= 20x faster).
 # Wall seconds, best of 3 (pyulog: 1 run); CPU seconds (user + sys) beside them, and the load
