@@ -201,8 +201,9 @@ mod x86 {
     #[target_feature(enable = "avx2")]
     #[inline]
     fn value(r: __m256i) -> u64 {
-        // pairs, then fours, then eights of digits: lanes 8–15, 16–23, 24–31
-        let twos = _mm256_maddubs_epi16(r, _mm256_set1_epi16(0x010a));
+        // pairs (bytes × 10, 1), fours (× 100, 1), eights (× 10000, 1) of digits; the
+        // eights of lanes 8–15, 16–23 and 24–31 make the number
+        let twos = _mm256_maddubs_epi16(r, _mm256_set1_epi16(0x01_0a));
         let fours = _mm256_madd_epi16(twos, _mm256_set1_epi32(0x0001_0064));
         let fours = _mm256_packus_epi32(fours, fours);
         let eights = _mm256_madd_epi16(fours, _mm256_set1_epi32(0x0001_2710));
