@@ -3,13 +3,11 @@
 //! leading minus) and finds its end; the 32 bytes that end where the field ends, with the
 //! bytes before the point moved up over it (a blend with the load one byte earlier), turn
 //! its at most 19 digits into an integer in one multiply-add tree; [`super::decimal`]
-//! rounds it. It takes only
-//! the plainest lines — a single-byte delimiter, every read field `-?digits[.digits]` with
-//! at most 19 digits, an integer time, the line ending straight after the last read column
-//! — and hands every other line to [`super::body::fast_row`], so it gives what `fast_row`
-//! gives, bit for bit, or nothing. [`rows`] reads plain lines one after another, each
-//! value straight into its column of the range's slot (no call and no row copied per
-//! line).
+//! rounds it. It takes only the plainest lines — a single-byte delimiter, every read field
+//! `-?digits[.digits]` with at most 19 digits, an integer time, the line ending straight
+//! after the last read column — and hands every other line to [`super::body::fast_row`], so
+//! it gives what `fast_row` gives, bit for bit, or nothing. [`rows`] reads plain lines one
+//! after another into the range's slot (no call per line).
 //! Why: issue 20's benchmark (a 4 h EuRoC CSV against pandas), where fast-float2's
 //! byte-at-a-time scan of 17-digit decimals was most of the time.
 
@@ -212,29 +210,29 @@ mod x86 {
         (high * 100_000_000 + (low & 0xffff_ffff)) * 100_000_000 + (low >> 32)
     }
 
-    /// The line at `text[pos..]`: each value read goes to `put(column, value)` (acc x y z
-    /// are columns 0–2, gyro x y z 3–5, in SI units) as it is read; its stamp and the bytes
-    /// it took with its line end, or `None` (the line is for `fast_row`; what `put` got of
-    /// it is to be dropped).
+    /// See [`super::row`].
     ///
     /// # Safety
     /// The CPU has AVX2, BMI1, BMI2 and LZCNT.
-    // One body, like fast_row: the position and the values stay in registers.
+    // One body, like fast_row: the position and the row stay in registers.
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     #[inline]
-    unsafe fn line(
+    pub(super) unsafe fn row(
         text: &[u8],
         pos: usize,
         lay: &Layout,
         cols: &[Col],
         d: u8,
-        mut put: impl FnMut(usize, f64),
-    ) -> Option<(u64, usize)> {
+    ) -> Option<(Row, usize)> {
         // every field starts within FIELD_WINDOW bytes of the one before
         if pos < READ_BEHIND || pos + FIELD_WINDOW * cols.len() + 2 > text.len() {
             return None;
         }
-        let mut stamp = 0;
+        let mut row = Row {
+            stamp: 0,
+            acc: [f64::NAN; 3],
+            gyro: [f64::NAN; 3],
+        };
         let mut a = pos;
         for (k, col) in cols.iter().enumerate() {
             // SAFETY: a < pos + FIELD_WINDOW · k (each field took less than FIELD_WINDOW
@@ -259,17 +257,17 @@ mod x86 {
                     if n.neg || n.point {
                         return None;
                     }
-                    stamp = n.w.checked_mul(lay.time_unit.nanos())?;
+                    row.stamp = n.w.checked_mul(lay.time_unit.nanos())?;
                     n.len
                 }
                 Col::Gyro(i) => {
                     let n = unsafe { number(at) }?;
-                    put(3 + i, to_f64(n.w, n.frac as usize, n.neg)? * lay.gyro_si);
+                    row.gyro[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.gyro_si;
                     n.len
                 }
                 Col::Acc(i) => {
                     let n = unsafe { number(at) }?;
-                    put(*i, to_f64(n.w, n.frac as usize, n.neg)? * lay.acc_si);
+                    row.acc[*i] = to_f64(n.w, n.frac as usize, n.neg)? * lay.acc_si;
                     n.len
                 }
             };
@@ -282,8 +280,8 @@ mod x86 {
             } else {
                 // the line ends straight after the last column read, or fast_row reads it
                 return match (text[end], text[end + 1]) {
-                    (b'\n', _) => Some((stamp, end + 1 - pos)),
-                    (b'\r', b'\n') => Some((stamp, end + 2 - pos)),
+                    (b'\n', _) => Some((row, end + 1 - pos)),
+                    (b'\r', b'\n') => Some((row, end + 2 - pos)),
                     _ => None,
                 };
             }
@@ -291,34 +289,10 @@ mod x86 {
         None
     }
 
-    /// See [`super::row`].
+    /// See [`super::rows`].
     ///
     /// # Safety
-    /// As [`line`].
-    #[cfg(test)]
-    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
-    pub(super) unsafe fn row(
-        text: &[u8],
-        pos: usize,
-        lay: &Layout,
-        cols: &[Col],
-        d: u8,
-    ) -> Option<(Row, usize)> {
-        let mut v = [f64::NAN; 6];
-        // SAFETY: the caller's contract
-        let (stamp, took) = unsafe { line(text, pos, lay, cols, d, |c, x| v[c] = x) }?;
-        let row = Row {
-            stamp,
-            acc: [v[0], v[1], v[2]],
-            gyro: [v[3], v[4], v[5]],
-        };
-        Some((row, took))
-    }
-
-    /// See [`super::rows`]: each value goes straight into its column of the slot.
-    ///
-    /// # Safety
-    /// As [`line`].
+    /// As [`row`].
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
     pub(super) unsafe fn rows(
         text: &[u8],
@@ -332,22 +306,14 @@ mod x86 {
         let got = &mut out.got;
         let slot = &mut out.slot;
         while got.filled < slot.cap() {
-            let i = got.filled;
-            let mut v = [f64::NAN; 6];
             // SAFETY: the caller's contract
-            let Some((stamp, took)) = (unsafe { line(text, pos, lay, cols, d, |c, x| v[c] = x) })
-            else {
+            let Some((row, took)) = (unsafe { row(text, pos, lay, cols, d) }) else {
                 break;
             };
-            let row = Row {
-                stamp,
-                acc: [v[0], v[1], v[2]],
-                gyro: [v[3], v[4], v[5]],
-            };
-            slot.set_row(i, stamp, &row);
+            slot.set_row(got.filled, row.stamp, &row);
             got.filled += 1;
             *line_no += 1;
-            got.order.next(*line_no, stamp);
+            got.order.next(*line_no, row.stamp);
             pos += took;
         }
         pos
