@@ -379,62 +379,128 @@ pub(super) fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usi
     (took > 0).then_some((row, took))
 }
 
-/// Parses the lines of `text` into `slot` (room for every line of it).
-pub(super) fn parse_range<'a>(
-    text: &[u8],
+/// Parses the lines of each range of `texts` into its slot (room for every line of it),
+/// two ranges at a time where the SIMD scanner reads them ([`parse_pair`]).
+pub(super) fn parse_ranges<'a>(
+    texts: &[&[u8]],
     lay: &Layout,
     quoted: bool,
-    slot: RowsMut<'a>,
-) -> Chunk<'a> {
-    let mut out = Chunk {
+    slots: Vec<RowsMut<'a>>,
+) -> Vec<Summary> {
+    let wide = wide::usable(lay);
+    let chunk = |slot| Chunk {
         slot,
         ..Chunk::default()
     };
-    if quoted {
-        out.got.lines = parse_csv(text, lay, 1, &mut out);
-        return out;
+    let mut work = texts.iter().copied().zip(slots.into_iter().map(chunk));
+    let mut got = Vec::with_capacity(texts.len());
+    while let Some((t, mut out)) = work.next() {
+        if quoted {
+            out.got.lines = parse_csv(t, lay, 1, &mut out);
+            got.push(out.got);
+        } else if wide && let Some((u, out_u)) = work.next() {
+            let (a, b) = parse_pair((t, u), lay, (out, out_u));
+            got.extend([a.got, b.got]);
+        } else {
+            got.push(parse_lines(t, lay, wide, out).got);
+        }
     }
-    parse_lines(text, lay, wide::usable(lay), out)
+    got
 }
 
-/// [`parse_range`] of an unquoted range: runs of lines by the SIMD scanner where `wide`,
-/// each other line by [`fast_row`], else by the csv crate.
-pub(super) fn parse_lines<'a>(
-    text: &[u8],
-    lay: &Layout,
-    wide: bool,
-    mut out: Chunk<'a>,
-) -> Chunk<'a> {
-    let cols = columns(lay);
-    let mut pos = 0;
-    let mut line = 0u64;
-    while pos < text.len() {
-        if wide {
-            pos = wide::rows(text, pos, lay, &cols, &mut out, &mut line);
-            if pos >= text.len() {
-                break;
-            }
+/// A range being read: its text, where reading is, the lines read so far and what it gave.
+pub(super) struct Cursor<'t, 'a> {
+    pub(super) text: &'t [u8],
+    pub(super) pos: usize,
+    pub(super) line: u64,
+    pub(super) out: Chunk<'a>,
+}
+
+impl<'t, 'a> Cursor<'t, 'a> {
+    pub(super) fn new(text: &'t [u8], out: Chunk<'a>) -> Self {
+        Cursor {
+            text,
+            pos: 0,
+            line: 0,
+            out,
         }
-        line += 1;
-        let rest = &text[pos..];
-        if let Some((row, took)) = fast_row(rest, lay, &cols) {
-            out.take(line, Ok(row));
-            pos += took;
-            continue;
+    }
+
+    pub(super) fn done(&self) -> bool {
+        self.pos >= self.text.len()
+    }
+
+    /// Reads the next line by [`fast_row`], else by the csv crate.
+    fn line_by_line(&mut self, lay: &Layout, cols: &[Col]) {
+        self.line += 1;
+        let rest = &self.text[self.pos..];
+        if let Some((row, took)) = fast_row(rest, lay, cols) {
+            self.out.take(self.line, Ok(row));
+            self.pos += took;
+            return;
         }
         let end = rest
             .iter()
             .position(|&c| c == b'\n')
             .map_or(rest.len(), |p| p + 1);
-        out.got.quoted |= rest[..end].contains(&b'"');
-        parse_csv(&rest[..end], lay, line, &mut out);
-        pos += end;
+        self.out.got.quoted |= rest[..end].contains(&b'"');
+        parse_csv(&rest[..end], lay, self.line, &mut self.out);
+        self.pos += end;
     }
-    out.got.lines = line;
-    out
+
+    /// Reads the rest of the range: runs of lines by the SIMD scanner where `wide`, each
+    /// other line line by line.
+    fn read_on(&mut self, lay: &Layout, cols: &[Col], wide: bool) {
+        while !self.done() {
+            if wide {
+                wide::rows(self, lay, cols);
+                if self.done() {
+                    break;
+                }
+            }
+            self.line_by_line(lay, cols);
+        }
+    }
+
+    fn finish(mut self) -> Chunk<'a> {
+        self.out.got.lines = self.line;
+        self.out
+    }
 }
 
-/// Rows a range of text can hold: one per line, as [`parse_range`] counts them.
+/// One unquoted range: runs of lines by the SIMD scanner where `wide`,
+/// each other line by [`fast_row`], else by the csv crate.
+pub(super) fn parse_lines<'a>(text: &[u8], lay: &Layout, wide: bool, out: Chunk<'a>) -> Chunk<'a> {
+    let mut c = Cursor::new(text, out);
+    c.read_on(lay, &columns(lay), wide);
+    c.finish()
+}
+
+/// Two unquoted ranges read together, as [`parse_lines`] reads each: the SIMD scanner takes
+/// a line of each in turn, field by field, so that the two lines' chains of loads (each
+/// field starts where the one before it ended) overlap in the CPU. Only where the scanner
+/// is [`wide::usable`].
+pub(super) fn parse_pair<'a>(
+    (a, b): (&[u8], &[u8]),
+    lay: &Layout,
+    (out_a, out_b): (Chunk<'a>, Chunk<'a>),
+) -> (Chunk<'a>, Chunk<'a>) {
+    let cols = columns(lay);
+    let (mut a, mut b) = (Cursor::new(a, out_a), Cursor::new(b, out_b));
+    while !a.done() && !b.done() {
+        let (stuck_a, stuck_b) = wide::rows2(&mut a, &mut b, lay, &cols);
+        for (c, stuck) in [(&mut a, stuck_a), (&mut b, stuck_b)] {
+            if stuck && !c.done() {
+                c.line_by_line(lay, &cols);
+            }
+        }
+    }
+    a.read_on(lay, &cols, true);
+    b.read_on(lay, &cols, true);
+    (a.finish(), b.finish())
+}
+
+/// Rows a range of text can hold: one per line, as [`parse_lines`] counts them.
 pub(super) fn room(text: &[u8]) -> usize {
     memchr::memchr_iter(b'\n', text).count() + usize::from(text.last().is_some_and(|&c| c != b'\n'))
 }
@@ -477,7 +543,15 @@ mod tests {
             let l = lay(d, Some(0));
             let n = room(text.as_bytes());
             let (mut fast_rows, mut slow_rows) = (Rows::zeroed(n), Rows::zeroed(n));
-            let fast = parse_range(text.as_bytes(), &l, false, fast_rows.split(&[n]).remove(0));
+            let fast = parse_lines(
+                text.as_bytes(),
+                &l,
+                wide::usable(&l),
+                Chunk {
+                    slot: fast_rows.split(&[n]).remove(0),
+                    ..Chunk::default()
+                },
+            );
             let mut slow = Chunk {
                 slot: slow_rows.split(&[n]).remove(0),
                 ..Chunk::default()

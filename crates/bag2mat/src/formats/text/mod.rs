@@ -35,7 +35,7 @@ use crate::source::InputKind;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
-use body::{Summary, line_range, parse_range, room};
+use body::{Summary, line_range, parse_ranges, room};
 use layout::{Delim, Layout, bad, layout};
 pub use units::{AccUnit, GyroUnit, TimeUnit};
 
@@ -165,10 +165,15 @@ fn read_body(bytes: &[u8], lay: &Layout) -> (Rows, Vec<Summary>) {
     let parse_into = |ranges: &[&[u8]], quoted: bool| {
         let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
         let mut rows = Rows::zeroed(room.iter().sum());
-        let got: Vec<Summary> = ranges
-            .par_iter()
-            .zip(rows.split(&room))
-            .map(|(r, slot)| parse_range(r, lay, quoted, slot).got)
+        // two ranges to a task: the SIMD scanner reads them side by side
+        let mut slots = rows.split(&room).into_iter();
+        let tasks: Vec<(&[&[u8]], Vec<_>)> = ranges
+            .chunks(2)
+            .map(|r| (r, slots.by_ref().take(r.len()).collect()))
+            .collect();
+        let got: Vec<Summary> = tasks
+            .into_par_iter()
+            .flat_map_iter(|(r, slots)| parse_ranges(r, lay, quoted, slots))
             .collect();
         // the rows of each range follow those of the ranges before it
         let mut n = 0;
