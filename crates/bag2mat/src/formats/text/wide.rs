@@ -161,14 +161,12 @@ mod x86 {
         // the field's length: its first byte that is no digit, point or leading minus
         let len = (!num).trailing_zeros();
         let points = _bzhi_u32(_mm256_movemask_epi8(dot) as u32, len);
-        if points & points.wrapping_sub(1) != 0 {
-            return None;
-        }
         let point = u32::from(points != 0);
-        // the sign and the point are lanes of their own, so this does not wrap; at most
+        // the sign and each point are lanes of their own, so this does not wrap; at most
         // MAX_DIGITS digits also bounds len below 32
         let digits = len - neg - point;
-        if digits.wrapping_sub(1) >= MAX_DIGITS {
+        // two points, no digit or too many: one branch (`|`, not `||`)
+        if (points & points.wrapping_sub(1) != 0) | (digits.wrapping_sub(1) >= MAX_DIGITS) {
             return None;
         }
         let frac = if point == 1 {
@@ -304,9 +302,13 @@ mod x86 {
 
     /// After a line's last field (ending at `end`): the bytes the line from `pos` took with
     /// its line end, or `None` when more follows (fast_row reads it).
+    ///
+    /// # Safety
+    /// `end + 1` is in `text` (as [`room_for`] leaves it after a line's last field).
     #[inline]
-    fn line_end(text: &[u8], pos: usize, end: usize) -> Option<usize> {
-        match (text[end], text[end + 1]) {
+    unsafe fn line_end(text: &[u8], pos: usize, end: usize) -> Option<usize> {
+        // SAFETY: the caller's contract
+        match unsafe { (*text.get_unchecked(end), *text.get_unchecked(end + 1)) } {
             (b'\n', _) => Some(end + 1 - pos),
             (b'\r', b'\n') => Some(end + 2 - pos),
             _ => None,
@@ -344,10 +346,12 @@ mod x86 {
             // SAFETY: a < pos + FIELD_WINDOW · k (each field took less than FIELD_WINDOW
             // bytes), so room_for leaves the 32 bytes from it in `text`; a ≥ READ_BEHIND
             let end = unsafe { field(text, a, f, dn, &mut stamp, &mut put) }?;
+            // SAFETY (both): a field ends within FIELD_WINDOW bytes of its start, and
+            // room_for leaves FIELD_WINDOW bytes per field and 2 more
             if k == last {
-                return line_end(text, pos, end).map(|took| (stamp, took));
+                return unsafe { line_end(text, pos, end) }.map(|took| (stamp, took));
             }
-            if text[end] != dn.0 {
+            if unsafe { *text.get_unchecked(end) } != dn.0 {
                 return None;
             }
             a = end + 1;
@@ -381,12 +385,14 @@ mod x86 {
             // SAFETY: as in `line`, for each
             let ea = unsafe { field(ta, a, f, dn, &mut sa, &mut put_a) }?;
             let eb = unsafe { field(tb, b, f, dn, &mut sb, &mut put_b) }?;
+            // SAFETY (each): a field ends within FIELD_WINDOW bytes of its start, and
+            // room_for leaves FIELD_WINDOW bytes per field and 2 more
             if k == last {
-                let took_a = line_end(ta, pa, ea)?;
-                let took_b = line_end(tb, pb, eb)?;
+                let took_a = unsafe { line_end(ta, pa, ea) }?;
+                let took_b = unsafe { line_end(tb, pb, eb) }?;
                 return Some(((sa, took_a), (sb, took_b)));
             }
-            if ta[ea] != dn.0 || tb[eb] != dn.0 {
+            if unsafe { *ta.get_unchecked(ea) != dn.0 || *tb.get_unchecked(eb) != dn.0 } {
                 return None;
             }
             (a, b) = (ea + 1, eb + 1);
@@ -464,8 +470,9 @@ mod x86 {
         #[inline(always)]
         fn put(&self, c: usize, v: f64) {
             debug_assert!(self.i < self.cap);
-            // SAFETY: i < cap (the loops check `full` first), and `of` checked the columns
-            unsafe { *self.dst[c].add(self.i) = v }
+            // SAFETY: i < cap (the loops check `full` first), and `of` checked the columns;
+            // c < 6: `fields` makes each dst i or 3 + i of a sensor axis i < 3
+            unsafe { *self.dst.get_unchecked(c).add(self.i) = v }
         }
 
         /// Completes the next row: its stamp, and NaN in the `absent` columns.
@@ -583,7 +590,7 @@ mod tests {
 
     /// A seeded field: a plain decimal of any length where `plain`, else mostly one and
     /// sometimes a form the scanner must leave to fast_row (exponent, blank, sign, too many
-    /// digits, text, empty).
+    /// digits, text, empty, two points).
     fn field(st: &mut u64, plain: bool) -> String {
         *st = st
             .wrapping_mul(6364136223846793005)
@@ -601,6 +608,7 @@ mod tests {
             2 if !plain => format!("+{int}.{frac}"),
             3 if !plain => "nan".into(),
             4 if !plain => String::new(),
+            8 if !plain => format!("{sign}{int}.{frac}.5"),
             5 => format!("{sign}{int}"),
             6 => format!("{sign}.{frac}"),
             7 => format!("{sign}{int}."),
