@@ -107,7 +107,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
     let lay = layout(path, head, bytes.len() as u64, opts)?;
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
-    let (mut rows, chunks) = read_body(bytes, &lay);
+    let (mut rows, chunks) = read_body(bytes, &lay, RANGE_BYTES);
     // the 1-based line number of each range's first line
     let line_starts: Vec<u64> = chunks
         .iter()
@@ -150,25 +150,32 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     })
 }
 
-/// The body of a file (`bytes`, laid out as `lay` says) in ranges parsed in parallel, each
+/// The body of a file (`bytes`, laid out as `lay` says) in ranges of about `range_bytes`
+/// ([`RANGE_BYTES`]; the tests' are smaller) parsed in parallel, each
 /// straight into its slot of the topic's columns (room for one row per line: no copy of
 /// the file nor of the rows), and what each range found. A quoted field may hold a line
 /// break: a file whose lines hold quotes is read by the csv crate whole instead.
-fn read_body(bytes: &[u8], lay: &Layout) -> (Rows, Vec<Summary>) {
+fn read_body(bytes: &[u8], lay: &Layout, range_bytes: usize) -> (Rows, Vec<Summary>) {
     let ranges: Vec<&[u8]> = (lay.body..bytes.len())
-        .step_by(RANGE_BYTES)
+        .step_by(range_bytes)
         .map(|a| {
-            let (s, e) = line_range(bytes, lay.body, (a, (a + RANGE_BYTES).min(bytes.len())));
+            let (s, e) = line_range(bytes, lay.body, (a, (a + range_bytes).min(bytes.len())));
             &bytes[s..e]
         })
         .collect();
     let parse_into = |ranges: &[&[u8]], quoted: bool| {
         let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
         let mut rows = Rows::zeroed(room.iter().sum());
-        // two ranges to a task: the SIMD scanner reads them side by side
+        // two ranges to a task, which the SIMD scanner reads side by side, where that still
+        // leaves every thread several tasks (a short file keeps one range to a task)
+        let per_task = if ranges.len() >= 4 * rayon::current_num_threads() {
+            2
+        } else {
+            1
+        };
         let mut slots = rows.split(&room).into_iter();
         let tasks: Vec<(&[&[u8]], Vec<_>)> = ranges
-            .chunks(2)
+            .chunks(per_task)
             .map(|r| (r, slots.by_ref().take(r.len()).collect()))
             .collect();
         let got: Vec<Summary> = tasks
@@ -344,4 +351,88 @@ pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Er
         p.notes,
         Vec::new(),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bytes per range that make a test body of a few hundred kB many ranges.
+    const SMALL_RANGE: usize = 4096;
+
+    /// A body read in many small ranges (two to a task, side by side) gives what it gives
+    /// read as one range: the same rows bit for bit, lines, malformed lines and stamp notes.
+    #[test]
+    fn a_body_in_many_ranges_reads_as_in_one() {
+        const LINES: u64 = 12_000;
+        let lay = Layout::for_test(
+            Delim::Byte(b','),
+            Some(0),
+            ([1, 2, 3], [4, 5, 6]),
+            (1.0, 1.0),
+        );
+        let mut st = 0x2026_1207_5EED_u64;
+        let mut text = String::new();
+        for i in 0..LINES {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let v = |k: u32| {
+                format!(
+                    "{}{}.{:017}",
+                    if (st >> k) & 1 == 1 { "-" } else { "" },
+                    (st >> (k + 1)) % 10,
+                    (st >> 20) % 100_000_000_000_000_000
+                )
+            };
+            // a stamp that repeats, one that goes back, a malformed line, a comment and a
+            // CRLF now and then
+            let t = 1_403_636_579_758_555_392 + 5_000_000 * (i - u64::from(i % 997 == 500))
+                - 10_000_000 * u64::from(i % 1499 == 700);
+            match i % 613 {
+                0 => text += "1,2\n",
+                1 => text += "# a comment\n",
+                _ => {
+                    text += &format!("{t},{},{},{},{},{},{}", v(1), v(3), v(5), v(7), v(9), v(11));
+                    text += if i % 7 == 0 { "\r\n" } else { "\n" };
+                }
+            }
+        }
+        assert!(
+            text.len() / SMALL_RANGE >= 4 * rayon::current_num_threads(),
+            "too few ranges for two to a task"
+        );
+        let read = |range_bytes| {
+            let (rows, chunks) = read_body(text.as_bytes(), &lay, range_bytes);
+            let line_starts: Vec<u64> = chunks
+                .iter()
+                .scan(lay.body_line, |l, c| {
+                    let first = *l;
+                    *l += c.lines;
+                    Some(first)
+                })
+                .collect();
+            let bad = malformed_lines(Path::new("t.csv"), &chunks, &line_starts);
+            let notes = (bad.ok().flatten(), stamp_order(&chunks, &line_starts));
+            let lines: u64 = chunks.iter().map(|c| c.lines).sum();
+            (rows, lines, notes)
+        };
+        let (many, one) = (read(SMALL_RANGE), read(usize::MAX / 2));
+        assert!(
+            many.0.len() as u64 > LINES * 9 / 10,
+            "{} rows",
+            many.0.len()
+        );
+        assert_eq!((many.1, &many.2), (one.1, &one.2));
+        assert!(many.2.0.is_some() && many.2.1.len() == 2, "{:?}", many.2);
+        assert_eq!(many.0.len(), one.0.len());
+        for i in 0..many.0.len() {
+            let (a, b) = (many.0.row(i), one.0.row(i));
+            assert_eq!(a.stamp, b.stamp, "row {i}");
+            for c in 0..3 {
+                assert_eq!(a.acc[c].to_bits(), b.acc[c].to_bits(), "row {i}");
+                assert_eq!(a.gyro[c].to_bits(), b.gyro[c].to_bits(), "row {i}");
+            }
+        }
+    }
 }
