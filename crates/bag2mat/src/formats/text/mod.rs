@@ -108,15 +108,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     let lay = layout(path, head, bytes.len() as u64, opts)?;
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
     let (mut rows, chunks) = read_body(bytes, &lay, RANGE_BYTES);
-    // the 1-based line number of each range's first line
-    let line_starts: Vec<u64> = chunks
-        .iter()
-        .scan(lay.body_line, |l, c| {
-            let first = *l;
-            *l += c.lines;
-            Some(first)
-        })
-        .collect();
+    let line_starts = line_starts(&chunks, lay.body_line);
     let mut notes = Vec::new();
     notes.extend(malformed_lines(path, &chunks, &line_starts)?);
     if lay.time.is_none() {
@@ -201,6 +193,18 @@ fn read_body(bytes: &[u8], lay: &Layout, range_bytes: usize) -> (Rows, Vec<Summa
         return parse_into(&[&bytes[lay.body..]], true);
     }
     (rows, chunks)
+}
+
+/// The 1-based line number of each range's first line, the first range's being `first`.
+fn line_starts(chunks: &[Summary], first: u64) -> Vec<u64> {
+    chunks
+        .iter()
+        .scan(first, |l, c| {
+            let at = *l;
+            *l += c.lines;
+            Some(at)
+        })
+        .collect()
 }
 
 /// The note on malformed lines (their count and the first, by its line number), or the
@@ -404,14 +408,7 @@ mod tests {
         );
         let read = |range_bytes| {
             let (rows, chunks) = read_body(text.as_bytes(), &lay, range_bytes);
-            let line_starts: Vec<u64> = chunks
-                .iter()
-                .scan(lay.body_line, |l, c| {
-                    let first = *l;
-                    *l += c.lines;
-                    Some(first)
-                })
-                .collect();
+            let line_starts = line_starts(&chunks, lay.body_line);
             let bad = malformed_lines(Path::new("t.csv"), &chunks, &line_starts);
             let notes = (bad.ok().flatten(), stamp_order(&chunks, &line_starts));
             let lines: u64 = chunks.iter().map(|c| c.lines).sum();

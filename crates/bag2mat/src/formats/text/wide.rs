@@ -719,38 +719,8 @@ mod tests {
                 };
                 let (w, l) = (read(&mut wide_rows, true), read(&mut line_rows, false));
                 assert!(w.filled > LINES / 2, "{} rows", w.filled);
-                assert_eq!(
-                    (w.filled, w.lines, w.bad, &w.first_bad, w.quoted),
-                    (l.filled, l.lines, l.bad, &l.first_bad, l.quoted)
-                );
-                let (wo, lo) = (w.order, l.order);
-                assert_eq!(
-                    (
-                        wo.first,
-                        wo.last,
-                        wo.back,
-                        wo.first_back,
-                        wo.dup,
-                        wo.first_dup
-                    ),
-                    (
-                        lo.first,
-                        lo.last,
-                        lo.back,
-                        lo.first_back,
-                        lo.dup,
-                        lo.first_dup
-                    )
-                );
-                for i in 0..w.filled {
-                    let (a, b) = (wide_rows.row(i), line_rows.row(i));
-                    assert_eq!(a.stamp, b.stamp, "row {i}");
-                    for c in 0..3 {
-                        assert_eq!(a.acc[c].to_bits(), b.acc[c].to_bits(), "row {i}");
-                        assert_eq!(a.gyro[c].to_bits(), b.gyro[c].to_bits(), "row {i}");
-                    }
-                    assert_eq!(wide_rows.record_time[i], line_rows.record_time[i]);
-                }
+                let what = format!("odd lines every {odd}");
+                same_reading((&w, &wide_rows), (&l, &line_rows), &what);
             }
         }
     }
