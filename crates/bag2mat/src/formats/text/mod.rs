@@ -11,7 +11,8 @@
 //! naming its line number and the count of such lines; past [`MAX_BAD_FRACTION`] of the
 //! lines the file is refused. Stamps that go backwards or repeat are reported.
 //!
-//! The body is read a byte range at a time, the ranges in parallel (`body`): runs of the
+//! The body is read a byte range at a time, the ranges in parallel (`body`; in a long file
+//! two ranges to a task, their lines read side by side): runs of the
 //! plainest lines by a SIMD scanner (`wide`, correctly rounded like `fast-float2`), other
 //! plain lines in one pass with `fast-float2`, any other line by the `csv` crate; times are
 //! parsed as decimals straight to nanoseconds, so `1403636579.758555` s keeps every digit.
