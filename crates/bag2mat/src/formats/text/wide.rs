@@ -426,8 +426,9 @@ mod x86 {
         Some((row, took))
     }
 
-    /// A cursor's slot as the loops write it: raw pointers to its columns (one bounds check
-    /// for all rows), and its counts in registers, stored back by [`Sink::store`].
+    /// A cursor as the loops read and write it: raw pointers to its slot's columns (one
+    /// bounds check for all rows), and its position and counts in registers, stored back by
+    /// [`Sink::store`].
     struct Sink {
         dst: [*mut f64; 6],
         record_time: *mut RosTime,
@@ -435,6 +436,8 @@ mod x86 {
         /// The next row, and the slot's room.
         i: usize,
         cap: usize,
+        /// Where the next line starts in the cursor's text.
+        pos: usize,
         line: u64,
         order: Order,
     }
@@ -457,6 +460,7 @@ mod x86 {
                 stamp: slot.stamp.as_mut_ptr(),
                 i: c.out.got.filled,
                 cap,
+                pos: c.pos,
                 line: c.line,
                 order: c.out.got.order,
             }
@@ -475,9 +479,10 @@ mod x86 {
             unsafe { *self.dst.get_unchecked(c).add(self.i) = v }
         }
 
-        /// Completes the next row: its stamp, and NaN in the `absent` columns.
+        /// Completes the next row, whose line took `took` bytes: its stamp, and NaN in the
+        /// `absent` columns.
         #[inline(always)]
-        fn commit(&mut self, t: u64, absent: &[usize]) {
+        fn commit(&mut self, (t, took): (u64, usize), absent: &[usize]) {
             let time = RosTime::from_nanos(t);
             // SAFETY: as in `put`
             unsafe {
@@ -488,12 +493,37 @@ mod x86 {
                 *self.stamp.add(self.i) = time;
             }
             self.i += 1;
+            self.pos += took;
             self.line += 1;
             self.order.next(self.line, t);
         }
 
+        /// Reads the next line of `text` into the next row if the scanner takes it.
+        ///
+        /// # Safety
+        /// As [`line`]; the slot is not [`Sink::full`].
+        #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt")]
+        #[inline]
+        unsafe fn next_line(
+            &mut self,
+            text: &[u8],
+            fields: &[Field],
+            dn: (u8, u64),
+            absent: &[usize],
+        ) -> bool {
+            // SAFETY: the caller's contract
+            match unsafe { line(text, self.pos, fields, dn, |k, v| self.put(k, v)) } {
+                Some(r) => {
+                    self.commit(r, absent);
+                    true
+                }
+                None => false,
+            }
+        }
+
         fn store(self, c: &mut Cursor) {
-            (c.out.got.filled, c.line, c.out.got.order) = (self.i, self.line, self.order);
+            (c.pos, c.out.got.filled, c.line) = (self.pos, self.i, self.line);
+            c.out.got.order = self.order;
         }
     }
 
@@ -506,17 +536,8 @@ mod x86 {
         let (fields, absent) = fields(lay, cols);
         let dn = (d, lay.time_unit.nanos());
         let mut s = Sink::of(c);
-        let (text, mut pos) = (c.text, c.pos);
-        while !s.full() {
-            // SAFETY: the caller's contract
-            let Some((t, took)) = (unsafe { line(text, pos, &fields, dn, |k, v| s.put(k, v)) })
-            else {
-                break;
-            };
-            s.commit(t, &absent);
-            pos += took;
-        }
-        c.pos = pos;
+        // SAFETY: the caller's contract; `full` is checked first
+        while !s.full() && unsafe { s.next_line(c.text, &fields, dn, &absent) } {}
         s.store(c);
     }
 
@@ -536,38 +557,28 @@ mod x86 {
         let dn = (d, lay.time_unit.nanos());
         let (mut sa, mut sb) = (Sink::of(ca), Sink::of(cb));
         let (ta, tb) = (ca.text, cb.text);
-        let (mut pa, mut pb) = (ca.pos, cb.pos);
         let stuck = loop {
             if sa.full() || sb.full() {
                 break (sa.full(), sb.full());
             }
-            let (put_a, put_b) = (|k, v| sa.put(k, v), |k, v| sb.put(k, v));
-            // SAFETY (each call): the caller's contract
-            match unsafe { line2((ta, pa), (tb, pb), &fields, dn, (put_a, put_b)) } {
-                Some(((t, took_a), (u, took_b))) => {
-                    sa.commit(t, &absent);
-                    sb.commit(u, &absent);
-                    (pa, pb) = (pa + took_a, pb + took_b);
+            let (a, b) = ((ta, sa.pos), (tb, sb.pos));
+            let puts = (|k, v| sa.put(k, v), |k, v| sb.put(k, v));
+            // SAFETY (each call): the caller's contract; neither slot is full
+            match unsafe { line2(a, b, &fields, dn, puts) } {
+                Some((ra, rb)) => {
+                    sa.commit(ra, &absent);
+                    sb.commit(rb, &absent);
                 }
                 None => {
                     // one of them (or both) is fast_row's: the other's line on its own
-                    let a = unsafe { line(ta, pa, &fields, dn, |k, v| sa.put(k, v)) };
-                    if let Some((t, took)) = a {
-                        sa.commit(t, &absent);
-                        pa += took;
-                    }
-                    let b = unsafe { line(tb, pb, &fields, dn, |k, v| sb.put(k, v)) };
-                    if let Some((t, took)) = b {
-                        sb.commit(t, &absent);
-                        pb += took;
-                    }
-                    if a.is_none() || b.is_none() {
-                        break (a.is_none(), b.is_none());
+                    let a = unsafe { sa.next_line(ta, &fields, dn, &absent) };
+                    let b = unsafe { sb.next_line(tb, &fields, dn, &absent) };
+                    if !(a && b) {
+                        break (!a, !b);
                     }
                 }
             }
         };
-        (ca.pos, cb.pos) = (pa, pb);
         sa.store(ca);
         sb.store(cb);
         stuck
