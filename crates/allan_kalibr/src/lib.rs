@@ -64,6 +64,7 @@ mod ieee952;
 mod input;
 mod kalibr;
 mod run;
+pub mod spline;
 mod yaml;
 
 pub use cli::{Args, TOOL};
