@@ -8,6 +8,7 @@ mod defects;
 mod defects19;
 mod issue18;
 mod logs;
+mod poses;
 mod real_tools;
 mod reference;
 mod ros2;

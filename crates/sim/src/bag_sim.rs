@@ -422,7 +422,7 @@ pub(crate) fn now_ns() -> u64 {
 
 /// Parse `--start-time` (UNIX seconds, decimal) into ns, exactly.
 pub(crate) fn parse_start_time(s: &str) -> Result<u64> {
-    match crate::textio::parse_time_ns(s) {
+    match bag2mat::parse_time_ns(s) {
         Some(ns) if (0..=MAX_ROS_NS as i64).contains(&ns) => Ok(ns as u64),
         Some(_) => Err(SimError::InvalidArgument(format!(
             "--start-time {s:?} is outside the ROS time range (0 to 4294967295 s)"

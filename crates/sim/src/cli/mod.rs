@@ -522,7 +522,7 @@ pub struct SplineArgs {
 fn time_arg(name: &str, s: &Option<String>) -> Result<Option<i64>> {
     s.as_ref()
         .map(|s| {
-            crate::textio::parse_time_ns(s).ok_or_else(|| {
+            bag2mat::parse_time_ns(s).ok_or_else(|| {
                 SimError::InvalidArgument(format!("{name} {s:?} is not a number of seconds"))
             })
         })
