@@ -29,10 +29,16 @@
 //! poses as control points (the spline then smooths by ≈ Δt²/6·p̈); `Fit::Interp` iterates
 //! c_j ← c_j·exp(1.5 r_j), r_j = log(R_spl(τ_j)ᵀ R_j), p_j += 1.5 (p_j − p_spl(τ_j)),
 //! re-extrapolating the pads, until the largest knot residual is below 1e-12.
+//! [`SplitSpline::fit_least_squares`] (`lsq`) fits poses at any times with knots at any
+//! spacing instead: the fit of a reference trajectory, whose poses are noisy and not on
+//! the knots.
 
 pub(crate) mod basis;
+mod lsq;
 pub(crate) mod segment;
 pub mod so3;
+
+pub use lsq::{LSQ_MAX_ITER, LSQ_TOLERANCE, LsqReport, SMOOTHING};
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -103,6 +109,8 @@ pub struct SplineSample {
     pub p: Vector3<f64>,
     /// Velocity (world), m/s.
     pub v: Vector3<f64>,
+    /// Acceleration (world), m/s².
+    pub a: Vector3<f64>,
     /// Rotation body → world.
     pub r: Matrix3<f64>,
     /// Body angular velocity, rad/s.
@@ -296,6 +304,7 @@ impl SplitSpline {
             t_ns,
             p,
             v,
+            a,
             r,
             gyro,
             acc,
