@@ -11,5 +11,6 @@ mod front;
 mod ieee952;
 mod issue18;
 mod logs;
+mod operating;
 mod reference;
 mod studies;

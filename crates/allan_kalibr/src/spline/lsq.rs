@@ -12,9 +12,11 @@
 //! largest correction is below [`LSQ_TOLERANCE`]. The fixed point is the rotation fit the
 //! linearisation describes (its first-order optimality condition).
 //!
-//! Both problems carry a weak second-difference penalty ([`SMOOTHING`], relative to the
-//! normal matrix' diagonal): it decides control points that no pose reaches (a gap in the
-//! reference, the end pads) and moves the others by far less than the data's precision.
+//! Both problems carry a weak second-difference penalty on the control points themselves
+//! ([`SMOOTHING`], relative to the normal matrix' diagonal; for the rotations on the
+//! second difference of their logarithms): it decides control points that no pose reaches
+//! (a gap in the reference, an end pad whose segment barely holds the last pose) and moves
+//! the others by far less than the data's precision.
 //! The normal matrices are banded (half-bandwidth 3) and solved by a banded Cholesky.
 
 use nalgebra::{Matrix3, Vector3};
@@ -64,6 +66,8 @@ struct Banded {
 }
 
 const BAND: usize = 3;
+/// The second difference's coefficients.
+const SECOND_DIFF: [f64; 3] = [1.0, -2.0, 1.0];
 
 impl Banded {
     fn new(n: usize) -> Banded {
@@ -78,16 +82,19 @@ impl Banded {
         self.a[i][j - i] += v;
     }
 
-    /// The weak second-difference penalty (module docs).
-    fn smooth(&mut self) {
+    /// The penalty weight μ: [`SMOOTHING`] times the mean diagonal (module docs).
+    fn mu(&self) -> f64 {
         let mean = self.a.iter().map(|r| r[0]).sum::<f64>() / self.n.max(1) as f64;
-        let mu = SMOOTHING * mean.max(f64::MIN_POSITIVE);
+        SMOOTHING * mean.max(f64::MIN_POSITIVE)
+    }
+
+    /// Adds the second-difference penalty μ·Σ|x_{k−1} − 2x_k + x_{k+1}|² (module docs).
+    fn smooth(&mut self, mu: f64) {
         for k in 1..self.n.saturating_sub(1) {
             let idx = [k - 1, k, k + 1];
-            let c = [1.0, -2.0, 1.0];
             for a in 0..3 {
                 for b in a..3 {
-                    self.add(idx[a], idx[b], mu * c[a] * c[b]);
+                    self.add(idx[a], idx[b], mu * SECOND_DIFF[a] * SECOND_DIFF[b]);
                 }
             }
         }
@@ -123,10 +130,7 @@ impl Banded {
         }
         // Uᵀ y = b
         for i in 0..n {
-            let mut v = b[i];
-            for k in i.saturating_sub(BAND)..i {
-                v -= b[k] * self.a[k][i - k];
-            }
+            let v = (i.saturating_sub(BAND)..i).fold(b[i], |v, k| v - b[k] * self.a[k][i - k]);
             b[i] = v / self.a[i][0];
         }
         // U x = y
@@ -194,7 +198,7 @@ impl SplitSpline {
         for (j, _) in &at {
             support[*j] += 1;
         }
-        let normal = || {
+        let data_normal = {
             let mut a = Banded::new(n);
             for (j, w) in &at {
                 for x in 0..4 {
@@ -203,7 +207,15 @@ impl SplitSpline {
                     }
                 }
             }
-            a.smooth();
+            a
+        };
+        let mu = data_normal.mu();
+        let normal = || {
+            let mut a = Banded {
+                n,
+                a: data_normal.a.clone(),
+            };
+            a.smooth(mu);
             a
         };
         // positions: one linear solve
@@ -237,6 +249,15 @@ impl SplitSpline {
                 let r = so3::log(&(segment::so3_value(&c, u).transpose() * p.r));
                 for k in 0..4 {
                     rhs[j + k] += r * w[k];
+                }
+            }
+            // the penalty acts on the rotations themselves: their second difference
+            // D_k = log(R_kᵀR_{k+1}) − log(R_{k−1}ᵀR_k) moves by the corrections' own
+            for k in 1..n - 1 {
+                let d = so3::log(&(s.rot[k].transpose() * s.rot[k + 1]))
+                    - so3::log(&(s.rot[k - 1].transpose() * s.rot[k]));
+                for (c, i) in SECOND_DIFF.iter().zip([k - 1, k, k + 1]) {
+                    rhs[i] -= d * (mu * c);
                 }
             }
             let delta = normal()
@@ -339,8 +360,9 @@ mod tests {
             for p in 0..n {
                 for r in p + 1..n {
                     let f = a[r][p] / a[p][p];
-                    for q in p..n {
-                        a[r][q] -= f * a[p][q];
+                    let pivot = a[p].clone();
+                    for (x, v) in a[r].iter_mut().zip(&pivot).skip(p) {
+                        *x -= f * v;
                     }
                     y[r] -= f * y[p];
                 }

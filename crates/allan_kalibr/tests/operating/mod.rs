@@ -1,0 +1,252 @@
+//! The operating-noise analysis (`--reference`, `--operating`) run as a user runs it, on
+//! records the tests' own writer made ([`record`]: closed-form motion and seeded noise, no
+//! spline, no sim), against what was injected:
+//!
+//! * the operating density within [`N_REL_TOL`] of the injected white noise plus the
+//!   injected lines' A²/(2 f_s), with a reference at the IMU's rate and at a motion-capture
+//!   rate below it;
+//! * each injected line found within [`LINE_FREQ_REL_TOL`] of its frequency;
+//! * the time offset within [`OFFSET_TOL`];
+//! * a static record analysed this way agreeing with the static analysis within
+//!   [`STATIC_REL_TOL`].
+
+pub mod record;
+
+use std::path::Path;
+use std::process::Command;
+
+/// The tolerance on the operating density (the estimate's own scatter on a few
+/// minutes is ~1–2 %; the rest is room for the calibration's and the spline's leftovers).
+pub const N_REL_TOL: f64 = 0.10;
+/// The tolerance on a line's frequency.
+pub const LINE_FREQ_REL_TOL: f64 = 0.02;
+/// The tolerance on the time offset, s.
+pub const OFFSET_TOL: f64 = 0.5e-3;
+/// The agreement of a static record analysed this way with the static analysis.
+pub const STATIC_REL_TOL: f64 = 0.05;
+
+pub fn run(args: &[&str]) -> (String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+        .args(args)
+        .output()
+        .expect("run allan_kalibr");
+    let (o, e) = (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    );
+    assert!(
+        out.status.success(),
+        "allan_kalibr {args:?} failed:\n{o}\n{e}"
+    );
+    (o, e)
+}
+
+/// The rows of a CSV with `#` comment lines, as (header → value) lookups.
+pub fn csv_rows(path: &Path) -> Vec<Vec<(String, String)>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let head: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .cloned()
+                .zip(l.split(',').map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
+
+pub fn field<'a>(row: &'a [(String, String)], key: &str) -> &'a str {
+    &row.iter()
+        .find(|(k, _)| k == key)
+        .unwrap_or_else(|| panic!("no column {key}"))
+        .1
+}
+
+pub fn num(row: &[(String, String)], key: &str) -> f64 {
+    field(row, key).parse().unwrap()
+}
+
+/// The section axis index (0–2 gyro, 3–5 acc) of a row.
+pub fn axis_index(row: &[(String, String)]) -> usize {
+    let base = if field(row, "sensor") == "gyroscope" {
+        0
+    } else {
+        3
+    };
+    base + ["x", "y", "z"]
+        .iter()
+        .position(|a| *a == field(row, "axis"))
+        .unwrap()
+}
+
+/// `key: value` of a flat yaml file.
+pub fn yaml(path: &Path, key: &str) -> f64 {
+    bag2mat::test_tools::yaml_number(&std::fs::read_to_string(path).unwrap(), key)
+}
+
+/// Runs the analysis against the reference and checks the proofs on `spec`.
+fn check_against_injected(spec: &record::Spec, tag: &str) {
+    let d = tempfile::tempdir().unwrap();
+    let w = record::write(d.path(), spec);
+    if let Ok(keep) = std::env::var("KEEP_OPERATING_RECORD") {
+        let k = std::path::Path::new(&keep);
+        std::fs::create_dir_all(k).unwrap();
+        std::fs::copy(&w.imu, k.join("imu.csv")).unwrap();
+        std::fs::copy(&w.reference, k.join("reference.tum")).unwrap();
+    }
+    let out = d.path().join("out");
+    let (text, _) = run(&[
+        w.imu.to_str().unwrap(),
+        "--reference",
+        w.reference.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    eprintln!("{tag}:\n{text}");
+    let want = spec.expected();
+    for row in csv_rows(&out.join("operating_noise.csv")) {
+        let a = axis_index(&row);
+        let n = num(&row, "noise_density");
+        let (lo, hi) = (num(&row, "ci95_lo"), num(&row, "ci95_hi"));
+        eprintln!(
+            "{tag} axis {a}: N_op {n:.4e} [{lo:.4e}, {hi:.4e}] injected {:.4e} ({:+.2} %)",
+            want[a],
+            100.0 * (n / want[a] - 1.0)
+        );
+        assert!(
+            (n / want[a] - 1.0).abs() < N_REL_TOL,
+            "{tag} axis {a}: N_op {n:e}, injected {:e}",
+            want[a]
+        );
+    }
+    let lines = csv_rows(&out.join("operating_lines.csv"));
+    for (a, f, _) in &spec.lines {
+        let found = lines
+            .iter()
+            .filter(|r| axis_index(r) == *a)
+            .map(|r| num(r, "frequency_hz"))
+            .min_by(|x, y| (x - f).abs().total_cmp(&(y - f).abs()))
+            .unwrap_or(f64::NAN);
+        eprintln!("{tag} line axis {a}: injected {f} Hz, found {found} Hz");
+        assert!(
+            (found / f - 1.0).abs() < LINE_FREQ_REL_TOL,
+            "{tag} axis {a}: line {f} Hz found at {found}"
+        );
+    }
+    let dt = yaml(&out.join("operating_calibration.yaml"), "time_offset_s");
+    eprintln!(
+        "{tag} time offset {:.4} ms (injected {:.4} ms)",
+        dt * 1e3,
+        spec.ref_offset * 1e3
+    );
+    assert!(
+        (dt - spec.ref_offset).abs() < OFFSET_TOL,
+        "{tag}: offset {dt}"
+    );
+    for f in [
+        "operating_psd.png",
+        "operating_spectrogram.png",
+        "operating_kalibr_imu_ieee952.yaml",
+        "operating_basalt_imu_noise_ieee952.json",
+    ] {
+        assert!(out.join(f).exists(), "{tag}: {f}");
+    }
+}
+
+#[test]
+fn operating_density_offset_and_lines_against_a_reference_at_the_imu_rate() {
+    check_against_injected(
+        &record::Spec::handheld(200.0, 200.0, 240.0, 1),
+        "200 Hz, reference 200 Hz",
+    );
+}
+
+#[test]
+fn operating_density_offset_and_lines_against_a_motion_capture_reference() {
+    check_against_injected(
+        &record::Spec::handheld(400.0, 120.0, 240.0, 2),
+        "400 Hz, reference 120 Hz",
+    );
+}
+
+/// The static record of the agreement test: 20 minutes at 200 Hz, white noise and random
+/// walk only (what the static analysis models exactly), a tilted IMU at rest.
+fn static_spec(seed: u64) -> record::Spec {
+    record::Spec {
+        motion: false,
+        seconds: 1200.0,
+        lines: Vec::new(),
+        ref_rate: 100.0,
+        ..record::Spec::handheld(200.0, 100.0, 1200.0, seed)
+    }
+}
+
+#[test]
+fn a_static_record_analysed_for_operating_noise_agrees_with_the_static_analysis() {
+    let d = tempfile::tempdir().unwrap();
+    let spec = static_spec(5);
+    let w = record::write(d.path(), &spec);
+    let imu = w.imu.to_str().unwrap();
+    let dir = |s: &str| d.path().join(s).to_str().unwrap().to_string();
+    run(&[imu, "-o", &dir("static"), "-q"]);
+    let mut stat = [f64::NAN; 6];
+    for row in csv_rows(&d.path().join("static/ieee952_terms.csv")) {
+        if field(&row, "term") == "N" {
+            stat[axis_index(&row)] = num(&row, "value");
+        }
+    }
+    for (tag, extra) in [
+        (
+            "reference",
+            vec!["--reference", w.reference.to_str().unwrap()],
+        ),
+        ("no reference", vec!["--operating"]),
+    ] {
+        let out = dir(tag);
+        let mut args = vec![imu, "-o", &out, "-q"];
+        args.extend(extra);
+        run(&args);
+        for row in csv_rows(&Path::new(&out).join("operating_noise.csv")) {
+            let a = axis_index(&row);
+            let n = num(&row, "noise_density");
+            eprintln!(
+                "static record, {tag}, axis {a}: operating {n:.4e}, static analysis {:.4e} ({:+.2} %), injected {:.4e}",
+                stat[a],
+                100.0 * (n / stat[a] - 1.0),
+                spec.n[a / 3]
+            );
+            assert!(
+                (n / stat[a] - 1.0).abs() < STATIC_REL_TOL,
+                "{tag} axis {a}: {n:e} vs the static analysis' {:e}",
+                stat[a]
+            );
+        }
+    }
+}
+
+#[test]
+fn a_moving_record_is_refused_by_default_and_the_refusal_names_the_operating_analysis() {
+    let d = tempfile::tempdir().unwrap();
+    let w = record::write(d.path(), &record::Spec::handheld(100.0, 100.0, 120.0, 3));
+    let out = d.path().join("out");
+    let (text, err) = run(&[w.imu.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+    let m = bag2mat::test_tools::warnings(&err, "motion");
+    assert!(
+        m.len() == 1 && m[0].contains("not static") && m[0].contains("not computed"),
+        "{err}"
+    );
+    assert!(
+        m[0].contains("--reference POSES") && m[0].contains("--operating"),
+        "the refusal names the operating analysis: {}",
+        m[0]
+    );
+    assert!(!text.contains("IEEE 952 noise terms"), "{text}");
+    assert!(!out.join("operating_noise.csv").exists());
+}
