@@ -428,6 +428,8 @@ fn calibration_yaml(op: &Operating) -> Option<String> {
     );
     let _ = writeln!(s, "imu_stamp_jitter_s: {}", f(r.jitter));
     let _ = writeln!(s, "iterations: {}", c.iterations);
+    let _ = writeln!(s, "first_sample_time_s: {}", f(op.t0));
+    let _ = writeln!(s, "samples_analysed: {}", op.samples);
     Some(s)
 }
 

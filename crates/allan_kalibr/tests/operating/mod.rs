@@ -250,3 +250,298 @@ fn a_moving_record_is_refused_by_default_and_the_refusal_names_the_operating_ana
     assert!(!text.contains("IEEE 952 noise terms"), "{text}");
     assert!(!out.join("operating_noise.csv").exists());
 }
+
+/// `key: [a, b, c]` of a flat yaml file.
+fn yaml_list(path: &Path, key: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let line = text
+        .lines()
+        .find_map(|l| l.strip_prefix(&format!("{key}:")))
+        .unwrap_or_else(|| panic!("{}: no {key}", path.display()));
+    line.trim()
+        .trim_start_matches('[')
+        .trim_end_matches(']')
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect()
+}
+
+/// `sim bag --motion handheld --reference-out` writes a record with its truth; analysed
+/// with that reference (a 120 Hz motion capture with its noise, under a 400 Hz IMU with
+/// its mounting errors), the operating densities, the lines and the offset match the
+/// truth file's.
+#[test]
+fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
+    let d = tempfile::tempdir().unwrap();
+    let spec = d.path().join("spec.yaml");
+    std::fs::write(
+        &spec,
+        "gyroscope:\n  white_noise: 1.0e-3\n  random_walk: 2.0e-5\n  axes:\n    z: {lines: [{frequency_hz: 29, amplitude: 4.0e-3}]}\naccelerometer:\n  white_noise: 1.5e-2\n  random_walk: 3.0e-4\n  lines: [{frequency_hz: 53, amplitude: 4.0e-2}]\n",
+    )
+    .unwrap();
+    let bag = d.path().join("hand.bag");
+    let reference = d.path().join("hand.tum");
+    let cli = <sim::Cli as clap::Parser>::try_parse_from([
+        "sim",
+        "bag",
+        "-o",
+        bag.to_str().unwrap(),
+        "--motion",
+        "handheld",
+        "--rate",
+        "400",
+        "--duration",
+        "180",
+        "--start-time",
+        "1700000000",
+        "--seed",
+        "11",
+        "--noise-spec",
+        spec.to_str().unwrap(),
+        "--reference-out",
+        reference.to_str().unwrap(),
+        "--reference-rate",
+        "120",
+        "--reference-offset",
+        "0.0035",
+        "--reference-noise",
+        "1e-4,3e-4",
+        "--imu-rotation",
+        "3,-2,90",
+        "--lever-arm",
+        "0.04,-0.02,0.03",
+        "--scale-error",
+        "0.005",
+        "--misalignment",
+        "0.003",
+        "--g-sensitivity",
+        "2e-4",
+        "-q",
+    ])
+    .unwrap();
+    let sim::Command::Bag(a) = cli.command else {
+        unreachable!()
+    };
+    let cfg = sim::BagConfig::try_from(*a).unwrap();
+    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
+    let truth = sim::reference_truth_path(&reference);
+    let want: Vec<f64> = yaml_list(&truth, "gyroscope_operating_noise_density")
+        .into_iter()
+        .chain(yaml_list(&truth, "accelerometer_operating_noise_density"))
+        .collect();
+    let out = d.path().join("out");
+    let (text, _) = run(&[
+        bag.to_str().unwrap(),
+        "--reference",
+        reference.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    eprintln!("{text}");
+    for row in csv_rows(&out.join("operating_noise.csv")) {
+        let a = axis_index(&row);
+        let n = num(&row, "noise_density");
+        eprintln!(
+            "sim bag axis {a}: N_op {n:.4e}, truth {:.4e} ({:+.2} %)",
+            want[a],
+            100.0 * (n / want[a] - 1.0)
+        );
+        assert!(
+            (n / want[a] - 1.0).abs() < N_REL_TOL,
+            "axis {a}: {n:e} vs {:e}",
+            want[a]
+        );
+    }
+    let lines = csv_rows(&out.join("operating_lines.csv"));
+    for (a, f) in [(2usize, 29.0), (3, 53.0), (4, 53.0), (5, 53.0)] {
+        assert!(
+            lines.iter().any(|r| axis_index(r) == a
+                && (num(r, "frequency_hz") / f - 1.0).abs() < LINE_FREQ_REL_TOL),
+            "axis {a}: no line at {f} Hz"
+        );
+    }
+    let dt = yaml(&out.join("operating_calibration.yaml"), "time_offset_s");
+    assert!(
+        (dt - yaml(&truth, "time_offset_s")).abs() < OFFSET_TOL,
+        "offset {dt}"
+    );
+}
+
+/// The reference as a bag's `geometry_msgs/PoseStamped` topic (ROS 1 and ROS 2 MCAP,
+/// written by rosbags, an independent writer, from the tests' own TUM file), and the IMU
+/// and reference as an EuRoC/ASL dataset (`mav0/imu0`, `mav0/state_groundtruth_estimate0`)
+/// given by its root: the same proofs hold.
+#[test]
+fn the_reference_as_a_bag_topic_and_as_an_euroc_ground_truth() {
+    let d = tempfile::tempdir().unwrap();
+    let spec = record::Spec::handheld(200.0, 100.0, 150.0, 21);
+    let w = record::write(d.path(), &spec);
+    let want = spec.expected();
+    let check = |out: &Path, tag: &str| {
+        for row in csv_rows(&out.join("operating_noise.csv")) {
+            let a = axis_index(&row);
+            let n = num(&row, "noise_density");
+            assert!(
+                (n / want[a] - 1.0).abs() < N_REL_TOL,
+                "{tag} axis {a}: {n:e} vs {:e}",
+                want[a]
+            );
+        }
+        let dt = yaml(&out.join("operating_calibration.yaml"), "time_offset_s");
+        assert!(
+            (dt - spec.ref_offset).abs() < OFFSET_TOL,
+            "{tag}: offset {dt}"
+        );
+    };
+    let script = bag2mat::test_tools::workspace().join("crates/bag2mat/tests/py/pose_bags.py");
+    for kind in ["ros1", "mcap"] {
+        let bag = d.path().join(if kind == "ros1" {
+            "ref.bag"
+        } else {
+            "ref_mcap"
+        });
+        bag2mat::test_tools::run_ok(
+            Command::new(bag2mat::test_tools::venv_python())
+                .arg(&script)
+                .arg(kind)
+                .arg(&bag)
+                .arg("--from-tum")
+                .arg(&w.reference),
+        );
+        let out = d.path().join(format!("out_{kind}"));
+        let (text, _) = run(&[
+            w.imu.to_str().unwrap(),
+            "--reference",
+            bag.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(
+            text.contains("topic '/mocap/body' (geometry_msgs"),
+            "{text}"
+        );
+        check(&out, kind);
+    }
+    // EuRoC/ASL: the IMU's data.csv and the ground truth (w first, ns) in a dataset folder
+    let root = d.path().join("MH_test");
+    let imu_dir = root.join("mav0/imu0");
+    let gt_dir = root.join("mav0/state_groundtruth_estimate0");
+    std::fs::create_dir_all(&imu_dir).unwrap();
+    std::fs::create_dir_all(&gt_dir).unwrap();
+    std::fs::copy(&w.imu, imu_dir.join("data.csv")).unwrap();
+    let mut gt = String::from(
+        "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z []\n",
+    );
+    for line in std::fs::read_to_string(&w.reference).unwrap().lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.is_empty() || f[0].starts_with('#') {
+            continue;
+        }
+        let (sec, frac) = f[0].split_once('.').unwrap();
+        let ns: i64 = sec.parse::<i64>().unwrap() * 1_000_000_000 + frac.parse::<i64>().unwrap();
+        gt.push_str(&format!(
+            "{ns},{},{},{},{},{},{},{}\n",
+            f[1], f[2], f[3], f[7], f[4], f[5], f[6]
+        ));
+    }
+    std::fs::write(gt_dir.join("data.csv"), gt).unwrap();
+    let out = d.path().join("out_euroc");
+    let (text, _) = run(&[
+        root.to_str().unwrap(),
+        "--topic",
+        "imu0",
+        "--reference",
+        root.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(text.contains("EuRoC/ASL ground truth"), "{text}");
+    check(&out, "euroc");
+}
+
+/// Flags that cannot run are usage errors (exit 2) that say why; a reference that cannot
+/// be used is an error (exit 1) naming it; nothing is written.
+#[test]
+fn operating_flags_and_references_that_cannot_run() {
+    let d = tempfile::tempdir().unwrap();
+    let w = record::write(d.path(), &record::Spec::handheld(100.0, 100.0, 60.0, 4));
+    let imu = w.imu.to_str().unwrap();
+    let out = d.path().join("o");
+    let o = out.to_str().unwrap();
+    let fail = |args: &[&str], code: i32, says: &str| {
+        let r = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    };
+    fail(
+        &[imu, "--static", imu, "-o", o],
+        2,
+        "--reference or --operating",
+    );
+    fail(
+        &[imu, "--band", "1:50", "-o", o],
+        2,
+        "--reference or --operating",
+    );
+    fail(
+        &[imu, "--operating", "--band", "50:1", "-o", o],
+        2,
+        "LO must be below HI",
+    );
+    fail(
+        &[imu, "--operating", "--static-density", "x", "-o", o],
+        2,
+        "--static-density",
+    );
+    fail(
+        &[
+            imu,
+            "--operating",
+            "--reference",
+            w.reference.to_str().unwrap(),
+            "-o",
+            o,
+        ],
+        2,
+        "cannot be used with",
+    );
+    fail(
+        &[imu, "--operating", "--compat-only", "-o", o],
+        2,
+        "--compat-only",
+    );
+    let missing = d.path().join("missing.tum");
+    fail(
+        &[imu, "--reference", missing.to_str().unwrap(), "-o", o],
+        1,
+        "missing.tum",
+    );
+    // a reference on another clock: no overlap within --max-offset
+    let shifted = d.path().join("shifted.tum");
+    let text: String = std::fs::read_to_string(&w.reference)
+        .unwrap()
+        .lines()
+        .map(|l| match l.split_once(' ') {
+            Some((t, rest)) if !l.starts_with('#') => {
+                let (s, f) = t.split_once('.').unwrap();
+                format!("{}.{f} {rest}\n", s.parse::<i64>().unwrap() - 5000)
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&shifted, text).unwrap();
+    fail(
+        &[imu, "--reference", shifted.to_str().unwrap(), "-o", o],
+        1,
+        "overlap",
+    );
+    assert!(!out.exists(), "nothing is written");
+}

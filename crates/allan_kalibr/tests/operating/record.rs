@@ -221,6 +221,9 @@ pub struct Written {
     pub imu: PathBuf,
     /// The reference (TUM).
     pub reference: PathBuf,
+    /// The injected noise per section axis (white noise and lines, the bias left out), at
+    /// each IMU sample.
+    pub noise: [Vec<f64>; 6],
 }
 
 /// Writes `spec`'s IMU log and reference into `dir`.
@@ -255,6 +258,7 @@ pub fn write(dir: &Path, spec: &Spec) -> Written {
     let mut csv = String::from(
         "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
     );
+    let mut noise: [Vec<f64>; 6] = Default::default();
     for k in 0..count {
         let t = k as f64 / spec.rate;
         let (_, _, w, f) = body(t, spec.motion);
@@ -264,12 +268,17 @@ pub fn write(dir: &Path, spec: &Spec) -> Written {
         let gyro = mg * w_i + gsens * f_i;
         let acc = ma * f_i;
         let mut v = [gyro.x, gyro.y, gyro.z, acc.x, acc.y, acc.z];
+        let mut e = [0.0; 6];
         for a in 0..6 {
             bias[a] += walk[a] * n();
-            v[a] += bias[a] + white[a] * n();
+            e[a] = white[a] * n();
         }
         for (l, ph) in spec.lines.iter().zip(&phases) {
-            v[l.0] += l.2 * (2.0 * PI * l.1 * t + ph).sin();
+            e[l.0] += l.2 * (2.0 * PI * l.1 * t + ph).sin();
+        }
+        for a in 0..6 {
+            v[a] += bias[a] + e[a];
+            noise[a].push(e[a]);
         }
         let ns = T0_NS + (t * 1e9).round() as i64;
         let _ = writeln!(
@@ -307,7 +316,11 @@ pub fn write(dir: &Path, spec: &Spec) -> Written {
     }
     let reference = dir.join("reference.tum");
     std::fs::write(&reference, tum).unwrap();
-    Written { imu, reference }
+    Written {
+        imu,
+        reference,
+        noise,
+    }
 }
 
 #[test]

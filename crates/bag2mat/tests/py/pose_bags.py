@@ -6,6 +6,9 @@ printed on stdout, a line per message: topic, header ns, record ns, x y z qx qy 
 (Python's repr: the shortest text of each double).
 
 usage: pose_bags.py ros1|mcap|sqlite3 OUT [--n N]
+       pose_bags.py ros1|mcap|sqlite3 OUT --from-tum FILE
+  (the second form writes FILE's poses as geometry_msgs/PoseStamped on /mocap/body, header
+  stamp and record time both the file's time: a motion-capture topic)
 """
 import math
 import sys
@@ -84,15 +87,28 @@ def main():
         from rosbags.rosbag1 import Writer
         w = Writer(out)
         w.open()
-        conns = {t: w.add_connection(t, mt, typestore=ts) for t, (mt, _) in topics.items()}
+        conns = {} if "--from-tum" in a else {t: w.add_connection(t, mt, typestore=ts) for t, (mt, _) in topics.items()}
         ser = lambda m, mt: ts.serialize_ros1(m, mt)
     else:
         from rosbags.rosbag2 import StoragePlugin, Writer
         plugin = StoragePlugin.MCAP if kind == "mcap" else StoragePlugin.SQLITE3
         w = Writer(out, version=8, storage_plugin=plugin)
         w.open()
-        conns = {t: w.add_connection(t, mt, typestore=ts) for t, (mt, _) in topics.items()}
+        conns = {} if "--from-tum" in a else {t: w.add_connection(t, mt, typestore=ts) for t, (mt, _) in topics.items()}
         ser = lambda m, mt: ts.serialize_cdr(m, mt)
+    if "--from-tum" in a:
+        mt = "geometry_msgs/msg/PoseStamped"
+        conn = w.add_connection("/mocap/body", mt, typestore=ts)
+        for line in open(a[a.index("--from-tum") + 1]):
+            f = line.split()
+            if not f or f[0].startswith("#"):
+                continue
+            sec, frac = f[0].split(".")
+            ns = int(sec) * 10**9 + int(frac.ljust(9, "0")[:9])
+            r = [ns, ns] + [float(x) for x in f[1:8]]
+            w.write(conn, ns, bytes(ser(topics["/vicon/body"][1](r), mt)))
+        w.close()
+        return
     for k, (t, (mt, make)) in enumerate(topics.items()):
         rows = poses(n, k)
         truth[t] = rows
