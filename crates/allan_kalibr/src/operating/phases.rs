@@ -4,10 +4,12 @@
 //! throttle, and a user asks which of them reach the estimator in which phase.
 //!
 //! A window ([`WINDOW_S`] long, half-overlapping, Hann) is **moving** when the signal below
-//! the band's lower edge carries more than a static sensor's drift (RMS above
-//! [`MOVING_RATE`] rad/s or [`MOVING_ACC`] m/s², the record check's motion thresholds);
+//! the band's lower edge carries, beyond the window's own noise floor, more than a static
+//! sensor's drift (an RMS above [`MOVING_RATE`] rad/s or [`MOVING_ACC`] m/s², the record
+//! check's motion thresholds, over the three axes);
 //! among the others it is **still** when the power above the edge is within
-//! [`STILL_VIBRATION`] times the quietest windows' (their 10th percentile), else
+//! [`STILL_VIBRATION`] times the quietest windows' (their 10th percentile) and no frequency
+//! there stands [`LINE_RATIO`] times above the quietest windows' (a rotor's line), else
 //! **vibrating** (motors on, on the ground). Runs shorter than [`MIN_PHASE_WINDOWS`] join
 //! the phase before them. The longest still stretch, when long enough
 //! ([`STILL_MIN_S`]), gives a static IEEE 952 value ([`still_analysis`]).
@@ -26,6 +28,12 @@ pub const MOVING_RATE: f64 = 0.05;
 pub const MOVING_ACC: f64 = 0.15;
 /// A window is still when its high band's power is within this factor of the quietest.
 pub const STILL_VIBRATION: f64 = 3.0;
+/// A resting window is vibrating when a frequency above the edge, averaged over
+/// ±[`LINE_SMOOTH_WINDOWS`] windows, is this many times the quietest resting windows' there
+/// (a rotor's line; with ~7 degrees of freedom the noise alone passes it once in ~10⁸ bins).
+pub const LINE_RATIO: f64 = 8.0;
+/// Windows either side averaged for the line test.
+pub const LINE_SMOOTH_WINDOWS: usize = 2;
 /// Shortest phase, windows.
 pub const MIN_PHASE_WINDOWS: usize = 4;
 /// The shortest still stretch that gives a static value, s (the IEEE 952 fit's N is
@@ -178,10 +186,29 @@ pub fn phases(
             .sum()
     };
     let find = |sensor: Sensor| spec.sensors.iter().find(|s| s.0 == sensor).map(|s| &s.1);
+    // the power below the edge beyond the window's own noise floor (its median density
+    // above the edge, carried down): the noise alone gives about zero
+    let excess = |s: &Vec<Vec<f64>>, j: usize| -> f64 {
+        let mut hi: Vec<f64> = spec
+            .freq
+            .iter()
+            .zip(&s[j])
+            .filter(|(f, _)| **f >= split)
+            .map(|(_, p)| *p)
+            .collect();
+        let floor = if hi.is_empty() {
+            0.0
+        } else {
+            let k = hi.len() / 2;
+            *hi.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        let low = spec.freq.iter().filter(|f| **f < split).count() as f64;
+        (power(s, j, true) - floor * low * df).max(0.0)
+    };
     let moving: Vec<bool> = (0..windows)
         .map(|j| {
-            find(Sensor::Gyro).is_some_and(|s| power(s, j, true).sqrt() > MOVING_RATE)
-                || find(Sensor::Acc).is_some_and(|s| power(s, j, true).sqrt() > MOVING_ACC)
+            find(Sensor::Gyro).is_some_and(|s| excess(s, j).sqrt() > MOVING_RATE)
+                || find(Sensor::Acc).is_some_and(|s| excess(s, j).sqrt() > MOVING_ACC)
         })
         .collect();
     let vib_src = find(Sensor::Acc).or(find(Sensor::Gyro));
@@ -198,11 +225,48 @@ pub fn phases(
         let k = quiet.len() / 10;
         *quiet.select_nth_unstable_by(k, f64::total_cmp).1
     };
+    // a line that comes and goes: each bin above the edge, averaged over
+    // ±LINE_SMOOTH_WINDOWS windows, against the quietest tenth of the resting windows there
+    let line_ratio: Vec<f64> = match vib_src {
+        Some(s) => {
+            let rest: Vec<usize> = (0..windows).filter(|&j| !moving[j]).collect();
+            let smooth = |j: usize, k: usize| {
+                let (a, b) = (
+                    j.saturating_sub(LINE_SMOOTH_WINDOWS),
+                    (j + LINE_SMOOTH_WINDOWS).min(windows - 1),
+                );
+                (a..=b).map(|i| s[i][k]).sum::<f64>() / (b - a + 1) as f64
+            };
+            let bins: Vec<usize> = (0..spec.freq.len())
+                .filter(|&k| spec.freq[k] >= split)
+                .collect();
+            let reference: Vec<f64> = bins
+                .iter()
+                .map(|&k| {
+                    let mut v: Vec<f64> = rest.iter().map(|&j| smooth(j, k)).collect();
+                    if v.is_empty() {
+                        return f64::INFINITY;
+                    }
+                    let q = v.len() / 10;
+                    *v.select_nth_unstable_by(q, f64::total_cmp).1
+                })
+                .collect();
+            (0..windows)
+                .map(|j| {
+                    bins.iter()
+                        .zip(&reference)
+                        .map(|(&k, r)| smooth(j, k) / r.max(f64::MIN_POSITIVE))
+                        .fold(0.0, f64::max)
+                })
+                .collect()
+        }
+        None => vec![0.0; windows],
+    };
     let kind: Vec<PhaseKind> = (0..windows)
         .map(|j| {
             if moving[j] {
                 PhaseKind::Moving
-            } else if vib[j] <= STILL_VIBRATION * quiet {
+            } else if vib[j] <= STILL_VIBRATION * quiet && line_ratio[j] <= LINE_RATIO {
                 PhaseKind::Still
             } else {
                 PhaseKind::Vibrating

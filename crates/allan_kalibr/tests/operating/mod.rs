@@ -545,3 +545,133 @@ fn operating_flags_and_references_that_cannot_run() {
     );
     assert!(!out.exists(), "nothing is written");
 }
+
+/// A flight log without a reference, written by the test itself: 90 s on the ground with
+/// the motors off, 60 s with them idling (a rotor line at 62 Hz on the accelerometer, no
+/// motion), 120 s of flight (the hand-held motion, the rotor line moved to 81 Hz with the
+/// throttle). The analysis finds the three phases in order with each phase's line, takes
+/// the static value from the still stretch, and counts the rotor line as operating noise.
+#[test]
+fn a_flight_log_by_phase_without_a_reference() {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    let d = tempfile::tempdir().unwrap();
+    let rate = 400.0;
+    let (still, idle, fly) = (90.0, 60.0, 120.0);
+    let (ng, na) = (1.5e-3, 1.8e-2);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(33);
+    let mut n = || -> f64 { StandardNormal.sample(&mut rng) };
+    let mut csv = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    let count = ((still + idle + fly) * rate) as usize;
+    for k in 0..count {
+        let t = k as f64 / rate;
+        let (w, f, line) = if t < still {
+            (
+                nalgebra::Vector3::zeros(),
+                nalgebra::Vector3::new(0.0, 0.0, record::G),
+                None,
+            )
+        } else if t < still + idle {
+            (
+                nalgebra::Vector3::zeros(),
+                nalgebra::Vector3::new(0.0, 0.0, record::G),
+                Some(62.0),
+            )
+        } else {
+            let (_, _, w, f) = record::body(t - still - idle, true);
+            (w, f, Some(81.0))
+        };
+        let mut v = [w.x, w.y, w.z, f.x, f.y, f.z];
+        for (a, x) in v.iter_mut().enumerate() {
+            *x += if a < 3 { ng } else { na } * rate.sqrt() * n();
+        }
+        if let Some(fl) = line {
+            v[3] += 0.5 * (2.0 * std::f64::consts::PI * fl * t).sin();
+            v[4] += 0.3 * (2.0 * std::f64::consts::PI * fl * t + 1.0).sin();
+        }
+        csv.push_str(&format!(
+            "{},{:e},{:e},{:e},{:e},{:e},{:e}\n",
+            record::T0_NS + (t * 1e9).round() as i64,
+            v[0],
+            v[1],
+            v[2],
+            v[3],
+            v[4],
+            v[5]
+        ));
+    }
+    let imu = d.path().join("flight.csv");
+    std::fs::write(&imu, csv).unwrap();
+    let out = d.path().join("out");
+    let (text, _) = run(&[
+        imu.to_str().unwrap(),
+        "--operating",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    eprintln!("{text}");
+    let phases = csv_rows(&out.join("operating_phases.csv"));
+    let mut kinds: Vec<(String, f64, f64)> = Vec::new();
+    for r in &phases {
+        let k = (
+            field(r, "kind").to_string(),
+            num(r, "t_start_s"),
+            num(r, "t_end_s"),
+        );
+        if kinds.last() != Some(&k) {
+            kinds.push(k);
+        }
+    }
+    let names: Vec<&str> = kinds.iter().map(|k| k.0.as_str()).collect();
+    assert_eq!(names, ["still", "vibrating", "moving"], "{kinds:?}");
+    // the phase boundaries within a spectrogram window (2 s) of the truth
+    assert!(
+        (kinds[1].1 - still).abs() < 2.5 && (kinds[2].1 - still - idle).abs() < 2.5,
+        "{kinds:?}"
+    );
+    let line_of = |kind: &str| -> Vec<f64> {
+        phases
+            .iter()
+            .filter(|r| field(r, "kind") == kind && axis_index(r) == 3)
+            .flat_map(|r| {
+                field(r, "lines")
+                    .split(';')
+                    .filter(|s| !s.is_empty())
+                    .map(|s| s.split(':').next().unwrap().parse::<f64>().unwrap())
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    assert!(
+        line_of("vibrating")
+            .iter()
+            .any(|f| (f / 62.0 - 1.0).abs() < LINE_FREQ_REL_TOL),
+        "{:?}",
+        line_of("vibrating")
+    );
+    assert!(
+        line_of("moving")
+            .iter()
+            .any(|f| (f / 81.0 - 1.0).abs() < LINE_FREQ_REL_TOL),
+        "{:?}",
+        line_of("moving")
+    );
+    assert!(line_of("still").is_empty(), "{:?}", line_of("still"));
+    // the static value from the still stretch, and the rotor line in the operating density
+    assert!(text.contains("still stretch"), "{text}");
+    for row in csv_rows(&out.join("operating_noise.csv")) {
+        let a = axis_index(&row);
+        let st = num(&row, "static_noise_density");
+        let nd = if a < 3 { ng } else { na };
+        assert!((st / nd - 1.0).abs() < N_REL_TOL, "axis {a}: static {st:e}");
+        if a == 3 {
+            assert!(
+                num(&row, "ratio") > 1.05,
+                "the rotor line lifts acc x: {row:?}"
+            );
+        }
+    }
+}

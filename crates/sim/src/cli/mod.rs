@@ -231,11 +231,11 @@ pub struct BagArgs {
     /// `allan_kalibr BAG --reference FILE` should find.
     #[arg(long, value_name = "FILE")]
     pub reference_out: Option<PathBuf>,
-    /// The reference's rate [Hz] (a motion-capture system's: 100–120) [default: --rate].
+    /// The reference's rate, Hz (a motion-capture system's: 100–120); default: --rate.
     #[arg(long, value_name = "HZ", requires = "reference_out")]
     pub reference_rate: Option<f64>,
-    /// The reference's clock runs this far ahead of the IMU's [s] (the IMU sample stamped t
-    /// is the reference at t + offset).
+    /// How far the reference's clock runs ahead of the IMU's, s (the IMU sample stamped t is
+    /// the reference at t + offset).
     #[arg(
         long,
         value_name = "S",
@@ -244,13 +244,13 @@ pub struct BagArgs {
         requires = "reference_out"
     )]
     pub reference_offset: f64,
-    /// The reference's white noise, POS,ROT [m, rad] per coordinate.
+    /// The reference's white noise per coordinate, POS,ROT in m and rad.
     #[arg(long, value_name = "POS,ROT", requires = "reference_out")]
     pub reference_noise: Option<String>,
-    /// The IMU's rotation on the body, roll,pitch,yaw [deg] (ZYX, IMU -> body).
+    /// The IMU's rotation on the body, roll,pitch,yaw in degrees (ZYX, IMU -> body).
     #[arg(long, value_name = "R,P,Y", allow_negative_numbers = true)]
     pub imu_rotation: Option<String>,
-    /// The IMU's origin in the body frame, x,y,z [m].
+    /// The IMU's origin in the body frame, x,y,z in m.
     #[arg(long, value_name = "X,Y,Z", allow_negative_numbers = true)]
     pub lever_arm: Option<String>,
     /// Scale error of both sensors (relative; the axes get s, -s/2, 0.7 s).
@@ -261,7 +261,7 @@ pub struct BagArgs {
         default_value_t = 0.0
     )]
     pub scale_error: f64,
-    /// Misalignment of both sensors [rad] (symmetric; the pairs get m, -m/2, 0.7 m).
+    /// Misalignment of both sensors, rad (symmetric; the pairs get m, -m/2, 0.7 m).
     #[arg(
         long,
         value_name = "RAD",
@@ -269,7 +269,7 @@ pub struct BagArgs {
         default_value_t = 0.0
     )]
     pub misalignment: f64,
-    /// The gyro's g-sensitivity on its diagonal [rad/s per m/s^2].
+    /// The gyro's g-sensitivity on its diagonal, rad/s per m/s^2.
     #[arg(
         long,
         value_name = "G",
