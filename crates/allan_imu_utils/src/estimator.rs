@@ -118,7 +118,7 @@ const FACTORS_PER_SWEEP: usize = 8;
 /// Overlapping Allan variances of one axis for every factor, in factor order
 /// (`calcVariance`): groups of consecutive factors in parallel, each group in one
 /// cache-blocked sweep over θ (`allan_kalibr::second_diff_sums`, the same sums as
-/// [`second_diff_sum`] bit for bit).
+/// `second_diff_sum` bit for bit).
 pub fn allan_variance(theta: &[f64], factors: &[usize], period: f64) -> Vec<f64> {
     let n = theta.len();
     factors

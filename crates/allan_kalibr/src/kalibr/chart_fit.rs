@@ -18,11 +18,13 @@ pub struct ChartFit {
     pub sigavg: Vec<f64>,
     /// 1-based index of the NaN-ignoring minimum of `sigavg` (first if tied), if any.
     pub minid: Option<usize>,
-    /// 1-based first index of the grid τ nearest to 1 s, and that τ.
+    /// 1-based first index of the grid τ nearest to 1 s.
     pub tauid1: usize,
+    /// The grid τ nearest to 1 s, s.
     pub tau_at1: f64,
-    /// 1-based first index of the grid τ nearest to 3 s, and that τ.
+    /// 1-based first index of the grid τ nearest to 3 s.
     pub tauid2: usize,
+    /// The grid τ nearest to 3 s, s.
     pub tau_at2: f64,
     /// Intercept (natural log) of the −½ line; NaN when its window has no finite point.
     pub c1: f64,
