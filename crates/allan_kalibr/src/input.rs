@@ -435,7 +435,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn issue21_a_measured_rate_is_said_without_float_noise() {
+    fn a_measured_rate_is_said_without_float_noise() {
         assert_eq!(snap_rate(62.49998612009537), 62.5);
         assert_eq!(snap_rate(199.3), 199.0);
         assert_eq!(snap_rate(33.333333), 33.333333);

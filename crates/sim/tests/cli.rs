@@ -275,7 +275,7 @@ fn spline_self_check_passes_and_from_model_writes_bag_and_text() {
 }
 
 #[test]
-fn defect_12_time_range_and_size_are_checked_up_front() {
+fn time_range_and_size_are_checked_up_front() {
     let d = tempfile::tempdir().unwrap();
     // The last stamp would pass 2^32 s (and saturate, jumping back): refused, exit 2.
     let out = crate::common::sim()
@@ -322,7 +322,7 @@ fn defect_12_time_range_and_size_are_checked_up_front() {
 }
 
 #[test]
-fn defect_14_one_error_convention() {
+fn one_error_convention() {
     let d = tempfile::tempdir().unwrap();
     let cases: [(&[&str], i32, &str); 4] = [
         (
@@ -363,7 +363,7 @@ fn defect_14_one_error_convention() {
 use bag2mat::test_tools::temp_files_in as temps;
 
 #[test]
-fn defect_08_sigterm_and_sigint_remove_temp_files() {
+fn sigterm_and_sigint_remove_temp_files() {
     let d = tempfile::tempdir().unwrap();
     for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGINT, 130)] {
         let mut child = crate::common::sim()
