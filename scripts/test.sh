@@ -8,6 +8,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# Every `docs/…md §N` citation in the code names a section that exists (seconds, no build).
+/usr/bin/python3 scripts/doc_citations.py
+
 need=()
 command -v rosbag >/dev/null 2>&1 || need+=(python3-rosbag)
 command -v octave >/dev/null 2>&1 || need+=(octave)

@@ -10,7 +10,7 @@ use bag2mat::{DataImu, write_data_imu};
 use crate::common::{CASES, final_full, process_lines, rel_err};
 
 /// The four numbers read back from imu.yaml: they are written in shortest round-trip form,
-/// so they carry the run's value exactly; vs the reference the spec's 1e-9 applies.
+/// so they carry the run's value exactly; vs the reference the 1e-9 of docs/upstream/kalibr_allan.md §7 applies.
 const NUMBERS_REL_TOL: f64 = 1e-9;
 /// The outputs a successful run writes.
 const OUTPUTS: [&str; 6] = [

@@ -1,4 +1,4 @@
-//! The bagconvert rules (kalibr_allan `9d38ea9` `bagconvert/src/main.cpp`, kalibr_allan.md §1):
+//! The bagconvert rules (kalibr_allan `9d38ea9` `bagconvert/src/main.cpp`, docs/upstream/kalibr_allan.md §1):
 //! one row `[record time, acc x y z, gyro x y z]` per Imu message of the topic, in
 //! record-time order, `t = sec + 1e-9·nsec` in double; the output goes beside the bag as
 //! `<stem>.mat`. Unlike bagconvert, a missing topic is an error (bagconvert writes an empty

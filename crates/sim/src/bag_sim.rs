@@ -1,5 +1,5 @@
 //! `sim bag`: the IMU bag of vio_data_simulation `ros_version` `gener_alldata.cpp`
-//! (spec §4), written with bag2mat's [`BagWriter`].
+//! (docs/upstream/vio_data_simulation.md §4), written with bag2mat's [`BagWriter`].
 //!
 //! Defaults reproduce the seed's run: static level IMU, 200 Hz, 14400 s on the
 //! double-accumulated grid ⇒ 2 880 001 messages, medium preset, topic `imu` (no slash),
@@ -147,7 +147,7 @@ impl ImuBagSink {
             }
         };
         // `header.seq` stays 0 and the covariances zero, as upstream's default-constructed
-        // message (quirk_03, spec §4).
+        // message (quirk_03, docs/upstream/vio_data_simulation.md §4).
         let imu = Imu {
             frame_id: frame_id.to_string(),
             ..Imu::default()
@@ -441,7 +441,7 @@ mod tests {
     #[test]
     fn default_count_is_upstream() {
         assert_eq!(message_count(200.0, 14400.0), 2_880_001);
-        // The 2 h txt tool's count (spec §4).
+        // The 2 h txt tool's count (docs/upstream/vio_data_simulation.md §4).
         assert_eq!(message_count(200.0, 7200.0), 1_440_000);
     }
 

@@ -162,7 +162,7 @@ fn traj_writes_the_upstream_files() {
             && o.join("keyframe/all_lines_0.txt").exists()
     );
     let first = std::fs::read_to_string(o.join("imu_pose.txt")).unwrap();
-    // Spec §2.1 sanity values at t = 0, as upstream prints them (%g, trailing space).
+    // docs/upstream/vio_data_simulation.md §2.1 sanity values at t = 0, as upstream prints them (%g, trailing space).
     assert_eq!(
         first.lines().next().unwrap(),
         "0 0.99875 0.0499792 0 0 20 5 5 0 0.230364 0.292623 -1.48044 0.979366 9.76099 "
@@ -193,7 +193,7 @@ fn integrate_prints_the_table_and_reads_traj_files() {
             .map(|x| x.parse().unwrap())
             .collect()
     };
-    // Reading the 6-digit text changes the results only in the 4th digit (spec §6).
+    // Reading the 6-digit text changes the results only in the 4th digit (docs/upstream/vio_data_simulation.md §6).
     let (e, m) = (row("clean", "euler"), row("clean", "midpoint"));
     assert!((0.9..=1.1).contains(&e[0]), "euler final {}", e[0]);
     assert!(m[0] <= 0.02, "midpoint final {}", m[0]);

@@ -11,7 +11,7 @@
 //!
 //! Sample count: `--samples` or `--duration`, else inferred where the grid implies it (with a
 //! note saying how), else unknown: then the analysis gives no intervals and says so.
-//! * imu_utils: its grid ends at the largest power of two ≤ N/2 (imu_utils.md §3.4), so
+//! * imu_utils: its grid ends at the largest power of two ≤ N/2 (docs/upstream/imu_utils.md §3.4), so
 //!   2·maxStride ≤ N < 4·maxStride; the lower end is used (conservative intervals).
 //! * kalibr_allan: its grid ends at m = ⌊(N − 1)/2⌋, so N = 2m + 1 (to ±1).
 //! * allan_variance_ros: a period has a value only with ≥ 2 bins, so the record is about
@@ -28,7 +28,7 @@ use bag2mat::Sensor;
 mod imu_utils;
 use imu_utils::{imu_utils_name, read_imu_utils};
 
-/// imu_utils' rad→deg constant (imu_utils.md §0): its gyro curves are in (rad/s)·57.3·3600.
+/// imu_utils' rad→deg constant (docs/upstream/imu_utils.md §0): its gyro curves are in (rad/s)·57.3·3600.
 pub const IMU_UTILS_PSEUDO_DEG_H: f64 = 57.3 * 3600.0;
 /// allan_variance_ros' period step: period = 0.1·p s.
 pub const AVR_PERIOD_STEP: f64 = 0.1;
