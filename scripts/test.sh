@@ -40,6 +40,14 @@ if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, 
   "$venv/bin/python" -m pip install -q "${pins[@]}"
 fi
 
+# House rules (ARCHITECTURE.md): formatted, clippy-clean with every lint an error (the
+# workspace's [workspace.lints] included: documented public items, SAFETY comments on unsafe
+# blocks), docs that build without a warning (broken and private links), no module cycles.
+cargo fmt --all -- --check
+cargo clippy --workspace --all-targets -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+# (module cycles: scripts/module_cycles.py joins this list once ieee952 has none)
+
 cargo test --workspace "$@"
 
 # Issue 10's accuracy studies of the IEEE 952 estimator (ignored by a plain `cargo test`;
