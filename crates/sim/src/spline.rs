@@ -1,5 +1,5 @@
 //! `sim`'s side of the workspace's one B-spline ([`allan_kalibr::spline`]): the self-check
-//! of Spline Fusion against the analytic ellipse model (vio_data_simulation.md §7.5), which
+//! of Spline Fusion against the analytic ellipse model (docs/upstream/vio_data_simulation.md §7.5), which
 //! needs `sim`'s motion model, and the names `sim spline` uses from the spline.
 
 use allan_kalibr::spline::so3;
@@ -26,13 +26,13 @@ pub struct SelfCheck {
 pub const SELF_CHECK_GYRO_TOL: f64 = 1e-5;
 /// Accel tolerance of the self-check (issue 5): m/s².
 pub const SELF_CHECK_ACC_TOL: f64 = 1e-3;
-/// Knot poses must be reproduced this closely by the interpolating fit (spec §7.5).
+/// Knot poses must be reproduced this closely by the interpolating fit (docs/upstream/vio_data_simulation.md §7.5).
 pub const SELF_CHECK_KNOT_TOL: f64 = 1e-9;
 
 /// Sample the analytic ellipse model's poses at `pose_rate` Hz on [0, 20] s (t_j = j/rate,
 /// in memory), fit, evaluate at twice the pose rate (knot and mid-knot times) with
 /// `trim_knots` knots trimmed at each end, and compare with the analytic gyro/acc
-/// (spec §7.5).
+/// (docs/upstream/vio_data_simulation.md §7.5).
 pub fn self_check(pose_rate: f64, fit: Fit, trim_knots: usize) -> Result<SelfCheck> {
     let poses = model_poses(20.0, pose_rate);
     let knots = knots_from_poses(&poses, None)?;
@@ -91,7 +91,7 @@ mod tests {
 
     #[test]
     fn self_check_interp_200hz_meets_issue_thresholds() {
-        // Issue 5 / spec §7.5: gyro ≤ 1e-5 rad/s, acc ≤ 1e-3 m/s², knots < 1e-9
+        // Issue 5 / docs/upstream/vio_data_simulation.md §7.5: gyro ≤ 1e-5 rad/s, acc ≤ 1e-3 m/s², knots < 1e-9
         // (the prototype reached 1.5e-10 and 2.0e-4).
         let c = self_check(200.0, Fit::Interp, 10).expect("fit");
         assert!(
@@ -115,7 +115,7 @@ mod tests {
 
     #[test]
     fn self_check_30hz_informative_tier() {
-        // Spec §7.5: interp with 30 Hz poses 8.4e-7 / 9.0e-3, tolerance 1e-5 / 2e-2.
+        // docs/upstream/vio_data_simulation.md §7.5: interp with 30 Hz poses 8.4e-7 / 9.0e-3, tolerance 1e-5 / 2e-2.
         let c = self_check(30.0, Fit::Interp, 10).expect("fit");
         assert!(c.max_gyro_err <= 1e-5, "gyro err {:.3e}", c.max_gyro_err);
         assert!(c.max_acc_err <= 2e-2, "acc err {:.3e}", c.max_acc_err);
@@ -125,7 +125,7 @@ mod tests {
     fn approx_smooths_and_is_worse_than_interp() {
         let a = self_check(200.0, Fit::Approx, 10).expect("fit");
         let i = self_check(200.0, Fit::Interp, 10).expect("fit");
-        // Spec §7.5: approx at 200 Hz 1.2e-6 / 5.1e-4.
+        // docs/upstream/vio_data_simulation.md §7.5: approx at 200 Hz 1.2e-6 / 5.1e-4.
         assert!(
             a.max_gyro_err > i.max_gyro_err,
             "approx {:.3e} vs interp {:.3e}",
@@ -141,7 +141,7 @@ mod tests {
 
     #[test]
     fn knot_shift_is_caught() {
-        // Spec §7.3 item 4: an off-by-one knot shift gives ≈ Δt·jerk ≈ 0.157 m/s² — the
+        // docs/upstream/vio_data_simulation.md §7.3 item 4: an off-by-one knot shift gives ≈ Δt·jerk ≈ 0.157 m/s² — the
         // comparison against the truth must see it.
         let poses = model_poses(20.0, 200.0);
         let knots = knots_from_poses(&poses, None).unwrap();

@@ -1,4 +1,4 @@
-//! The upstream text layouts (vio_data_simulation.md §5), read and written. Writers go
+//! The upstream text layouts (docs/upstream/vio_data_simulation.md §5), read and written. Writers go
 //! through bag2mat's atomic file helper; numbers use [`bag2mat::shared::cfmt`] for upstream parity
 //! (`%g`, 6 significant digits) or the shortest round-trip form for full precision.
 

@@ -7,7 +7,7 @@
 //! (scale, misalignment, g-sensitivity), timing errors — and, when the motion is known only
 //! through a reference, the reference's own error. The analysis separates them:
 //!
-//! * **With a reference** ([`reference`], [`calibrate`]): the continuous-time B-spline
+//! * **With a reference** ([`reference`](mod@reference), [`calibrate`]): the continuous-time B-spline
 //!   ([`crate::spline`]) is fitted to the poses with the knot spacing that leaves the widest
 //!   clean band (its own error, model and reference noise, is estimated for each candidate);
 //!   it predicts the body rate and the specific force; the IMU-to-reference rotation, the
@@ -28,7 +28,7 @@
 //! error. [`phases`] cuts the record by flight phase (still, vibrating in place, moving) on
 //! the signal's spectrogram and gives each phase its lines and density; its longest still
 //! stretch gives a static value when no `--static` record or value is given. The outputs
-//! ([`files`], [`plot`], [`report`]) are `operating_noise.csv`, `operating_lines.csv`,
+//! (`files`, `plot`, `report`) are `operating_noise.csv`, `operating_lines.csv`,
 //! `operating_phases.csv`, `operating_calibration.yaml`, the residual PSD chart and the
 //! spectrogram, and the Kalibr/VINS/ORB-SLAM3/OpenVINS/Basalt files with the operating values
 //! (`operating_*`), the static analysis' beside them (`static_*`).

@@ -1,14 +1,14 @@
 //! Spline Fusion: a uniform cumulative cubic B-spline on ℝ³ × SO(3) (the *split*
 //! representation, as basalt `Se3Spline` and kontiki `SplitTrajectory`), fitted to
-//! timestamped poses, and the IMU readings derived from it (vio_data_simulation.md §7).
+//! timestamped poses, and the IMU readings derived from it (docs/upstream/vio_data_simulation.md §7).
 //!
 //! The workspace's one B-spline: `sim spline` synthesises IMU data from poses with it, and
 //! the operating-noise analysis ([`crate::operating`]) predicts what an IMU riding a
 //! reference trajectory reads. It lives here, not in `sim`, because `sim` depends on this
 //! crate (for `sim compare`): the simulator uses the estimator's spline, never a copy.
 //!
-//! Layers, as sophus-rs splits them: [`basis`] (the blending matrix C and its derivatives),
-//! [`segment`] (four control points at u ∈ [0, 1]), [`so3`] (exp/log), and here the spline
+//! Layers, as sophus-rs splits them: `basis` (the blending matrix C and its derivatives),
+//! `segment` (four control points at u ∈ [0, 1]), [`so3`] (exp/log), and here the spline
 //! (knot times in integer nanoseconds, control points, segment lookup) and the fit.
 //!
 //! ```text
@@ -22,7 +22,7 @@
 //! accel = Rᵀ (p̈ − g_w),  g_w = (0, 0, −9.81)  ⇒ a level IMU at rest reads +9.81 on z
 //! ```
 //! Accel comes from the ℝ³ part, never from the body twist vee(T⁻¹Ṫ) (that would miss
-//! the −ω×(Rᵀṗ) term; spec §7.3 item 2).
+//! the −ω×(Rᵀṗ) term; docs/upstream/vio_data_simulation.md §7.3 item 2).
 //!
 //! End pads are second-order extrapolations: c₋₁ = 3c₀ − 3c₁ + c₂ and
 //! R₋₁ = R₀·exp(2·log(R₁ᵀR₀) − log(R₂ᵀR₁)), mirrored at the end. `Fit::Approx` uses the
@@ -80,7 +80,7 @@ pub enum Fit {
 /// Convergence threshold of the interpolation fit (m and rad): a few hundred ulps of the
 /// trajectory's coordinates (tens of metres).
 pub const FIT_TOLERANCE: f64 = 1e-12;
-/// The fit fails after this many iterations (typically 26–34 are needed; spec §7.4).
+/// The fit fails after this many iterations (typically 26–34 are needed; docs/upstream/vio_data_simulation.md §7.4).
 pub const FIT_MAX_ITER: usize = 200;
 /// Relaxation factor of the fixed-point fit: the knot operator's eigenvalues lie in
 /// [1/3, 1], so 1.5 gives a contraction factor ≤ 0.5.
@@ -271,7 +271,7 @@ impl SplitSpline {
     }
 
     /// Segment index j and u for time `t_ns`, clamped to the valid range (t = τ_last falls
-    /// in the last segment with u = 1; spec §7.3 item 4).
+    /// in the last segment with u = 1; docs/upstream/vio_data_simulation.md §7.3 item 4).
     pub fn index_and_u(&self, t_ns: i64) -> (usize, f64) {
         let (a, b) = self.range_ns();
         let t = t_ns.clamp(a, b) - self.t0_ns;
@@ -328,7 +328,7 @@ pub struct Knots {
 
 /// Choose the knot spacing (`knot_dt_ns` or the median input spacing) and, when the input is
 /// uniform at that spacing within max(1 µs, 1e-3·Δt), use the poses as knots; otherwise
-/// resample at τ_j = t₀ + j·Δt (spec §7.4 items 2–3).
+/// resample at τ_j = t₀ + j·Δt (docs/upstream/vio_data_simulation.md §7.4 items 2–3).
 pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots> {
     if poses.len() < 4 {
         return Err(SplineError::Fit(format!(
@@ -404,7 +404,7 @@ mod tests {
 
     #[test]
     fn static_input_reads_gravity_only() {
-        // Spec §7.3 item 3 / §7.5: all poses equal ⇒ gyro 0, acc = Rᵀ(0, 0, 9.81) to 1e-12.
+        // docs/upstream/vio_data_simulation.md §7.3 item 3 / §7.5: all poses equal ⇒ gyro 0, acc = Rᵀ(0, 0, 9.81) to 1e-12.
         let r = so3::exp(&Vector3::new(0.3, -0.2, 1.0));
         let knots = vec![(Vector3::new(1.0, 2.0, 3.0), r); 10];
         let (s, _) = SplitSpline::fit(0, 5_000_000, &knots, Fit::Interp).expect("fit");
