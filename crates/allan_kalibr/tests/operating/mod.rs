@@ -251,6 +251,209 @@ fn a_moving_record_is_refused_by_default_and_the_refusal_names_the_operating_ana
     assert!(!out.join("operating_noise.csv").exists());
 }
 
+/// The static side of the ratio: a static record of the same IMU (`--static LOG`) gives
+/// `static_noise_density` equal to that record's own IEEE 952 N, the ratio is N_op over it,
+/// and the static analysis' configuration files lie beside the operating ones (each saying
+/// which it is); a given value (`--static-density GYRO,ACC`) is used as given. The same run
+/// checks what the calibration estimated against what the writer injected.
+#[test]
+fn the_ratio_to_a_static_record_or_a_given_density_and_the_calibration() {
+    let d = tempfile::tempdir().unwrap();
+    let rest_dir = d.path().join("rest");
+    let move_dir = d.path().join("moving");
+    std::fs::create_dir_all(&rest_dir).unwrap();
+    std::fs::create_dir_all(&move_dir).unwrap();
+    let rest = record::write(
+        &rest_dir,
+        &record::Spec {
+            seconds: 600.0,
+            ..static_spec(41)
+        },
+    );
+    let spec = record::Spec::handheld(200.0, 200.0, 150.0, 42);
+    let w = record::write(&move_dir, &spec);
+    let dir = |s: &str| d.path().join(s);
+    // the static analysis of the static record alone
+    run(&[
+        rest.imu.to_str().unwrap(),
+        "-o",
+        dir("alone").to_str().unwrap(),
+        "-q",
+    ]);
+    let mut stat = [f64::NAN; 6];
+    for row in csv_rows(&dir("alone").join("ieee952_terms.csv")) {
+        if field(&row, "term") == "N" {
+            stat[axis_index(&row)] = num(&row, "value");
+        }
+    }
+    let out = dir("out");
+    let (text, _) = run(&[
+        w.imu.to_str().unwrap(),
+        "--reference",
+        w.reference.to_str().unwrap(),
+        "--static",
+        rest.imu.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(text.contains("inflate:"), "{text}");
+    let want = spec.expected();
+    let mut n_max = [0.0f64; 2];
+    for row in csv_rows(&out.join("operating_noise.csv")) {
+        let a = axis_index(&row);
+        let (n, st, r) = (
+            num(&row, "noise_density"),
+            num(&row, "static_noise_density"),
+            num(&row, "ratio"),
+        );
+        assert!(
+            (st / stat[a] - 1.0).abs() < PRINTED_REL_TOL,
+            "axis {a}: static {st:e}, the static record's own N {:e}",
+            stat[a]
+        );
+        assert!(
+            (r / (n / st) - 1.0).abs() < PRINTED_REL_TOL,
+            "axis {a}: ratio {r}"
+        );
+        let (rl, rh) = (num(&row, "ratio_ci95_lo"), num(&row, "ratio_ci95_hi"));
+        assert!(rl < r && r < rh, "axis {a}: ratio {r} [{rl}, {rh}]");
+        // the measured inflation factor against the injected one
+        let truth = want[a] / spec.n[a / 3];
+        assert!(
+            (r / truth - 1.0).abs() < N_REL_TOL + STATIC_REL_TOL,
+            "axis {a}: ratio {r}, injected {truth}"
+        );
+        n_max[a / 3] = n_max[a / 3].max(n);
+    }
+    // the configuration files: the operating values (the largest axis) in operating_*, the
+    // static record's own analysis' values (its configuration file's) in static_* beside
+    // them, each saying which it is
+    let op_file = out.join("operating_kalibr_imu_ieee952.yaml");
+    let st_file = out.join("static_kalibr_imu_ieee952.yaml");
+    let alone = dir("alone").join("kalibr_imu_ieee952.yaml");
+    let (alone_g, alone_a) = (
+        yaml(&alone, "gyroscope_noise_density"),
+        yaml(&alone, "accelerometer_noise_density"),
+    );
+    for (file, want_g, want_a, says) in [
+        (&op_file, n_max[0], n_max[1], "OPERATING-CONDITION VALUES"),
+        (&st_file, alone_g, alone_a, "IEEE 952"),
+    ] {
+        let g = yaml(file, "gyroscope_noise_density");
+        let a = yaml(file, "accelerometer_noise_density");
+        assert!(
+            (g / want_g - 1.0).abs() < CONFIG_REL_TOL && (a / want_a - 1.0).abs() < CONFIG_REL_TOL,
+            "{}: {g:e} {a:e} vs {want_g:e} {want_a:e}",
+            file.display()
+        );
+        let t = std::fs::read_to_string(file).unwrap();
+        assert!(t.contains(says), "{}", file.display());
+    }
+    assert!(
+        !std::fs::read_to_string(&st_file)
+            .unwrap()
+            .contains("OPERATING-CONDITION"),
+        "the static file is not labelled operating"
+    );
+    // what a calibration would estimate, against what was injected (the writer's maps:
+    // A = (I + S) R with S symmetric, so S is exactly the injected scale/misalignment)
+    let cal = out.join("operating_calibration.yaml");
+    let sym = |s: f64, m: f64| {
+        [
+            s,
+            m,
+            -0.5 * m,
+            m,
+            -0.5 * s,
+            0.7 * m,
+            -0.5 * m,
+            0.7 * m,
+            0.7 * s,
+        ]
+    };
+    for (name, injected) in [
+        ("gyro", sym(spec.scale, spec.misalign)),
+        ("acc", sym(-0.8 * spec.scale, 1.3 * spec.misalign)),
+    ] {
+        let got = yaml_list(&cal, &format!("{name}_scale_misalignment"));
+        let se = yaml_list(&cal, &format!("{name}_scale_misalignment_std_err"));
+        for k in 0..9 {
+            eprintln!(
+                "{name} S[{k}]: {:+.5} ± {:.5} (injected {:+.5})",
+                got[k], se[k], injected[k]
+            );
+            assert!(
+                (got[k] - injected[k]).abs() < CALIBRATION_SE * se[k] + CALIBRATION_ABS,
+                "{name} scale/misalignment [{k}]: {} ± {}, injected {}",
+                got[k],
+                se[k],
+                injected[k]
+            );
+        }
+        assert!(
+            text_of(&cal).contains(&format!("{name}_scale_misalignment_excited: true")),
+            "{name}: the hand-held motion excites scale and misalignment"
+        );
+    }
+    let lever = yaml_list(&cal, "lever_arm_m");
+    for (k, (got, inj)) in lever.iter().zip(spec.lever).enumerate() {
+        assert!(
+            (got - inj).abs() < LEVER_TOL,
+            "lever arm [{k}]: {got} vs {inj}"
+        );
+    }
+    let gs = yaml_list(&cal, "gyro_g_sensitivity_rad_s_per_m_s2");
+    for k in [0, 4, 8] {
+        assert!(
+            (gs[k] - spec.g_sens).abs() < CALIBRATION_ABS,
+            "g-sensitivity [{k}]: {} vs {}",
+            gs[k],
+            spec.g_sens
+        );
+    }
+    // a given static value is used as it is given
+    let out2 = dir("given");
+    run(&[
+        w.imu.to_str().unwrap(),
+        "--reference",
+        w.reference.to_str().unwrap(),
+        "--static-density",
+        "1e-3,1.5e-2",
+        "-o",
+        out2.to_str().unwrap(),
+        "-q",
+    ]);
+    for row in csv_rows(&out2.join("operating_noise.csv")) {
+        let a = axis_index(&row);
+        let given = [1e-3, 1.5e-2][a / 3];
+        assert_eq!(num(&row, "static_noise_density"), given, "axis {a}");
+        let r = num(&row, "ratio");
+        assert!(
+            (r / (num(&row, "noise_density") / given) - 1.0).abs() < PRINTED_REL_TOL,
+            "axis {a}: ratio {r}"
+        );
+    }
+    assert!(!out2.join("static_kalibr_imu_ieee952.yaml").exists());
+}
+
+/// Numbers printed to the CSVs round-trip; ratios of printed numbers agree to this.
+const PRINTED_REL_TOL: f64 = 1e-9;
+/// The configuration files print 6 significant digits or more.
+const CONFIG_REL_TOL: f64 = 1e-5;
+/// A calibrated term within this many of its stated standard errors …
+const CALIBRATION_SE: f64 = 4.0;
+/// … plus this (0.02 % of scale, 0.2 mrad, 2e-5 rad/s per m/s²: a tenth of the smallest
+/// injected error, room for what the spline leaves in the prediction).
+const CALIBRATION_ABS: f64 = 2e-4;
+/// The lever arm within 5 mm (a hand-held motion's angular accelerations of a few rad/s²
+/// make a few mm visible).
+const LEVER_TOL: f64 = 5e-3;
+
+fn text_of(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// `key: [a, b, c]` of a flat yaml file.
 fn yaml_list(path: &Path, key: &str) -> Vec<f64> {
     let text = std::fs::read_to_string(path).unwrap();
