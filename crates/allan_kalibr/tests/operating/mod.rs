@@ -472,7 +472,8 @@ fn yaml_list(path: &Path, key: &str) -> Vec<f64> {
 /// `sim bag --motion handheld --reference-out` writes a record with its truth; analysed
 /// with that reference (a 120 Hz motion capture with its noise, under a 400 Hz IMU with
 /// its mounting errors), the operating densities, the lines and the offset match the
-/// truth file's.
+/// truth file's, and each line says where it lands for an estimator reading the IMU at
+/// 100 Hz (`--estimator-rate`).
 #[test]
 fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
     let d = tempfile::tempdir().unwrap();
@@ -537,6 +538,8 @@ fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
         bag.to_str().unwrap(),
         "--reference",
         reference.to_str().unwrap(),
+        "--estimator-rate",
+        "100",
         "-o",
         out.to_str().unwrap(),
         "-q",
@@ -564,6 +567,18 @@ fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
             "axis {a}: no line at {f} Hz"
         );
     }
+    // an estimator reading this 400 Hz IMU at 100 Hz: the 53 Hz lines fold to 47 Hz, the
+    // 29 Hz line stays where it is (below the estimator's 50 Hz Nyquist frequency)
+    for r in &lines {
+        let f = num(r, "frequency_hz");
+        let al = num(r, "alias_hz");
+        if (f / 53.0 - 1.0).abs() < LINE_FREQ_REL_TOL {
+            assert!((al - (100.0 - f)).abs() < 1e-9, "{f} Hz aliases to {al}");
+        } else if f < 50.0 {
+            assert!(al.is_nan(), "{f} Hz does not alias: {al}");
+        }
+    }
+    assert!(text.contains("aliases to 47."), "{text}");
     let dt = yaml(&out.join("operating_calibration.yaml"), "time_offset_s");
     assert!(
         (dt - yaml(&truth, "time_offset_s")).abs() < OFFSET_TOL,
