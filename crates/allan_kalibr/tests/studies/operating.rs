@@ -25,7 +25,7 @@ const MIN_COVERAGE: f64 = 0.92;
 const MAX_COVERAGE: f64 = 0.985;
 
 #[test]
-#[ignore = "issue 42's coverage study: about 8 minutes on two cores (scripts/test.sh runs it)"]
+#[ignore = "the operating interval's coverage study: about 4 minutes on two busy cores (scripts/test.sh runs it)"]
 fn operating_interval_coverage_study() {
     let setups: [(&str, f64, f64, (f64, f64)); 2] = [
         ("200 Hz IMU, reference 200 Hz", 200.0, 200.0, (0.0, 0.0)),
