@@ -169,6 +169,14 @@ fn operating_density_offset_and_lines_against_a_reference_at_the_imu_rate() {
 }
 
 #[test]
+fn operating_density_offset_and_lines_of_a_100_hz_imu() {
+    check_against_injected(
+        &record::Spec::handheld(100.0, 100.0, 240.0, 3),
+        "100 Hz, reference 100 Hz",
+    );
+}
+
+#[test]
 fn operating_density_offset_and_lines_against_a_motion_capture_reference() {
     check_against_injected(
         &record::Spec::handheld(400.0, 120.0, 240.0, 2),
