@@ -40,6 +40,9 @@ pub struct Args {
     /// Replay upstream's running-mean recursion: curves bit-identical to kalibr_allan (slower).
     #[arg(long)]
     pub bit_exact: bool,
+    /// The operating-noise analysis: the noise the estimator will see in a moving record.
+    #[command(flatten)]
+    pub operating: crate::operating::OperatingArgs,
 }
 
 /// The tool's name: its default output folder is `<input stem>_allan_kalibr/`.
@@ -50,6 +53,17 @@ impl TryFrom<Args> for Config {
 
     fn try_from(a: Args) -> Result<Config, Self::Error> {
         a.common.curve_flags_need_curves(&[])?;
+        let operating = a.operating.resolve()?;
+        if operating.is_some() && a.common.input.is_none() {
+            return Err(bag2mat::shared::cli::UsageError(
+                "--reference and --operating analyse samples, not --curves".into(),
+            ));
+        }
+        if operating.is_some() && (a.bit_exact || a.common.compat_only) {
+            return Err(bag2mat::shared::cli::UsageError(
+                "--bit-exact and --compat-only are for the static Allan analysis, not --reference or --operating".into(),
+            ));
+        }
         // a text log without a time column is sampled at --rate
         let text_rate = crate::front::rate_for_text(a.common.input.as_deref(), a.common.rate);
         Ok(Config {
@@ -60,6 +74,7 @@ impl TryFrom<Args> for Config {
             } else {
                 Estimator::PrefixSum
             },
+            operating,
         })
     }
 }

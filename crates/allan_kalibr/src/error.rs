@@ -48,4 +48,7 @@ pub enum Error {
     /// `--curves` input that cannot be read.
     #[error(transparent)]
     Curves(#[from] crate::ieee952::curves_in::CurvesError),
+    /// The operating-noise analysis cannot run (`--reference`, `--operating`).
+    #[error(transparent)]
+    Operating(#[from] crate::operating::OperatingError),
 }

@@ -16,6 +16,11 @@
 //!   ([`gen_chart`], [`ChartFit`]); `kalibr::report`, the exact printed text
 //!   ([`chart_lines`], [`final_lines`]); `kalibr::curves`, the CSV; `kalibr::chart`, the two
 //!   charts.
+//! * [`operating`]: the noise the estimator will see — the operating-condition noise density
+//!   of a moving record against a reference trajectory (`--reference`) or from the signal
+//!   alone (`--operating`), with its interval, ratio to the static value and breakdown.
+//! * [`spline`]: the workspace's one continuous-time B-spline (Spline Fusion), which the
+//!   operating analysis predicts the IMU with and `sim spline` synthesises it with.
 //! * `yaml`: Kalibr imu.yaml and the YAML spelling both halves write.
 //! * `input`: `.mat`/`.bag` loading and the update-rate check ([`load_input`],
 //!   [`snap_rate`]); `run`: the whole job ([`run()`], [`Config`]).
@@ -63,7 +68,9 @@ mod front;
 mod ieee952;
 mod input;
 mod kalibr;
+pub mod operating;
 mod run;
+pub mod spline;
 mod yaml;
 
 pub use cli::{Args, TOOL};

@@ -29,6 +29,9 @@ pub struct Config {
     pub title: String,
     /// Fast prefix sums or the bit-exact recursion.
     pub estimator: Estimator,
+    /// The operating-noise analysis instead of the static one (`--reference`,
+    /// `--operating`).
+    pub operating: Option<crate::operating::Settings>,
 }
 
 impl Config {
@@ -38,6 +41,7 @@ impl Config {
             common: crate::front::Common::new(input, out_dir),
             title: String::new(),
             estimator: Estimator::PrefixSum,
+            operating: None,
         }
     }
 }
@@ -128,6 +132,9 @@ impl std::fmt::Display for Timings {
 pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Error> {
     if let crate::front::Input::Curves(curves) = &config.common.input {
         return Ok(vec![run_curves(config, curves, outputs)?]);
+    }
+    if let Some(s) = &config.operating {
+        return crate::operating::sections(config, s, outputs);
     }
     Ok(run(config, outputs)?
         .into_iter()
@@ -362,7 +369,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
 
 /// The finiteness and value checks of each column present (`absent`: the sensor the record
 /// lacks): a column that cannot be analysed is an error, a doubtful one a warning in `notes`.
-fn check_scans(
+pub(crate) fn check_scans(
     scans: &[input::ColumnScan; 6],
     absent: Option<bag2mat::Sensor>,
     notes: &mut Vec<Note>,
@@ -506,7 +513,11 @@ fn write_outputs(
 
 /// `--skip-start`: drops the samples of the first `seconds` of the record, said in `notes`
 /// (a warning when that is most of it).
-fn skip_start(data: &mut ImuData, seconds: f64, notes: &mut Vec<Note>) -> Result<(), Error> {
+pub(crate) fn skip_start(
+    data: &mut ImuData,
+    seconds: f64,
+    notes: &mut Vec<Note>,
+) -> Result<(), Error> {
     let (k, warning) = bag2mat::checked_skip(&data.t, seconds)?;
     data.drop_first(k);
     notes.extend(warning.map(Note::warning));

@@ -9,6 +9,7 @@ mod consumers;
 mod front;
 mod ieee952;
 mod logs;
+mod operating;
 mod outputs_and_messages;
 mod record_checks;
 mod reference;

@@ -9,6 +9,7 @@
 mod accuracy;
 mod bandlimited;
 mod lines;
+mod operating;
 mod profiles;
 mod real;
 mod stable32;

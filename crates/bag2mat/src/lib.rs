@@ -26,6 +26,9 @@
 //! * `mat`: the N×7 `data_imu` MAT file of kalibr_allan's `bagconvert`, read and written
 //!   ([`DataImu`], [`read_data_imu`], [`write_data_imu`]); `convert`: the bagconvert rules
 //!   (rows, output paths) and the csv/npy alternatives ([`OutputFormat`], [`write_matrix`]).
+//! * `poses`: reference trajectories ([`read_poses`]): a TUM file, the EuRoC/ASL ground
+//!   truth, or a pose/odometry topic of a bag (`poses::msg`: `PoseStamped`,
+//!   `PoseWithCovarianceStamped`, `TransformStamped`, `Odometry`, ROS 1 and CDR).
 //! * `info`: what an input holds ([`info()`]) (`bag2mat info`); `record_check`: is a record
 //!   fit for an Allan analysis ([`check_record`]: clocks, duplicates, gaps through `timing`
 //!   ([`analyse_timing`]), the one gap rule; outliers, warm-up, motion), typed findings
@@ -57,6 +60,7 @@ mod input;
 mod mapped;
 mod mat;
 mod mcap;
+mod poses;
 mod printable;
 mod record_check;
 mod rosbag2;
@@ -92,6 +96,8 @@ pub use info::{InfoReport, TopicInfo, info, info_with};
 pub use input::{open as open_input, read_imu_series, read_imu_topics, read_imu_topics_with};
 pub use mat::{DataImu, read_data_imu, write_data_imu};
 pub use mcap::{ChunkCompression, MAGIC as MCAP_MAGIC};
+pub use poses::msg::{POSE_TYPES, PoseMsg, PoseType, Wire as PoseWire, decode as decode_pose};
+pub use poses::{PoseOptions, PoseSeries, QUAT_NORM_TOL, parse_time_ns, read_poses, read_tum};
 pub use printable::escape as escape_printable;
 pub use record_check::Axis as FindingAxis;
 pub use record_check::warmup::{Fit as WarmupFit, find as find_warmup};

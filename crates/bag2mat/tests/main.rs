@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod duplicated_rows;
 mod logs;
+mod poses;
 mod real_tools;
 mod reference;
 mod ros1_damage_and_outputs;

@@ -49,6 +49,10 @@ pub struct BagConfig {
     pub frame_id: String,
     /// Motion model.
     pub motion: Motion,
+    /// How the IMU sits on the moving body, and its deterministic errors.
+    pub mounting: crate::mounting::Mounting,
+    /// The body's poses written as a reference trajectory beside the bag.
+    pub reference: Option<crate::reference_out::ReferenceOut>,
     /// Chunk compression (ROS 1 bags).
     pub compression: Compression,
     /// Container: a ROS 1 bag (upstream), or a ROS 2 bag directory (Imu as CDR).
@@ -324,7 +328,9 @@ pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
     )?;
     let mut noise = Noise::of(cfg)?;
     // The static model does not depend on t (upstream calls MotionModel(0)): compute it once.
-    let fixed = (cfg.motion == Motion::Static).then(|| cfg.motion.sample(0.0));
+    let mounting = cfg.mounting;
+    let fixed =
+        (cfg.motion == Motion::Static && mounting.is_identity()).then(|| cfg.motion.sample(0.0));
     let to_xyzw = |q: [f64; 4]| [q[1], q[2], q[3], q[0]];
     let fixed_q = fixed.map(|m| to_xyzw(quat_from_matrix(&m.r_wb)));
     // A moving IMU's motion goes through the sensor's low-pass and decimation like its
@@ -349,10 +355,11 @@ pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
         let (mut g, mut a): ([f64; 3], [f64; 3]) = match &mut chain {
             Some(c) => c.output(
                 t,
-                |tau| motion.sample(tau).gyro.into(),
-                |tau| motion.sample(tau).acc.into(),
+                |tau| mounting.reading(motion, tau).0,
+                |tau| mounting.reading(motion, tau).1,
             ),
-            None => (m.gyro.into(), m.acc.into()),
+            None if mounting.is_identity() => (m.gyro.into(), m.acc.into()),
+            None => mounting.reading(motion, t),
         };
         noise.apply(&mut g, &mut a);
         let stamp = RosTime::from_nanos(cfg.start_ns + (t * 1e9).round() as u64);
@@ -372,13 +379,23 @@ pub fn run(cfg: &BagConfig, outputs: &Outputs) -> Result<BagSummary> {
             rate: cfg.rate,
             samples: n as usize,
             seed: cfg.seed,
-            motion: match cfg.motion {
-                Motion::Static => "static",
-                Motion::Ellipse => "ellipse",
-            },
+            motion: cfg.motion.name(),
         },
     )?
     .to_vec();
+    if let Some(r) = &cfg.reference {
+        s.truth.extend(crate::reference_out::write(
+            outputs,
+            r,
+            cfg.motion,
+            &cfg.mounting,
+            &cfg.model,
+            cfg.rate,
+            cfg.duration,
+            cfg.start_ns,
+            cfg.seed,
+        )?);
+    }
     pb.finish_and_clear();
     Ok(s)
 }
@@ -423,7 +440,7 @@ pub(crate) fn now_ns() -> u64 {
 
 /// Parse `--start-time` (UNIX seconds, decimal) into ns, exactly.
 pub(crate) fn parse_start_time(s: &str) -> Result<u64> {
-    match crate::textio::parse_time_ns(s) {
+    match bag2mat::parse_time_ns(s) {
         Some(ns) if (0..=MAX_ROS_NS as i64).contains(&ns) => Ok(ns as u64),
         Some(_) => Err(SimError::InvalidArgument(format!(
             "--start-time {s:?} is outside the ROS time range (0 to 4294967295 s)"

@@ -47,6 +47,17 @@ pub enum SimError {
     Bag(#[from] bag2mat::Error),
 }
 
+/// The spline's errors keep the kinds `sim` always said them as: a setting out of range is
+/// an invalid argument, poses that make no spline a spline error.
+impl From<allan_kalibr::spline::SplineError> for SimError {
+    fn from(e: allan_kalibr::spline::SplineError) -> Self {
+        match e {
+            allan_kalibr::spline::SplineError::Invalid(m) => SimError::InvalidArgument(m),
+            allan_kalibr::spline::SplineError::Fit(m) => SimError::Spline(m),
+        }
+    }
+}
+
 /// What is wrong inside a `--noise-spec` (or truth) file; [`SimError::Spec`] adds the path.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

@@ -4,7 +4,10 @@
 //! * `noise`: continuous ↔ discrete noise parameters (THE place for these conversions in
 //!   the workspace), the seeded `addIMUnoise` generator, and the real-sensor model (every
 //!   IEEE 952 term, the DLPF chain, profiles, spec files) with its exact truth curves.
-//! * `motion`: the analytic models (static level IMU, 20 s ellipse);
+//! * `motion`: the analytic models (static level IMU, 20 s ellipse, hand-held);
+//!   `mounting`: the IMU's rotation, lever arm, scale/misalignment and g-sensitivity on the
+//!   body; `reference_out`: the body's poses as a reference trajectory with its truth
+//!   (`sim bag --reference-out`, the records of `allan_kalibr --reference`);
 //!   `sensor_chain`: a moving IMU's motion through the sensor's low-pass and decimation.
 //! * `grid`: upstream's accumulated time grids.
 //! * `bag_sim`: `sim bag` — the `ros_version` static (or ellipse) IMU bag via bag2mat.
@@ -49,8 +52,10 @@ mod error;
 mod grid;
 mod integrate;
 mod motion;
+mod mounting;
 mod noise;
 mod plot;
+mod reference_out;
 mod report;
 mod rotation;
 mod sensor_chain;
@@ -72,7 +77,8 @@ pub use cli::{Cli, Command};
 pub use command::run;
 pub use error::{Result, SimError};
 pub use motion::MotionSample;
-pub use motion::{Motion, ellipse};
+pub use motion::{Motion, ellipse, handheld};
+pub use mounting::{Mounting, scale_misalignment};
 pub use noise::DiscreteNoise;
 pub use noise::generate::axis_series;
 pub use noise::model::{AxisModel, Chain, Filter, ImuModel, Line, SensorModel};
@@ -82,4 +88,5 @@ pub use noise::truth::AxisTruth;
 pub use noise::truth::{FilteredWhite, TermAvar};
 pub use noise::truth_file::read_model;
 pub use noise::{ContinuousNoise, NoiseGenerator, Preset, white_rw_axis};
+pub use reference_out::{ReferenceOut, expected_operating, truth_path as reference_truth_path};
 pub use rotation::quat_from_matrix;

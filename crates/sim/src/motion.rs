@@ -32,6 +32,10 @@ pub enum Motion {
     Static,
     /// `master`: the 20 s ellipse with sinusoidal z, roll and pitch.
     Ellipse,
+    /// Hand-held: a slow wander of position and attitude as sums of sinusoids (0.3–2 Hz),
+    /// body rates up to about 2 rad/s, accelerations up to about 3 m/s²
+    /// ([`handheld`]): the motion of the operating-noise records.
+    Handheld,
 }
 
 /// Ground truth at one instant (upstream `MotionData`).
@@ -59,7 +63,66 @@ impl Motion {
         match self {
             Motion::Static => static_level(t),
             Motion::Ellipse => ellipse(t),
+            Motion::Handheld => handheld(t),
         }
+    }
+
+    /// The name on the command line and in the truth files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Motion::Static => "static",
+            Motion::Ellipse => "ellipse",
+            Motion::Handheld => "handheld",
+        }
+    }
+}
+
+/// The hand-held motion's terms: amplitude (m or rad), frequency (Hz), phase (rad), per
+/// coordinate. Incommensurate frequencies: the motion does not repeat within a record.
+const HAND_POS: [[(f64, f64, f64); 2]; 3] = [
+    [(0.09, 0.63, 0.0), (0.012, 1.45, 0.8)],
+    [(0.11, 0.41, 1.3), (0.010, 1.72, 0.2)],
+    [(0.05, 0.83, 2.1), (0.008, 1.27, 0.5)],
+];
+/// Roll, pitch, yaw terms (rad, Hz, rad).
+const HAND_ATT: [[(f64, f64, f64); 2]; 3] = [
+    [(0.22, 0.57, 0.4), (0.07, 1.51, 1.1)],
+    [(0.18, 0.47, 0.9), (0.055, 1.83, 0.3)],
+    [(0.45, 0.31, 0.1), (0.08, 1.17, 1.7)],
+];
+
+/// Σ a·sin(2πft + φ) and its first two time derivatives.
+fn sum_of_sines(t: f64, terms: &[(f64, f64, f64)]) -> (f64, f64, f64) {
+    let (mut x, mut v, mut a) = (0.0, 0.0, 0.0);
+    for &(amp, f, ph) in terms {
+        let w = 2.0 * std::f64::consts::PI * f;
+        let (sn, cs) = (w * t + ph).sin_cos();
+        x += amp * sn;
+        v += amp * w * cs;
+        a -= amp * w * w * sn;
+    }
+    (x, v, a)
+}
+
+/// The hand-held motion at time `t` (closed form: ZYX Euler angles and their rates give
+/// the body rate, the positions' second derivative the specific force).
+pub fn handheld(t: f64) -> MotionSample {
+    let pos: [(f64, f64, f64); 3] = std::array::from_fn(|i| sum_of_sines(t, &HAND_POS[i]));
+    let att: [(f64, f64, f64); 3] = std::array::from_fn(|i| sum_of_sines(t, &HAND_ATT[i]));
+    let p = Vector3::new(pos[0].0, pos[1].0, pos[2].0);
+    let v = Vector3::new(pos[0].1, pos[1].1, pos[2].1);
+    let a = Vector3::new(pos[0].2, pos[1].2, pos[2].2);
+    let rpy = Vector3::new(att[0].0, att[1].0, att[2].0);
+    let rates = Vector3::new(att[0].1, att[1].1, att[2].1);
+    let r_wb = euler_to_rotation(rpy);
+    MotionSample {
+        t,
+        r_wb,
+        p,
+        v,
+        a,
+        gyro: euler_rates_to_body_rates(rpy) * rates,
+        acc: r_wb.transpose() * (a - GRAVITY_W),
     }
 }
 
@@ -194,6 +257,26 @@ pub fn static_level(t: f64) -> MotionSample {
 mod tests {
     use super::*;
     use crate::rotation::quat_from_matrix;
+
+    /// The hand-held motion: body rates to about 2 rad/s, accelerations to about 3 m/s²,
+    /// and its body rate is the rotation's own derivative.
+    #[test]
+    fn handheld_is_hand_held_and_consistent() {
+        let (mut w, mut a) = (0.0f64, 0.0f64);
+        for k in 0..30_000 {
+            let t = k as f64 * 0.01;
+            let m = handheld(t);
+            w = w.max(m.gyro.norm());
+            a = a.max(m.a.norm());
+            let h = 1e-6;
+            let (r0, r1) = (handheld(t - h).r_wb, handheld(t + h).r_wb);
+            let d = (r0.transpose() * r1 - r1.transpose() * r0) / (4.0 * h);
+            let num = Vector3::new(d[(2, 1)], d[(0, 2)], d[(1, 0)]);
+            assert!((num - m.gyro).norm() < 1e-6, "t {t}");
+        }
+        assert!(w > 1.5 && w < 2.5, "{w}");
+        assert!(a > 2.0 && a < 3.5, "{a}");
+    }
 
     /// The sanity values of docs/upstream/vio_data_simulation.md §2.1 are printed with 5–6 significant digits.
     const SPEC_DIGITS_TOL: f64 = 1e-5;

@@ -13,10 +13,7 @@ pub fn bag_header(c: &BagConfig) -> String {
     let n = crate::bag_sim::message_count(c.rate, c.duration);
     format!(
         "sim bag: {} motion, {} Hz, {} s -> {} messages on topic '{}' (frame_id '{}'), start {}.{:09}, format {}, compression {}, seed {}\n{}",
-        match c.motion {
-            crate::motion::Motion::Static => "static",
-            crate::motion::Motion::Ellipse => "ellipse",
-        },
+        c.motion.name(),
         c.rate,
         c.duration,
         n,

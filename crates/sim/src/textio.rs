@@ -161,97 +161,25 @@ pub fn read_pose_rows(path: &Path) -> Result<Vec<PoseRow>> {
     Ok(rows)
 }
 
-/// Parse a decimal time in seconds into integer nanoseconds exactly (no f64 rounding for
-/// plain decimals; exponent forms go through f64).
-pub(crate) fn parse_time_ns(s: &str) -> Option<i64> {
-    let s = s.trim();
-    if s.contains(['e', 'E']) {
-        let x: f64 = s.parse().ok()?;
-        return x.is_finite().then(|| (x * 1e9).round() as i64);
-    }
-    let (neg, body) = match s.strip_prefix('-') {
-        Some(b) => (true, b),
-        None => (false, s.strip_prefix('+').unwrap_or(s)),
-    };
-    let (int, frac) = body.split_once('.').unwrap_or((body, ""));
-    if (int.is_empty() && frac.is_empty())
-        || !int.bytes().all(|b| b.is_ascii_digit())
-        || !frac.bytes().all(|b| b.is_ascii_digit())
-    {
-        return None;
-    }
-    let whole: i64 = if int.is_empty() { 0 } else { int.parse().ok()? };
-    let mut ns: i64 = 0;
-    let digits = frac.as_bytes();
-    for k in 0..9 {
-        ns = ns * 10 + digits.get(k).map_or(0, |d| (d - b'0') as i64);
-    }
-    // Round half up on the 10th digit.
-    if digits.get(9).is_some_and(|d| *d >= b'5') {
-        ns += 1;
-    }
-    let v = whole.checked_mul(1_000_000_000)?.checked_add(ns)?;
-    Some(if neg { -v } else { v })
-}
-
-/// Maximum allowed deviation of an input quaternion's norm from 1 (docs/upstream/vio_data_simulation.md §7.4 item 1).
-pub const TUM_QUAT_NORM_TOL: f64 = 1e-3;
-
-/// Read a TUM trajectory `t tx ty tz qx qy qz qw` (`#` comments, any whitespace).
+/// Read a TUM trajectory `t tx ty tz qx qy qz qw` (`#` comments, any whitespace) through
+/// bag2mat's reader (the workspace's one), in file order.
 pub fn read_tum(path: &Path) -> Result<Vec<Pose>> {
-    let text = read_to_string(path)?;
-    let mut out = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let err = |msg: String| SimError::Parse {
-            path: path.into(),
-            line: i + 1,
-            msg,
-        };
-        let mut it = line.split_whitespace();
-        let t = it.next().ok_or_else(|| err("empty line".into()))?;
-        let t_ns = parse_time_ns(t).ok_or_else(|| err(format!("bad time {t:?}")))?;
-        let rest: Vec<&str> = it.collect();
-        let v = parse_fields(path, i + 1, &rest.join(" "), 7)?;
-        let q = [v[6], v[3], v[4], v[5]];
-        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if (n - 1.0).abs() > TUM_QUAT_NORM_TOL {
-            return Err(err(format!(
-                "quaternion norm {n} is not 1 (±{TUM_QUAT_NORM_TOL})"
-            )));
-        }
-        out.push(Pose {
-            t_ns,
-            p: Vector3::new(v[0], v[1], v[2]),
-            r: matrix_from_quat(q),
-        });
-    }
-    Ok(out)
+    let s = bag2mat::read_tum(path)?;
+    Ok((0..s.len())
+        .map(|i| {
+            let [x, y, z, w] = s.orientation[i];
+            Pose {
+                t_ns: s.t_ns[i],
+                p: Vector3::from(s.position[i]),
+                r: matrix_from_quat([w, x, y, z]),
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn time_parsing_is_exact() {
-        assert_eq!(
-            parse_time_ns("1700000000.123456789"),
-            Some(1_700_000_000_123_456_789)
-        );
-        assert_eq!(parse_time_ns("0.033333335"), Some(33_333_335));
-        assert_eq!(parse_time_ns("12"), Some(12_000_000_000));
-        assert_eq!(parse_time_ns(".5"), Some(500_000_000));
-        assert_eq!(parse_time_ns("1.00000000049"), Some(1_000_000_000));
-        assert_eq!(parse_time_ns("1.0000000005"), Some(1_000_000_001));
-        assert_eq!(parse_time_ns("1e-3"), Some(1_000_000));
-        assert_eq!(parse_time_ns("-2.5"), Some(-2_500_000_000));
-        assert_eq!(parse_time_ns("abc"), None);
-        assert_eq!(parse_time_ns("1.2.3"), None);
-    }
 
     #[test]
     fn pose_rows_round_trip_full_precision() {

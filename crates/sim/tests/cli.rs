@@ -409,3 +409,97 @@ fn a_failing_standard_output_is_an_error_not_a_panic() {
     assert!(err.starts_with("sim: error: standard output:"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// The sha256 of `sim spline`'s outputs, recorded with the spline still in `sim` (before it
+/// moved to `allan_kalibr::spline`, the workspace's one B-spline): the move and anything
+/// after it must leave them byte for byte as they were.
+const SPLINE_OUTPUT_SHA256: [(&str, &str); 6] = [
+    (
+        "a/imu.bag",
+        "5d32acea1c5d03faddaa4242c154fc8615e8cca4b2eee26fdb33d78e2711d387",
+    ),
+    (
+        "a/imu_pose.txt",
+        "387286b719190c87347c68d3276e62eddf5d83ba3536536471078cc89aea60a3",
+    ),
+    (
+        "a/imu_pose_noise.txt",
+        "39c4d7964bfc68cd66fa9080287141581666148c608a41e9ae7d92e2286a173f",
+    ),
+    (
+        "b/x.bag",
+        "3b593e5a66485cd990dacc5be519b3f01fbae8b5d9106a55d8c8221f6473a1e5",
+    ),
+    (
+        "c/imu_pose.txt",
+        "5c1432af8e78fdbc82d6fc971082e96d3a5a2cb276627ca9b2d611562b8d559f",
+    ),
+    (
+        "c/imu_pose_noise.txt",
+        "a26c9a32c901fd21b9e4e9cad9d53d7736baacd22d62df50ce3c23a59b4eb455",
+    ),
+];
+
+#[test]
+fn spline_outputs_are_byte_identical_to_the_spline_in_sim() {
+    use sha2::{Digest, Sha256};
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    ok(
+        p,
+        &[
+            "spline",
+            "--from-model",
+            "-o",
+            "a",
+            "--start-time",
+            START,
+            "--seed",
+            "5",
+            "-q",
+        ],
+    );
+    ok(p, &["traj", "-o", "t"]);
+    ok(
+        p,
+        &[
+            "spline",
+            "--poses",
+            "t/imu_pose_tum.txt",
+            "-o",
+            "b/x.bag",
+            "--start-time",
+            START,
+            "--seed",
+            "7",
+            "-q",
+            "--knot-dt",
+            "0.01",
+        ],
+    );
+    ok(
+        p,
+        &[
+            "spline",
+            "--poses",
+            "t/imu_pose_tum.txt",
+            "-o",
+            "c",
+            "--start-time",
+            START,
+            "--fit",
+            "approx",
+            "--rate",
+            "333",
+            "-q",
+        ],
+    );
+    for (file, want) in SPLINE_OUTPUT_SHA256 {
+        let bytes = std::fs::read(p.join(file)).unwrap();
+        let got: String = Sha256::digest(&bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        assert_eq!(got, want, "{file}");
+    }
+}

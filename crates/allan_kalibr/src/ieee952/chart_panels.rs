@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 /// A chart's white page with `title` across the top and the panels of `axes` axes below it,
 /// three to a row.
-pub(super) fn titled_panels<DB: DrawingBackend>(
+pub(crate) fn titled_panels<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     axes: usize,
@@ -30,7 +30,7 @@ where
 /// A panel of the section's charts: log–log axes over `x` × `y`, its caption, the axis
 /// descriptions `desc` (x, y) and the light grid, sized for `scale` (see
 /// [`bag2mat::shared::plot::Figure`]).
-pub(super) fn log_log_panel<'a, DB: DrawingBackend>(
+pub(crate) fn log_log_panel<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: String,
     x: (f64, f64),
@@ -62,7 +62,7 @@ where
 }
 
 /// A log–log panel's drawing context.
-pub(super) type LogLog<'a, DB> = ChartContext<
+pub(crate) type LogLog<'a, DB> = ChartContext<
     'a,
     DB,
     plotters::coord::cartesian::Cartesian2d<
@@ -72,7 +72,7 @@ pub(super) type LogLog<'a, DB> = ChartContext<
 >;
 
 /// The legend of a panel, lower left, sized for `scale`.
-pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a>(
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
     ctx: &mut LogLog<'a, DB>,
     scale: f64,
 ) -> Result<(), Box<dyn std::error::Error>>

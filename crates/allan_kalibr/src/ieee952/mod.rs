@@ -95,13 +95,13 @@ pub(crate) mod noise_id;
 pub(crate) mod oadev;
 pub(crate) mod plot;
 pub(crate) mod psd;
-mod psd_plot;
+pub(crate) mod psd_plot;
 pub(crate) mod region;
 pub(crate) mod stated;
 mod tau_grid;
-mod vio_files;
+pub(crate) mod vio_files;
 
-mod chart_panels;
+pub(crate) mod chart_panels;
 mod config_values;
 mod curve_data;
 mod declare;

@@ -77,6 +77,11 @@ impl Psd {
     pub(crate) fn resolution(&self) -> f64 {
         self.rate / self.segment as f64
     }
+
+    /// Which bins belong to lines (the bins [`floor`] leaves out).
+    pub(crate) fn line_marks(&self) -> &[bool] {
+        &self.marks
+    }
 }
 
 /// A line found in a PSD.

@@ -87,15 +87,15 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
 
 /// One log bin of the chart: its centre frequency, the mean and the largest density in it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Bin {
-    freq: f64,
-    mean: f64,
-    max: f64,
+pub(crate) struct Bin {
+    pub(crate) freq: f64,
+    pub(crate) mean: f64,
+    pub(crate) max: f64,
 }
 
 /// `(freq, density)` averaged over `bins` log-spaced bins between the first and the last
 /// frequency (bins holding no point are left out; a bin's frequency is its points' mean).
-fn log_bins(freq: &[f64], density: &[f64], bins: usize) -> Vec<Bin> {
+pub(crate) fn log_bins(freq: &[f64], density: &[f64], bins: usize) -> Vec<Bin> {
     let (Some(&f0), Some(&f1)) = (freq.first(), freq.last()) else {
         return Vec::new();
     };

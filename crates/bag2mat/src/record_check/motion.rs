@@ -117,7 +117,7 @@ pub fn find(
         first as f64 * wt,
         max_g.to_degrees(),
         if refuse {
-            "motion is not noise, so the IEEE 952 section is not computed (its terms would be the motion's); record the IMU at rest. The upstream-compatible part still runs, as upstream would, and carries the motion in every figure"
+            "motion is not noise, so the IEEE 952 section is not computed (its terms would be the motion's); record the IMU at rest, or measure the noise in operation: allan_kalibr LOG --reference POSES (a reference trajectory), or --operating without one. The upstream-compatible part still runs, as upstream would, and carries the motion in every figure"
         } else {
             "the IMU moved briefly: the terms at τ near those times carry it"
         }

@@ -116,6 +116,9 @@ pub enum MotionArg {
     Static,
     /// The 20 s ellipse (master), repeated.
     Ellipse,
+    /// Hand-held: position and attitude wandering at 0.3–2 Hz, body rates to ~2 rad/s,
+    /// accelerations to ~3 m/s² (with --reference-out: an operating-noise record).
+    Handheld,
 }
 
 /// Bag chunk compression.
@@ -228,6 +231,57 @@ pub struct BagArgs {
     /// Chunk compression (ROS 1: none, bz2, lz4; MCAP: none, zstd, lz4).
     #[arg(long, value_enum, default_value_t = CompressionArg::None)]
     pub compression: CompressionArg,
+    /// Also write the body's poses as a reference trajectory (TUM) to FILE, with
+    /// FILE.truth.yaml: what was injected and the operating noise density
+    /// `allan_kalibr BAG --reference FILE` should find.
+    #[arg(long, value_name = "FILE")]
+    pub reference_out: Option<PathBuf>,
+    /// The reference's rate, Hz (a motion-capture system's: 100–120); default: --rate.
+    #[arg(long, value_name = "HZ", requires = "reference_out")]
+    pub reference_rate: Option<f64>,
+    /// How far the reference's clock runs ahead of the IMU's, s (the IMU sample stamped t is
+    /// the reference at t + offset).
+    #[arg(
+        long,
+        value_name = "S",
+        allow_negative_numbers = true,
+        default_value_t = 0.0,
+        requires = "reference_out"
+    )]
+    pub reference_offset: f64,
+    /// The reference's white noise per coordinate, POS,ROT in m and rad.
+    #[arg(long, value_name = "POS,ROT", requires = "reference_out")]
+    pub reference_noise: Option<String>,
+    /// The IMU's rotation on the body, roll,pitch,yaw in degrees (ZYX, IMU -> body).
+    #[arg(long, value_name = "R,P,Y", allow_negative_numbers = true)]
+    pub imu_rotation: Option<String>,
+    /// The IMU's origin in the body frame, x,y,z in m.
+    #[arg(long, value_name = "X,Y,Z", allow_negative_numbers = true)]
+    pub lever_arm: Option<String>,
+    /// Scale error of both sensors (relative; the axes get s, -s/2, 0.7 s).
+    #[arg(
+        long,
+        value_name = "S",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
+    pub scale_error: f64,
+    /// Misalignment of both sensors, rad (symmetric; the pairs get m, -m/2, 0.7 m).
+    #[arg(
+        long,
+        value_name = "RAD",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
+    pub misalignment: f64,
+    /// The gyro's g-sensitivity on its diagonal, rad/s per m/s^2.
+    #[arg(
+        long,
+        value_name = "G",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
+    pub g_sensitivity: f64,
     /// No progress bar and no parameter report (errors are still printed)
     #[arg(short, long)]
     pub quiet: bool,
@@ -244,6 +298,7 @@ impl TryFrom<BagArgs> for BagConfig {
             None => now_ns(),
         };
         crate::bag_sim::validate_rate(a.rate)?;
+        let mounting = mounting_of(&a)?;
         let format = bag_format(a.format, a.compression)?;
         let out = a.output.unwrap_or_else(|| {
             PathBuf::from(if format == crate::bag_sim::BagFormat::Ros1 {
@@ -264,6 +319,28 @@ impl TryFrom<BagArgs> for BagConfig {
             motion: match a.motion {
                 MotionArg::Static => Motion::Static,
                 MotionArg::Ellipse => Motion::Ellipse,
+                MotionArg::Handheld => Motion::Handheld,
+            },
+            mounting,
+            reference: match &a.reference_out {
+                Some(p) => Some(crate::reference_out::ReferenceOut {
+                    path: p.clone(),
+                    rate: positive("--reference-rate", a.reference_rate.unwrap_or(a.rate))?,
+                    offset: finite("--reference-offset", a.reference_offset)?,
+                    noise: match &a.reference_noise {
+                        Some(s) => {
+                            let v = numbers("--reference-noise", s, 2)?;
+                            if v.iter().any(|x| *x < 0.0) {
+                                return Err(SimError::InvalidArgument(format!(
+                                    "--reference-noise {s:?}: noise levels cannot be negative"
+                                )));
+                            }
+                            (v[0], v[1])
+                        }
+                        None => (0.0, 0.0),
+                    },
+                }),
+                None => None,
             },
             compression: if format == crate::bag_sim::BagFormat::Ros1 {
                 a.compression.into()
@@ -276,6 +353,55 @@ impl TryFrom<BagArgs> for BagConfig {
         crate::bag_sim::validate(&cfg)?;
         Ok(cfg)
     }
+}
+
+/// `count` comma-separated finite numbers of the flag `name`.
+fn numbers(name: &str, s: &str, count: usize) -> Result<Vec<f64>> {
+    let v: std::result::Result<Vec<f64>, _> =
+        s.split(',').map(|x| x.trim().parse::<f64>()).collect();
+    match v {
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(SimError::InvalidArgument(format!(
+            "{name} {s:?}: give {count} comma-separated numbers"
+        ))),
+    }
+}
+
+fn finite(name: &str, v: f64) -> Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(SimError::InvalidArgument(format!(
+            "{name} must be a finite number, got {v}"
+        )))
+    }
+}
+
+/// The IMU's mounting and errors from `sim bag`'s flags.
+fn mounting_of(a: &BagArgs) -> Result<crate::mounting::Mounting> {
+    use nalgebra::{Matrix3, Vector3};
+    let rotation = match &a.imu_rotation {
+        Some(s) => {
+            let v = numbers("--imu-rotation", s, 3)?;
+            crate::motion::euler_to_rotation(Vector3::new(v[0], v[1], v[2]).map(f64::to_radians))
+        }
+        None => Matrix3::identity(),
+    };
+    let lever = match &a.lever_arm {
+        Some(s) => Vector3::from_vec(numbers("--lever-arm", s, 3)?),
+        None => Vector3::zeros(),
+    };
+    let sm = crate::mounting::scale_misalignment(
+        finite("--scale-error", a.scale_error)?,
+        finite("--misalignment", a.misalignment)?,
+    );
+    Ok(crate::mounting::Mounting {
+        rotation,
+        lever,
+        gyro_sm: sm,
+        acc_sm: sm,
+        g_sens: Matrix3::from_diagonal_element(finite("--g-sensitivity", a.g_sensitivity)?),
+    })
 }
 
 /// `sim traj`.
@@ -527,7 +653,7 @@ pub struct SplineArgs {
 fn time_arg(name: &str, s: &Option<String>) -> Result<Option<i64>> {
     s.as_ref()
         .map(|s| {
-            crate::textio::parse_time_ns(s).ok_or_else(|| {
+            bag2mat::parse_time_ns(s).ok_or_else(|| {
                 SimError::InvalidArgument(format!("{name} {s:?} is not a number of seconds"))
             })
         })

@@ -2,8 +2,13 @@
 //! representation, as basalt `Se3Spline` and kontiki `SplitTrajectory`), fitted to
 //! timestamped poses, and the IMU readings derived from it (docs/upstream/vio_data_simulation.md §7).
 //!
-//! Layers, as sophus-rs splits them: [`basis`] (the blending matrix C and its derivatives),
-//! [`segment`] (four control points at u ∈ [0, 1]), [`so3`] (exp/log), and here the spline
+//! The workspace's one B-spline: `sim spline` synthesises IMU data from poses with it, and
+//! the operating-noise analysis ([`crate::operating`]) predicts what an IMU riding a
+//! reference trajectory reads. It lives here, not in `sim`, because `sim` depends on this
+//! crate (for `sim compare`): the simulator uses the estimator's spline, never a copy.
+//!
+//! Layers, as sophus-rs splits them: `basis` (the blending matrix C and its derivatives),
+//! `segment` (four control points at u ∈ [0, 1]), [`so3`] (exp/log), and here the spline
 //! (knot times in integer nanoseconds, control points, segment lookup) and the fit.
 //!
 //! ```text
@@ -24,13 +29,33 @@
 //! poses as control points (the spline then smooths by ≈ Δt²/6·p̈); `Fit::Interp` iterates
 //! c_j ← c_j·exp(1.5 r_j), r_j = log(R_spl(τ_j)ᵀ R_j), p_j += 1.5 (p_j − p_spl(τ_j)),
 //! re-extrapolating the pads, until the largest knot residual is below 1e-12.
+//! [`SplitSpline::fit_least_squares`] (`lsq`) fits poses at any times with knots at any
+//! spacing instead: the fit of a reference trajectory, whose poses are noisy and not on
+//! the knots.
 
 pub(crate) mod basis;
+mod lsq;
 pub(crate) mod segment;
-pub(crate) mod so3;
+pub mod so3;
 
-use crate::error::{Result, SimError};
+pub use lsq::{LSQ_MAX_ITER, LSQ_TOLERANCE, LsqReport, SMOOTHING};
+
 use nalgebra::{Matrix3, Vector3};
+
+/// Why a spline cannot be built; `sim` says the first kind as an invalid argument.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SplineError {
+    /// A setting is out of range (a knot spacing that is not positive).
+    #[error("{0}")]
+    Invalid(String),
+    /// The poses do not make a spline (too few, not increasing, too far apart, no
+    /// convergence).
+    #[error("{0}")]
+    Fit(String),
+}
+
+/// The spline's results.
+pub type Result<T> = std::result::Result<T, SplineError>;
 
 /// A timestamped pose (body → world).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,6 +109,8 @@ pub struct SplineSample {
     pub p: Vector3<f64>,
     /// Velocity (world), m/s.
     pub v: Vector3<f64>,
+    /// Acceleration (world), m/s².
+    pub a: Vector3<f64>,
     /// Rotation body → world.
     pub r: Matrix3<f64>,
     /// Body angular velocity, rad/s.
@@ -113,10 +140,10 @@ impl SplitSpline {
     ) -> Result<(Self, FitReport)> {
         let m = knots.len();
         if m < 4 {
-            return Err(SimError::Spline(format!("need at least 4 poses, got {m}")));
+            return Err(SplineError::Fit(format!("need at least 4 poses, got {m}")));
         }
         if dt_ns <= 0 {
-            return Err(SimError::Spline(format!(
+            return Err(SplineError::Fit(format!(
                 "knot spacing must be positive, got {dt_ns} ns"
             )));
         }
@@ -124,7 +151,7 @@ impl SplitSpline {
         for j in 1..m {
             let ang = so3::log(&(knots[j - 1].1.transpose() * knots[j].1)).norm();
             if ang >= std::f64::consts::FRAC_PI_2 {
-                return Err(SimError::Spline(format!(
+                return Err(SplineError::Fit(format!(
                     "poses {} and {j} differ by {:.1}° (≥ 90°): the rotation between knots is ambiguous; use a smaller --knot-dt or denser poses",
                     j - 1,
                     ang.to_degrees()
@@ -160,7 +187,7 @@ impl SplitSpline {
                 break;
             }
             if report.iterations == FIT_MAX_ITER {
-                return Err(SimError::Spline(format!(
+                return Err(SplineError::Fit(format!(
                     "interpolation fit did not converge in {FIT_MAX_ITER} iterations (residual {mp:.3e} m, {mr:.3e} rad)"
                 )));
             }
@@ -277,6 +304,7 @@ impl SplitSpline {
             t_ns,
             p,
             v,
+            a,
             r,
             gyro,
             acc,
@@ -303,14 +331,14 @@ pub struct Knots {
 /// resample at τ_j = t₀ + j·Δt (docs/upstream/vio_data_simulation.md §7.4 items 2–3).
 pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots> {
     if poses.len() < 4 {
-        return Err(SimError::Spline(format!(
+        return Err(SplineError::Fit(format!(
             "need at least 4 poses, got {}",
             poses.len()
         )));
     }
     for (i, w) in poses.windows(2).enumerate() {
         if w[1].t_ns <= w[0].t_ns {
-            return Err(SimError::Spline(format!(
+            return Err(SplineError::Fit(format!(
                 "pose times must increase strictly: pose {} at {} ns, pose {} at {} ns",
                 i,
                 w[0].t_ns,
@@ -324,7 +352,7 @@ pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots
     let median = gaps[gaps.len() / 2];
     let h = knot_dt_ns.unwrap_or(median);
     if h <= 0 {
-        return Err(SimError::InvalidArgument(format!(
+        return Err(SplineError::Invalid(format!(
             "knot spacing must be positive, got {h} ns"
         )));
     }
@@ -357,7 +385,7 @@ pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots
         tau += h;
     }
     if out.len() < 4 {
-        return Err(SimError::Spline(format!(
+        return Err(SplineError::Fit(format!(
             "knot spacing {h} ns leaves only {} knots",
             out.len()
         )));
@@ -370,136 +398,9 @@ pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots
     })
 }
 
-/// Result of [`self_check`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SelfCheck {
-    /// The fit's report.
-    pub fit: FitReport,
-    /// Max ‖spline gyro − analytic gyro‖ away from the ends, rad/s.
-    pub max_gyro_err: f64,
-    /// Max ‖spline acc − analytic acc‖ away from the ends, m/s².
-    pub max_acc_err: f64,
-    /// Max knot pose error (position m, rotation rad), over all knots.
-    pub max_knot_err: f64,
-    /// Number of comparison instants.
-    pub samples: usize,
-}
-
-/// Gyro tolerance of the self-check (issue 5): rad/s.
-pub const SELF_CHECK_GYRO_TOL: f64 = 1e-5;
-/// Accel tolerance of the self-check (issue 5): m/s².
-pub const SELF_CHECK_ACC_TOL: f64 = 1e-3;
-/// Knot poses must be reproduced this closely by the interpolating fit (docs/upstream/vio_data_simulation.md §7.5).
-pub const SELF_CHECK_KNOT_TOL: f64 = 1e-9;
-
-/// Sample the analytic ellipse model's poses at `pose_rate` Hz on [0, 20] s (t_j = j/rate,
-/// in memory), fit, evaluate at twice the pose rate (knot and mid-knot times) with
-/// `trim_knots` knots trimmed at each end, and compare with the analytic gyro/acc
-/// (docs/upstream/vio_data_simulation.md §7.5).
-pub fn self_check(pose_rate: f64, fit: Fit, trim_knots: usize) -> Result<SelfCheck> {
-    let poses = model_poses(20.0, pose_rate);
-    let knots = knots_from_poses(&poses, None)?;
-    let (spline, report) = SplitSpline::fit(knots.t0_ns, knots.dt_ns, &knots.poses, fit)?;
-    let mut max_knot_err = 0.0f64;
-    for p in &poses {
-        let s = spline.sample(p.t_ns);
-        max_knot_err = max_knot_err
-            .max((s.p - p.p).norm())
-            .max(so3::log(&(s.r.transpose() * p.r)).norm());
-    }
-    let (a, b) = spline.range_ns();
-    let half = spline.dt_ns() / 2;
-    let (mut t, end) = (
-        a + trim_knots as i64 * spline.dt_ns(),
-        b - trim_knots as i64 * spline.dt_ns(),
-    );
-    let (mut mg, mut ma, mut n) = (0.0f64, 0.0f64, 0);
-    while t <= end {
-        let s = spline.sample(t);
-        let m = crate::motion::ellipse(t as f64 * 1e-9);
-        mg = mg.max((s.gyro - m.gyro).norm());
-        ma = ma.max((s.acc - m.acc).norm());
-        n += 1;
-        t += half;
-    }
-    Ok(SelfCheck {
-        fit: report,
-        max_gyro_err: mg,
-        max_acc_err: ma,
-        max_knot_err,
-        samples: n,
-    })
-}
-
-/// Poses of the analytic ellipse model at t_j = j/rate on [0, duration] (exact grid).
-pub fn model_poses(duration: f64, rate: f64) -> Vec<Pose> {
-    crate::grid::Grid::Exact
-        .times(duration, rate)
-        .enumerate()
-        .map(|(j, t)| {
-            let m = crate::motion::ellipse(t);
-            Pose {
-                t_ns: (j as f64 * 1e9 / rate).round() as i64,
-                p: m.p,
-                r: m.r_wb,
-            }
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn self_check_interp_200hz_meets_issue_thresholds() {
-        // Issue 5 / docs/upstream/vio_data_simulation.md §7.5: gyro ≤ 1e-5 rad/s, acc ≤ 1e-3 m/s², knots < 1e-9
-        // (the prototype reached 1.5e-10 and 2.0e-4).
-        let c = self_check(200.0, Fit::Interp, 10).expect("fit");
-        assert!(
-            c.max_gyro_err <= SELF_CHECK_GYRO_TOL,
-            "gyro err {:.3e} > {SELF_CHECK_GYRO_TOL:e}",
-            c.max_gyro_err
-        );
-        assert!(
-            c.max_acc_err <= SELF_CHECK_ACC_TOL,
-            "acc err {:.3e} > {SELF_CHECK_ACC_TOL:e}",
-            c.max_acc_err
-        );
-        assert!(
-            c.max_knot_err < SELF_CHECK_KNOT_TOL,
-            "knot err {:.3e} ≥ {SELF_CHECK_KNOT_TOL:e}",
-            c.max_knot_err
-        );
-        assert!(c.fit.iterations > 0 && c.fit.iterations < FIT_MAX_ITER);
-        assert_eq!(c.samples, 2 * (4001 - 1 - 20) + 1, "comparison instants");
-    }
-
-    #[test]
-    fn self_check_30hz_informative_tier() {
-        // docs/upstream/vio_data_simulation.md §7.5: interp with 30 Hz poses 8.4e-7 / 9.0e-3, tolerance 1e-5 / 2e-2.
-        let c = self_check(30.0, Fit::Interp, 10).expect("fit");
-        assert!(c.max_gyro_err <= 1e-5, "gyro err {:.3e}", c.max_gyro_err);
-        assert!(c.max_acc_err <= 2e-2, "acc err {:.3e}", c.max_acc_err);
-    }
-
-    #[test]
-    fn approx_smooths_and_is_worse_than_interp() {
-        let a = self_check(200.0, Fit::Approx, 10).expect("fit");
-        let i = self_check(200.0, Fit::Interp, 10).expect("fit");
-        // docs/upstream/vio_data_simulation.md §7.5: approx at 200 Hz 1.2e-6 / 5.1e-4.
-        assert!(
-            a.max_gyro_err > i.max_gyro_err,
-            "approx {:.3e} vs interp {:.3e}",
-            a.max_gyro_err,
-            i.max_gyro_err
-        );
-        assert!(
-            a.max_knot_err > 1e-6,
-            "approx should not reproduce the knots: {:.3e}",
-            a.max_knot_err
-        );
-    }
 
     #[test]
     fn static_input_reads_gravity_only() {
@@ -517,55 +418,5 @@ mod tests {
                 x.acc
             );
         }
-    }
-
-    #[test]
-    fn knot_shift_is_caught() {
-        // docs/upstream/vio_data_simulation.md §7.3 item 4: an off-by-one knot shift gives ≈ Δt·jerk ≈ 0.157 m/s² — the
-        // comparison against the truth must see it.
-        let poses = model_poses(20.0, 200.0);
-        let knots = knots_from_poses(&poses, None).unwrap();
-        let (s, _) = SplitSpline::fit(
-            knots.t0_ns + knots.dt_ns,
-            knots.dt_ns,
-            &knots.poses,
-            Fit::Interp,
-        )
-        .unwrap();
-        let m = crate::motion::ellipse(10.0);
-        let err = (s.sample(10_000_000_000).acc - m.acc).norm();
-        assert!(err > 0.05, "shifted spline acc err {err}");
-    }
-
-    #[test]
-    fn velocity_matches_numeric_derivative_across_knots() {
-        // Continuity at ±1 µs around knots, and ṗ against a central difference.
-        let poses = model_poses(2.0, 50.0);
-        let k = knots_from_poses(&poses, None).unwrap();
-        let (s, _) = SplitSpline::fit(k.t0_ns, k.dt_ns, &k.poses, Fit::Interp).unwrap();
-        for j in 2..90 {
-            let t = j * 20_000_000;
-            let (a, b) = (s.sample(t - 1000), s.sample(t + 1000));
-            let fd = (b.p - a.p) / 2e-6;
-            let v = s.sample(t).v;
-            assert!((fd - v).norm() < 1e-5, "knot {j}: fd {fd:?} vs v {v:?}");
-            assert!(
-                (a.acc - b.acc).norm() < 1e-3,
-                "knot {j}: acc jumps {:?} → {:?}",
-                a.acc,
-                b.acc
-            );
-        }
-    }
-
-    #[test]
-    fn resampling_when_not_uniform() {
-        let mut poses = model_poses(2.0, 100.0);
-        poses[50].t_ns += 3_000_000; // a 3 ms jitter
-        let k = knots_from_poses(&poses, None).unwrap();
-        assert!(k.resampled);
-        assert_eq!(k.poses.len(), 201);
-        let k = knots_from_poses(&model_poses(2.0, 100.0), None).unwrap();
-        assert!(!k.resampled);
     }
 }
