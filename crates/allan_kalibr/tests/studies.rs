@@ -8,6 +8,7 @@
 
 mod accuracy;
 mod bandlimited;
+mod coverage;
 mod lines;
 mod profiles;
 mod real;

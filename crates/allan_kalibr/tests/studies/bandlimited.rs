@@ -34,7 +34,7 @@ const N_REL_TOL: f64 = 0.05;
 const SEED: u64 = 0xB088;
 
 /// The BMI088-like model with the low-pass corner at `frac` of the output rate.
-fn model(frac: f64) -> ImuModel {
+pub(super) fn model(frac: f64) -> ImuModel {
     let chain = Chain {
         internal_rate_hz: Some(INTERNAL_RATE),
         filter: Filter::Butterworth2 {
