@@ -9,10 +9,10 @@ use super::avar_cov;
 use super::{
     APPROX_CHI2, APPROX_DELTA, AxisVerdict, Config, CurveData, CurvePoint, FIT_TOL,
     MIN_RANGE_DECADES, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN, SHORT_FEATURE_SPAN, Term,
-    Verdict, ci, edf, fit, pipeline, short, terms,
+    Verdict, band, ci, fit, pipeline, short, terms,
 };
 
-/// Chooses the fitted range and fits it: the start from [`fit::choose_start`], then the
+/// Chooses the fitted range and fits it: from `start` ([`fit::choose_start`]), then the
 /// declared-fit check — every curve point of the range within the larger of [`FIT_TOL`] and
 /// its 95 % band of the model. A miss among the first points of the range moves the start
 /// past it; a miss further up ends the range before it (the long τ the model cannot
@@ -27,9 +27,10 @@ pub(super) fn declare_fit(
     fd: &fit::FitData,
     valid: &[&CurvePoint],
     cfg: &Config,
+    start: usize,
 ) -> Declared {
     let bounds = Bounds {
-        start: fit::choose_start(fd, &cfg.fit),
+        start,
         end: fd.points.len(),
         long_cut: false,
         feature: false,
@@ -291,7 +292,6 @@ fn fit_and_check(
     start: usize,
     end: usize,
 ) -> Option<Checked> {
-    let n_phase = data.n.map(|n| n + 1);
     let used: Vec<usize> = (start..end).collect();
     let f = fit::fit(fd, &used, &cfg.fit)?;
     let (lo_t, hi_t) = (fd.points[start].tau, fd.points[end - 1].tau);
@@ -307,10 +307,11 @@ fn fit_and_check(
             -1.0
         };
         max_mis = max_mis.max(mis.abs());
-        let alpha = fit::TERM_ALPHA[fit::dominant_term(&f.coef, &f.shapes, p.tau)];
-        // the model within the data's 95 % interval: model/data ∈ [lo, hi]
-        let band = n_phase
-            .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
+        // the model within the data's 95 % interval (the EDF its own mixture gives the
+        // point, [`band`]): model/data ∈ [lo, hi]
+        let band = fd
+            .basis
+            .and_then(|b| band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau))
             .and_then(|nu| ci::chi2_interval(1.0, nu, level))
             .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
             .unwrap_or(0.0);
@@ -362,8 +363,10 @@ fn extension_is_honest(
     let terms = |x: &fit::FitResult| {
         let first = fd.points[x.used[0]].tau;
         let last = fd.points[x.used[x.used.len() - 1]].tau;
-        let curve = pipeline::curve_points(data, cfg, Some(x), Some((first, last)));
-        let t = terms::make_terms(x, fd, &curve, cfg);
+        let curve =
+            pipeline::curve_points(data, cfg, Some(x), Some(x), fd.basis, Some((first, last)));
+        let record = terms::record_points(&curve, fd, first);
+        let t = terms::make_terms(x, fd, &curve, &record, cfg);
         t.as_array().into_iter().chain([t.g])
     };
     let resolved = |t: &Term| t.verdict == Verdict::Resolved;

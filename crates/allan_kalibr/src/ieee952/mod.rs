@@ -82,6 +82,7 @@
 
 pub(crate) mod advisor;
 mod avar_cov;
+mod band;
 pub(crate) mod ci;
 pub(crate) mod curves_in;
 pub(crate) mod edf;
@@ -89,6 +90,7 @@ pub(crate) mod files;
 pub(crate) mod fit;
 pub(crate) mod imu;
 mod input_error;
+pub(crate) mod line_check;
 pub(crate) mod lines;
 mod model;
 pub(crate) mod noise_id;

@@ -3,10 +3,10 @@
 //! readings, the terms ([`super::terms`]) and the fit's diagnostics.
 
 use super::declare::declare_fit;
-use super::terms::{make_terms, region_terms};
+use super::terms::{make_terms, record_points, region_terms};
 use super::{
     AlphaSource, Analysis, AxisVerdict, Config, CovBasis, CurveData, CurvePoint, FIT_TOL,
-    FitSummary, IdMethod, Ieee952Error, Point, ci, edf, fit, region,
+    FitSummary, Ieee952Error, Point, band, ci, fit, region,
 };
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
@@ -28,10 +28,12 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
     let fd = fit_data(data, cfg, &valid, basis);
 
     // the range and the fit, then the declared-fit check
-    let (fitted, mut verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg);
+    let start = fit::choose_start(&fd, &cfg.fit);
+    let (fitted, mut verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg, start);
     // the curve with its bounds
     let range = verdict.range();
-    let curve = curve_points(data, cfg, fitted.as_ref(), range);
+    let band_model = fitted.as_ref().filter(|_| verdict.fits());
+    let curve = curve_points(data, cfg, fitted.as_ref(), band_model, basis, range);
     if let Some(f) = &fitted {
         name_short_cut(&mut verdict, f, &curve);
     }
@@ -46,9 +48,14 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         .collect();
     let region = region::read(&region_pts);
 
+    // the whole record's bounds are taken from where the curve is the model's at short τ
+    // on: the fitted range's start, or without a fit where it starts to fall like white
+    // noise (the band-limited points below lie under every term's line)
+    let from_tau = range.map_or_else(|| fd.points.get(start).map_or(0.0, |p| p.tau), |(lo, _)| lo);
+    let record = record_points(&curve, &fd, from_tau);
     let terms = match (&fitted, verdict.fits()) {
-        (Some(f), true) => make_terms(f, &fd, &curve, cfg),
-        _ => region_terms(&region, &curve),
+        (Some(f), true) => make_terms(f, &fd, &curve, &record, cfg),
+        _ => region_terms(&region, &record),
     };
     let fit = fitted.map(|f| FitSummary {
         coef: f.coef,
@@ -66,9 +73,10 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         max_misfit,
     });
     let bounds = (
-        region::upper_bound(curve.iter(), |t| fit::basis(1, t).sqrt()),
-        region::upper_bound(curve.iter(), |t| fit::basis(3, t).sqrt()),
+        region::upper_bound(record.iter().copied(), |t| fit::basis(1, t).sqrt()),
+        region::upper_bound(record.iter().copied(), |t| fit::basis(3, t).sqrt()),
     );
+    drop(record);
     Analysis {
         n: data.n,
         tau0: data.tau0,
@@ -119,34 +127,40 @@ fn fit_data<'a>(
     }
 }
 
-/// The analysed curve: each valid point with its α (identified, else the fitted model's
-/// dominant term), its Greenhall EDF, its bounds at `cfg.curve_confidence` and at 95 %,
-/// whether it is in the declared `range`, and the model there.
+/// The analysed curve: each valid point with its EDF and α ([`band`]: from `band_model`,
+/// the fit declared, whose exact variance `basis` gives; without one, from the curve's
+/// local slope), its bounds at `cfg.curve_confidence` and at 95 %, whether it is in the
+/// declared `range`, and the model `fitted` there.
 pub(super) fn curve_points(
     data: &CurveData,
     cfg: &Config,
     fitted: Option<&fit::FitResult>,
+    band_model: Option<&fit::FitResult>,
+    basis: Option<&CovBasis>,
     range: Option<(f64, f64)>,
 ) -> Vec<Point> {
-    let n_phase = data.n.map(|n| n + 1);
-    data.points
+    let valid: Vec<&CurvePoint> = data
+        .points
         .iter()
         .filter(|p| p.avar > 0.0 && p.avar.is_finite())
-        .map(|p| {
-            let (alpha, alpha_source) = match (p.id, p.id_method) {
-                (Some(a), IdMethod::Lag1) => (a, AlphaSource::Lag1),
-                (Some(a), _) => (a, AlphaSource::B1),
-                (None, _) => match fitted {
-                    Some(f) => (
-                        fit::TERM_ALPHA[fit::dominant_term(&f.coef, &f.shapes, p.tau)],
-                        AlphaSource::Model,
-                    ),
-                    None => (0, AlphaSource::Assumed),
-                },
-            };
-            let nu = n_phase
-                .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
-                .unwrap_or(f64::NAN);
+        .collect();
+    let slope = band::slope_alphas(&valid);
+    valid
+        .iter()
+        .zip(slope)
+        .map(|(p, slope_alpha)| {
+            let from_model = band_model.zip(basis).and_then(|(f, b)| {
+                let nu = band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau)?;
+                let dominant = fit::dominant_term(&f.coef, &f.shapes, p.tau);
+                Some((nu, fit::TERM_ALPHA[dominant], AlphaSource::Model))
+            });
+            let (nu, alpha, alpha_source) = from_model.unwrap_or_else(|| {
+                let nu = data
+                    .n
+                    .and_then(|n| band::slope_edf(slope_alpha, p.m, n, data.kind))
+                    .unwrap_or(f64::NAN);
+                (nu, slope_alpha, AlphaSource::CurveSlope)
+            });
             let adev = p.avar.sqrt();
             let (lo, hi) =
                 ci::chi2_interval(adev, nu, cfg.curve_confidence).unwrap_or((f64::NAN, f64::NAN));

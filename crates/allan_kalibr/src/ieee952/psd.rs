@@ -504,9 +504,9 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
     let at = |fc: f64, lb: f64| chi2(fc, lb.exp()).map_or(f64::INFINITY, |r| r.0);
     let (mut fc, mut lb) = (f0, b0.ln());
     for _ in 0..RESONANCE_FIT_ROUNDS {
-        lb = golden_min(|x| at(fc, x), lb - 1.5, lb + 1.5);
+        lb = golden_min(|x| at(fc, x), lb - 1.5, lb + 1.5, GOLDEN_REL_TOL);
         let bw = lb.exp();
-        fc = golden_min(|x| at(x, lb), fc - bw, fc + bw);
+        fc = golden_min(|x| at(x, lb), fc - bw, fc + bw, GOLDEN_REL_TOL);
     }
     let best = at(fc, lb);
     if !best.is_finite() {
@@ -593,11 +593,11 @@ const RESONANCE_SE_STEP: f64 = 0.02;
 /// 4/9 and second neighbours' at 1/36, 1 + 2·(4/9 + 1/36) ≈ 1.94.
 const HANN_BIN_VARIANCE: f64 = 1.944;
 
-/// The minimum of a unimodal `f` on [a, b], golden-section search to a relative 1e-6 of
-/// the interval.
-fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+/// The minimum of a unimodal `f` on [a, b], golden-section search to `rel_tol` of the
+/// interval.
+pub(crate) fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, rel_tol: f64) -> f64 {
     const G: f64 = 0.618_033_988_749_894_8;
-    let tol = 1e-6 * (b - a).abs();
+    let tol = rel_tol * (b - a).abs();
     let (mut x1, mut x2) = (b - G * (b - a), a + G * (b - a));
     let (mut f1, mut f2) = (f(x1), f(x2));
     while (b - a).abs() > tol {
@@ -615,6 +615,8 @@ fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     }
     0.5 * (a + b)
 }
+/// The resonance fit's searches stop at this share of their interval.
+const GOLDEN_REL_TOL: f64 = 1e-6;
 /// Hann window's equivalent noise bandwidth, bins.
 const HANN_ENBW_BINS: f64 = 1.5;
 /// A peak this many times wider than a sinusoid's is a resonance.

@@ -6,17 +6,15 @@
 use super::{APPROX_DELTA, B_FLOOR_TOL, FIT_TOL, analyse};
 use super::{Overlap, fit, psd, region};
 
-/// Where a point's α (used for its EDF) came from.
+/// Where a point's EDF (and the α printed beside it) came from (see [`super::band`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AlphaSource {
-    /// Lag-1 autocorrelation noise identification.
-    Lag1,
-    /// B1 ratio noise identification (few clusters).
-    B1,
-    /// Not identifiable from the data at this τ: α of the fitted model's dominant term.
+    /// The declared fit's model: the exact variance of the estimate under its mixture of
+    /// terms; α is its dominant term's.
     Model,
-    /// Nothing available; white FM (α = 0) assumed.
-    Assumed,
+    /// No model describes the curve: Greenhall's EDF of the FM power law of the curve's
+    /// local slope there, α.
+    CurveSlope,
 }
 
 /// One point of the analysed Allan deviation curve.
@@ -38,9 +36,9 @@ pub struct Point {
     pub lo95: f64,
     /// Upper bound at 95 %, U.
     pub hi95: f64,
-    /// Greenhall EDF used for the bounds.
+    /// Equivalent degrees of freedom of the estimate behind the bounds (see `alpha_source`).
     pub edf: f64,
-    /// Power-law α used for the EDF.
+    /// Power-law α of the point's dominant noise (see `alpha_source`).
     pub alpha: i32,
     /// Where α came from.
     pub alpha_source: AlphaSource,
@@ -350,8 +348,8 @@ pub struct Analysis {
     pub psd: Option<psd::Psd>,
     /// Every line the PSD shows, strongest first (those in the model are in `terms.lines`).
     pub lines: Vec<psd::Line>,
-    /// The largest N and K every curve point allows at 95 % (its upper band over the
-    /// term's Allan deviation per unit, the minimum over the whole curve: for K,
-    /// min σ_hi95(τ)·√(3/τ)); the yaml files never write more.
+    /// The largest N and K the whole record allows at 95 %, jointly over the points of the
+    /// fit grid from the fitted range's start on (each point below its one-sided limit at
+    /// 1 − 0.05/k, Bonferroni: see `region::upper_bound`); ∞ without a sample count.
     pub bounds: (f64, f64),
 }

@@ -99,7 +99,11 @@ fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
     let dt = 1.0 / rate;
     let sw = a.n / dt.sqrt();
     let q = a.k * dt.sqrt();
-    let phi = if a.gm_t > 0.0 { (-dt / a.gm_t).exp() } else { 0.0 };
+    let phi = if a.gm_t > 0.0 {
+        (-dt / a.gm_t).exp()
+    } else {
+        0.0
+    };
     let gi = a.gm_sigma * (1.0 - phi * phi).sqrt();
     let mut walk = 0.0;
     let mut g = a.gm_sigma * e();
@@ -127,8 +131,7 @@ fn own_avar(a: OwnAxis, rate: f64, m: usize) -> f64 {
         let one_phi = -(-beta).exp_m1();
         let one_phim = -(-beta * mf).exp_m1();
         let s2 = a.gm_sigma * a.gm_sigma;
-        let var_s =
-            s2 * (mf + 2.0 * (mf * phi * one_phi - phi * one_phim) / (one_phi * one_phi));
+        let var_s = s2 * (mf + 2.0 * (mf * phi * one_phi - phi * one_phim) / (one_phi * one_phi));
         let cov = s2 * phi * one_phim * one_phim / (one_phi * one_phi);
         (var_s - cov) / (mf * mf)
     } else {
@@ -158,8 +161,9 @@ fn own_gm_avar_direct(sigma: f64, t: f64, rate: f64, m: usize) -> f64 {
 /// and returns the analysis and the samples skipped.
 fn analyse_as_user(y: &[f64], rate: f64, cfg: &Ieee952Config) -> (Ieee952Analysis, usize) {
     let tau0 = 1.0 / rate;
-    let skip = bag2mat::find_warmup(y, tau0)
-        .map_or(0, |w| ((w.skip.ceil() / tau0).round() as usize).min(y.len() / 2));
+    let skip = bag2mat::find_warmup(y, tau0).map_or(0, |w| {
+        ((w.skip.ceil() / tau0).round() as usize).min(y.len() / 2)
+    });
     let data = CurveData::from_samples(&y[skip..], tau0, cfg).expect("study series");
     let basis = data.basis(cfg.fit.per_octave);
     (analyse_curve(&data, cfg, basis.as_ref()), skip)
@@ -342,14 +346,27 @@ fn run_all() -> Vec<Axis> {
             out.extend(sim_record("band-limited", &band, 400.0, 3600.0, seed));
         }
         if want("flicker+rw") {
-            out.extend(sim_record("flicker+rw", &flicker, 100.0, 4.0 * 3600.0, seed));
+            out.extend(sim_record(
+                "flicker+rw",
+                &flicker,
+                100.0,
+                4.0 * 3600.0,
+                seed,
+            ));
         }
         if want("lines") {
             let rate = super::lines::RATE;
             out.extend(sim_record("lines", &lines, rate, 2.0 * 3600.0, seed));
         }
         if want("30-minute") {
-            out.extend(own_record("30-minute", short_gyro, short_acc, 200.0, 1800.0, seed));
+            out.extend(own_record(
+                "30-minute",
+                short_gyro,
+                short_acc,
+                200.0,
+                1800.0,
+                seed,
+            ));
         }
         if want("gauss-markov") {
             let (g, a) = (bump_axis(0.01, 2e-5), bump_axis(0.02, 4e-4));
@@ -580,6 +597,9 @@ fn print_axis(x: &Axis) {
         if let Some(f) = &a.fit {
             println!("coef {:?} shapes {:?}", f.coef, f.shapes);
         }
+        for l in &a.lines {
+            println!("line {l:?}");
+        }
     }
     let mut c = Counts::default();
     c.add(x);
@@ -664,14 +684,22 @@ fn coverage_study() {
             ("R", &a.terms.r),
             ("G", &a.terms.g),
         ] {
-            rows.extend(term_row_faults(name, t).into_iter().map(|f| format!("{id}: {f}")));
+            rows.extend(
+                term_row_faults(name, t)
+                    .into_iter()
+                    .map(|f| format!("{id}: {f}")),
+            );
         }
     }
     let yaml: Vec<String> = axes
         .chunks(6)
         .flat_map(|rec| yaml_faults(&rec.iter().collect::<Vec<_>>()))
         .collect();
-    println!("coverage study ({} axes, {:.1} s):", axes.len(), t0.elapsed().as_secs_f64());
+    println!(
+        "coverage study ({} axes, {:.1} s):",
+        axes.len(),
+        t0.elapsed().as_secs_f64()
+    );
     for (name, c) in &per {
         println!("{}", c.line(name));
     }
@@ -722,6 +750,10 @@ fn coverage_study() {
         "EDF {:.2}·n/m",
         total.max_edf_ratio
     );
-    assert!(rows.is_empty(), "{} term rows contradict themselves", rows.len());
+    assert!(
+        rows.is_empty(),
+        "{} term rows contradict themselves",
+        rows.len()
+    );
     assert!(yaml.is_empty(), "{} yaml values", yaml.len());
 }
