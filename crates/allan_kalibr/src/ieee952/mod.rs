@@ -133,6 +133,13 @@ pub use result::{
 /// The model may miss a curve point by this fraction (ADEV) where the point's own 95 % band
 /// is narrower: the bar for "the model describes the curve".
 pub const FIT_TOL: f64 = 0.10;
+/// A declared fit tolerates misses (curve points beyond the larger of [`FIT_TOL`] and their
+/// 95 % band) on at most this share of its range's points, as chance gives them…
+pub const MAX_MISS_SHARE: f64 = 0.10;
+/// …and no run of consecutive misses on one side of the model wider than this factor of τ
+/// (an octave: neighbouring overlapping estimates move together over about that much, so a
+/// wider run is the model, not the data).
+pub const MISS_RUN_SPAN: f64 = 2.0;
 /// A term is resolved only where its own Allan variance is at least this share of the
 /// measured one somewhere in the fitted range: its line within 20 % (0.8² = 0.64) of the
 /// curve.

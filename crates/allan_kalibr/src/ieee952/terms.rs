@@ -171,6 +171,17 @@ impl TermsOfFit<'_> {
         })
     }
 
+    /// The profile term `j`'s interval comes from: K beyond a bump where the model has one
+    /// ([`BEYOND_BUMP`]), else the fit's range.
+    fn chosen(&self, j: usize) -> Option<&fit::Profile<'_, '_>> {
+        if j == 3 && self.f.coef[fit::GM] > 0.0 {
+            self.k_beyond.as_ref()
+        } else {
+            self.profile.as_ref()
+        }
+        .filter(|p| p.has(j))
+    }
+
     /// The interval of term `j`'s coefficient at the χ²(1) `level` (two-sided 95 %, or the
     /// one-sided bound; the lower end only with `lower`, else 0): the profile, widened to
     /// span the flicker floor's plausible shapes ([`fit::FitResult::alternatives`]) and, in
@@ -186,12 +197,7 @@ impl TermsOfFit<'_> {
             self.record_bound(j).powi(2)
         };
         let bump_k = j == 3 && f.coef[fit::GM] > 0.0;
-        let profile = if bump_k {
-            self.k_beyond.as_ref()
-        } else {
-            self.profile.as_ref()
-        };
-        let (mut lo_c, mut hi_c) = match profile {
+        let (mut lo_c, mut hi_c) = match self.chosen(j) {
             Some(p) if p.has(j) => p.interval(j, level, lower, guess),
             // too few points beyond the bump: K is not told from it; its bound is the
             // whole range's
@@ -264,7 +270,17 @@ impl TermsOfFit<'_> {
                 },
             };
         }
-        let (lo_c, hi_c) = self.interval(j, self.levels.0, true);
+        // zero within the two-sided level (or a bump explains the term as well): not
+        // resolved, and only the one-sided bound is wanted
+        let zero_allowed = f.ambiguous[j]
+            || self
+                .chosen(j)
+                .is_some_and(|p| p.allows(j, 0.0, self.levels.0));
+        let (lo_c, hi_c) = if zero_allowed {
+            (0.0, f64::NAN)
+        } else {
+            self.interval(j, self.levels.0, true)
+        };
         let verdict = if !fit::is_positive(lo_c) || f.ambiguous[j] {
             Verdict::NotSignificant
         } else if !dominant_somewhere {
@@ -330,7 +346,8 @@ impl TermsOfFit<'_> {
         // a band-limited range the curve lies a little under the white-noise line (the
         // model's negative 1/τ² correction), so N's bound there is no bound
         let pushes_long = matches!(j, 2 | 3 | 4 | fit::GM);
-        if t.verdict == Verdict::Resolved && pushes_long && t.value > bound {
+        // (a term the fit puts above the record's bound, resolved or with its whole interval)
+        if pushes_long && (t.value > bound && t.verdict == Verdict::Resolved || t.lo >= bound) {
             return Term {
                 value: 0.0,
                 std_err: f64::NAN,
@@ -339,8 +356,14 @@ impl TermsOfFit<'_> {
                 verdict: Verdict::Contradicted,
             };
         }
-        if pushes_long && !t.hi.is_finite() && bound.is_finite() {
-            t.hi = bound.max(t.value);
+        if pushes_long && t.verdict != Verdict::Resolved && bound < t.hi {
+            // the fit's bound says less than the whole record's: the record's (both are
+            // 95 % statements, each conservative — the profile's where its model is free
+            // at the long end, the record's by Bonferroni — so the lesser keeps its level
+            // in the coverage study; a value the record rules out is not shown)
+            t.hi = bound;
+            t.value = t.value.min(bound);
+            t.lo = t.lo.min(bound);
         }
         t
     }

@@ -10,8 +10,8 @@
 //! * each curve point's 95 % band holds the exact truth curve (the share per study);
 //! * no point with m ≥ n/100 has an EDF above [`MAX_EDF_RATIO`]·n/m;
 //! * every term's value lies inside its own interval, its verdict agrees with it, and each
-//!   sensor's yaml values are what the axes say (the largest N; a K neither below a printed
-//!   resolved interval nor above every axis' bound).
+//!   sensor's yaml values are what the axes say (`profiles::yaml_faults`: the largest N; a K
+//!   neither below a printed resolved interval nor above the data's bound).
 //!
 //! The Gauss–Markov and the 30-minute records come from a small generator of this file's
 //! own (white noise, a random walk, an AR(1) bias: [`own_series`]) with its own exact Allan
@@ -21,10 +21,7 @@
 //! Cost: 126 axes of 0.36–1.44 M samples; about a minute on two cores in the optimised test
 //! build.
 
-use allan_kalibr::{
-    AxisResult, CurveData, Ieee952Analysis, Ieee952Config, ImuAnalysis, Term, Verdict,
-    analyse_curve,
-};
+use allan_kalibr::{CurveData, Ieee952Analysis, Ieee952Config, Term, Verdict, analyse_curve};
 use bag2mat::Sensor;
 use rand::SeedableRng;
 use rand::rngs::StdRng;
@@ -422,72 +419,6 @@ fn term_row_faults(name: &str, t: &Term) -> Vec<String> {
     f
 }
 
-/// The yaml values of one record (six axes) against its axes: N the largest axis' N (or,
-/// when none is resolved, the largest bound); K never below a resolved axis' printed
-/// interval nor above every axis' upper end. Returns the faults.
-fn yaml_faults(rec: &[&Axis]) -> Vec<String> {
-    let imu = ImuAnalysis {
-        rate: f64::NAN,
-        axes: rec
-            .iter()
-            .map(|x| AxisResult {
-                sensor: x.sensor,
-                axis: x.axis,
-                analysis: x.analysis.clone(),
-                advice: None,
-            })
-            .collect(),
-        checks: Vec::new(),
-        notes: Vec::new(),
-    };
-    let mut f = Vec::new();
-    for s in [Sensor::Gyro, Sensor::Acc] {
-        let axes: Vec<&Ieee952Analysis> = rec
-            .iter()
-            .filter(|x| x.sensor == s)
-            .map(|x| &x.analysis)
-            .collect();
-        let label = format!("{} s{} {s:?}", rec[0].study, rec[0].seed);
-        let resolved = |t: &Term| matches!(t.verdict, Verdict::Resolved | Verdict::RegionReading);
-        if let Some(v) = imu.noise_density(s) {
-            let ns: Vec<&Term> = axes.iter().map(|a| &a.terms.n).collect();
-            let want = if ns.iter().any(|t| resolved(t)) {
-                ns.iter()
-                    .filter(|t| resolved(t))
-                    .map(|t| t.value)
-                    .fold(0.0, f64::max)
-            } else {
-                ns.iter().map(|t| t.hi).fold(0.0, f64::max)
-            };
-            if (v.value / want - 1.0).abs() > ROUND_REL {
-                f.push(format!(
-                    "{label}: yaml N {:e}, the largest axis says {want:e}",
-                    v.value
-                ));
-            }
-        }
-        if let Some(v) = imu.random_walk(s) {
-            for a in &axes {
-                let k = a.terms.k;
-                if resolved(&k) && v.value < k.lo * (1.0 - ROUND_REL) {
-                    f.push(format!(
-                        "{label}: yaml K {:e} below a printed resolved interval [{:e}, {:e}]",
-                        v.value, k.lo, k.hi
-                    ));
-                }
-            }
-            let top = axes.iter().map(|a| a.terms.k.hi).fold(0.0, f64::max);
-            if v.value > top * (1.0 + ROUND_REL) {
-                f.push(format!(
-                    "{label}: yaml K {:e} above every axis' upper end {top:e}",
-                    v.value
-                ));
-            }
-        }
-    }
-    f
-}
-
 /// Counts of one study (or all).
 #[derive(Default, Debug, Clone)]
 struct Counts {
@@ -693,7 +624,14 @@ fn coverage_study() {
     }
     let yaml: Vec<String> = axes
         .chunks(6)
-        .flat_map(|rec| yaml_faults(&rec.iter().collect::<Vec<_>>()))
+        .flat_map(|rec| {
+            let label = format!("{} s{}", rec[0].study, rec[0].seed);
+            let a: Vec<(Sensor, usize, &Ieee952Analysis)> = rec
+                .iter()
+                .map(|x| (x.sensor, x.axis, &x.analysis))
+                .collect();
+            super::profiles::yaml_faults(&label, &a)
+        })
         .collect();
     println!(
         "coverage study ({} axes, {:.1} s):",

@@ -64,8 +64,8 @@ const GN_HALVINGS: usize = 6;
 /// A pass is converged when a step lowers D by less than this (D is a χ²).
 const GN_TOL: f64 = 1e-7;
 /// Bisection steps of an interval end in log of the term's value (from a factor-2
-/// bracket: 2^(−12) relative).
-const END_BISECT: usize = 12;
+/// bracket: 2^(−8) relative, 0.3 %).
+const END_BISECT: usize = 8;
 /// Doublings of the term's value tried while bracketing an upper end (4096×).
 const END_EXPAND: usize = 12;
 
@@ -205,6 +205,19 @@ impl<'d, 'a> Profile<'d, 'a> {
             out = Some(out.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
         }
         out.unwrap_or((0.0, f64::INFINITY))
+    }
+
+    /// Whether the value `cj` of term `j`'s coefficient is within `level` of the least D
+    /// (in some plausible variant).
+    pub(crate) fn allows(&self, j: usize, cj: f64, level: f64) -> bool {
+        self.variants
+            .iter()
+            .filter(|v| v.d_min - self.d_min <= level)
+            .any(|v| {
+                let mut seen = vec![(v.c_min[j], v.c_min)];
+                v.at(j, cj, &mut seen)
+                    .is_some_and(|d| d - self.d_min <= level)
+            })
     }
 
     /// Whether term `j` can be profiled.
@@ -510,9 +523,14 @@ impl<'d, 'a> Variant<'d, 'a> {
         };
         // the lower end: 0 unless P(0) is beyond the level
         let lo = if lower && c_hat > 0.0 && excess(0.0, &mut seen) > 0.0 {
-            let (mut a, mut b) = (0.0, t_hat); // excess(a) > 0 ≥ excess(b)
-            for _ in 0..END_BISECT + 6 {
-                let mid = 0.5 * (a + b);
+            // bracket from the top by halvings, then log bisection
+            let (mut a, mut b) = (t_hat / 2.0, t_hat); // excess(a) > 0 ≥ excess(b)
+            while a > t_hat * 1e-6 && excess(a * a, &mut seen) <= 0.0 {
+                b = a;
+                a /= 2.0;
+            }
+            for _ in 0..END_BISECT {
+                let mid = (a * b).sqrt();
                 if excess(mid * mid, &mut seen) > 0.0 {
                     a = mid;
                 } else {
