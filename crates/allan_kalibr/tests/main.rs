@@ -13,3 +13,4 @@ mod issue18;
 mod logs;
 mod reference;
 mod studies;
+mod uncertainty;

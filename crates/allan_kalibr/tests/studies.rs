@@ -8,7 +8,7 @@
 
 mod accuracy;
 mod bandlimited;
-mod coverage;
+pub(crate) mod coverage;
 mod lines;
 mod profiles;
 mod real;

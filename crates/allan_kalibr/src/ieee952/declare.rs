@@ -223,6 +223,10 @@ fn past_misses(
     ControlFlow::Continue(cut)
 }
 
+/// The level of the band beyond which a miss is never chance ([`by_chance`]): a stretch of
+/// correlated points moves together, but a point outside its 99.9 % band is the model's.
+const GROSS_LEVEL: f64 = 0.999;
+
 /// A curve point the fitted model misses (beyond [`FIT_TOL`] and its own 95 % band).
 #[derive(Clone, Copy, Debug)]
 struct Miss {
@@ -301,7 +305,7 @@ fn fit_and_check(
     let count = valid.iter().filter(|p| in_range(p.tau)).count();
     let level = check_level(data.kind, count);
     // each point's state in τ order: None within its band, Some(above) a miss
-    let mut states: Vec<(f64, Option<bool>)> = Vec::with_capacity(count);
+    let mut states: Vec<(f64, Option<(bool, bool)>)> = Vec::with_capacity(count);
     for p in valid.iter().filter(|p| in_range(p.tau)) {
         let model = f.predict(p.tau);
         let mis = if model > 0.0 {
@@ -312,19 +316,22 @@ fn fit_and_check(
         max_mis = max_mis.max(mis.abs());
         // the model within the data's 95 % interval (the EDF its own mixture gives the
         // point, [`band`]): model/data ∈ [lo, hi]
-        let band = fd
+        let nu = fd
             .basis
-            .and_then(|b| band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau))
-            .and_then(|nu| ci::chi2_interval(1.0, nu, level))
-            .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
-            .unwrap_or(0.0);
-        if model <= 0.0 || mis.abs() > FIT_TOL.max(band) {
+            .and_then(|b| band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau));
+        let band_at = |c: f64| {
+            nu.and_then(|nu| ci::chi2_interval(1.0, nu, c))
+                .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
+                .unwrap_or(0.0)
+        };
+        if model <= 0.0 || mis.abs() > FIT_TOL.max(band_at(level)) {
             misses.push(Miss {
                 tau: p.tau,
                 size: mis.abs(),
                 above: mis < 0.0,
             });
-            states.push((p.tau, Some(mis < 0.0)));
+            let gross = model <= 0.0 || mis.abs() > FIT_TOL.max(band_at(GROSS_LEVEL));
+            states.push((p.tau, Some((mis < 0.0, gross))));
         } else {
             states.push((p.tau, None));
         }
@@ -336,24 +343,27 @@ fn fit_and_check(
 }
 
 /// Whether the misses among `states` (each curve point of a range in τ order: its τ and,
-/// for a miss, whether the data lie above the model) are what chance gives a model that
-/// describes the curve: at most [`MAX_MISS_SHARE`] of the points, and no run of
+/// for a miss, whether the data lie above the model and whether it is gross) are what
+/// chance gives a model that describes the curve: none beyond the point's
+/// [`GROSS_LEVEL`] band, at most [`MAX_MISS_SHARE`] of the points, and no run of
 /// consecutive misses on one side wider than [`MISS_RUN_SPAN`] in τ. Overlapping estimates
 /// at neighbouring τ share most of their data, so a chance excursion of the curve takes a
 /// stretch of points past their 95 % bands together (a clean 30-minute record's white
 /// noise 10 % low over 10–16 s cut its fit at 7 s); a model that misses the curve does so
-/// over a wider stretch, or at many points.
-fn by_chance(states: &[(f64, Option<bool>)]) -> bool {
+/// by more, over a wider stretch, or at many points.
+fn by_chance(states: &[(f64, Option<(bool, bool)>)]) -> bool {
     let missed = states.iter().filter(|s| s.1.is_some()).count();
     if missed == 0 {
         return true;
     }
-    if missed as f64 > MAX_MISS_SHARE * states.len() as f64 {
+    if missed as f64 > MAX_MISS_SHARE * states.len() as f64
+        || states.iter().any(|s| s.1.is_some_and(|m| m.1))
+    {
         return false;
     }
     let mut run: Option<(f64, bool)> = None; // (first τ, side) of the run going on
     for &(tau, st) in states {
-        match (st, run) {
+        match (st.map(|m| m.0), run) {
             (Some(side), Some((t0, s0))) if side == s0 => {
                 if tau / t0 > MISS_RUN_SPAN {
                     return false;

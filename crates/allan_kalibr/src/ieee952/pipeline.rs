@@ -186,9 +186,13 @@ pub(super) fn curve_points(
         .collect()
 }
 
-/// What the left-out short τ of a declared fit `f` are: below the model's white-noise line
-/// (band-limited), above it (a bump), or both — said from the points themselves, not from
-/// how the range was cut.
+/// What the left-out short τ of a declared fit `f` are, named from where those points lie
+/// against the fitted white-noise line N/√τ (the model's N alone: a negative 1/τ²
+/// low-pass correction bends the model under that line, and a point between the two is
+/// below the white noise, not a bump over the model): below it beyond the larger of
+/// [`FIT_TOL`] and the point's 95 % band, band-limited (the sensor's low-pass filter or
+/// decimation); above it so, a bump (a vibration, a resonance); both, both; neither (every
+/// left-out point within its band of the line), "its first points are out of line".
 fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]) {
     let AxisVerdict::Fits {
         range,
@@ -200,34 +204,19 @@ fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]
     else {
         return;
     };
-    let (mut above, mut below, mut lean) = (false, false, 0.0);
+    let (mut above, mut below) = (false, false);
     for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
-        let model = f.predict(p.tau).max(0.0).sqrt();
-        let band = (p.hi95 / p.adev - 1.0).max(0.0);
-        if !fit::is_positive(model) {
+        let white = (f.coef[1] * fit::basis(1, p.tau)).max(0.0).sqrt();
+        if !fit::is_positive(white) {
             continue;
         }
-        let mis = p.adev / model - 1.0;
-        // below the white-noise line (with the quantization's): what a band limit does;
-        // a point under the model but over that line is the model's line or bump shape
-        let white = (f.coef[0].max(0.0) * fit::basis(0, p.tau) + f.coef[1] * fit::basis(1, p.tau))
-            .max(0.0)
-            .sqrt();
-        let under_white = p.adev / white - 1.0;
-        lean += under_white.min(0.0) + mis.max(0.0);
-        if band.is_finite() && mis > FIT_TOL.max(band) {
-            above = true;
-        } else if band.is_finite() && under_white < -FIT_TOL.max(band) {
-            below = true;
-        }
+        // the line outside the point's band (its value alone without a sample count)
+        let r = p.adev / white - 1.0;
+        let lo = if p.lo95.is_finite() { p.lo95 } else { p.adev };
+        let hi = if p.hi95.is_finite() { p.hi95 } else { p.adev };
+        above |= r > FIT_TOL && white < lo;
+        below |= r < -FIT_TOL && white > hi;
     }
-    // by the misses beyond the points' bands; without any, as the range was cut (a
-    // feature the start moved past, else the band limit of old)
-    if above || below {
-        *short_feature = above;
-        *band_limited = below;
-    } else {
-        // within their bands: below the model's white-noise line only if they lean below
-        *band_limited = lean < 0.0 && !*short_feature;
-    }
+    *short_feature = above;
+    *band_limited = below;
 }

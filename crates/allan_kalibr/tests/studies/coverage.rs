@@ -64,7 +64,7 @@ struct Truth {
 }
 
 /// One analysed axis.
-struct Axis {
+pub(crate) struct Axis {
     study: &'static str,
     seed: u64,
     sensor: Sensor,
@@ -77,20 +77,36 @@ struct Axis {
 
 // ---- this file's own generator (independent of `sim`) ----
 
-/// One axis of the own generator: white noise of density `n`, a random walk `k`, and a
+/// One axis of the own generator: white noise of density `n`, a random walk `k`, a
 /// first-order Gauss–Markov bias of σ `gm_sigma` and correlation time `gm_t` (0: none), in
-/// continuous-time units at `rate` Hz.
+/// continuous-time units at `rate` Hz, and a sinusoid `line` (amplitude, Hz; 0: none).
 #[derive(Clone, Copy, Debug)]
-struct OwnAxis {
-    n: f64,
-    k: f64,
-    gm_sigma: f64,
-    gm_t: f64,
+pub(crate) struct OwnAxis {
+    pub(crate) n: f64,
+    pub(crate) k: f64,
+    pub(crate) gm_sigma: f64,
+    pub(crate) gm_t: f64,
+    pub(crate) line: (f64, f64),
 }
 
-/// `len` samples of `a` at `rate`: y = σ_w·w + b + g, b the walk (b₀ = 0, step K√Δt), g
-/// the AR(1) started from its stationary law (x' = φx + σ√(1 − φ²)·e, φ = e^(−Δt/T)).
-fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
+impl OwnAxis {
+    /// White noise `n` and a random walk `k` alone.
+    pub(crate) fn white_rw(n: f64, k: f64) -> OwnAxis {
+        OwnAxis {
+            n,
+            k,
+            gm_sigma: 0.0,
+            gm_t: 0.0,
+            line: (0.0, 0.0),
+        }
+    }
+}
+
+/// `len` samples of `a` at `rate`: y = σ_w·w + b + g + l, b the walk (b₀ = 0, step K√Δt),
+/// g the AR(1) started from its stationary law (x' = φx + σ√(1 − φ²)·e, φ = e^(−Δt/T)), l
+/// the sinusoid with a random phase. (The exact Allan variance [`own_avar`] leaves the
+/// sinusoid out.)
+pub(crate) fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
     let mut rng = StdRng::seed_from_u64(seed);
     let mut e = || -> f64 { StandardNormal.sample(&mut rng) };
     let dt = 1.0 / rate;
@@ -104,9 +120,17 @@ fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
     let gi = a.gm_sigma * (1.0 - phi * phi).sqrt();
     let mut walk = 0.0;
     let mut g = a.gm_sigma * e();
+    let (amp, f0) = a.line;
+    let phase = e(); // any real number is a phase
+    let w = 2.0 * std::f64::consts::PI * f0 * dt;
     let mut out = Vec::with_capacity(len);
-    for _ in 0..len {
-        out.push(sw * e() + walk + g);
+    for i in 0..len {
+        let line = if amp != 0.0 {
+            amp * (w * i as f64 + phase).sin()
+        } else {
+            0.0
+        };
+        out.push(sw * e() + walk + g + line);
         walk += q * e();
         g = phi * g + gi * e();
     }
@@ -116,7 +140,7 @@ fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
 /// The exact Allan variance of [`own_series`] at cluster size m: white σ_w²/m; the walk
 /// q²(2m² + 1)/(6m); the AR(1) (Var(S) − Cov(S₁, S₂))/m² with S a cluster's sum,
 /// Var(S) = σ²[m + 2(mφ(1 − φ) − φ(1 − φᵐ))/(1 − φ)²], Cov = σ²φ(1 − φᵐ)²/(1 − φ)².
-fn own_avar(a: OwnAxis, rate: f64, m: usize) -> f64 {
+pub(crate) fn own_avar(a: OwnAxis, rate: f64, m: usize) -> f64 {
     let dt = 1.0 / rate;
     let mf = m as f64;
     let white = a.n * a.n / dt / mf;
@@ -223,7 +247,7 @@ fn sim_record(
 }
 
 /// The six axes of the own generator (`gyro`, `acc`: each sensor's three axes alike).
-fn own_record(
+pub(crate) fn own_record(
     study: &'static str,
     gyro: OwnAxis,
     acc: OwnAxis,
@@ -265,17 +289,16 @@ fn own_record(
 
 /// A strong Gauss–Markov bump: T = 50 s, its Allan deviation peak (0.62·σ near 1.9·T) five
 /// times the white-noise-and-walk curve there.
-fn bump_axis(n: f64, k: f64) -> OwnAxis {
+pub(crate) fn bump_axis(n: f64, k: f64) -> OwnAxis {
     let t = 50.0;
     let at = 1.9 * t;
     let base = (n * n / at + k * k * at / 3.0).sqrt();
     // the AR(1)'s continuous Allan variance peaks at ≈ 0.38·σ² (IEEE 952 Annex C)
     let sigma = 5.0 * base / 0.38f64.sqrt();
     OwnAxis {
-        n,
-        k,
         gm_sigma: sigma,
         gm_t: t,
+        ..OwnAxis::white_rw(n, k)
     }
 }
 
@@ -320,17 +343,7 @@ fn run_all() -> Vec<Axis> {
     let flicker = flicker_model();
     let lines = lines_model();
     let warm = Profile::Adis16470.model();
-    let short_gyro = OwnAxis {
-        n: 0.01,
-        k: 1e-4,
-        gm_sigma: 0.0,
-        gm_t: 0.0,
-    };
-    let short_acc = OwnAxis {
-        n: 0.02,
-        k: 1e-3,
-        ..short_gyro
-    };
+    let (short_gyro, short_acc) = (OwnAxis::white_rw(0.01, 1e-4), OwnAxis::white_rw(0.02, 1e-3));
     // development: COVERAGE_ONLY=gauss-markov runs one study (the asserts then judge it alone)
     let only = std::env::var("COVERAGE_ONLY").ok();
     let want = |name: &str| only.as_deref().is_none_or(|o| o == name);
@@ -566,10 +579,9 @@ fn the_own_generators_allan_variance_matches_the_direct_sum() {
     // the closed form's cancellations (1 − φ ≈ 2e-4) cost a few digits at most
     const CLOSED_FORM_REL_TOL: f64 = 1e-7;
     let a = OwnAxis {
-        n: 0.0,
-        k: 0.0,
         gm_sigma: 0.3,
         gm_t: 50.0,
+        ..OwnAxis::white_rw(0.0, 0.0)
     };
     for m in [1usize, 2, 7, 100, 1000, 5000, 20_000] {
         let fast = own_avar(a, 100.0, m);
