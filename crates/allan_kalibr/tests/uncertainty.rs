@@ -124,12 +124,11 @@ const MISS_SHARE: f64 = 0.10;
 
 /// The records of the bump tests: 4 h at 100 Hz of white noise, a random walk and a
 /// Gauss–Markov bias of T = 50 s whose Allan peak is 5× the rest of the curve there (issue
-/// 40.4), the gyro axes of the coverage study's first seed.
-fn bump_records() -> Vec<(OwnAxis, Ieee952Analysis)> {
+/// 40.4), the gyro axes `axes` of the coverage study's seed `seed`.
+fn bump_records(seed: u64, axes: &[u64]) -> Vec<(OwnAxis, Ieee952Analysis)> {
     let a = bump_axis(0.01, 2e-5);
-    (0..3u64)
-        .into_par_iter()
-        .map(|k| (a, analyse(a, 100.0, 1_440_000, 401 * 16 + k)))
+    axes.par_iter()
+        .map(|&k| (a, analyse(a, 100.0, 1_440_000, seed * 16 + k)))
         .collect()
 }
 
@@ -140,7 +139,7 @@ fn bump_records() -> Vec<(OwnAxis, Ieee952Analysis)> {
 /// `MAX_MISS_SHARE` of the points, no same-side run wider than `MISS_RUN_SPAN`).
 #[test]
 fn a_strong_gauss_markov_bump_is_not_read_as_a_random_walk() {
-    let recs = bump_records();
+    let recs = bump_records(401, &[0, 1, 2]);
     for (k, (a, r)) in recs.iter().enumerate() {
         let t = r.terms.k;
         assert!(
@@ -190,7 +189,9 @@ fn a_strong_gauss_markov_bump_is_not_read_as_a_random_walk() {
 /// its bound.
 #[test]
 fn the_terms_and_the_chart_tell_one_story() {
-    let recs = bump_records();
+    // the axes of the coverage study whose rows contradicted themselves before
+    let mut recs = bump_records(402, &[0, 1]);
+    recs.extend(bump_records(403, &[0, 2]));
     let mut faults = Vec::new();
     for (k, (_, r)) in recs.iter().enumerate() {
         let t = &r.terms;
@@ -318,24 +319,65 @@ fn low_frequency_lines_are_sinusoids_the_whole_record_holds() {
 /// random walk and a vibration line).
 #[test]
 fn no_flicker_floor_is_resolved_where_there_is_none() {
-    let rate = 200.0;
-    let a = OwnAxis {
-        line: (0.05, 2.0),
-        ..OwnAxis::white_rw(1e-3, 1e-5)
-    };
-    let found: Vec<String> = (0..4u64)
+    let rate = 100.0;
+    // lines mid-curve (0.5 Hz) and at short τ (5 Hz), their Allan bumps ~10× and ~30× the
+    // white noise's deviation there
+    let cases: Vec<(OwnAxis, u64)> = [(0.5, 0.01), (0.5, 0.03), (5.0, 0.03), (5.0, 0.1)]
+        .into_iter()
+        .enumerate()
+        .flat_map(|(i, (f0, amp))| {
+            let a = OwnAxis {
+                line: (amp, f0),
+                ..OwnAxis::white_rw(1e-3, 1e-5)
+            };
+            (0..2u64).map(move |s| (a, 900 + 10 * i as u64 + s))
+        })
+        .collect();
+    let found: Vec<String> = cases
         .into_par_iter()
-        .filter_map(|seed| {
-            let r = analyse(a, rate, 1_440_000, 900 + seed);
+        .filter_map(|(a, seed)| {
+            let r = analyse(a, rate, 720_000, seed);
             (r.terms.b.verdict == Verdict::Resolved).then(|| {
                 format!(
-                    "seed {seed}: B {:e} [{:e}, {:e}]",
-                    r.terms.b.value, r.terms.b.lo, r.terms.b.hi
+                    "line {:?} seed {seed}: B {:e} [{:e}, {:e}]",
+                    a.line, r.terms.b.value, r.terms.b.lo, r.terms.b.hi
                 )
             })
         })
         .collect();
     assert!(found.is_empty(), "{found:?}");
+}
+
+/// Issue 40.7: the one resolved B of a flicker study was 2.4–2.6× the truth with an interval
+/// excluding it: a Gauss–Markov bump's shoulder beside the floor read as the floor. Its
+/// interval spans the model with a bump beside the floor (a BMI088-like gyro: white noise,
+/// a flicker floor from 5 to 500 s, a bump of T = 20 s, a random walk).
+#[test]
+fn a_bump_beside_a_flicker_floor_is_not_read_as_the_floor() {
+    let (b, rate) = (9.7e-6, 100.0);
+    let a = OwnAxis {
+        gm_sigma: 3e-5,
+        gm_t: 20.0,
+        flicker: (b, 5.0, 500.0),
+        ..OwnAxis::white_rw(2.45e-4, 4e-7)
+    };
+    let wrong: Vec<String> = (0..6u64)
+        .into_par_iter()
+        .filter_map(|seed| {
+            let t = analyse(a, rate, 1_440_000, 700 + seed).terms.b;
+            let holds = match t.verdict {
+                Verdict::Resolved | Verdict::NeverDominant => t.lo <= b && b <= t.hi,
+                _ => t.hi >= b,
+            };
+            (!holds).then(|| {
+                format!(
+                    "seed {seed}: B {:e} [{:e}, {:e}] {:?}",
+                    t.value, t.lo, t.hi, t.verdict
+                )
+            })
+        })
+        .collect();
+    assert!(wrong.is_empty(), "truth {b:e}: {wrong:?}");
 }
 
 /// An exact curve of `n` samples at `tau0` on a 1.25-geometric grid up to n/2.3.

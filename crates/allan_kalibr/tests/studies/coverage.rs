@@ -79,7 +79,8 @@ pub(crate) struct Axis {
 
 /// One axis of the own generator: white noise of density `n`, a random walk `k`, a
 /// first-order Gauss–Markov bias of σ `gm_sigma` and correlation time `gm_t` (0: none), in
-/// continuous-time units at `rate` Hz, and a sinusoid `line` (amplitude, Hz; 0: none).
+/// continuous-time units at `rate` Hz, a sinusoid `line` (amplitude, Hz; 0: none), and a
+/// flicker floor `flicker` (B, shortest and longest correlation time s; B = 0: none).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct OwnAxis {
     pub(crate) n: f64,
@@ -87,6 +88,7 @@ pub(crate) struct OwnAxis {
     pub(crate) gm_sigma: f64,
     pub(crate) gm_t: f64,
     pub(crate) line: (f64, f64),
+    pub(crate) flicker: (f64, f64, f64),
 }
 
 impl OwnAxis {
@@ -98,14 +100,18 @@ impl OwnAxis {
             gm_sigma: 0.0,
             gm_t: 0.0,
             line: (0.0, 0.0),
+            flicker: (0.0, 0.0, 0.0),
         }
     }
 }
 
+/// Correlation times per octave of the flicker floor's AR(1) components.
+const FLICKER_PER_OCTAVE: f64 = 2.0;
+
 /// `len` samples of `a` at `rate`: y = σ_w·w + b + g + l, b the walk (b₀ = 0, step K√Δt),
 /// g the AR(1) started from its stationary law (x' = φx + σ√(1 − φ²)·e, φ = e^(−Δt/T)), l
-/// the sinusoid with a random phase. (The exact Allan variance [`own_avar`] leaves the
-/// sinusoid out.)
+/// the sinusoid with a random phase, plus the flicker floor's components. (The exact Allan
+/// variance [`own_avar`] leaves the sinusoid and the flicker out.)
 pub(crate) fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f64> {
     let mut rng = StdRng::seed_from_u64(seed);
     let mut e = || -> f64 { StandardNormal.sample(&mut rng) };
@@ -121,8 +127,23 @@ pub(crate) fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f6
     let mut walk = 0.0;
     let mut g = a.gm_sigma * e();
     let (amp, f0) = a.line;
-    let phase = e(); // any real number is a phase
+    let phase = if amp != 0.0 { e() } else { 0.0 }; // any real number is a phase
     let w = 2.0 * std::f64::consts::PI * f0 * dt;
+    // the flicker floor: AR(1) components with correlation times spread evenly in ln T from
+    // T_lo to T_hi, each of variance B²·ΔlnT/π (a 1/f spectrum: their Allan variances sum
+    // to the floor (2 ln2/π)·B² between the corners)
+    let (b, t_lo, t_hi) = a.flicker;
+    let mut fl: Vec<(f64, f64, f64)> = Vec::new(); // (φ, innovation σ, state)
+    if b > 0.0 {
+        let step = std::f64::consts::LN_2 / FLICKER_PER_OCTAVE;
+        let var = b * b * step / std::f64::consts::PI;
+        let mut t = t_lo;
+        while t <= t_hi * (1.0 + 1e-9) {
+            let p = (-dt / t).exp();
+            fl.push((p, (var * (1.0 - p * p)).sqrt(), var.sqrt() * e()));
+            t *= step.exp();
+        }
+    }
     let mut out = Vec::with_capacity(len);
     for i in 0..len {
         let line = if amp != 0.0 {
@@ -130,7 +151,12 @@ pub(crate) fn own_series(a: OwnAxis, rate: f64, len: usize, seed: u64) -> Vec<f6
         } else {
             0.0
         };
-        out.push(sw * e() + walk + g + line);
+        let mut flick = 0.0;
+        for c in fl.iter_mut() {
+            flick += c.2;
+            c.2 = c.0 * c.2 + c.1 * e();
+        }
+        out.push(sw * e() + walk + g + line + flick);
         walk += q * e();
         g = phi * g + gi * e();
     }

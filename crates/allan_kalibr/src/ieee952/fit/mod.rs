@@ -243,6 +243,11 @@ pub struct FitResult {
     /// Terms in the model that a Gauss–Markov bias explains as well (see [`fit`]): B or K
     /// whose floor or rise is a bump's shoulder or tail; not "resolved".
     pub ambiguous: [bool; TERM_COUNT],
+    /// Where the model has a flicker floor and no Gauss–Markov bias: the best correlation
+    /// time of a bump in the floor's place (NaN: none searched). B's interval spans the
+    /// model with that bump beside the floor ([`Profile`]): a bump's shoulder read as a
+    /// floor gave a B 2.4× the truth with an interval excluding it.
+    pub bump_for_floor: f64,
     /// Largest share of the model's Allan variance each term's own line has at a used point:
     /// ≈ 1 where it alone makes the curve, ≥ 0.64 where its line comes within 20 % of it.
     pub max_share: [f64; TERM_COUNT],
@@ -494,7 +499,8 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         shapes,
         coef: &coef,
     };
-    let (ambiguous, alternatives) = (model.ambiguous_terms(), model.floor_alternatives());
+    let ((ambiguous, bump_for_floor), alternatives) =
+        (model.ambiguous_terms(), model.floor_alternatives());
     let max_share = max_shares(data, used, &coef, &shapes);
     Some(FitResult {
         coef,
@@ -515,6 +521,7 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         shapes,
         alternatives,
         ambiguous,
+        bump_for_floor,
         max_share,
     })
 }
@@ -728,7 +735,9 @@ impl FinalModel<'_> {
     /// B or K only where no Gauss–Markov bias explains the data as well: the model with the
     /// term swapped for a bump (its best correlation time) must fit worse, under the final
     /// model's covariance (`s`), by Akaike's measure (the bump has one more parameter).
-    fn ambiguous_terms(&self) -> [bool; TERM_COUNT] {
+    /// Also returns the best correlation time of a bump in place of the flicker floor (NaN
+    /// without one), [`FitResult::bump_for_floor`].
+    fn ambiguous_terms(&self) -> ([bool; TERM_COUNT], f64) {
         let FinalModel {
             data,
             used,
@@ -740,6 +749,7 @@ impl FinalModel<'_> {
         } = *self;
         let signed = signed_terms(cfg);
         let mut ambiguous = [false; TERM_COUNT];
+        let mut bump_for_floor = f64::NAN;
         if cfg.select && cfg.terms[GM] {
             let d = if data.basis.is_none() { 1.0 } else { s.delta };
             let grid = shape_grid(data, used, GM_GRID);
@@ -759,15 +769,21 @@ impl FinalModel<'_> {
                     } else {
                         grid.clone()
                     };
-                    let alt = times
+                    let (alt, at) = times
                         .iter()
-                        .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }))
-                        .fold(f64::INFINITY, f64::min);
+                        .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }).map(|c| (c, tg)))
+                        .fold(
+                            (f64::INFINITY, f64::NAN),
+                            |a, b| if b.0 < a.0 { b } else { a },
+                        );
                     ambiguous[j] = alt + SWAP_PENALTY <= cur;
+                    if j == 2 && !terms[GM] {
+                        bump_for_floor = at;
+                    }
                 }
             }
         }
-        ambiguous
+        (ambiguous, bump_for_floor)
     }
 
     /// The flicker floor's shape as the data leave it: every corner (and the flat floor) whose

@@ -79,6 +79,8 @@ pub(crate) struct Profile<'d, 'a> {
 
 /// The profile machinery under one set of shapes.
 struct Variant<'d, 'a> {
+    /// Used for this term's interval only (None: for every term).
+    only: Option<usize>,
     p: Problem<'d, 'a>,
     delta: f64,
     /// Terms free in the profile's model.
@@ -178,12 +180,26 @@ impl<'d, 'a> Profile<'d, 'a> {
                 }
             }
         }
-        let variants: Vec<Variant> = shapes
+        let mut variants: Vec<Variant> = shapes
             .into_iter()
             .filter_map(|sh| Variant::new(data, res, cfg, sh, used))
             .collect();
+        // for the flicker floor's interval: the model with a bump beside it, at the time
+        // that explains the floor best (B's only: a bump beside the floor is no statement
+        // on the other terms)
+        if res.bump_for_floor.is_finite() && res.coef[GM] == 0.0 && cfg.terms[GM] {
+            let sh = Shapes {
+                gm_t: res.bump_for_floor,
+                ..res.shapes
+            };
+            if let Some(mut v) = Variant::new(data, res, cfg, sh, used) {
+                v.only = Some(2);
+                variants.push(v);
+            }
+        }
         let d_min = variants
             .iter()
+            .filter(|v| v.only.is_none())
             .map(|v| v.d_min)
             .fold(f64::INFINITY, f64::min);
         (!variants.is_empty()).then_some(Profile { variants, d_min })
@@ -212,7 +228,7 @@ impl<'d, 'a> Profile<'d, 'a> {
     pub(crate) fn allows(&self, j: usize, cj: f64, level: f64) -> bool {
         self.variants
             .iter()
-            .filter(|v| v.d_min - self.d_min <= level)
+            .filter(|v| v.only.is_none_or(|o| o == j) && v.d_min - self.d_min <= level)
             .any(|v| {
                 let mut seen = vec![(v.c_min[j], v.c_min)];
                 v.at(j, cj, &mut seen)
@@ -246,10 +262,13 @@ impl<'d, 'a> Variant<'d, 'a> {
         used: &[usize],
     ) -> Option<Variant<'d, 'a>> {
         let p = Problem::new(data, used, shapes);
-        // the fit's terms, N and K always, and a flicker floor
+        // the fit's terms, N and K always, a flicker floor, and a bump where these shapes
+        // hold one
         let free: Vec<usize> = (0..TERM_COUNT)
             .filter(|&j| cfg.terms[j] && shapes.has(j))
-            .filter(|&j| res.coef[j] != 0.0 || j == 1 || j == 2 || j == 3)
+            .filter(|&j| {
+                res.coef[j] != 0.0 || matches!(j, 1..=3) || (j == GM && shapes.gm_t.is_finite())
+            })
             .collect();
         let delta = if res.delta.is_finite() {
             res.delta
@@ -261,6 +280,7 @@ impl<'d, 'a> Variant<'d, 'a> {
             cfg.terms[j] && shapes.has(j) && (j != GM || shapes.gm_t.is_finite())
         });
         let mut pr = Variant {
+            only: None,
             p,
             delta,
             free,
