@@ -378,6 +378,25 @@ fn a_bump_beside_a_flicker_floor_is_not_read_as_the_floor() {
         })
         .collect();
     assert!(wrong.is_empty(), "truth {b:e}: {wrong:?}");
+    // and the profiles study's BMI088 gyro x of seed 103 (`sim`), where it happened
+    let m = sim::Profile::Bmi088.model();
+    let y = sim::axis_series(&m, Sensor::Gyro, 0, 200.0, 2_880_000, 103, 0.0).expect("sim");
+    let t = analyse_ieee952(&y, 1.0 / 200.0, &Ieee952Config::default())
+        .expect("series")
+        .terms
+        .b;
+    let truth = m.gyro.axes[0].bias_instability.expect("a floor").b;
+    assert!(
+        match t.verdict {
+            Verdict::Resolved | Verdict::NeverDominant => t.lo <= truth && truth <= t.hi,
+            _ => t.hi >= truth,
+        },
+        "BMI088 gyro x: B {:e} [{:e}, {:e}] {:?} vs {truth:e}",
+        t.value,
+        t.lo,
+        t.hi,
+        t.verdict
+    );
 }
 
 /// An exact curve of `n` samples at `tau0` on a 1.25-geometric grid up to n/2.3.
