@@ -60,7 +60,7 @@ impl CurveData {
 
     /// The same curve with the PSD and the lines of its samples `y` (`psd`; a line near
     /// the PSD's lowest bins only where a sinusoid over the whole record confirms it,
-    /// [`line_check`]).
+    /// `line_check`).
     pub fn with_spectrum(mut self, y: &[f64]) -> Self {
         self.psd = psd::welch(y, 1.0 / self.tau0);
         self.lines = self

@@ -6,7 +6,8 @@
 use super::{APPROX_DELTA, B_FLOOR_TOL, FIT_TOL, analyse};
 use super::{Overlap, fit, psd, region};
 
-/// Where a point's EDF (and the α printed beside it) came from (see [`super::band`]).
+/// Where a point's EDF (and the α printed beside it) came from (the `band` module: the
+/// fitted model's mixture, else the curve's slope).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AlphaSource {
     /// The declared fit's model: the exact variance of the estimate under its mixture of
