@@ -647,3 +647,34 @@ fn check_yaml_against_terms(dir: &Path) {
         );
     }
 }
+
+/// The printed cross-check's N agrees with the fitted N within this (the PSD floor's median
+/// over a few hundred bins of a 2 h record: a few percent).
+const PSD_N_REL_TOL: f64 = 0.10;
+
+/// Issue 40.8: "N from the PSD level" was read at 0.5–2 Hz whatever the record, 0.11× the
+/// level on a low-passed one. It is read where the fitted model is white noise and the
+/// fitted range describes the spectrum (a 0.3 Hz low-pass at 20 Hz here).
+#[test]
+fn n_from_the_psd_level_is_read_where_the_model_is_white() {
+    let rate = 20.0;
+    let y = low_passed(1e-3, 1e-6, 0.3, rate, 144_000, 77);
+    let r = analyse_ieee952(&y, 1.0 / rate, &Ieee952Config::default()).expect("series");
+    let n = r.terms.n.value;
+    let mut a = imu(vec![(Sensor::Gyro, 0, r)]);
+    a.rate = rate;
+    let text = ieee952_summary_text(&a);
+    let line = text
+        .lines()
+        .find(|l| l.contains("N from the PSD level"))
+        .unwrap_or_else(|| panic!("no cross-check in {text}"));
+    let psd_n: f64 = line
+        .rsplit(' ')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number: {line}"));
+    assert!(
+        (psd_n / n - 1.0).abs() < PSD_N_REL_TOL,
+        "N from the PSD {psd_n:e} vs the fitted {n:e}: {line}"
+    );
+}

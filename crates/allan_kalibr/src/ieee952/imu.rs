@@ -499,7 +499,11 @@ fn readings_text(an: &Analysis) -> String {
     let psd_n = an
         .psd
         .as_ref()
-        .and_then(super::psd::white_density)
+        .zip(an.fit.as_ref())
+        .zip(an.verdict.range())
+        .and_then(|((p, f), (start, _))| {
+            super::psd::white_density(p, &f.coef, &f.shapes, an.tau0, start)
+        })
         .map_or("-".into(), |v| format!("{v:.3e}"));
     let _ = writeln!(
         s,
