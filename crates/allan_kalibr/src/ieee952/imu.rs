@@ -364,8 +364,8 @@ fn term_text(t: &Term, unit: &str) -> String {
             t.value, t.hi
         ),
         Verdict::Contradicted => format!(
-            "not resolved: the whole record does not agree with the fit's {:.2e} {unit} (95 % upper bound from the curve {:.2e} {unit})",
-            t.value, t.hi
+            "not resolved: the whole record does not agree with the fit (95 % upper bound from the curve {:.2e} {unit})",
+            t.hi
         ),
         Verdict::RegionReading => {
             format!("{:.4e} {unit}{} (IEEE 952 region reading)", t.value, iv(t))

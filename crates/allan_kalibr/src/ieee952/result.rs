@@ -66,9 +66,9 @@ pub enum Verdict {
     RegionReading,
     /// No reliable fit and no region for the term: only the 95 % upper bound is known.
     RegionBound,
-    /// Fitted, but the whole record does not agree with it: its value is above what every
-    /// point's upper 95 % band allows, or the model it lifts rises above the curve's upper
-    /// band beyond the fitted range. Only the record's 95 % upper bound is reported.
+    /// Fitted, but the whole record does not agree with it: its value (or its whole
+    /// interval) lies above the 95 % bound the curve's points give it jointly. Only that
+    /// bound is reported (value 0, interval [0, bound]).
     Contradicted,
     /// Not in the fitted model, or nothing could be computed.
     NotFitted,
@@ -82,10 +82,11 @@ pub struct Term {
     /// Standard error of `value` (delta method from the coefficient's); NaN when value = 0.
     pub std_err: f64,
     /// Lower end of the interval at `Config::term_confidence`, in the term's unit: the
-    /// square root of the coefficient interval {c ≥ 0 : |ĉ − c| ≤ z·se(c)}
-    /// (`fit::inverted_interval`). NaN without a sample count.
+    /// profile of the term under the joint fit (`fit::Profile`); 0 for a term not resolved,
+    /// whose `hi` is then its one-sided upper bound. The value always lies inside. NaN
+    /// without a sample count.
     pub lo: f64,
-    /// Upper end of the interval.
+    /// Upper end of the interval (a term not resolved: its one-sided 95 % upper bound).
     pub hi: f64,
     /// Can this term be reported?
     pub verdict: Verdict,
