@@ -189,64 +189,66 @@ fn a_strong_gauss_markov_bump_is_not_read_as_a_random_walk() {
 /// its bound.
 #[test]
 fn the_terms_and_the_chart_tell_one_story() {
-    // the axes of the coverage study whose rows contradicted themselves before
-    let mut recs = bump_records(402, &[0, 1]);
-    recs.extend(bump_records(403, &[0, 2]));
-    let mut faults = Vec::new();
-    for (k, (_, r)) in recs.iter().enumerate() {
-        let t = &r.terms;
-        for (name, x) in [
-            ("Q", &t.q),
-            ("N", &t.n),
-            ("B", &t.b),
-            ("K", &t.k),
-            ("R", &t.r),
-            ("G", &t.g),
-        ] {
-            faults.extend(
-                row_faults(name, x)
-                    .into_iter()
-                    .map(|f| format!("gyro {k} {f}")),
-            );
+    // the axes of the coverage study whose rows contradicted themselves before, one chart per
+    // record (each gyro axis at its own index)
+    for (seed, axes) in [(402u64, [0u64, 1]), (403, [0, 2])] {
+        let recs = bump_records(seed, &axes);
+        let mut faults = Vec::new();
+        for (&k, (_, r)) in axes.iter().zip(&recs) {
+            let t = &r.terms;
+            for (name, x) in [
+                ("Q", &t.q),
+                ("N", &t.n),
+                ("B", &t.b),
+                ("K", &t.k),
+                ("R", &t.r),
+                ("G", &t.g),
+            ] {
+                faults.extend(
+                    row_faults(name, x)
+                        .into_iter()
+                        .map(|f| format!("seed {seed} gyro {k} {f}")),
+                );
+            }
         }
-    }
-    assert!(faults.is_empty(), "{faults:#?}");
-    let imu = imu(recs
-        .into_iter()
-        .enumerate()
-        .map(|(k, (_, r))| (Sensor::Gyro, k, r))
-        .collect());
-    let dir = tempfile::tempdir().unwrap();
-    let files = write_ieee952_chart(
-        &bag2mat::shared::output::Outputs::direct(),
-        &imu,
-        "bump",
-        None,
-        dir.path(),
-        "",
-    )
-    .expect("chart");
-    let svg = files
-        .iter()
-        .find(|p| p.extension().is_some_and(|e| e == "svg"))
-        .map(|p| std::fs::read_to_string(p).unwrap())
-        .expect("an svg");
-    for ax in &imu.axes {
-        let (t, fit) = (&ax.analysis.terms, ax.analysis.fit.as_ref());
-        for (name, term, j) in [("B", &t.b, 2), ("K", &t.k, 3)] {
-            let drawn = fit.is_some_and(|f| f.coef[j] > 0.0) && term.value > 0.0;
-            if drawn && term.verdict != Verdict::Resolved {
-                let estimate = format!("{name} = {:.2e}", term.value);
-                assert!(
-                    !svg.contains(&estimate),
-                    "the legend gives {estimate} for a term not resolved"
-                );
-                assert!(
-                    svg.contains(&format!("{name} &lt; {:.2e}", term.hi))
-                        || svg.contains(&format!("{name} < {:.2e}", term.hi)),
-                    "the legend lacks {name}'s bound {:.2e}",
-                    term.hi
-                );
+        assert!(faults.is_empty(), "{faults:#?}");
+        let imu = imu(axes
+            .iter()
+            .zip(recs)
+            .map(|(&k, (_, r))| (Sensor::Gyro, k as usize, r))
+            .collect());
+        let dir = tempfile::tempdir().unwrap();
+        let files = write_ieee952_chart(
+            &bag2mat::shared::output::Outputs::direct(),
+            &imu,
+            "bump",
+            None,
+            dir.path(),
+            "",
+        )
+        .expect("chart");
+        let svg = files
+            .iter()
+            .find(|p| p.extension().is_some_and(|e| e == "svg"))
+            .map(|p| std::fs::read_to_string(p).unwrap())
+            .expect("an svg");
+        for ax in &imu.axes {
+            let (t, fit) = (&ax.analysis.terms, ax.analysis.fit.as_ref());
+            for (name, term, j) in [("B", &t.b, 2), ("K", &t.k, 3)] {
+                let drawn = fit.is_some_and(|f| f.coef[j] > 0.0) && term.value > 0.0;
+                if drawn && term.verdict != Verdict::Resolved {
+                    let estimate = format!("{name} = {:.2e}", term.value);
+                    assert!(
+                        !svg.contains(&estimate),
+                        "seed {seed}: the legend gives {estimate} for a term not resolved"
+                    );
+                    assert!(
+                        svg.contains(&format!("{name} &lt; {:.2e}", term.hi))
+                            || svg.contains(&format!("{name} < {:.2e}", term.hi)),
+                        "seed {seed}: the legend lacks {name}'s bound {:.2e}",
+                        term.hi
+                    );
+                }
             }
         }
     }
