@@ -55,12 +55,14 @@ cargo test --workspace "$@"
 # 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
 # Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
-# runs beside them, and issue 42's coverage count of the operating-noise interval (80 seeded
-# hand-held records with a reference, through the allan_kalibr binary: 249 s measured on two
-# cores shared with other builds).
+# runs beside them, issue 40's coverage study (126 axes of known truth: how often each
+# interval, bound and band holds it; about a minute) and issue 42's coverage count of the
+# operating-noise interval (80 seeded hand-held records with a reference, through the
+# allan_kalibr binary: 249 s measured on two cores shared with other builds).
 cargo test -p allan_kalibr --test main -- --ignored --exact \
   studies::profiles::profiles_study studies::bandlimited::bandlimited_study \
-  studies::lines::lines_study studies::operating::operating_interval_coverage_study
+  studies::lines::lines_study studies::coverage::coverage_study \
+  studies::operating::operating_interval_coverage_study
 
 # Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
 # with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,

@@ -109,8 +109,8 @@ pub use ieee952::stated::section_text as ieee952_section_text;
 pub use ieee952::{
     AlphaSource, Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CovBasis,
     CurveData, CurvePoint, FitConfig, FitSummary, GridSpec, IdMethod, Ieee952Error, LineShape,
-    LineTerm, Overlap, Phase, Point as CurveFitPoint, Shapes, Term, Terms, Verdict,
-    analyse as analyse_ieee952, analyse_curve, short,
+    LineTerm, MAX_MISS_SHARE, MISS_RUN_SPAN, Overlap, Phase, Point as CurveFitPoint, Shapes, Term,
+    Terms, Verdict, analyse as analyse_ieee952, analyse_curve, short,
 };
 pub use input::{Clock, RateChoice};
 pub use input::{ImuData, load as load_input, snap_rate, value_problem};

@@ -14,3 +14,4 @@ mod outputs_and_messages;
 mod record_checks;
 mod reference;
 mod studies;
+mod uncertainty;

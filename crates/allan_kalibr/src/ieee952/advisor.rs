@@ -60,13 +60,21 @@ pub struct Advice {
 /// The z of the 95 % intervals.
 const Z95: f64 = 1.959_963_984_540_054;
 
-/// Advice for a term of a record of `record` seconds.
+/// Advice for a term of a record of `record` seconds: from its standard error where the fit
+/// resolves it; for an IEEE 952 region reading (a value the report prints) from its own
+/// 95 % interval's relative half-width, so that the advice never calls a printed value "not
+/// resolved".
 fn term_advice(t: &Term, record: f64) -> TermAdvice {
-    if t.verdict != Verdict::Resolved || !super::fit::is_positive(t.value) || !t.std_err.is_finite()
-    {
+    if !super::fit::is_positive(t.value) {
         return TermAdvice::none();
     }
-    let p = Z95 * t.std_err / t.value;
+    let p = match t.verdict {
+        Verdict::Resolved if t.std_err.is_finite() => Z95 * t.std_err / t.value,
+        Verdict::RegionReading if t.lo.is_finite() && t.hi.is_finite() => {
+            0.5 * (t.hi - t.lo) / t.value
+        }
+        _ => return TermAdvice::none(),
+    };
     let needed = |x: f64| record * (p / x).powi(2);
     TermAdvice {
         precision: p,

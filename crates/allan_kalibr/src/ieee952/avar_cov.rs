@@ -318,6 +318,11 @@ pub struct CovBasis {
     sums: Vec<[f64; 10]>,
     /// Non-overlapping only: exact variance sums of each point.
     normal_var: Vec<[f64; 10]>,
+    /// Every point of the curve (ascending m), for its own variance: the band of each
+    /// point follows from the fitted model ([`CovBasis::point_var`]).
+    point_ms: Vec<usize>,
+    /// The variance sums of each of `point_ms`.
+    point_sums: Vec<[f64; 10]>,
 }
 
 impl CovBasis {
@@ -345,7 +350,36 @@ impl CovBasis {
             kind,
             sums,
             normal_var,
+            point_ms: Vec::new(),
+            point_sums: Vec::new(),
         }
+    }
+
+    /// The same basis with the variance of every point of `points` (ascending, distinct
+    /// cluster sizes of the whole curve) of `n` samples at `tau0`: each is one diagonal
+    /// entry of [`pair_sums`] (or the non-overlapping variance), a few thousand terms.
+    pub(crate) fn with_points(mut self, points: &[usize], n: usize, tau0: f64) -> CovBasis {
+        let kind = self.kind;
+        self.point_sums = points
+            .par_iter()
+            .map(|&m| match kind {
+                Overlap::Overlapping => {
+                    let big_m = (n + 1).saturating_sub(2 * m);
+                    pair_sums(m, m, big_m, big_m, tau0)
+                }
+                Overlap::Normal => normal_var_sums(m, (n / m).saturating_sub(1), tau0),
+            })
+            .collect();
+        self.point_ms = points.to_vec();
+        self
+    }
+
+    /// Variance of the estimate at cluster size `m` (a point given to
+    /// [`CovBasis::with_points`]) for coefficients `c` (Q², N², B², K², …); `None` for
+    /// another m.
+    pub(crate) fn point_var(&self, m: usize, c: &[f64]) -> Option<f64> {
+        let i = self.point_ms.binary_search(&m).ok()?;
+        Some(quad(&self.point_sums[i], c))
     }
 
     /// Cluster sizes of the basis.

@@ -36,6 +36,16 @@ pub fn chi2_interval(dev: f64, edf: f64, confidence: f64) -> Option<(f64, f64)> 
     Some((dev * (edf / upper_q).sqrt(), dev * (edf / lower_q).sqrt()))
 }
 
+/// The one-sided upper limit of the deviation σ at confidence `confidence` (σ̂·√(ν/χ²_{1−c}(ν))).
+/// `None` as [`chi2_interval`].
+pub fn chi2_upper(dev: f64, edf: f64, confidence: f64) -> Option<f64> {
+    if !(edf > 0.0 && edf.is_finite() && confidence > 0.0 && confidence < 1.0) {
+        return None;
+    }
+    let q = chi2_quantile(edf, 1.0 - confidence)?;
+    (q > 0.0).then(|| dev * (edf / q).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

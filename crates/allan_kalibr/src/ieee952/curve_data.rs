@@ -4,7 +4,8 @@
 use rayon::prelude::*;
 
 use super::{
-    Config, CovBasis, IdMethod, Ieee952Error, LINE_MIN_SHARE, Overlap, Phase, fit, noise_id, psd,
+    Config, CovBasis, IdMethod, Ieee952Error, LINE_MIN_SHARE, Overlap, Phase, fit, line_check,
+    noise_id, psd,
 };
 
 /// One measured point handed to the analysis.
@@ -57,10 +58,16 @@ impl CurveData {
         }
     }
 
-    /// The same curve with the PSD and the lines of its samples `y` (`psd`).
+    /// The same curve with the PSD and the lines of its samples `y` (`psd`; a line near
+    /// the PSD's lowest bins only where a sinusoid over the whole record confirms it,
+    /// `line_check`).
     pub fn with_spectrum(mut self, y: &[f64]) -> Self {
         self.psd = psd::welch(y, 1.0 / self.tau0);
-        self.lines = self.psd.as_ref().map(psd::find_lines).unwrap_or_default();
+        self.lines = self
+            .psd
+            .as_ref()
+            .map(|p| line_check::confirmed(y, p, psd::find_lines(p)))
+            .unwrap_or_default();
         self
     }
 
@@ -126,27 +133,33 @@ impl CurveData {
 
     /// Cluster sizes of the fit grid (the valid points nearest 2^(k/p)).
     pub(crate) fn fit_ms(&self, per_octave: u32) -> Vec<usize> {
-        let valid: Vec<usize> = self
-            .points
-            .iter()
-            .filter(|p| p.avar > 0.0 && p.avar.is_finite())
-            .map(|p| p.m)
-            .collect();
+        let valid = self.valid_ms();
         fit::thin_to_grid(&valid, per_octave)
             .into_iter()
             .map(|i| valid[i])
             .collect()
     }
 
-    /// The statistical covariance basis of the fit grid (None without a sample count).
+    /// The statistical covariance basis of the fit grid, with the variance of every valid
+    /// point of the curve (None without a sample count).
     pub fn basis(&self, per_octave: u32) -> Option<CovBasis> {
         let n = self.n?;
-        Some(CovBasis::new(
-            &self.fit_ms(per_octave),
-            n,
-            self.tau0,
-            self.kind,
-        ))
+        Some(
+            CovBasis::new(&self.fit_ms(per_octave), n, self.tau0, self.kind).with_points(
+                &self.valid_ms(),
+                n,
+                self.tau0,
+            ),
+        )
+    }
+
+    /// Cluster sizes of the valid points (AVAR positive and finite), ascending.
+    pub(crate) fn valid_ms(&self) -> Vec<usize> {
+        self.points
+            .iter()
+            .filter(|p| p.avar > 0.0 && p.avar.is_finite())
+            .map(|p| p.m)
+            .collect()
     }
 }
 

@@ -7,12 +7,12 @@ use std::ops::ControlFlow;
 #[cfg(doc)]
 use super::avar_cov;
 use super::{
-    APPROX_CHI2, APPROX_DELTA, AxisVerdict, Config, CurveData, CurvePoint, FIT_TOL,
-    MIN_RANGE_DECADES, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN, SHORT_FEATURE_SPAN, Term,
-    Verdict, ci, edf, fit, pipeline, short, terms,
+    APPROX_CHI2, APPROX_DELTA, AxisVerdict, Config, CurveData, CurvePoint, FIT_TOL, MAX_MISS_SHARE,
+    MIN_RANGE_DECADES, MISS_RUN_SPAN, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN,
+    SHORT_FEATURE_SPAN, Term, Verdict, band, ci, fit, pipeline, short, terms,
 };
 
-/// Chooses the fitted range and fits it: the start from [`fit::choose_start`], then the
+/// Chooses the fitted range and fits it: from `start` ([`fit::choose_start`]), then the
 /// declared-fit check — every curve point of the range within the larger of [`FIT_TOL`] and
 /// its 95 % band of the model. A miss among the first points of the range moves the start
 /// past it; a miss further up ends the range before it (the long τ the model cannot
@@ -27,9 +27,10 @@ pub(super) fn declare_fit(
     fd: &fit::FitData,
     valid: &[&CurvePoint],
     cfg: &Config,
+    start: usize,
 ) -> Declared {
     let bounds = Bounds {
-        start: fit::choose_start(fd, &cfg.fit),
+        start,
         end: fd.points.len(),
         long_cut: false,
         feature: false,
@@ -222,6 +223,10 @@ fn past_misses(
     ControlFlow::Continue(cut)
 }
 
+/// The level of the band beyond which a miss is never chance ([`by_chance`]): a stretch of
+/// correlated points moves together, but a point outside its 99.9 % band is the model's.
+const GROSS_LEVEL: f64 = 0.999;
+
 /// A curve point the fitted model misses (beyond [`FIT_TOL`] and its own 95 % band).
 #[derive(Clone, Copy, Debug)]
 struct Miss {
@@ -291,14 +296,16 @@ fn fit_and_check(
     start: usize,
     end: usize,
 ) -> Option<Checked> {
-    let n_phase = data.n.map(|n| n + 1);
     let used: Vec<usize> = (start..end).collect();
     let f = fit::fit(fd, &used, &cfg.fit)?;
     let (lo_t, hi_t) = (fd.points[start].tau, fd.points[end - 1].tau);
     let in_range = |t: f64| t >= lo_t * (1.0 - 1e-12) && t <= hi_t * (1.0 + 1e-12);
     let mut misses: Vec<Miss> = Vec::new();
     let mut max_mis: f64 = 0.0;
-    let level = check_level(data.kind, valid.iter().filter(|p| in_range(p.tau)).count());
+    let count = valid.iter().filter(|p| in_range(p.tau)).count();
+    let level = check_level(data.kind, count);
+    // each point's state in τ order: None within its band, Some(above) a miss
+    let mut states: Vec<(f64, Option<(bool, bool)>)> = Vec::with_capacity(count);
     for p in valid.iter().filter(|p| in_range(p.tau)) {
         let model = f.predict(p.tau);
         let mis = if model > 0.0 {
@@ -307,22 +314,66 @@ fn fit_and_check(
             -1.0
         };
         max_mis = max_mis.max(mis.abs());
-        let alpha = fit::TERM_ALPHA[fit::dominant_term(&f.coef, &f.shapes, p.tau)];
-        // the model within the data's 95 % interval: model/data ∈ [lo, hi]
-        let band = n_phase
-            .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
-            .and_then(|nu| ci::chi2_interval(1.0, nu, level))
-            .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
-            .unwrap_or(0.0);
-        if model <= 0.0 || mis.abs() > FIT_TOL.max(band) {
+        // the model within the data's 95 % interval (the EDF its own mixture gives the
+        // point, [`band`]): model/data ∈ [lo, hi]
+        let nu = fd
+            .basis
+            .and_then(|b| band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau));
+        let band_at = |c: f64| {
+            nu.and_then(|nu| ci::chi2_interval(1.0, nu, c))
+                .map(|(lo, hi)| if mis > 0.0 { hi - 1.0 } else { 1.0 - lo })
+                .unwrap_or(0.0)
+        };
+        if model <= 0.0 || mis.abs() > FIT_TOL.max(band_at(level)) {
             misses.push(Miss {
                 tau: p.tau,
                 size: mis.abs(),
                 above: mis < 0.0,
             });
+            let gross = model <= 0.0 || mis.abs() > FIT_TOL.max(band_at(GROSS_LEVEL));
+            states.push((p.tau, Some((mis < 0.0, gross))));
+        } else {
+            states.push((p.tau, None));
         }
     }
+    if by_chance(&states) {
+        misses.clear();
+    }
     Some((f, misses, max_mis))
+}
+
+/// Whether the misses among `states` (each curve point of a range in τ order: its τ and,
+/// for a miss, whether the data lie above the model and whether it is gross) are what
+/// chance gives a model that describes the curve: none beyond the point's
+/// [`GROSS_LEVEL`] band, at most [`MAX_MISS_SHARE`] of the points, and no run of
+/// consecutive misses on one side wider than [`MISS_RUN_SPAN`] in τ. Overlapping estimates
+/// at neighbouring τ share most of their data, so a chance excursion of the curve takes a
+/// stretch of points past their 95 % bands together (a clean 30-minute record's white
+/// noise 10 % low over 10–16 s cut its fit at 7 s); a model that misses the curve does so
+/// by more, over a wider stretch, or at many points.
+fn by_chance(states: &[(f64, Option<(bool, bool)>)]) -> bool {
+    let missed = states.iter().filter(|s| s.1.is_some()).count();
+    if missed == 0 {
+        return true;
+    }
+    if missed as f64 > MAX_MISS_SHARE * states.len() as f64
+        || states.iter().any(|s| s.1.is_some_and(|m| m.1))
+    {
+        return false;
+    }
+    let mut run: Option<(f64, bool)> = None; // (first τ, side) of the run going on
+    for &(tau, st) in states {
+        match (st.map(|m| m.0), run) {
+            (Some(side), Some((t0, s0))) if side == s0 => {
+                if tau / t0 > MISS_RUN_SPAN {
+                    return false;
+                }
+            }
+            (Some(side), _) => run = Some((tau, side)),
+            (None, _) => run = None,
+        }
+    }
+    true
 }
 
 /// The level of each point's band in the range check of `points` points of a curve of
@@ -362,8 +413,10 @@ fn extension_is_honest(
     let terms = |x: &fit::FitResult| {
         let first = fd.points[x.used[0]].tau;
         let last = fd.points[x.used[x.used.len() - 1]].tau;
-        let curve = pipeline::curve_points(data, cfg, Some(x), Some((first, last)));
-        let t = terms::make_terms(x, fd, &curve, cfg);
+        let curve =
+            pipeline::curve_points(data, cfg, Some(x), Some(x), fd.basis, Some((first, last)));
+        let record = terms::record_points(&curve, fd, first);
+        let t = terms::make_terms(x, fd, &curve, &record, cfg);
         t.as_array().into_iter().chain([t.g])
     };
     let resolved = |t: &Term| t.verdict == Verdict::Resolved;

@@ -64,19 +64,20 @@ pub struct SensorValue {
 /// Groups curves by what their statistical covariance depends on, so each basis is built
 /// once (the axes of an IMU share the grid, the sample count and the estimator).
 fn bases(curves: &[&CurveData], cfg: &Config) -> Vec<Option<CovBasis>> {
-    let mut keys: Vec<(Vec<usize>, Option<usize>, u64, super::Overlap)> = Vec::new();
+    type Key = (Vec<usize>, Option<usize>, u64, super::Overlap);
+    let mut keys: Vec<(Key, &CurveData)> = Vec::new();
     let mut which = Vec::with_capacity(curves.len());
     for c in curves {
-        let key = (c.fit_ms(cfg.fit.per_octave), c.n, c.tau0.to_bits(), c.kind);
-        let i = keys.iter().position(|k| *k == key).unwrap_or_else(|| {
-            keys.push(key);
+        let key = (c.valid_ms(), c.n, c.tau0.to_bits(), c.kind);
+        let i = keys.iter().position(|k| k.0 == key).unwrap_or_else(|| {
+            keys.push((key, c));
             keys.len() - 1
         });
         which.push(i);
     }
     let built: Vec<Option<CovBasis>> = keys
         .par_iter()
-        .map(|(ms, n, tau0, kind)| n.map(|n| CovBasis::new(ms, n, f64::from_bits(*tau0), *kind)))
+        .map(|(_, c)| c.basis(cfg.fit.per_octave))
         .collect();
     which.into_iter().map(|i| built[i].clone()).collect()
 }
@@ -219,34 +220,17 @@ impl ImuAnalysis {
         self.axes.iter().filter(move |a| a.sensor == s)
     }
 
-    /// One value of a term for a sensor (`term` picks it from the terms): the largest
-    /// resolved axis value (or region reading, marked); when no axis has one, the largest
-    /// 95 % upper bound, marked. `None` when the sensor is absent or nothing is known.
+    /// One value of a term for a sensor (`term` picks it from the terms): the largest axis'
+    /// value where any axis reports one (resolved, or an IEEE 952 region reading, marked);
+    /// when none does, the largest 95 % upper bound, marked. Never capped by anything else:
+    /// each axis' term already says what its data support (a resolved value above the whole
+    /// record's bound is not resolved, [`Verdict::Contradicted`]). `None` when the sensor is
+    /// absent or nothing is known.
     pub fn sensor_value(&self, s: Sensor, term: fn(&super::Terms) -> &Term) -> Option<SensorValue> {
-        self.sensor_value_within(s, term, |_| f64::INFINITY)
-    }
-
-    /// [`ImuAnalysis::sensor_value`] with every axis' value at most `bound` of its analysis
-    /// (the curve's own 95 % bound of the term, [`super::Analysis::bounds`]).
-    pub(crate) fn sensor_value_within(
-        &self,
-        s: Sensor,
-        term: fn(&super::Terms) -> &Term,
-        bound: fn(&super::Analysis) -> f64,
-    ) -> Option<SensorValue> {
-        let terms: Vec<Term> = self
+        let terms: Vec<&Term> = self
             .sensor_axes(s)
-            .map(|a| {
-                let mut t = *term(&a.analysis.terms);
-                let b = bound(&a.analysis);
-                if b.is_finite() {
-                    t.value = t.value.min(b);
-                    t.hi = t.hi.min(b);
-                }
-                t
-            })
+            .map(|a| term(&a.analysis.terms))
             .collect();
-        let terms: Vec<&Term> = terms.iter().collect();
         if terms.is_empty() {
             return None;
         }
@@ -281,16 +265,14 @@ impl ImuAnalysis {
         })
     }
 
-    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]), never above
-    /// what the curve allows.
+    /// White-noise density N of a sensor (see [`ImuAnalysis::sensor_value`]).
     pub fn noise_density(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value_within(s, |t| &t.n, |a| a.bounds.0)
+        self.sensor_value(s, |t| &t.n)
     }
 
-    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]), never above the
-    /// curve's own bound min σ_hi95(τ)·√(3/τ) (issue 17).
+    /// Random walk K of a sensor (see [`ImuAnalysis::sensor_value`]).
     pub fn random_walk(&self, s: Sensor) -> Option<SensorValue> {
-        self.sensor_value_within(s, |t| &t.k, |a| a.bounds.1)
+        self.sensor_value(s, |t| &t.k)
     }
 
     /// The record check's warnings on one axis (a warm-up, a spike).
@@ -382,8 +364,8 @@ fn term_text(t: &Term, unit: &str) -> String {
             t.value, t.hi
         ),
         Verdict::Contradicted => format!(
-            "not resolved: the whole record does not agree with the fit's {:.2e} {unit} (95 % upper bound from the curve {:.2e} {unit})",
-            t.value, t.hi
+            "not resolved: the whole record does not agree with the fit (95 % upper bound from the curve {:.2e} {unit})",
+            t.hi
         ),
         Verdict::RegionReading => {
             format!("{:.4e} {unit}{} (IEEE 952 region reading)", t.value, iv(t))
@@ -517,7 +499,11 @@ fn readings_text(an: &Analysis) -> String {
     let psd_n = an
         .psd
         .as_ref()
-        .and_then(super::psd::white_density)
+        .zip(an.fit.as_ref())
+        .zip(an.verdict.range())
+        .and_then(|((p, f), (start, _))| {
+            super::psd::white_density(p, &f.coef, &f.shapes, an.tau0, start)
+        })
         .map_or("-".into(), |v| format!("{v:.3e}"));
     let _ = writeln!(
         s,

@@ -3,10 +3,10 @@
 //! readings, the terms ([`super::terms`]) and the fit's diagnostics.
 
 use super::declare::declare_fit;
-use super::terms::{make_terms, region_terms};
+use super::terms::{make_terms, record_points, region_terms};
 use super::{
     AlphaSource, Analysis, AxisVerdict, Config, CovBasis, CurveData, CurvePoint, FIT_TOL,
-    FitSummary, IdMethod, Ieee952Error, Point, ci, edf, fit, region,
+    FitSummary, Ieee952Error, Point, band, ci, fit, region,
 };
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
@@ -28,10 +28,12 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
     let fd = fit_data(data, cfg, &valid, basis);
 
     // the range and the fit, then the declared-fit check
-    let (fitted, mut verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg);
+    let start = fit::choose_start(&fd, &cfg.fit);
+    let (fitted, mut verdict, max_misfit) = declare_fit(data, &fd, &valid, cfg, start);
     // the curve with its bounds
     let range = verdict.range();
-    let curve = curve_points(data, cfg, fitted.as_ref(), range);
+    let band_model = fitted.as_ref().filter(|_| verdict.fits());
+    let curve = curve_points(data, cfg, fitted.as_ref(), band_model, basis, range);
     if let Some(f) = &fitted {
         name_short_cut(&mut verdict, f, &curve);
     }
@@ -46,9 +48,14 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         .collect();
     let region = region::read(&region_pts);
 
+    // the whole record's bounds are taken from where the curve is the model's at short τ
+    // on: the fitted range's start, or without a fit where it starts to fall like white
+    // noise (the band-limited points below lie under every term's line)
+    let from_tau = range.map_or_else(|| fd.points.get(start).map_or(0.0, |p| p.tau), |(lo, _)| lo);
+    let record = record_points(&curve, &fd, from_tau);
     let terms = match (&fitted, verdict.fits()) {
-        (Some(f), true) => make_terms(f, &fd, &curve, cfg),
-        _ => region_terms(&region, &curve),
+        (Some(f), true) => make_terms(f, &fd, &curve, &record, cfg),
+        _ => region_terms(&region, &record),
     };
     let fit = fitted.map(|f| FitSummary {
         coef: f.coef,
@@ -66,9 +73,10 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         max_misfit,
     });
     let bounds = (
-        region::upper_bound(curve.iter(), |t| fit::basis(1, t).sqrt()),
-        region::upper_bound(curve.iter(), |t| fit::basis(3, t).sqrt()),
+        region::upper_bound(record.iter().copied(), |t| fit::basis(1, t).sqrt()),
+        region::upper_bound(record.iter().copied(), |t| fit::basis(3, t).sqrt()),
     );
+    drop(record);
     Analysis {
         n: data.n,
         tau0: data.tau0,
@@ -119,34 +127,40 @@ fn fit_data<'a>(
     }
 }
 
-/// The analysed curve: each valid point with its α (identified, else the fitted model's
-/// dominant term), its Greenhall EDF, its bounds at `cfg.curve_confidence` and at 95 %,
-/// whether it is in the declared `range`, and the model there.
+/// The analysed curve: each valid point with its EDF and α ([`band`]: from `band_model`,
+/// the fit declared, whose exact variance `basis` gives; without one, from the curve's
+/// local slope), its bounds at `cfg.curve_confidence` and at 95 %, whether it is in the
+/// declared `range`, and the model `fitted` there.
 pub(super) fn curve_points(
     data: &CurveData,
     cfg: &Config,
     fitted: Option<&fit::FitResult>,
+    band_model: Option<&fit::FitResult>,
+    basis: Option<&CovBasis>,
     range: Option<(f64, f64)>,
 ) -> Vec<Point> {
-    let n_phase = data.n.map(|n| n + 1);
-    data.points
+    let valid: Vec<&CurvePoint> = data
+        .points
         .iter()
         .filter(|p| p.avar > 0.0 && p.avar.is_finite())
-        .map(|p| {
-            let (alpha, alpha_source) = match (p.id, p.id_method) {
-                (Some(a), IdMethod::Lag1) => (a, AlphaSource::Lag1),
-                (Some(a), _) => (a, AlphaSource::B1),
-                (None, _) => match fitted {
-                    Some(f) => (
-                        fit::TERM_ALPHA[fit::dominant_term(&f.coef, &f.shapes, p.tau)],
-                        AlphaSource::Model,
-                    ),
-                    None => (0, AlphaSource::Assumed),
-                },
-            };
-            let nu = n_phase
-                .and_then(|np| edf::greenhall_edf(alpha, p.m, np, data.kind))
-                .unwrap_or(f64::NAN);
+        .collect();
+    let slope = band::slope_alphas(&valid);
+    valid
+        .iter()
+        .zip(slope)
+        .map(|(p, slope_alpha)| {
+            let from_model = band_model.zip(basis).and_then(|(f, b)| {
+                let nu = band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau)?;
+                let dominant = fit::dominant_term(&f.coef, &f.shapes, p.tau);
+                Some((nu, fit::TERM_ALPHA[dominant], AlphaSource::Model))
+            });
+            let (nu, alpha, alpha_source) = from_model.unwrap_or_else(|| {
+                let nu = data
+                    .n
+                    .and_then(|n| band::slope_edf(slope_alpha, p.m, n, data.kind))
+                    .unwrap_or(f64::NAN);
+                (nu, slope_alpha, AlphaSource::CurveSlope)
+            });
             let adev = p.avar.sqrt();
             let (lo, hi) =
                 ci::chi2_interval(adev, nu, cfg.curve_confidence).unwrap_or((f64::NAN, f64::NAN));
@@ -172,9 +186,13 @@ pub(super) fn curve_points(
         .collect()
 }
 
-/// What the left-out short τ of a declared fit `f` are: below the model's white-noise line
-/// (band-limited), above it (a bump), or both — said from the points themselves, not from
-/// how the range was cut.
+/// What the left-out short τ of a declared fit `f` are, named from where those points lie
+/// against the fitted white-noise line N/√τ (the model's N alone: a negative 1/τ²
+/// low-pass correction bends the model under that line, and a point between the two is
+/// below the white noise, not a bump over the model): below it beyond the larger of
+/// [`FIT_TOL`] and the point's 95 % band, band-limited (the sensor's low-pass filter or
+/// decimation); above it so, a bump (a vibration, a resonance); both, both; neither (every
+/// left-out point within its band of the line), "its first points are out of line".
 fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]) {
     let AxisVerdict::Fits {
         range,
@@ -186,34 +204,19 @@ fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]
     else {
         return;
     };
-    let (mut above, mut below, mut lean) = (false, false, 0.0);
+    let (mut above, mut below) = (false, false);
     for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
-        let model = f.predict(p.tau).max(0.0).sqrt();
-        let band = (p.hi95 / p.adev - 1.0).max(0.0);
-        if !fit::is_positive(model) {
+        let white = (f.coef[1] * fit::basis(1, p.tau)).max(0.0).sqrt();
+        if !fit::is_positive(white) {
             continue;
         }
-        let mis = p.adev / model - 1.0;
-        // below the white-noise line (with the quantization's): what a band limit does;
-        // a point under the model but over that line is the model's line or bump shape
-        let white = (f.coef[0].max(0.0) * fit::basis(0, p.tau) + f.coef[1] * fit::basis(1, p.tau))
-            .max(0.0)
-            .sqrt();
-        let under_white = p.adev / white - 1.0;
-        lean += under_white.min(0.0) + mis.max(0.0);
-        if band.is_finite() && mis > FIT_TOL.max(band) {
-            above = true;
-        } else if band.is_finite() && under_white < -FIT_TOL.max(band) {
-            below = true;
-        }
+        // the line outside the point's band (its value alone without a sample count)
+        let r = p.adev / white - 1.0;
+        let lo = if p.lo95.is_finite() { p.lo95 } else { p.adev };
+        let hi = if p.hi95.is_finite() { p.hi95 } else { p.adev };
+        above |= r > FIT_TOL && white < lo;
+        below |= r < -FIT_TOL && white > hi;
     }
-    // by the misses beyond the points' bands; without any, as the range was cut (a
-    // feature the start moved past, else the band limit of old)
-    if above || below {
-        *short_feature = above;
-        *band_limited = below;
-    } else {
-        // within their bands: below the model's white-noise line only if they lean below
-        *band_limited = lean < 0.0 && !*short_feature;
-    }
+    *short_feature = above;
+    *band_limited = below;
 }

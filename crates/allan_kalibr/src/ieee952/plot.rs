@@ -339,14 +339,7 @@ where
             px(4.0),
             c.stroke_width(px(1.0).max(1)),
         ))?
-        .label(format!(
-            "{name} = {v:.2e}{}",
-            if terms[j].verdict == super::Verdict::Resolved {
-                ""
-            } else {
-                " (not resolved)"
-            }
-        ))
+        .label(term_label(name, &terms[j]))
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
     }
     if coef[super::fit::GM] > 0.0 {
@@ -371,6 +364,17 @@ where
     .label("model (fitted range)")
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
     Ok(())
+}
+
+/// A fitted term's legend entry, as stdout and the files state it: a resolved term (or a
+/// region reading) its value, any other its 95 % upper bound — the dashed line is the fit's
+/// component, but the number a reader takes from the legend is the one the record supports.
+pub(crate) fn term_label(name: &str, t: &super::Term) -> String {
+    match t.reported() {
+        Some(v) => format!("{name} = {v:.2e}"),
+        None if t.hi.is_finite() => format!("{name} < {:.2e} (not resolved, 95 % bound)", t.hi),
+        None => format!("{name}: not resolved"),
+    }
 }
 
 /// The truth curve `sim` wrote, inside the τ range `(x0, x1)`.

@@ -118,27 +118,48 @@ pub const BUMP_X: f64 = 1.165_561_185_207_21;
 /// max sin⁴x/x².
 pub const BUMP_PEAK: f64 = 0.525_013_282_891_573;
 
-/// The white-noise density N the PSD shows: √(S/2) of its floor's median over 0.5–2 Hz
-/// (within the bins' range; where IEEE 952 reads N, τ ≈ 1 s), the section's cross-check of
-/// the fitted N.
-pub(crate) fn white_density(p: &Psd) -> Option<f64> {
+/// The white-noise density N the PSD shows, the section's cross-check of the fitted N:
+/// √(S/2) of its floor's median over the bins where the fitted model (`coef`, `shapes` at
+/// sample period `tau0`) is white noise — its PSD within [`WHITE_SHARE`] of 2N² — and that
+/// the fitted range describes (f ≤ 1/(2·`range_start`): a low-pass filter's roll-off lies
+/// above it). Reading a fixed 0.5–2 Hz gave 0.11× the level on a record whose filter, or
+/// whose other terms, shape that band. `None` with fewer than [`MIN_WHITE_BINS`] such bins.
+pub(crate) fn white_density(
+    p: &Psd,
+    coef: &[f64; super::fit::TERM_COUNT],
+    shapes: &super::fit::Shapes,
+    tau0: f64,
+    range_start: f64,
+) -> Option<f64> {
+    let white = 2.0 * coef[1].max(0.0);
+    if !is_positive(white) {
+        return None;
+    }
     let fl = floor(p);
-    let top = 0.4 * p.rate;
-    let (lo, hi) = (0.5f64.min(top / 4.0), 2.0f64.min(top));
+    let top = (0.4 * p.rate).min(0.5 / range_start);
     let mut v: Vec<f64> = p
         .freq
         .iter()
         .zip(&fl)
         .enumerate()
-        .filter(|(k, (f, _))| *k >= FIRST_LINE_BIN && **f >= lo && **f <= hi)
+        .filter(|(k, (f, _))| {
+            *k >= FIRST_LINE_BIN
+                && **f <= top
+                && model_psd(**f, coef, shapes, tau0) <= white / WHITE_SHARE
+        })
         .map(|(_, (_, s))| *s)
         .collect();
-    if v.is_empty() {
+    if v.len() < MIN_WHITE_BINS {
         return None;
     }
     v.sort_by(f64::total_cmp);
     Some((v[v.len() / 2] / 2.0).sqrt())
 }
+
+/// The white noise is this share of the model's PSD at least where [`white_density`] reads.
+pub const WHITE_SHARE: f64 = 0.8;
+/// Fewest bins [`white_density`] reads over.
+pub const MIN_WHITE_BINS: usize = 8;
 
 /// One-sided PSD (U²/Hz) of the fitted IEEE 952 terms at `f` Hz (IEEE 952 Annex C's
 /// densities, two-sided there, doubled): quantization 8Q²sin²(πfτ₀)/τ₀, white noise 2N²,
@@ -509,9 +530,9 @@ fn fit_resonance(p: &Psd, f0: f64, b0: f64) -> Option<ResonanceFit> {
     let at = |fc: f64, lb: f64| chi2(fc, lb.exp()).map_or(f64::INFINITY, |r| r.0);
     let (mut fc, mut lb) = (f0, b0.ln());
     for _ in 0..RESONANCE_FIT_ROUNDS {
-        lb = golden_min(|x| at(fc, x), lb - 1.5, lb + 1.5);
+        lb = golden_min(|x| at(fc, x), lb - 1.5, lb + 1.5, GOLDEN_REL_TOL);
         let bw = lb.exp();
-        fc = golden_min(|x| at(x, lb), fc - bw, fc + bw);
+        fc = golden_min(|x| at(x, lb), fc - bw, fc + bw, GOLDEN_REL_TOL);
     }
     let best = at(fc, lb);
     if !best.is_finite() {
@@ -598,11 +619,11 @@ const RESONANCE_SE_STEP: f64 = 0.02;
 /// 4/9 and second neighbours' at 1/36, 1 + 2·(4/9 + 1/36) ≈ 1.94.
 const HANN_BIN_VARIANCE: f64 = 1.944;
 
-/// The minimum of a unimodal `f` on [a, b], golden-section search to a relative 1e-6 of
-/// the interval.
-fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+/// The minimum of a unimodal `f` on [a, b], golden-section search to `rel_tol` of the
+/// interval.
+pub(crate) fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, rel_tol: f64) -> f64 {
     const G: f64 = 0.618_033_988_749_894_8;
-    let tol = 1e-6 * (b - a).abs();
+    let tol = rel_tol * (b - a).abs();
     let (mut x1, mut x2) = (b - G * (b - a), a + G * (b - a));
     let (mut f1, mut f2) = (f(x1), f(x2));
     while (b - a).abs() > tol {
@@ -620,6 +641,8 @@ fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     }
     0.5 * (a + b)
 }
+/// The resonance fit's searches stop at this share of their interval.
+const GOLDEN_REL_TOL: f64 = 1e-6;
 /// Hann window's equivalent noise bandwidth, bins.
 const HANN_ENBW_BINS: f64 = 1.5;
 /// A peak this many times wider than a sinusoid's is a resonance.

@@ -15,11 +15,16 @@
 //!   [`SLOPE_TOL`] of 0, B = σ_min/√(2 ln2/π), interval likewise. (The minimum of noisy
 //!   points is biased low.)
 //! * **K** — the +½ line at τ = 3 s: the long-τ points whose local slope is within
-//!   [`SLOPE_TOL_K`] of +½; K = σ(τ)·√(3/τ) at the region's most precise point (shortest τ).
-//! * A term whose region is absent gets an upper bound instead: every term's Allan deviation
-//!   is at most the curve's, so e.g. K ≤ min over points of σ_hi(τ)·√(3/τ) at 95 %.
+//!   [`SLOPE_TOL_K`] of +½; K = σ(τ)·√(3/τ) at the region's most precise point (shortest τ)
+//!   — a reading only where the record shows the rise: a point of the region whose lower
+//!   95 % limit lies above the floor's upper one. A slope of +½ among the last, noisiest
+//!   points of a short record is as often chance (issue 41.2: 0.29 s of batch samples gave
+//!   a "random walk"); then K is bounded instead.
+//! * A term whose region is absent (or not shown) gets a 95 % upper bound instead: every
+//!   term's Allan deviation is at most the curve's, jointly over the points ([`upper_bound`]:
+//!   Bonferroni, not the least of the pointwise limits).
 
-use super::Point;
+use super::{Point, ci};
 
 /// Half-width of the slope window that defines the white-noise and floor regions.
 pub const SLOPE_TOL: f64 = 0.1;
@@ -99,21 +104,35 @@ pub(crate) fn white_near_1s(tau: &[f64], is_white: &[bool]) -> Vec<usize> {
 /// Half-width (a factor of τ) of the window of white-noise points the N reading averages.
 pub const N_WINDOW: f64 = 2.0;
 
-/// The largest value of a term the curve allows at 95 %: every term's Allan deviation is at
-/// most the curve's, so the term is at most min over `points` of σ_hi95(τ) / `per_unit`(τ),
-/// `per_unit` being the term's Allan deviation per unit of its value (∞ when no point
-/// bounds it). The region readings' upper bounds and the fit's bound on a term it left at
-/// zero both come from here.
+/// The largest value of a term the curve allows at 95 %, jointly over `points`: every
+/// term's Allan variance is at most the curve's (where no filter acts: callers leave out the
+/// band-limited short τ), and the k points all lie below their one-sided upper limits at
+/// 1 − 0.05/k together with probability 95 % at least (Bonferroni) — so the term is at most
+/// min over them of that limit over `per_unit`(τ), the term's Allan deviation per unit of
+/// its value (∞ when no point bounds it). The minimum of each point's own 95 % limit is not
+/// a bound: the least of k pointwise limits lies below the truth far more often than one
+/// time in twenty (issue 40.2). The region readings' bounds and each term's whole-record
+/// bound come from here.
 pub(crate) fn upper_bound<'a>(
     points: impl IntoIterator<Item = &'a Point>,
     per_unit: impl Fn(f64) -> f64,
 ) -> f64 {
-    points
+    let pts: Vec<&Point> = points
         .into_iter()
-        .map(|p| p.hi95 / per_unit(p.tau))
+        .filter(|p| p.edf.is_finite() && p.edf > 0.0 && p.adev > 0.0)
+        .collect();
+    if pts.is_empty() {
+        return f64::INFINITY;
+    }
+    let level = 1.0 - BOUND_RISK / pts.len() as f64;
+    pts.iter()
+        .filter_map(|p| ci::chi2_upper(p.adev, p.edf, level).map(|hi| hi / per_unit(p.tau)))
         .filter(|v| v.is_finite() && *v >= 0.0)
         .fold(f64::INFINITY, f64::min)
 }
+
+/// The risk of [`upper_bound`] over all its points together (a 95 % bound).
+pub const BOUND_RISK: f64 = 0.05;
 
 /// The N reading from the white-noise points `white` of `pts` (their τ and deviations
 /// `tau`, `adev`): the −½ line through them, read at 1 s, with the relative interval of the
@@ -201,8 +220,10 @@ pub(crate) fn read(points: &[Point]) -> Readings {
             break;
         }
     }
+    // …where the rise above the floor is beyond both points' bands somewhere in the region
+    let shown = |i: usize| (i..pts.len()).any(|r| pts[r].lo95 > pts[imin].hi95);
     let k = first_k
-        .filter(|&i| i > imin)
+        .filter(|&i| i > imin && shown(i))
         .map(|i| scaled(i, (3.0 / tau[i]).sqrt()))
         .or_else(|| bound(&|t: f64| (t / 3.0).sqrt()));
     Readings { n, b, k }

@@ -6,17 +6,16 @@
 use super::{APPROX_DELTA, B_FLOOR_TOL, FIT_TOL, analyse};
 use super::{Overlap, fit, psd, region};
 
-/// Where a point's α (used for its EDF) came from.
+/// Where a point's EDF (and the α printed beside it) came from (the `band` module: the
+/// fitted model's mixture, else the curve's slope).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AlphaSource {
-    /// Lag-1 autocorrelation noise identification.
-    Lag1,
-    /// B1 ratio noise identification (few clusters).
-    B1,
-    /// Not identifiable from the data at this τ: α of the fitted model's dominant term.
+    /// The declared fit's model: the exact variance of the estimate under its mixture of
+    /// terms; α is its dominant term's.
     Model,
-    /// Nothing available; white FM (α = 0) assumed.
-    Assumed,
+    /// No model describes the curve: Greenhall's EDF of the FM power law of the curve's
+    /// local slope there, α.
+    CurveSlope,
 }
 
 /// One point of the analysed Allan deviation curve.
@@ -38,9 +37,9 @@ pub struct Point {
     pub lo95: f64,
     /// Upper bound at 95 %, U.
     pub hi95: f64,
-    /// Greenhall EDF used for the bounds.
+    /// Equivalent degrees of freedom of the estimate behind the bounds (see `alpha_source`).
     pub edf: f64,
-    /// Power-law α used for the EDF.
+    /// Power-law α of the point's dominant noise (see `alpha_source`).
     pub alpha: i32,
     /// Where α came from.
     pub alpha_source: AlphaSource,
@@ -67,9 +66,9 @@ pub enum Verdict {
     RegionReading,
     /// No reliable fit and no region for the term: only the 95 % upper bound is known.
     RegionBound,
-    /// Fitted, but the whole record does not agree with it: its value is above what every
-    /// point's upper 95 % band allows, or the model it lifts rises above the curve's upper
-    /// band beyond the fitted range. Only the record's 95 % upper bound is reported.
+    /// Fitted, but the whole record does not agree with it: its value (or its whole
+    /// interval) lies above the 95 % bound the curve's points give it jointly. Only that
+    /// bound is reported (value 0, interval [0, bound]).
     Contradicted,
     /// Not in the fitted model, or nothing could be computed.
     NotFitted,
@@ -83,10 +82,11 @@ pub struct Term {
     /// Standard error of `value` (delta method from the coefficient's); NaN when value = 0.
     pub std_err: f64,
     /// Lower end of the interval at `Config::term_confidence`, in the term's unit: the
-    /// square root of the coefficient interval {c ≥ 0 : |ĉ − c| ≤ z·se(c)}
-    /// (`fit::inverted_interval`). NaN without a sample count.
+    /// profile of the term under the joint fit (`fit::Profile`); 0 for a term not resolved,
+    /// whose `hi` is then its one-sided upper bound. The value always lies inside. NaN
+    /// without a sample count.
     pub lo: f64,
-    /// Upper end of the interval.
+    /// Upper end of the interval (a term not resolved: its one-sided 95 % upper bound).
     pub hi: f64,
     /// Can this term be reported?
     pub verdict: Verdict,
@@ -350,8 +350,8 @@ pub struct Analysis {
     pub psd: Option<psd::Psd>,
     /// Every line the PSD shows, strongest first (those in the model are in `terms.lines`).
     pub lines: Vec<psd::Line>,
-    /// The largest N and K every curve point allows at 95 % (its upper band over the
-    /// term's Allan deviation per unit, the minimum over the whole curve: for K,
-    /// min σ_hi95(τ)·√(3/τ)); the yaml files never write more.
+    /// The largest N and K the whole record allows at 95 %, jointly over the points of the
+    /// fit grid from the fitted range's start on (each point below its one-sided limit at
+    /// 1 − 0.05/k, Bonferroni: see `region::upper_bound`); ∞ without a sample count.
     pub bounds: (f64, f64),
 }

@@ -1,30 +1,21 @@
 //! The IEEE 952 terms of a declared fit, each with its interval and verdict, and of an axis
 //! without one (the region readings, each bounded by the whole curve).
 
-use statrs::distribution::{ContinuousCDF, Normal};
-
 use super::{
     B_FLOOR_TOL, Config, LineTerm, Point, RESOLVED_SHARE, Term, Terms, Verdict, fit, region,
 };
 #[cfg(doc)]
 use super::{imu, psd};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
 
-/// The z of the two-sided interval at `confidence`.
-fn z_of(confidence: f64) -> f64 {
-    Normal::new(0.0, 1.0)
-        .map(|d| d.inverse_cdf(0.5 + confidence / 2.0))
-        .unwrap_or(1.96)
-}
-
-/// The largest value of term `j` the fitted points allow on their own (the curve's upper
-/// 95 % band, [`region::upper_bound`]): the upper bound of a term the fit left at zero whose
-/// interval says nothing (0 or ∞).
-fn data_bound(j: usize, f: &fit::FitResult, fd: &fit::FitData, curve: &[Point]) -> f64 {
-    let used = f
-        .used
-        .iter()
-        .filter_map(|&i| curve.iter().find(|c| c.m == fd.points[i].m));
-    region::upper_bound(used, |tau| fit::basis_at(j, tau, &f.shapes).sqrt())
+/// The χ²(1) levels of a term's two-sided interval at `confidence` and of its one-sided
+/// upper bound at the same confidence ([`fit::TWO_SIDED_95`], [`fit::ONE_SIDED_95`] at 95 %).
+fn levels(confidence: f64) -> (f64, f64) {
+    let q = |p: f64| ChiSquared::new(1.0).ok().map(|c| c.inverse_cdf(p));
+    (
+        q(confidence).unwrap_or(fit::TWO_SIDED_95),
+        q(2.0 * confidence - 1.0).unwrap_or(fit::ONE_SIDED_95),
+    )
 }
 
 /// The variance each coefficient takes from the resonances' bandwidths: the PSD measures a
@@ -71,21 +62,24 @@ fn line_shape_variance(
 }
 
 /// The terms of a fit the axis verdict declares: each term's value, its interval at
-/// `cfg.term_confidence` and its verdict ([`TermsOfFit::fitted`]), then bounded by the whole
-/// record ([`TermsOfFit::bounded`]).
+/// `cfg.term_confidence` and its verdict ([`TermsOfFit::fitted`]: the profile of the
+/// term, [`fit::Profile`]), then held against the whole record ([`TermsOfFit::bounded`]).
+/// `record` are the curve points the whole-record bound is taken over (the fit grid from
+/// the range's start on: the band-limited short τ lie below every term's line).
 pub(super) fn make_terms(
     f: &fit::FitResult,
     fd: &fit::FitData,
     curve: &[Point],
+    record: &[&Point],
     cfg: &Config,
 ) -> Terms {
+    let have_stats = fd.basis.is_some();
     let t = TermsOfFit {
         f,
         fd,
-        curve,
+        record,
         cfg,
-        z: z_of(cfg.term_confidence),
-        have_stats: fd.basis.is_some(),
+        have_stats,
         // the measured floor of the fitted range, for B's verdict (see [`B_FLOOR_TOL`])
         floor: curve
             .iter()
@@ -93,6 +87,15 @@ pub(super) fn make_terms(
             .map(|p| p.adev)
             .fold(f64::INFINITY, f64::min),
         shape_var: line_shape_variance(f, fd, cfg),
+        profile: if have_stats {
+            fit::Profile::new(fd, f, &cfg.fit)
+        } else {
+            None
+        },
+        levels: levels(cfg.term_confidence),
+        k_beyond: (have_stats && f.coef[fit::GM] > 0.0)
+            .then(|| fit::Profile::beyond(fd, f, &cfg.fit, BEYOND_BUMP * f.shapes.gm_t))
+            .flatten(),
     };
     let term = |j: usize| t.bounded(j, t.fitted(j));
     Terms {
@@ -115,28 +118,121 @@ pub(super) fn make_terms(
     }
 }
 
+/// The fit grid's curve points from `from_tau` on (the points a whole-record bound is
+/// taken over, see [`make_terms`]).
+pub(super) fn record_points<'c>(
+    curve: &'c [Point],
+    fd: &fit::FitData,
+    from_tau: f64,
+) -> Vec<&'c Point> {
+    curve
+        .iter()
+        .filter(|p| p.tau >= from_tau * (1.0 - 1e-12))
+        .filter(|p| fd.points.iter().any(|q| q.m == p.m))
+        .collect()
+}
+
 /// What the terms of one fit are made from.
 struct TermsOfFit<'a> {
     f: &'a fit::FitResult,
     fd: &'a fit::FitData<'a>,
-    curve: &'a [Point],
+    record: &'a [&'a Point],
     cfg: &'a Config,
-    /// The normal quantile of the terms' confidence.
-    z: f64,
     /// The fit has a sample count (a statistical covariance): intervals and verdicts.
     have_stats: bool,
     floor: f64,
     shape_var: [f64; fit::TERM_COUNT],
+    /// The profile of the terms under the full model (None without statistics).
+    profile: Option<fit::Profile<'a, 'a>>,
+    /// The χ²(1) levels of the two-sided interval and the one-sided bound ([`levels`]).
+    levels: (f64, f64),
+    /// With a Gauss–Markov bias in the model: the profile on the points beyond its bump
+    /// ([`BEYOND_BUMP`]), K's (None: too few points there, or no bump).
+    k_beyond: Option<fit::Profile<'a, 'a>>,
 }
 
+/// With a Gauss–Markov bias of correlation time T in the model, K's interval comes from the
+/// points from this many T on only: there the bias is white noise (its Allan variance within
+/// 20 % of 2σ²T/τ, and its estimates' covariance that of white noise), so a random walk is
+/// resolved only where the long end shows it beyond the bump. Below, the bias rises like a
+/// random walk of 2σ²/T, decorrelating after T — the power laws' covariance the fit uses
+/// there correlates its points far more than they are (0.6 against 0.4 and 0.4 against 0.0
+/// between points an octave and a decade apart, Monte Carlo), and a K read there traded
+/// with the bump's time (issue 40.4: a gyro K "resolved" at 6× the truth).
+pub const BEYOND_BUMP: f64 = 8.0;
+
 impl TermsOfFit<'_> {
+    /// The whole record's 95 % upper bound of term `j` ([`region::upper_bound`] over
+    /// `record`).
+    fn record_bound(&self, j: usize) -> f64 {
+        let shapes = &self.f.shapes;
+        region::upper_bound(self.record.iter().copied(), |tau| {
+            fit::basis_at(j, tau, shapes).sqrt()
+        })
+    }
+
+    /// The profile term `j`'s interval comes from: K beyond a bump where the model has one
+    /// ([`BEYOND_BUMP`]), else the fit's range.
+    fn chosen(&self, j: usize) -> Option<&fit::Profile<'_, '_>> {
+        if j == 3 && self.f.coef[fit::GM] > 0.0 {
+            self.k_beyond.as_ref()
+        } else {
+            self.profile.as_ref()
+        }
+        .filter(|p| p.has(j))
+    }
+
+    /// The interval of term `j`'s coefficient at the χ²(1) `level` (two-sided 95 %, or the
+    /// one-sided bound; the lower end only with `lower`, else 0): the profile, widened to
+    /// span the flicker floor's plausible shapes ([`fit::FitResult::alternatives`]) and, in
+    /// quadrature, the resonances' bandwidths, and always holding the fitted value.
+    fn interval(&self, j: usize, level: f64, lower: bool) -> (f64, f64) {
+        let TermsOfFit { f, fd, cfg, .. } = *self;
+        let z = level.sqrt();
+        let c = f.coef[j].max(0.0);
+        let se_c = f.cov[j][j].max(0.0).sqrt();
+        let guess = if se_c.is_finite() && se_c > 0.0 {
+            c + z * se_c
+        } else {
+            self.record_bound(j).powi(2)
+        };
+        let bump_k = j == 3 && f.coef[fit::GM] > 0.0;
+        let (mut lo_c, mut hi_c) = match self.chosen(j) {
+            Some(p) if p.has(j) => p.interval(j, level, lower, guess),
+            // too few points beyond the bump: K is not told from it; its bound is the
+            // whole range's
+            _ if bump_k => match &self.profile {
+                Some(p) if p.has(j) => (0.0, p.interval(j, level, false, guess).1),
+                _ => (0.0, self.record_bound(j).powi(2)),
+            },
+            _ => {
+                let (l, h) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
+                (if lower { l } else { 0.0 }, h)
+            }
+        };
+        lo_c = lo_c.min(c);
+        hi_c = hi_c.max(c);
+        for alt in &f.alternatives {
+            if lower {
+                lo_c = lo_c.min((alt.coef[j] - z * alt.std_err[j]).max(0.0));
+            }
+            hi_c = hi_c.max(alt.coef[j] + z * alt.std_err[j]);
+        }
+        let spread = z * self.shape_var[j].sqrt();
+        if fit::is_positive(spread) {
+            if lower {
+                lo_c = (c - (c - lo_c).hypot(spread)).max(0.0);
+            }
+            hi_c = c + (hi_c - c).hypot(spread);
+        }
+        (lo_c, hi_c)
+    }
+
     /// Term `j` from the fit alone: its value, interval and verdict.
     fn fitted(&self, j: usize) -> Term {
         let TermsOfFit {
             f,
-            fd,
             cfg,
-            z,
             have_stats,
             floor,
             ref shape_var,
@@ -154,145 +250,132 @@ impl TermsOfFit<'_> {
             return Term::not_fitted();
         }
         if f.left_out[j] || c <= 0.0 {
-            return self.absent(j, se_c);
+            return self.absent(j);
         }
         let value = c.sqrt();
         let std_err = nan_if((se_c * se_c + shape_var[j]).sqrt() / (2.0 * value));
-        let (mut lo_c, mut hi_c) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
-        // spanning the shapes of the flicker floor the data do not reject
-        for alt in &f.alternatives {
-            lo_c = lo_c.min((alt.coef[j] - z * alt.std_err[j]).max(0.0));
-            hi_c = hi_c.max(alt.coef[j] + z * alt.std_err[j]);
-        }
-        // and the resonances' bandwidths the PSD measured, in quadrature
-        let spread = z * shape_var[j].sqrt();
-        if fit::is_positive(spread) {
-            lo_c = (c - (c - lo_c).hypot(spread)).max(0.0);
-            hi_c = c + (hi_c - c).hypot(spread);
-        }
         let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE && (j != 2 || floor_shown(value));
-        let verdict = if !have_stats {
+        if !have_stats {
             // no sample count: no interval, so nothing is "resolved" statistically; a term the
             // model needs and that dominates somewhere is still the model's
-            if dominant_somewhere {
-                Verdict::NeverDominant
-            } else {
-                Verdict::NotSignificant
-            }
-        } else if !fit::is_positive(lo_c) || f.ambiguous[j] {
+            return Term {
+                value,
+                std_err,
+                lo: f64::NAN,
+                hi: f64::NAN,
+                verdict: if dominant_somewhere {
+                    Verdict::NeverDominant
+                } else {
+                    Verdict::NotSignificant
+                },
+            };
+        }
+        // zero within the two-sided level (or a bump explains the term as well): not
+        // resolved, and only the one-sided bound is wanted
+        let zero_allowed = f.ambiguous[j]
+            || self
+                .chosen(j)
+                .is_some_and(|p| p.allows(j, 0.0, self.levels.0));
+        let (lo_c, hi_c) = if zero_allowed {
+            (0.0, f64::NAN)
+        } else {
+            self.interval(j, self.levels.0, true)
+        };
+        let verdict = if !fit::is_positive(lo_c) || f.ambiguous[j] {
             Verdict::NotSignificant
         } else if !dominant_somewhere {
             Verdict::NeverDominant
         } else {
             Verdict::Resolved
         };
+        let (lo_c, hi_c) = if verdict == Verdict::NotSignificant {
+            // zero is in the interval (or a bump explains the term as well): its one-sided
+            // 95 % upper bound
+            self.interval(j, self.levels.1, false)
+        } else {
+            (lo_c, hi_c)
+        };
         Term {
             value,
             std_err,
-            lo: nan_if(lo_c.sqrt()),
-            hi: nan_if(hi_c.sqrt()),
+            lo: lo_c.sqrt(),
+            hi: hi_c.sqrt(),
             verdict,
         }
     }
 
-    /// Term `j` the selection left out or the fit put at its bound (standard error `se_c`
-    /// of its coefficient): 0 with its upper bound.
-    fn absent(&self, j: usize, se_c: f64) -> Term {
-        let TermsOfFit {
-            f,
-            fd,
-            curve,
-            cfg,
-            z,
-            have_stats,
-            ..
-        } = *self;
-        let nan_if = |v: f64| if have_stats { v } else { f64::NAN };
-        // left out by the selection, at its bound, or the 1/τ² coefficient negative
-        // (the low-pass correction, not a quantization): 0 with the upper bound
-        let mut hi = if f.left_out[j] {
-            (f.left_out_coef[j] + z * se_c).sqrt()
-        } else {
-            fit::inverted_interval(fd, f, &cfg.fit, j, z)
-                .1
-                .max(0.0)
-                .sqrt()
-        };
+    /// Term `j` the selection left out or the fit put at its bound: 0 with its one-sided
+    /// 95 % upper bound (the profile's; the whole record's where that says nothing).
+    fn absent(&self, j: usize) -> Term {
+        if !self.have_stats {
+            return Term {
+                value: 0.0,
+                std_err: f64::NAN,
+                lo: f64::NAN,
+                hi: f64::NAN,
+                verdict: Verdict::NotSignificant,
+            };
+        }
+        let mut hi = self.interval(j, self.levels.1, false).1.max(0.0).sqrt();
         if !(hi > 0.0 && hi.is_finite()) {
-            // The fit's own error says nothing here (a term left out where the full fit
-            // had it at its bound has no standard error; an interval the data do not
-            // close is ∞): bound the term by the curve itself, never "< 0".
-            hi = data_bound(j, f, fd, curve);
+            // an interval the data do not close: bound the term by the curve itself
+            hi = self.record_bound(j);
         }
         Term {
             value: 0.0,
             std_err: f64::NAN,
-            lo: nan_if(0.0),
-            hi: nan_if(hi),
+            lo: 0.0,
+            hi,
             verdict: Verdict::NotSignificant,
         }
     }
 
-    /// Term `j` bounded by the whole record's say (issue 17): every curve point bounds every
-    /// term (its Allan deviation is at most the point's upper 95 % band), the points the
-    /// range left out too;
-    /// and a term that pushes the model up at long τ (B, K, R, a Gauss–Markov bias) is not
-    /// resolved where the model then rises above the upper band of a point beyond the range
-    /// and the term's own share is what lifts it there (a K fitted to the shoulder of a line,
-    /// or to a bend the range cut, whose +½ line the long-τ curve does not follow).
+    /// Term `j` held against the whole record: every curve point from the range's start
+    /// bounds every term (its Allan deviation is at most the curve's), the points the range
+    /// left out at the long end too ([`region::upper_bound`], jointly at 95 %). A resolved
+    /// value above that bound is contradicted by the record (a K fitted to the shoulder of a
+    /// line, or to a bend the range cut, whose +½ line the long-τ curve does not follow):
+    /// not resolved, the record's bound instead. A bound the fit's profile leaves open is
+    /// the record's.
     fn bounded(&self, j: usize, mut t: Term) -> Term {
-        let TermsOfFit {
-            f,
-            fd,
-            curve,
-            have_stats,
-            ..
-        } = *self;
-        let range_end = f.used.last().map_or(f64::INFINITY, |&i| fd.points[i].tau);
-        let long_cut = f.used.last().is_some_and(|&i| i + 1 < fd.points.len());
-        let record_bound = |j: usize| {
-            region::upper_bound(curve.iter(), |tau| fit::basis_at(j, tau, &f.shapes).sqrt())
-        };
-        let contradicted = |j: usize| {
-            curve
-                .iter()
-                .filter(|p| p.tau > range_end * (1.0 + 1e-12) && p.hi95.is_finite())
-                .any(|p| {
-                    let model = f.predict(p.tau);
-                    let over = model - p.hi95 * p.hi95;
-                    over > 0.0 && f.coef[j] * fit::basis_at(j, p.tau, &f.shapes) >= over
-                })
-        };
-        if !have_stats || matches!(t.verdict, Verdict::NotFitted) || j == 0 {
+        if !self.have_stats || matches!(t.verdict, Verdict::NotFitted) || j == 0 {
             return t;
         }
-        let bound = record_bound(j);
+        let bound = self.record_bound(j);
+        // only a term that lifts the long end can be contradicted by it: near the start of
+        // a band-limited range the curve lies a little under the white-noise line (the
+        // model's negative 1/τ² correction), so N's bound there is no bound
         let pushes_long = matches!(j, 2 | 3 | 4 | fit::GM);
-        // (a resolved value above the curve's bound stays resolved here — one point's band
-        // of many is below the truth by chance often enough — and the yaml files take the
-        // bound instead, [`imu::ImuAnalysis::sensor_value`])
-        if t.verdict == Verdict::Resolved && pushes_long && contradicted(j) {
-            t.verdict = Verdict::Contradicted;
+        // (a term the fit puts above the record's bound, resolved or with its whole interval)
+        if pushes_long && (t.value > bound && t.verdict == Verdict::Resolved || t.lo >= bound) {
+            return Term {
+                value: 0.0,
+                std_err: f64::NAN,
+                lo: 0.0,
+                hi: bound,
+                verdict: Verdict::Contradicted,
+            };
         }
-        if t.verdict != Verdict::Resolved && bound.is_finite() && (long_cut || !t.hi.is_finite()) {
-            // an unresolved term where the long end was cut: the fit's own interval speaks for
-            // the range only, the bound is the whole curve's. (Elsewhere the fit's inverted
-            // interval is the 95 % statement: the minimum of many points' 95 % bands is below
-            // the truth far more often than one in twenty — issue 18.5 — so it is not taken
-            // here; the yaml files never write more than it, [`imu::ImuAnalysis::random_walk`].)
+        if pushes_long && t.verdict != Verdict::Resolved && bound < t.hi {
+            // the fit's bound says less than the whole record's: the record's (both are
+            // 95 % statements, each conservative — the profile's where its model is free
+            // at the long end, the record's by Bonferroni — so the lesser keeps its level
+            // in the coverage study; a value the record rules out is not shown)
             t.hi = bound;
-            t.lo = t.lo.min(t.hi);
+            t.value = t.value.min(bound);
+            t.lo = t.lo.min(bound);
         }
         t
     }
 }
 
-/// The terms of an axis without a reliable fit: N, B and K read from their regions, a
-/// reading above what another point's upper band allows is that bound instead; the rest
-/// not fitted.
-pub(super) fn region_terms(region: &region::Readings, curve: &[Point]) -> Terms {
+/// The terms of an axis without a reliable fit: N, B and K read from their regions, each
+/// held against the whole record (`record`: the points from where the curve starts to fall
+/// like white noise on, [`region::upper_bound`]) — a reading above that bound is the bound
+/// instead; the rest not fitted.
+pub(super) fn region_terms(region: &region::Readings, record: &[&Point]) -> Terms {
     let clamp = |j: usize, t: Term| -> Term {
-        let bound = region::upper_bound(curve.iter(), |tau| {
+        let bound = region::upper_bound(record.iter().copied(), |tau| {
             fit::basis_at(j, tau, &fit::Shapes::FLAT).sqrt()
         });
         match t.verdict {
@@ -303,8 +386,9 @@ pub(super) fn region_terms(region: &region::Readings, curve: &[Point]) -> Terms 
                 hi: bound,
                 verdict: Verdict::RegionBound,
             },
-            Verdict::RegionBound => Term {
-                hi: t.hi.min(bound),
+            Verdict::RegionReading => Term {
+                hi: t.hi.max(t.value),
+                lo: t.lo.min(t.value),
                 ..t
             },
             _ => t,

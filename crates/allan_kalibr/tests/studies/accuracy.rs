@@ -321,9 +321,13 @@ const K_LOW_REL_TOL: f64 = 0.35;
 /// Issue 6: the 95 % intervals must contain the truth in at least 90 % of the cases.
 const MIN_COVERAGE: f64 = 0.90;
 /// For the gyro K at 4 h no estimator reaches 20 % reliably (Cramér–Rao 20.4 %); we demand
-/// that the estimate is within this many of its own reported standard errors — the interval
-/// is honest — and that the RMS error is within this factor of the bound.
-const K_GYRO_MAX_Z: f64 = 3.0;
+/// that the resolved ones' 95 % intervals hold the truth this often — the interval is
+/// honest (before issue 40 the estimate within 3 of its Gaussian standard errors: the
+/// error of a K read off few-cluster points is skewed, and one series whose random walk
+/// ran at 0.3× its variance over 300–1500 s lies 4.5 of them off, 1.7 of its interval's
+/// half-width) —…
+const K_GYRO_MIN_COVERAGE: f64 = 0.90;
+/// …and that the RMS error is within this factor of the bound.
 const K_GYRO_RMS_OVER_BOUND: f64 = 1.5;
 
 /// Asserts the issue's targets that are statistically attainable; returns (N covered, K
@@ -353,17 +357,20 @@ fn check_targets(cases: &[Case], duration: f64, coverage: bool) -> (usize, usize
                 c.k_est,
                 c.k_verdict
             );
-        } else if resolved {
-            let z = (c.k_est - c.k_true) / c.k_se;
-            assert!(
-                z.abs() < K_GYRO_MAX_Z,
-                "{case}: K expected {:e}, got {:e} ± {:e} (z = {z:.2}), tol {K_GYRO_MAX_Z} se",
-                c.k_true,
-                c.k_est,
-                c.k_se
-            );
         }
     }
+    // the gyro K a record resolves: its 95 % interval (the profile's, skewed where the
+    // long-τ points have few degrees of freedom) holds the truth as often as it says
+    let gyro_resolved: Vec<&Case> = cases
+        .iter()
+        .filter(|c| c.is_gyro() && c.preset != "low" && c.k_verdict == Verdict::Resolved)
+        .collect();
+    let gyro_in = gyro_resolved.iter().filter(|c| c.k_in).count();
+    assert!(
+        gyro_in as f64 >= K_GYRO_MIN_COVERAGE * gyro_resolved.len() as f64,
+        "resolved gyro K covered {gyro_in}/{}",
+        gyro_resolved.len()
+    );
     for preset in ["medium", "high"] {
         let gy: Vec<&Case> = cases
             .iter()

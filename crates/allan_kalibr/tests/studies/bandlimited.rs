@@ -3,7 +3,8 @@
 //! Butterworth low-pass, decimated to 400 Hz, 2 h; and its accelerometer twin (BMI088's
 //! accelerometer white noise and random walk through the same chain). For low-pass corners
 //! from 0.05 to 0.45 of the output rate: N within 5 % of the truth, and K's 95 % interval
-//! covering the truth (or K unresolved with an upper bound at or above it).
+//! covering the truth (or K unresolved with an upper bound at or above it) on
+//! [`K_MIN_COVERAGE`] of the cases.
 //!
 //! Simulated by `sim`'s generator (issue 9's filter and decimation chain; truth from its
 //! exact `AxisTruth`). One corner also goes the way a user's file does: written as a `.mat`
@@ -34,7 +35,7 @@ const N_REL_TOL: f64 = 0.05;
 const SEED: u64 = 0xB088;
 
 /// The BMI088-like model with the low-pass corner at `frac` of the output rate.
-fn model(frac: f64) -> ImuModel {
+pub(super) fn model(frac: f64) -> ImuModel {
     let chain = Chain {
         internal_rate_hz: Some(INTERNAL_RATE),
         filter: Filter::Butterworth2 {
@@ -233,5 +234,14 @@ fn bandlimited_study() {
             100.0 * c.n_err
         );
     }
-    assert!(k_miss.is_empty(), "K not covered: {k_miss:?}");
+    assert!(
+        (cases.len() - k_miss.len()) as f64 >= K_MIN_COVERAGE * cases.len() as f64,
+        "K not covered: {k_miss:?}"
+    );
 }
+
+/// K's interval holds the truth, or its upper bound is at or above it, on this share of the
+/// cases at least. A bound is a one-sided 95 % statement (issue 40): of 16 cases one or two
+/// miss by chance (two or more with probability 19 %, three or more 4 %); the coverage
+/// study counts it over 126 axes.
+const K_MIN_COVERAGE: f64 = 0.85;

@@ -92,6 +92,7 @@ use super::avar_cov::CovBasis;
 
 mod gls;
 mod linalg;
+mod profile;
 mod range_end;
 use super::model::effective_coef;
 pub(in crate::ieee952) use super::model::is_positive;
@@ -104,6 +105,7 @@ pub use super::model::{
 use gls::{Delta, FixedLs, Problem, Solve, fixed_ls, gls};
 pub(in crate::ieee952) use linalg::solve_spd;
 use linalg::{covariance, whiten};
+pub(in crate::ieee952) use profile::{ONE_SIDED_95, Profile, TWO_SIDED_95};
 pub(in crate::ieee952) use range_end::extension_agrees;
 
 /// Fit settings.
@@ -241,6 +243,11 @@ pub struct FitResult {
     /// Terms in the model that a Gauss–Markov bias explains as well (see [`fit`]): B or K
     /// whose floor or rise is a bump's shoulder or tail; not "resolved".
     pub ambiguous: [bool; TERM_COUNT],
+    /// Where the model has a flicker floor and no Gauss–Markov bias: the best correlation
+    /// time of a bump in the floor's place (NaN: none searched). B's interval spans the
+    /// model with that bump beside the floor ([`Profile`]): a bump's shoulder read as a
+    /// floor gave a B 2.4× the truth with an interval excluding it.
+    pub bump_for_floor: f64,
     /// Largest share of the model's Allan variance each term's own line has at a used point:
     /// ≈ 1 where it alone makes the curve, ≥ 0.64 where its line comes within 20 % of it.
     pub max_share: [f64; TERM_COUNT],
@@ -492,7 +499,8 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         shapes,
         coef: &coef,
     };
-    let (ambiguous, alternatives) = (model.ambiguous_terms(), model.floor_alternatives());
+    let ((ambiguous, bump_for_floor), alternatives) =
+        (model.ambiguous_terms(), model.floor_alternatives());
     let max_share = max_shares(data, used, &coef, &shapes);
     Some(FitResult {
         coef,
@@ -513,6 +521,7 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
         shapes,
         alternatives,
         ambiguous,
+        bump_for_floor,
         max_share,
     })
 }
@@ -675,7 +684,27 @@ fn best_candidate(
             && i > 0
             && i + 1 < grid.len()
         {
-            consider(Some(GM), cur - c - SELECT_CHI2_GM, sh);
+            // the time between the grid's neighbours (the grid's half octave is a 19 %
+            // step: a bump at 50 s fitted at 45 s left its tail to a random walk 5× the
+            // truth)
+            let at = |lt: f64| {
+                let s2 = Shapes {
+                    gm_t: lt.exp(),
+                    ..shapes
+                };
+                chi(tt, s2).unwrap_or(f64::INFINITY)
+            };
+            let l0 = sh.gm_t.ln();
+            let half = 0.5 * std::f64::consts::LN_2 / GM_GRID.per_octave;
+            let lt = super::psd::golden_min(at, l0 - 2.0 * half, l0 + 2.0 * half, GM_T_REL_TOL);
+            let refined = Shapes {
+                gm_t: lt.exp(),
+                ..shapes
+            };
+            match chi(tt, refined) {
+                Some(cr) if cr < c => consider(Some(GM), cur - cr - SELECT_CHI2_GM, refined),
+                _ => consider(Some(GM), cur - c - SELECT_CHI2_GM, sh),
+            }
         }
     }
     if t[2] && shapes.b_lo == 0.0 {
@@ -706,7 +735,9 @@ impl FinalModel<'_> {
     /// B or K only where no Gauss–Markov bias explains the data as well: the model with the
     /// term swapped for a bump (its best correlation time) must fit worse, under the final
     /// model's covariance (`s`), by Akaike's measure (the bump has one more parameter).
-    fn ambiguous_terms(&self) -> [bool; TERM_COUNT] {
+    /// Also returns the best correlation time of a bump in place of the flicker floor (NaN
+    /// without one), [`FitResult::bump_for_floor`].
+    fn ambiguous_terms(&self) -> ([bool; TERM_COUNT], f64) {
         let FinalModel {
             data,
             used,
@@ -718,6 +749,7 @@ impl FinalModel<'_> {
         } = *self;
         let signed = signed_terms(cfg);
         let mut ambiguous = [false; TERM_COUNT];
+        let mut bump_for_floor = f64::NAN;
         if cfg.select && cfg.terms[GM] {
             let d = if data.basis.is_none() { 1.0 } else { s.delta };
             let grid = shape_grid(data, used, GM_GRID);
@@ -737,15 +769,21 @@ impl FinalModel<'_> {
                     } else {
                         grid.clone()
                     };
-                    let alt = times
+                    let (alt, at) = times
                         .iter()
-                        .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }))
-                        .fold(f64::INFINITY, f64::min);
+                        .filter_map(|&tg| chi(tt, Shapes { gm_t: tg, ..shapes }).map(|c| (c, tg)))
+                        .fold(
+                            (f64::INFINITY, f64::NAN),
+                            |a, b| if b.0 < a.0 { b } else { a },
+                        );
                     ambiguous[j] = alt + SWAP_PENALTY <= cur;
+                    if j == 2 && !terms[GM] {
+                        bump_for_floor = at;
+                    }
                 }
             }
         }
-        ambiguous
+        (ambiguous, bump_for_floor)
     }
 
     /// The flicker floor's shape as the data leave it: every corner (and the flat floor) whose
@@ -823,13 +861,17 @@ fn max_shares(
 /// time free the bump fits such data about as well by chance.
 const SWAP_PENALTY: f64 = 2.0;
 
+/// The Gauss–Markov correlation time is refined between its grid neighbours to this share
+/// of their span (about 1 % in T).
+const GM_T_REL_TOL: f64 = 0.01;
+
 /// χ²(2) quantile at 0.999: the Gauss–Markov bias enters with two parameters, its σ and a
 /// correlation time searched over `GM_GRID`, so it must lower χ² by more than this.
 pub const SELECT_CHI2_GM: f64 = 13.815_510_557_964_274;
 /// Where a shape parameter is searched on a fitted range, relative to its first and last τ,
 /// and how finely.
 #[derive(Clone, Copy, Debug)]
-struct ShapeGrid {
+pub(super) struct ShapeGrid {
     /// Lowest candidate over the range's first τ.
     from_first: f64,
     /// Lowest candidate at all, s.
@@ -850,7 +892,7 @@ pub const GM_MIN_T: f64 = 1.0;
 /// Gauss–Markov correlation times: from 4× the first τ (and [`GM_MIN_T`]) (the rise must be seen) to 1/8 of
 /// the last (and the turn-down after the bump; a longer T is a random walk over the
 /// record), two per octave.
-const GM_GRID: ShapeGrid = ShapeGrid {
+pub(super) const GM_GRID: ShapeGrid = ShapeGrid {
     from_first: 4.0,
     floor: GM_MIN_T,
     to_last: 1.0 / 8.0,
