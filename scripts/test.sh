@@ -27,10 +27,11 @@ fi
 # The independent readers the cross-checks run, pinned (bag2mat::test_tools finds them
 # here): the ROS 2 implementations; for the logs from outside ROS pyulog (ULog, also its
 # writer), pymavlink's DFReader (DataFlash) and pandas/numpy (CSV layouts); allantools (the
-# IEEE 952 curve against its oadev).
+# IEEE 952 curve against its oadev); GTSAM's Python bindings (the GTSAM file read back through
+# PreintegrationCombinedParams' setters and getters).
 venv=target/py-venv
-pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6)
-if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools" >/dev/null 2>&1 \
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6 gtsam==4.3.0)
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools, gtsam" >/dev/null 2>&1 \
    || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icxF "$(printf '%s\n' "${pins[@]}")")" != ${#pins[@]} ]; then
   echo "installing ${pins[*]} into $venv"
   /usr/bin/python3 -m venv "$venv"

@@ -107,9 +107,17 @@ fn push_block(out: &mut String, b: &Block<'_>) {
     }
 }
 
-/// The yaml text for `mode`.
-pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode) -> String {
-    let mut out = String::from("%YAML:1.0\n---\ntype: IMU\n");
+/// The yaml text for `mode`. The continuous file (this project's, not upstream's) carries
+/// `comments` as `#` lines after its `---` (the tool, version, input and time, caveats);
+/// upstream's file is written as upstream writes it and takes none.
+pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode, comments: &[String]) -> String {
+    let mut out = String::from("%YAML:1.0\n---\n");
+    if mode == YamlMode::Continuous {
+        for c in comments {
+            let _ = writeln!(out, "# {c}");
+        }
+    }
+    out.push_str("type: IMU\n");
     let _ = writeln!(out, "name: {}", string(name));
     let blocks = match mode {
         YamlMode::Compat => {

@@ -11,6 +11,7 @@ mod cli;
 mod common;
 mod curves;
 mod defects19;
+mod files;
 mod fit_reference;
 mod front;
 mod issue18;

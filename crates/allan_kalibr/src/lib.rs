@@ -58,6 +58,7 @@
 //!   and a warning printed, which upstream never does).
 
 mod cli;
+pub mod consumers;
 mod error;
 mod front;
 mod ieee952;
@@ -69,7 +70,9 @@ mod yaml;
 pub use cli::{Args, TOOL};
 pub use error::Error;
 pub use front::CurvesInput;
-pub use front::{Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text};
+pub use front::{
+    Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text, refusal_text,
+};
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};
 pub use ieee952::ci::chi2_interval;
@@ -81,7 +84,8 @@ pub use ieee952::edf::greenhall_edf;
 pub use ieee952::files::{
     COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_RESOLVED,
     COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU,
-    CURVES_FILE, TERMS_FILE, write_outputs as write_ieee952_files,
+    CURVES_FILE, TERMS_FILE, file_names as ieee952_file_names,
+    write_outputs as write_ieee952_files,
 };
 pub use ieee952::fit::GM;
 pub use ieee952::imu::SensorValue;
@@ -111,4 +115,4 @@ pub use kalibr::chart_fit::{ChartFit, gen_chart};
 pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 pub use kalibr::grid::TauGrid;
 pub use kalibr::report::{chart_lines, final_lines};
-pub use run::{Analysis, Config, RunOutput, analyse, run, sections};
+pub use run::{Analysis, Config, RunOutput, analyse, curves_rate, curves_text, run, sections};

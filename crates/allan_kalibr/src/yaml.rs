@@ -82,22 +82,68 @@ pub(crate) fn key_line(key: &str, value: &str, comment: &str) -> String {
     format!("{:<29}{:<23} #{comment}\n", format!("{key}:"), value)
 }
 
+/// What became of the IEEE 952 section's `kalibr_imu_ieee952.yaml` in the run that writes an
+/// imu.yaml (its header points the user there only when it exists).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum SectionFile {
+    /// Written beside imu.yaml.
+    Written,
+    /// Not computed, with the reason (a record that is not static, one too short, …).
+    NotComputed(String),
+    /// `--compat-only`.
+    CompatOnly,
+}
+
 impl ImuYaml {
-    /// The file text of the kalibr_allan-compatible run. `source` (input file name) goes
-    /// into a comment.
-    pub(crate) fn render(&self, source: &str) -> String {
-        let first = format!("IMU noise model for Kalibr, written by allan_kalibr from {source}");
-        self.render_with(&[
-            &first,
+    /// The file text of the kalibr_allan-compatible run: its first line names the tool, its
+    /// version, the time and the input (`prov`); then what the numbers are and, as `section`
+    /// says, where the IEEE 952 file is or why there is none.
+    pub(crate) fn render(
+        &self,
+        prov: &crate::consumers::Provenance,
+        section: &SectionFile,
+    ) -> String {
+        let first = format!(
+            "IMU noise model for Kalibr, written by {} on {} from {}",
+            prov.tool, prov.written, prov.input
+        );
+        let mut lines: Vec<String> = [
+            first.as_str(),
             "(rpng/kalibr_allan method: non-overlapping Allan deviation, averaged axes,",
             " -1/2 line read at tau = 1 s, +1/2 line read at tau = 3 s).",
             "These are CONTINUOUS-TIME values (noise densities and random walks);",
             "Kalibr discretises them with update_rate. Values from static data are",
             "optimistic: users commonly inflate them (x10 or more) before use.",
             ".nan means the fit window was empty (Allan minimum too close to the end).",
-            "For Kalibr, prefer kalibr_imu_ieee952.yaml beside this file (the IEEE 952 fit,",
-            "every value within what the data support); this one reproduces kalibr_allan.",
-        ])
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        match section {
+            SectionFile::Written => lines.extend([
+                "For Kalibr, prefer kalibr_imu_ieee952.yaml beside this file (the IEEE 952 fit,"
+                    .into(),
+                "every value within what the data support); this one reproduces kalibr_allan."
+                    .into(),
+            ]),
+            SectionFile::CompatOnly => lines.extend([
+                "This run was --compat-only: no kalibr_imu_ieee952.yaml (the IEEE 952 fit, every"
+                    .into(),
+                "value within what the data support) was written; run without it for that file."
+                    .into(),
+            ]),
+            SectionFile::NotComputed(why) => {
+                lines.extend(crate::consumers::render::wrap(&format!(
+                    "NO kalibr_imu_ieee952.yaml was written: {why}."
+                )));
+                lines.push(
+                    "The numbers below are kalibr_allan's method applied as it is; they need not be noise figures."
+                        .into(),
+                );
+            }
+        }
+        let refs: Vec<&str> = lines.iter().map(|s| s.as_str()).collect();
+        self.render_with(&refs)
     }
 
     /// The file text after the given comment lines (each written as `# line`).
@@ -176,6 +222,15 @@ impl ImuYaml {
 mod tests {
     use super::*;
 
+    fn test_prov() -> crate::consumers::Provenance {
+        crate::consumers::Provenance {
+            tool: "allan_kalibr 0.0.0".into(),
+            input: "x.bag".into(),
+            written: "2025-01-01T00:00:00Z".into(),
+            rate: crate::consumers::RecordRate::Measured(100.0),
+        }
+    }
+
     /// Values seen in the reference outputs and edge cases of the formatter.
     const SAMPLES: [f64; 8] = [
         0.032430110313947616,
@@ -218,7 +273,7 @@ mod tests {
             update_rate: 200.0,
             absent: None,
         };
-        let text = y.render("x.bag");
+        let text = y.render(&test_prov(), &SectionFile::Written);
         let line = text
             .lines()
             .find(|l| l.starts_with("gyroscope_random_walk:"))
@@ -307,7 +362,7 @@ mod tests {
             update_rate: 100.0,
             absent: None,
         };
-        let text = y.render("x.bag");
+        let text = y.render(&test_prov(), &SectionFile::Written);
         for key in [
             "accelerometer_noise_density:",
             "accelerometer_random_walk:",

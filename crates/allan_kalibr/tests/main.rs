@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod consumers;
 mod defects19;
+mod files;
 mod front;
 mod ieee952;
 mod issue18;

@@ -99,10 +99,9 @@ mod psd_plot;
 pub(crate) mod region;
 pub(crate) mod stated;
 mod tau_grid;
-mod vio_files;
 
 mod chart_panels;
-mod config_values;
+pub(crate) mod config_values;
 mod curve_data;
 mod declare;
 mod pipeline;
