@@ -96,7 +96,7 @@ pub struct CommonArgs {
 }
 
 /// `--rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
-fn rate_hz(s: &str) -> Result<f64, cli::UsageError> {
+pub(crate) fn rate_hz(s: &str) -> Result<f64, cli::UsageError> {
     let v = cli::positive_f64(s)?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
         return Err(cli::UsageError(format!(
@@ -342,7 +342,7 @@ pub struct Section {
 /// A tool's settings as the front end runs them: the shared part, and the job that turns
 /// them into sections.
 pub trait Job {
-    /// The job's error (said once by [`finish`]).
+    /// The job's error (said once by `finish`).
     type Error: std::fmt::Display;
     /// The settings both analysers share.
     fn common(&self) -> &Common;
@@ -354,18 +354,34 @@ pub trait Job {
 }
 
 /// A tool's whole `main`: the worker threads started, the arguments `A` parsed and resolved
-/// into the settings `C`, the job run inside its output stage and said ([`finish`]).
+/// into the settings `C` ([`command_line`]), the job run inside its output stage and said
+/// ([`run_job`]).
 pub fn main<A, C>(tool: &str) -> ExitCode
 where
     A: clap::Parser,
     C: Job + TryFrom<A>,
     <C as TryFrom<A>>::Error: std::fmt::Display,
 {
+    match command_line::<A, C>(tool) {
+        Ok(config) => run_job(tool, &config),
+        Err(code) => code,
+    }
+}
+
+/// The worker threads started, the arguments `A` parsed and resolved into the settings `C`;
+/// or the exit code of `--help`/`--version` (0) or of a command line that cannot be run (2).
+pub fn command_line<A, C>(tool: &str) -> Result<C, ExitCode>
+where
+    A: clap::Parser,
+    C: TryFrom<A>,
+    <C as TryFrom<A>>::Error: std::fmt::Display,
+{
     bag2mat::shared::alloc::start_threads(tool);
-    let config = match parse::<A, C, _>(tool, C::try_from) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
+    parse::<A, C, _>(tool, C::try_from)
+}
+
+/// Runs the job `config` inside its output stage and says what it found (`finish`).
+pub fn run_job<C: Job>(tool: &str, config: &C) -> ExitCode {
     finish(tool, config.common(), &config.output_names(), |outputs| {
         config.sections(outputs)
     })

@@ -17,6 +17,11 @@
 //!   ([`chart_lines`], [`final_lines`]); `kalibr::curves`, the CSV; `kalibr::chart`, the two
 //!   charts.
 //! * `yaml`: Kalibr imu.yaml and the YAML spelling both halves write.
+//! * [`consumers`]: every estimator users feed the figures into (Kalibr, OpenVINS, VINS,
+//!   ORB-SLAM3, Basalt, PX4 EKF2, ArduPilot EKF3, GTSAM), each described once — keys, units,
+//!   convention, the source it was read from — and the config files written for them,
+//!   `allan_kalibr check` ([`consumers::check`]) and `allan_kalibr plan`
+//!   ([`consumers::plan`]).
 //! * `input`: `.mat`/`.bag` loading and the update-rate check ([`load_input`],
 //!   [`snap_rate`]); `run`: the whole job ([`run()`], [`Config`]).
 //! * `ieee952`: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
@@ -67,11 +72,12 @@ mod kalibr;
 mod run;
 mod yaml;
 
-pub use cli::{Args, TOOL};
+pub use cli::{Args, Cli, Command, Run, TOOL, command_main};
 pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
-    Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text, refusal_text,
+    Common, CommonArgs, Input, Job, Section, command_line, main as analyser_main, rate_for_text,
+    refusal_text, run_job,
 };
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};

@@ -195,6 +195,45 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> 
     Ok(outs)
 }
 
+/// The IEEE 952 analysis of `config`'s first topic, nothing written (what `allan_kalibr
+/// check --against LOG` compares with): the analysis, or why the record cannot have one.
+pub(crate) fn section_only(
+    config: &Config,
+) -> Result<Result<crate::ieee952::imu::ImuAnalysis, String>, Error> {
+    let mut datas = input::load_all(
+        config.common.samples_path(),
+        &config.common.topics,
+        config.common.time,
+        true,
+        &config.common.input_options,
+    )?;
+    if datas.is_empty() {
+        return Ok(Err("no IMU topic".into()));
+    }
+    let mut data = datas.swap_remove(0);
+    let mut notes = Vec::new();
+    if let Some(skip) = config.common.skip_start {
+        skip_start(&mut data, skip, &mut notes)?;
+    }
+    if data.len() < 3 {
+        return Err(Error::TooShort { n: data.len() });
+    }
+    let mut c = check_record(config, data, &mut notes)?;
+    if let Some(r) = &c.refusal {
+        return Ok(Err(format!(
+            "the record breaks the IEEE 952 analysis' assumptions ({}): nothing measured to compare with",
+            crate::front::refusal_text(r)
+        )));
+    }
+    let (curves, _) = section_curves(config, &mut c, &mut notes);
+    Ok(curves
+        .map(|cv| cv.finish(c.findings.clone(), &crate::ieee952::Config::default()))
+        .ok_or_else(|| {
+            let why: Vec<String> = notes.iter().map(|n| n.line()).collect();
+            format!("no IEEE 952 analysis of this record ({})", why.join("; "))
+        }))
+}
+
 /// The section's six series (gyro x y z, then acc x y z) of the `data_imu`-ordered columns.
 fn section_series(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
     [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]]

@@ -3,6 +3,7 @@
 //! other tools' curves, warm-up and gap checks (ieee952.rs); the studies of the IEEE 952
 //! estimator on simulated and real data (studies.rs, the long ones `#[ignore]`d).
 
+mod check;
 mod cli;
 mod common;
 mod consumers;

@@ -436,6 +436,12 @@ pub const CONSUMERS: [Consumer; 8] = [
     },
 ];
 
+/// A number as the config files write it: scientific notation with the shortest digits
+/// that read back to the same f64, which YAML 1.1 and 1.2, OpenCV and JSON all read as a real.
+pub fn sci(x: f64) -> String {
+    crate::yaml::yaml_sci(x)
+}
+
 /// The consumer `id`.
 pub fn consumer(id: ConsumerId) -> &'static Consumer {
     CONSUMERS
