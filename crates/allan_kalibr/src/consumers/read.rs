@@ -469,7 +469,7 @@ mod tests {
         assert_eq!(vins.get("body_T_cam0/rows").unwrap().value, Ok(4.0));
         let px4 = read(
             "p.params",
-            "# Onboard parameters\n1\t1\tEKF2_GYR_NOISE\t0.015000000596046448\t9\n",
+            "# Onboard parameters\n1\t1\tEKF2_GYR_NOISE\t0.014999999664723873\t9\n",
         );
         assert_eq!(px4.kind, Some(Kind::Consumer(ConsumerId::Px4)));
         assert_eq!(
