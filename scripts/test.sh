@@ -45,10 +45,11 @@ cargo test --workspace "$@"
 # 3 seeds, 4 h at 200 Hz, and the band-limited BMI088-like gyro and accelerometer (3.2 kHz
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
 # Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
-# runs beside them.
+# runs beside them, and `allan_kalibr plan` against the analysis' advice on four simulated
+# sensors × 5 seeds (issue 43).
 cargo test -p allan_kalibr --test main -- --ignored --exact \
   studies::profiles::profiles_study studies::bandlimited::bandlimited_study \
-  studies::lines::lines_study
+  studies::lines::lines_study studies::plan::plan_study
 
 # Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
 # with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,

@@ -13,5 +13,6 @@ mod front;
 mod ieee952;
 mod issue18;
 mod logs;
+mod plan;
 mod reference;
 mod studies;

@@ -2,13 +2,15 @@
 //! issue 10's accuracy studies on every `sim` profile (profiles.rs) and on band-limited
 //! sensors (bandlimited.rs), issue 17's vibration lines (lines.rs), N and K against the
 //! Cramér–Rao bound (accuracy.rs), the real-IMU curves of `testdata/real_curves` (real.rs)
-//! and parity with Stable32 and allantools (stable32.rs). The long ones are `#[ignore]`d;
+//! parity with Stable32 and allantools (stable32.rs), and `allan_kalibr plan` against the
+//! analysis' advice (plan.rs). The long ones are `#[ignore]`d;
 //! scripts/test.sh runs the three release studies by name (`studies::profiles::profiles_study`,
 //! `studies::bandlimited::bandlimited_study`, `studies::lines::lines_study`).
 
 mod accuracy;
 mod bandlimited;
 mod lines;
+pub(crate) mod plan;
 mod profiles;
 mod real;
 mod stable32;
