@@ -64,7 +64,7 @@ pub(crate) fn ratios(plan_n: &Records, plan_k: &Records, adv: &Advice) -> [f64; 
 }
 
 pub(crate) fn within(r: f64) -> bool {
-    r.is_finite() && r <= AGREE && r >= 1.0 / AGREE
+    r.is_finite() && (1.0 / AGREE..=AGREE).contains(&r)
 }
 
 #[test]
@@ -125,7 +125,7 @@ fn plan_study() {
                 if holds { "inside" } else { "OUTSIDE" }
             );
             records += 1;
-            hw_ok += usize::from(hw <= 0.25 * PRECISION_FACTOR && hw >= 0.25 / PRECISION_FACTOR);
+            hw_ok += usize::from((0.25 / PRECISION_FACTOR..=0.25 * PRECISION_FACTOR).contains(&hw));
             err_ok += usize::from((t.value / k - 1.0).abs() <= 0.25);
             covered += usize::from(holds);
         }
