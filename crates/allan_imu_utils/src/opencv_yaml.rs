@@ -107,10 +107,20 @@ fn push_block(out: &mut String, b: &Block<'_>) {
     }
 }
 
-/// The yaml text for `mode`. The continuous file (this project's, not upstream's) carries
-/// `comments` as `#` lines after its `---` (the tool, version, input and time, caveats);
-/// upstream's file is written as upstream writes it and takes none.
-pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode, comments: &[String]) -> String {
+/// What the continuous file (this project's, not upstream's) says besides the fit: `#`
+/// lines after its `---` (the tool, version, input and time, caveats) and the record's rate.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Extra {
+    /// Comment lines.
+    pub comments: Vec<String>,
+    /// The record's rate, Hz (the stamps' nominal rate, not imu_utils' mean period).
+    pub rate: Option<f64>,
+}
+
+/// The yaml text for `mode`: upstream's file as upstream writes it; the continuous one with
+/// `extra` (its `update_rate` the record's rate, else imu_utils' own).
+pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode, extra: &Extra) -> String {
+    let comments = &extra.comments;
     let mut out = String::from("%YAML:1.0\n---\n");
     if mode == YamlMode::Continuous {
         for c in comments {
@@ -149,7 +159,11 @@ pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode, comments: &[String])
                 out,
                 "convention: \"continuous-time noise densities (Kalibr / OpenVINS / ORB-SLAM3); fit of imu_utils read as |N|, sqrt(3)|K|, |B|/0.664\""
             );
-            let _ = writeln!(out, "update_rate: {}", real(an.axes[0].freq));
+            let _ = writeln!(
+                out,
+                "update_rate: {}",
+                real(extra.rate.unwrap_or(an.axes[0].freq))
+            );
             let v = |base: usize| {
                 [0, 1, 2].map(|k| {
                     let f = &an.fits[base + k];

@@ -472,6 +472,13 @@ struct Continuous<'a> {
     caveats: Option<Vec<String>>,
 }
 
+impl Continuous<'_> {
+    /// The record's rate the files state.
+    fn rate(&self) -> Option<f64> {
+        self.prov.rate.hz()
+    }
+}
+
 /// Writes imu_utils' two yaml files: upstream's as upstream writes it, the continuous one
 /// as `c` says; returns the paths.
 fn write_yaml_files(
@@ -487,13 +494,17 @@ fn write_yaml_files(
             (YamlMode::Continuous, Some(v)) => v.clone(),
             (YamlMode::Continuous, None) => continue,
         };
-        let mut comments = vec![c.prov.line()];
+        let mut comments = vec![c.prov.line(), c.prov.rate_line()];
         comments.extend(caveats);
+        let extra = opencv_yaml::Extra {
+            comments,
+            rate: c.rate(),
+        };
         let p = config.common.out_dir.join(mode.file_name(&config.name));
         report::write_text(
             outputs,
             &p,
-            &opencv_yaml::yaml_text(analysis, &config.name, mode, &comments),
+            &opencv_yaml::yaml_text(analysis, &config.name, mode, &extra),
         )?;
         files.push(p);
     }

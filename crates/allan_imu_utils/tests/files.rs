@@ -41,6 +41,37 @@ fn a_moving_record_gets_no_continuous_yaml_and_the_folder_keeps_only_its_own_fil
         "{cont}"
     );
 
+    // OpenCV (VINS-style loaders) reads it, the comments included, with its numbers
+    let cv = Command::new("/usr/bin/python3")
+        .arg("-c")
+        .arg(format!(
+            "import cv2; fs = cv2.FileStorage('{}', cv2.FILE_STORAGE_READ); print(' '.join(repr(fs.getNode(s).getNode('avg-axis').getNode(k).real()) for s, k in [('Gyr', 'gyr_n'), ('Gyr', 'gyr_w'), ('Acc', 'acc_n'), ('Acc', 'acc_w')]), repr(fs.getNode('update_rate').real()))",
+            out.join("x_imu_param_continuous.yaml").display()
+        ))
+        .output()
+        .expect("python3 with OpenCV (scripts/test.sh installs it)");
+    assert!(
+        cv.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cv.stderr)
+    );
+    let got: Vec<f64> = String::from_utf8_lossy(&cv.stdout)
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let want: Vec<f64> = [
+        "Gyr/avg-axis/gyr_n",
+        "Gyr/avg-axis/gyr_w",
+        "Acc/avg-axis/acc_n",
+        "Acc/avg-axis/acc_w",
+        "update_rate",
+    ]
+    .iter()
+    .map(|k| bag2mat::test_tools::yaml_number(&cont, k))
+    .collect();
+    assert_eq!(got, want, "{cont}");
+    assert_eq!(got[4], 100.0);
+
     let err = ok(&imu_utils(&hand, "x", &out));
     // before: written from the hand-held record with no word of motion, and the still
     // record's section files stayed beside it

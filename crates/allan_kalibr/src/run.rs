@@ -672,7 +672,8 @@ pub fn curves_rate(given: Option<f64>, c: &crate::ieee952::curves_in::Curves) ->
     }
     match c.format {
         Format::Ieee952 | Format::ImuUtils | Format::KalibrAllan => RecordRate::Curves {
-            rate: c.rate,
+            // 1/τ0 of a printed τ: the round rate it stands for (0.005000000001 s is 200 Hz)
+            rate: input::snap_rate(c.rate),
             how: format!(
                 "1/tau0 of the {} curves (their first point is one sample)",
                 c.format

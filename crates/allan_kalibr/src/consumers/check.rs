@@ -773,93 +773,101 @@ fn check_file(
     match kind {
         Kind::Consumer(id) => {
             let c = consumer(*id);
-            // the block the keys are in (OpenVINS' imu0/, Basalt's value0/)
-            let prefix = file
-                .entries
-                .iter()
-                .find_map(|e| {
-                    c.keys.iter().find_map(|k| {
-                        e.path
-                            .strip_suffix(k.name)
-                            .filter(|p| p.is_empty() || p.ends_with('/'))
-                            .map(str::to_string)
-                    })
-                })
-                .unwrap_or_default();
-            let rate_entry = c.rate_key.and_then(|k| file.get(&format!("{prefix}{k}")));
-            // the rate the consumer uses: its own key, else the record's
-            let rate = rate_entry
-                .and_then(|e| e.value.as_ref().ok().copied())
-                .filter(|r| *r > 0.0)
-                .or(record_rate.map(|r| r.0));
-            // PX4's prediction step, when the file sets it
-            let mut form = c.form;
-            if *id == ConsumerId::Px4
-                && let Some(Ok(us)) = file.get("EKF2_PREDICT_US").map(|e| e.value.clone())
-                && us > 0.0
-            {
-                form = Form::PerFilterStep { dt: us * 1e-6 };
-                out.push(line(
-                    "EKF2_PREDICT_US",
-                    &file
-                        .get("EKF2_PREDICT_US")
-                        .map_or(String::new(), |e| e.raw.clone()),
-                    Verdict::Ok(format!(
-                        "the EKF steps every {} s: the values are per step of that",
-                        us * 1e-6
-                    )),
-                ));
+            // the blocks the keys are in (OpenVINS' and Kalibr's imu0/, imu1/ …; Basalt's
+            // value0/): each is checked
+            let mut prefixes: Vec<String> = Vec::new();
+            for e in &file.entries {
+                for k in &c.keys {
+                    if let Some(p) = e
+                        .path
+                        .strip_suffix(k.name)
+                        .filter(|p| p.is_empty() || p.ends_with('/'))
+                        .map(str::to_string)
+                        && !prefixes.contains(&p)
+                    {
+                        prefixes.push(p);
+                    }
+                }
             }
-            for k in &c.keys {
-                let q = k.quantity;
-                let judge = |axis: Option<usize>| Judge {
-                    consumer: c,
-                    form,
-                    key: k,
-                    rate,
-                    measured: reference.and_then(|r| match axis {
-                        Some(a) => r.axes[q.index()][a],
-                        None => r.values[q.index()],
-                    }),
-                    floors: reference.map_or(&[][..], |r| {
-                        &r.floors[usize::from(q.sensor() == bag2mat::Sensor::Gyro)][..]
-                    }),
-                    what: reference.map_or("", |r| r.what.as_str()),
-                };
-                let path = format!("{prefix}{}", k.name);
-                if *id == ConsumerId::Basalt {
-                    let mut any = false;
-                    for a in 0..3 {
-                        let p = format!("{path}[{a}]");
-                        if let Some(e) = file.get(&p) {
-                            any = true;
-                            out.push(line(
-                                &p,
-                                &e.raw,
-                                entry_verdict(e, c, |v| judge(Some(a)).judge(v)),
-                            ));
+            if prefixes.is_empty() {
+                prefixes.push(String::new());
+            }
+            for prefix in prefixes {
+                let rate_entry = c.rate_key.and_then(|k| file.get(&format!("{prefix}{k}")));
+                // the rate the consumer uses: its own key, else the record's
+                let rate = rate_entry
+                    .and_then(|e| e.value.as_ref().ok().copied())
+                    .filter(|r| *r > 0.0)
+                    .or(record_rate.map(|r| r.0));
+                // PX4's prediction step, when the file sets it
+                let mut form = c.form;
+                if *id == ConsumerId::Px4
+                    && let Some(Ok(us)) = file.get("EKF2_PREDICT_US").map(|e| e.value.clone())
+                    && us > 0.0
+                {
+                    form = Form::PerFilterStep { dt: us * 1e-6 };
+                    out.push(line(
+                        "EKF2_PREDICT_US",
+                        &file
+                            .get("EKF2_PREDICT_US")
+                            .map_or(String::new(), |e| e.raw.clone()),
+                        Verdict::Ok(format!(
+                            "the EKF steps every {} s: the values are per step of that",
+                            us * 1e-6
+                        )),
+                    ));
+                }
+                for k in &c.keys {
+                    let q = k.quantity;
+                    let judge = |axis: Option<usize>| Judge {
+                        consumer: c,
+                        form,
+                        key: k,
+                        rate,
+                        measured: reference.and_then(|r| match axis {
+                            Some(a) => r.axes[q.index()][a],
+                            None => r.values[q.index()],
+                        }),
+                        floors: reference.map_or(&[][..], |r| {
+                            &r.floors[usize::from(q.sensor() == bag2mat::Sensor::Gyro)][..]
+                        }),
+                        what: reference.map_or("", |r| r.what.as_str()),
+                    };
+                    let path = format!("{prefix}{}", k.name);
+                    if *id == ConsumerId::Basalt {
+                        let mut any = false;
+                        for a in 0..3 {
+                            let p = format!("{path}[{a}]");
+                            if let Some(e) = file.get(&p) {
+                                any = true;
+                                out.push(line(
+                                    &p,
+                                    &e.raw,
+                                    entry_verdict(e, c, |v| judge(Some(a)).judge(v)),
+                                ));
+                            }
                         }
+                        if !any {
+                            out.push(line(&path, "", missing(c, k)));
+                        }
+                        continue;
                     }
-                    if !any {
-                        out.push(line(&path, "", missing(c, k)));
+                    match file.get(&path) {
+                        Some(e) => out.push(line(
+                            &path,
+                            &e.raw,
+                            entry_verdict(e, c, |v| judge(None).judge(v)),
+                        )),
+                        None => out.push(line(&path, "", missing(c, k))),
                     }
-                    continue;
                 }
-                match file.get(&path) {
-                    Some(e) => out.push(line(
-                        &path,
+                if let (Some(k), Some(e)) = (c.rate_key, rate_entry) {
+                    out.push(line(
+                        &format!("{prefix}{k}"),
                         &e.raw,
-                        entry_verdict(e, c, |v| judge(None).judge(v)),
-                    )),
-                    None => out.push(line(&path, "", missing(c, k))),
+                        judge_rate(c, e, record_rate),
+                    ));
                 }
-            }
-            if let (Some(k), Some(e)) = (c.rate_key, rate_entry) {
-                out.push(line(
-                    &format!("{prefix}{k}"),
-                    &e.raw,
-                    judge_rate(c, e, record_rate),
-                ));
             }
         }
         Kind::ImuUtils { continuous } => out.extend(
@@ -1007,5 +1015,63 @@ pub fn main(args: &CheckArgs) -> std::process::ExitCode {
             std::process::ExitCode::SUCCESS
         }
         Err(e) => bag2mat::shared::cli::fail(crate::cli::TOOL, &e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Kalibr's imu_chain (and OpenVINS') holds one block per IMU: each is checked.
+    #[test]
+    fn every_imu_of_a_chain_is_checked() {
+        let text = "imu0:\n  accelerometer_noise_density: 2.0e-03\n  accelerometer_random_walk: 3.0e-05\n  gyroscope_noise_density: 1.7e-04\n  gyroscope_random_walk: 2.0e-06\n  update_rate: 200.0\nimu1:\n  accelerometer_noise_density: 2.0e-03\n  accelerometer_random_walk: 3.0e-05\n  gyroscope_noise_density: 57.0\n  gyroscope_random_walk: 2.0e-06\n  update_rate: 400.0\n";
+        let lines = check_file(Path::new("chain.yaml"), text, None, None);
+        assert_eq!(lines.len(), 10, "{lines:#?}");
+        let bad: Vec<&Line> = lines
+            .iter()
+            .filter(|l| matches!(l.verdict, Verdict::Finding(..)))
+            .collect();
+        assert_eq!(bad.len(), 1, "{lines:#?}");
+        assert_eq!(bad[0].key, "imu1/gyroscope_noise_density");
+    }
+
+    /// The telltale ratios against a measured reference, from the judge itself: √rate for a
+    /// discrete value in a continuous key, 1/√rate for the reverse in VINS, the square.
+    #[test]
+    fn telltale_ratios_name_their_mistake() {
+        let m = Measured {
+            value: 1.0e-3,
+            lo: 0.9e-3,
+            hi: 1.1e-3,
+            bound: false,
+        };
+        let judge = |id: ConsumerId, v: f64| {
+            let c = consumer(id);
+            Judge {
+                consumer: c,
+                form: c.form,
+                key: c.key(Quantity::AccNoise),
+                rate: Some(400.0),
+                measured: Some(m),
+                floors: &[],
+                what: "the test",
+            }
+            .judge(v)
+        };
+        let name = |v: Verdict| match v {
+            Verdict::Ok(_) => "ok",
+            Verdict::Finding(w, _) => w,
+        };
+        assert_eq!(name(judge(ConsumerId::Kalibr, 1.0e-3)), "ok");
+        assert_eq!(name(judge(ConsumerId::Kalibr, 20e-3)), "discrete value");
+        assert_eq!(name(judge(ConsumerId::Kalibr, 1.0e-6)), "variance");
+        assert_eq!(name(judge(ConsumerId::Kalibr, 5.0e-3)), "inflated");
+        assert_eq!(name(judge(ConsumerId::Kalibr, 0.3e-3)), "deflated");
+        assert_eq!(name(judge(ConsumerId::Vins, 1.0e-3)), "continuous value");
+        assert_eq!(name(judge(ConsumerId::Vins, 20e-3)), "ok");
+        assert_eq!(name(judge(ConsumerId::Px4, 1.0e-3)), "continuous value");
+        assert_eq!(name(judge(ConsumerId::Px4, 20e-3)), "per-sample value");
+        assert_eq!(name(judge(ConsumerId::Gtsam, 1.0e-3)), "standard deviation");
     }
 }

@@ -6,7 +6,7 @@
 //!
 //! The record lengths are the analysis' own advice (`crate::ieee952::advisor`): the
 //! analysis of a record whose Allan curve is exactly the figures' model is asked what it
-//! would advise ([`crate::ieee952::advisor::expected`]), at the record length it advises
+//! would advise (`crate::ieee952::advisor::expected`), at the record length it advises
 //! until the two agree — so a plan and the advice printed after a record of that sensor are
 //! the same rule, not a second formula.
 //!

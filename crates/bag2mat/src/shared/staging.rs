@@ -2,7 +2,7 @@
 //! directory and a kill during the commit.
 //!
 //! Every file the atomic outputs of [`super::output`] write through a staged
-//! [`super::output::Outputs`] (which holds a [`Staging`]) waits in a stage:
+//! [`super::output::Outputs`] (which holds a `Staging`) waits in a stage:
 //!
 //! * for a directory that does not exist yet: a hidden directory beside it
 //!   (`.<name>.<pid>.<n>.tmp`) that one rename turns into it;
@@ -13,7 +13,8 @@
 //! * for the current directory (or one beside which no stage can be made): hidden temporary
 //!   files inside it, moved in the same way after a journal.
 //!
-//! A run may also retire files of an earlier run ([`remove_at_commit`]): they are removed
+//! A run may also retire files of an earlier run
+//! ([`super::output::Outputs::remove_at_commit`]): they are removed
 //! by the same commit (with the exchange, as the old directory goes; after the moves, named
 //! in the journal so that the next run finishes a killed commit's removals too), and not at
 //! all if the run fails.
