@@ -227,6 +227,41 @@ mod tests {
         assert_eq!(string(""), "\"\"");
     }
 
+    /// The continuous file's numbers, OpenCV's `%.16e`, read back by OpenCV itself
+    /// (`cv2.FileStorage`, what VINS-style loaders use) bit for bit, from 1e-12 to 1e3, with
+    /// the file's `#` comment lines after its `---`.
+    #[test]
+    fn opencv_reads_the_continuous_numbers_from_1e_12_to_1e3() {
+        let mut values = vec![1e-12, 1e3, 200.0, 1.0];
+        let mut x = 1.3e-12_f64;
+        while x < 1e3 {
+            values.push(x * std::f64::consts::E);
+            x *= 9.7;
+        }
+        let mut text = String::from("%YAML:1.0\n---\n# a comment line, as the file has\n");
+        for (i, v) in values.iter().enumerate() {
+            text.push_str(&format!("v{i}: {}\n", real(*v)));
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("c.yaml");
+        std::fs::write(&f, text).unwrap();
+        let o = std::process::Command::new("/usr/bin/python3")
+            .arg("-c")
+            .arg(format!(
+                "import cv2; fs = cv2.FileStorage('{}', cv2.FILE_STORAGE_READ); print(' '.join(repr(fs.getNode('v%d' % i).real()) for i in range({})))",
+                f.display(),
+                values.len()
+            ))
+            .output()
+            .expect("python3 with OpenCV (scripts/test.sh installs it)");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let got: Vec<f64> = String::from_utf8_lossy(&o.stdout)
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(got, values);
+    }
+
     /// Quirk 12: the leading space of upstream's unit strings makes OpenCV quote them.
     #[test]
     fn quirk_12_quoted_unit_strings() {
