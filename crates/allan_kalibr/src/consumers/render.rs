@@ -134,8 +134,11 @@ fn convention(c: &Consumer) -> &'static str {
 fn header(c: &Consumer, v: &ConfigValues, prov: &Provenance, title: &str) -> Vec<String> {
     let mut h = vec![title.to_string(), prov.line()];
     h.push(match v.origin {
+        Origin::Measured if c.id == ConsumerId::Basalt => {
+            "Values: the IEEE 952 fit of the overlapping Allan deviation, each axis its own (resolved, else its 95 % upper bound). Static data give optimistic values: inflate before use.".into()
+        }
         Origin::Measured => {
-            "Values: the IEEE 952 fit of the overlapping Allan deviation, the largest of the three axes (Basalt: each axis). Static data give optimistic values: inflate before use.".into()
+            "Values: the IEEE 952 fit of the overlapping Allan deviation, the largest of the three axes. Static data give optimistic values: inflate before use.".into()
         }
         Origin::Datasheet => {
             "Values: FROM A DATASHEET, NOT MEASURED (allan_kalibr plan): what the part is specified to be, not what yours is. Measure it (allan_kalibr on a static record) before trusting them.".into()
@@ -324,11 +327,11 @@ fn vins(c: &Consumer, v: &ConfigValues, prov: &Provenance) -> String {
         ),
         (
             Quantity::AccWalk,
-            "accelerometer bias random work noise standard deviation",
+            "accelerometer bias random walk noise standard deviation",
         ),
         (
             Quantity::GyroWalk,
-            "gyroscope bias random work noise standard deviation",
+            "gyroscope bias random walk noise standard deviation",
         ),
     ] {
         match number(c, v, q, rate) {
