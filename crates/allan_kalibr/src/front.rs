@@ -30,6 +30,9 @@ pub const MAX_RATE_HZ: f64 = 1e7;
 pub const DEFAULT_TOPIC: &str = "imu";
 
 /// The arguments both analysers take, in one place.
+// The field docs are clap's help texts, which write defaults as `<input stem>_<tool>/`:
+// rustdoc would read those as HTML tags, and escaping them would show in `--help`.
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct CommonArgs {
     /// The input: a ROS 1 bag (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, an
@@ -91,6 +94,7 @@ pub struct CommonArgs {
     /// Only what the upstream tool produces: skip the IEEE 952 section and its files.
     #[arg(long)]
     pub compat_only: bool,
+    /// How the input is read (bag2mat's input flags: units, columns, time).
     #[command(flatten)]
     pub input_args: bag2mat::InputArgs,
 }

@@ -4,11 +4,11 @@
 
 mod cli;
 mod common;
-mod defects;
-mod defects19;
-mod issue18;
+mod duplicated_rows;
 mod logs;
 mod real_tools;
 mod reference;
+mod ros1_damage_and_outputs;
 mod ros2;
+mod ros2_damage_and_outputs;
 mod roundtrip;
