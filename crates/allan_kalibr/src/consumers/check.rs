@@ -551,12 +551,33 @@ impl Judge<'_> {
             return Verdict::Ok(format!("{base}: at the bound{range}"));
         }
         // imu_utils' *_w pasted where a random walk belongs: the record's Allan floor
-        if q.is_walk()
-            && let Some(f) = self
-                .floors
+        let on_floor = |y: f64| {
+            self.floors
                 .iter()
-                .find(|f| near(v, **f, MISTAKE_FACTOR) || near(x, **f, MISTAKE_FACTOR))
-        {
+                .find(|f| near(y, **f, MISTAKE_FACTOR))
+                .filter(|_| q.is_walk())
+        };
+        let floor = on_floor(v).or_else(|| on_floor(x));
+        // Where the record bounds K without resolving it, the bound and the Allan floor are
+        // of one size (a random walk's bound is the floor times √(3/τ) near the floor's τ):
+        // a continuous value inside the bound is what the record allows, whatever its origin,
+        // and the floor only a caution. A consumer that converts (VINS' per-sample value,
+        // a filter step, a covariance) tells them apart: there the floor itself as the raw
+        // value is the pasted figure.
+        let converts = !near(v, x, MISTAKE_FACTOR);
+        if m.bound && x <= m.hi && !(converts && on_floor(v).is_some()) {
+            let caution = floor
+                .map(|f| {
+                    format!(
+                        " (it is also near the record's Allan floor {} {}: if it was copied from imu_utils' gyr_w/acc_w, that is a bias instability, not a random walk, though the record allows it)",
+                        n(*f),
+                        q.sensor().unit()
+                    )
+                })
+                .unwrap_or_default();
+            return Verdict::Ok(format!("{base}: within the bound{caution}{range}"));
+        }
+        if let Some(f) = floor {
             return Verdict::Finding(
                 "bias instability",
                 format!(
@@ -1073,5 +1094,51 @@ mod tests {
         assert_eq!(name(judge(ConsumerId::Px4, 1.0e-3)), "continuous value");
         assert_eq!(name(judge(ConsumerId::Px4, 20e-3)), "per-sample value");
         assert_eq!(name(judge(ConsumerId::Gtsam, 1.0e-3)), "standard deviation");
+    }
+
+    /// A random walk the record only bounds: a continuous value inside the bound is allowed
+    /// even where it matches the Allan floor (the two are of one size); the floor as the raw
+    /// value of a consumer that converts (VINS' per-sample `gyr_w`) is imu_utils' figure;
+    /// above the bound the floor is named.
+    #[test]
+    fn a_floor_inside_a_random_walk_bound_is_named_only_where_it_can_be_told_apart() {
+        let m = Measured {
+            value: 1.3e-3,
+            lo: 0.0,
+            hi: 1.3e-3,
+            bound: true,
+        };
+        let floors = [1.0e-3];
+        let judge = |id: ConsumerId, v: f64, m: Measured| {
+            let c = consumer(id);
+            Judge {
+                consumer: c,
+                form: c.form,
+                key: c.key(Quantity::GyroWalk),
+                rate: Some(400.0),
+                measured: Some(m),
+                floors: &floors,
+                what: "the test",
+            }
+            .judge(v)
+        };
+        let name = |v: Verdict| match v {
+            Verdict::Ok(t) if t.contains("Allan floor") => "ok, cautioned",
+            Verdict::Ok(_) => "ok",
+            Verdict::Finding(w, _) => w,
+        };
+        assert_eq!(name(judge(ConsumerId::Kalibr, 0.9e-3, m)), "ok, cautioned");
+        assert_eq!(name(judge(ConsumerId::Kalibr, 0.5e-3, m)), "ok");
+        assert_eq!(name(judge(ConsumerId::Vins, 1.0e-3, m)), "bias instability");
+        assert_eq!(name(judge(ConsumerId::Vins, 0.4e-3 * 20.0, m)), "ok");
+        let low = Measured {
+            value: 0.4e-3,
+            hi: 0.4e-3,
+            ..m
+        };
+        assert_eq!(
+            name(judge(ConsumerId::Kalibr, 1.0e-3, low)),
+            "bias instability"
+        );
     }
 }
