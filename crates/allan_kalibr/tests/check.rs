@@ -305,6 +305,18 @@ fn check_refuses_what_it_cannot_read() {
     let o = run(&["check", "x.yaml", "--against", tmp.path().to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("ieee952_terms.csv"));
+    // a log that cannot be analysed: the message names the flag it came from
+    let missing = tmp.path().join("missing.bag");
+    let o = run(&["check", "x.yaml", "--against", missing.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.starts_with(&format!(
+            "allan_kalibr: error: --against {}: ",
+            missing.display()
+        )),
+        "{err}"
+    );
     // the analysis' own command line is unchanged: an input named as before
     let o = run(&[
         CASES[2].bag().to_str().unwrap(),

@@ -80,8 +80,13 @@ pub enum CheckError {
         what: String,
     },
     /// Analysing the `--against` log failed.
-    #[error(transparent)]
-    Analysis(#[from] crate::Error),
+    #[error("--against {path}: {source}")]
+    Analysis {
+        /// The log.
+        path: PathBuf,
+        /// Why the analysis failed.
+        source: crate::Error,
+    },
 }
 
 /// A measured value: its value, its 95 % interval, and whether it is only an upper bound.
@@ -311,7 +316,12 @@ fn reference(args: &CheckArgs) -> Result<Option<Reference>, CheckError> {
         };
     }
     config.common.rate = args.rate;
-    let an = crate::run::section_only(&config)?.map_err(against)?;
+    let an = crate::run::section_only(&config)
+        .map_err(|source| CheckError::Analysis {
+            path: p.clone(),
+            source,
+        })?
+        .map_err(against)?;
     let text = terms::terms_csv(&an);
     let curves = terms::curves_csv(&an);
     Reference::from_terms_csv(
