@@ -8,6 +8,7 @@ use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 use rayon::prelude::*;
 
+use allan_kalibr::consumers::{Provenance, RecordRate, input_text};
 use allan_kalibr::{
     CurveData, CurvePoint, ImuAnalysis, Overlap, Section, analyse_imu_curves, ieee952_summary_text,
     read_curves, write_ieee952_files,
@@ -139,6 +140,28 @@ impl allan_kalibr::Job for Config {
     fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
         sections(self, outputs)
     }
+    fn output_names(&self) -> Vec<String> {
+        output_names(&self.name)
+    }
+}
+
+/// Every file a run of allan_imu_utils with IMU name `name` may write into an output folder
+/// (another name's files are another IMU's, kept: imu_utils' `data_save_path` holds several).
+pub fn output_names(name: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    for sensor in ["gyr", "acc"] {
+        for part in ["t", "x", "y", "z"] {
+            v.push(format!("data_{name}_sim_{sensor}_{part}.txt"));
+            v.push(format!("data_{name}_{sensor}_{part}.txt"));
+        }
+        for ext in ["png", "svg"] {
+            v.push(format!("allan_{sensor}.{ext}"));
+        }
+    }
+    v.push(YamlMode::Compat.file_name(name));
+    v.push(YamlMode::Continuous.file_name(name));
+    v.extend(allan_kalibr::ieee952_file_names(&format!("{name}_")));
+    v
 }
 
 /// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
@@ -201,8 +224,39 @@ fn run_series(
         analysis::allan_step(&collected, config.max_cluster, config.common.ieee952)?;
     timings.push(("allan", t1.elapsed()));
     let t1 = Instant::now();
-    let ieee = ieee952_section(config, &check, &axes, &collected, absent, &mut notes);
+    let section_rate = check
+        .rate
+        .map(allan_kalibr::snap_rate)
+        .unwrap_or(axes[0].freq);
+    let ieee = ieee952_section(
+        config,
+        &check,
+        &axes,
+        &collected,
+        absent,
+        section_rate,
+        &mut notes,
+    );
     timings.push(("ieee952", t1.elapsed()));
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), Some(&topic)),
+        RecordRate::Measured(section_rate),
+    );
+    let motion = check.refusal().map(allan_kalibr::refusal_text);
+    if let Some(m) = &motion {
+        notes.push(Note::warning(format!(
+            "{} not written: the record breaks the analysis' assumptions ({m}); imu_utils' own {} is written as upstream writes it, but its numbers describe this record, not the IMU's noise",
+            YamlMode::Continuous.file_name(&config.name),
+            YamlMode::Compat.file_name(&config.name)
+        )));
+    }
+    let caveats: Vec<String> = check
+        .findings
+        .iter()
+        .filter(|f| f.level >= bag2mat::FindingLevel::Warning)
+        .map(|f| format!("RECORD CHECK: {}; the values below carry it.", f.short()))
+        .collect();
     drop(collected);
     drop(series);
     let t1 = Instant::now();
@@ -216,7 +270,17 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    let files = write_outputs(outputs, &analysis, ieee.as_ref(), config, &topic)?;
+    let files = write_outputs(
+        outputs,
+        &analysis,
+        ieee.as_ref(),
+        config,
+        &topic,
+        &Continuous {
+            prov: &prov,
+            caveats: (motion.is_none()).then_some(caveats),
+        },
+    )?;
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee
         .as_ref()
@@ -307,12 +371,9 @@ fn ieee952_section(
     axes: &[AxisAllan],
     collected: &collect::Collected,
     absent: Option<Sensor>,
+    section_rate: f64,
     notes: &mut Vec<Note>,
 ) -> Option<ImuAnalysis> {
-    let section_rate = check
-        .rate
-        .map(allan_kalibr::snap_rate)
-        .unwrap_or(axes[0].freq);
     if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
         notes.push(Note::warning(format!(
             "IEEE 952 section not computed: the record breaks its assumptions ({})",
@@ -403,6 +464,53 @@ fn section(
     an
 }
 
+/// What `<name>_imu_param_continuous.yaml` (this project's file) is written with: the files'
+/// provenance, and the record check's caveats — `None` when the record is not fit for a
+/// noise analysis at all (a moving record), and the file is not written.
+struct Continuous<'a> {
+    prov: &'a Provenance,
+    caveats: Option<Vec<String>>,
+}
+
+impl Continuous<'_> {
+    /// The record's rate the files state.
+    fn rate(&self) -> Option<f64> {
+        self.prov.rate.hz()
+    }
+}
+
+/// Writes imu_utils' two yaml files: upstream's as upstream writes it, the continuous one
+/// as `c` says; returns the paths.
+fn write_yaml_files(
+    outputs: &Outputs,
+    analysis: &Analysis,
+    config: &Config,
+    c: &Continuous<'_>,
+) -> Result<Vec<PathBuf>, Error> {
+    let mut files = Vec::new();
+    for mode in [YamlMode::Compat, YamlMode::Continuous] {
+        let caveats = match (mode, &c.caveats) {
+            (YamlMode::Compat, _) => Vec::new(),
+            (YamlMode::Continuous, Some(v)) => v.clone(),
+            (YamlMode::Continuous, None) => continue,
+        };
+        let mut comments = vec![c.prov.line(), c.prov.rate_line()];
+        comments.extend(caveats);
+        let extra = opencv_yaml::Extra {
+            comments,
+            rate: c.rate(),
+        };
+        let p = config.common.out_dir.join(mode.file_name(&config.name));
+        report::write_text(
+            outputs,
+            &p,
+            &opencv_yaml::yaml_text(analysis, &config.name, mode, &extra),
+        )?;
+        files.push(p);
+    }
+    Ok(files)
+}
+
 /// imu_utils' files (curves, both yaml modes, plots) and the section's.
 fn write_outputs(
     outputs: &Outputs,
@@ -410,19 +518,12 @@ fn write_outputs(
     ieee: Option<&ImuAnalysis>,
     config: &Config,
     topic: &str,
+    c: &Continuous<'_>,
 ) -> Result<Vec<PathBuf>, Error> {
     outputs.ensure_dir(&config.common.out_dir)?;
     let mut files =
         report::write_curve_files(outputs, analysis, &config.name, &config.common.out_dir)?;
-    for mode in [YamlMode::Compat, YamlMode::Continuous] {
-        let p = config.common.out_dir.join(mode.file_name(&config.name));
-        report::write_text(
-            outputs,
-            &p,
-            &opencv_yaml::yaml_text(analysis, &config.name, mode),
-        )?;
-        files.push(p);
-    }
+    files.extend(write_yaml_files(outputs, analysis, config, c)?);
     if config.plots {
         files.extend(plot::write_plots(
             outputs,
@@ -432,7 +533,7 @@ fn write_outputs(
         )?);
     }
     if let Some(an) = ieee {
-        files.extend(write_ieee952(outputs, an, config, topic)?);
+        files.extend(write_ieee952(outputs, an, config, topic, c.prov)?);
     }
     Ok(files)
 }
@@ -443,9 +544,11 @@ fn write_ieee952(
     an: &ImuAnalysis,
     config: &Config,
     rostopic: &str,
+    prov: &Provenance,
 ) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = write_ieee952_files(outputs, an, &config.common.out_dir, &prefix, rostopic)?;
+    let mut out =
+        write_ieee952_files(outputs, an, &config.common.out_dir, &prefix, rostopic, prov)?;
     if config.plots {
         let truth = allan_kalibr::find_truth(config.common.samples_path(), an);
         out.extend(allan_kalibr::write_ieee952_chart(
@@ -468,6 +571,11 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
         return Err(Error::Config("no --curves given".into()));
     };
     let c = read_curves(&input.paths, &input.options)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        allan_kalibr::curves_text(&input.paths),
+        allan_kalibr::curves_rate(config.common.rate, &c),
+    );
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
@@ -485,15 +593,15 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
             .collect();
         let an = Analysis::from_curves(raw, fits, freq);
         stdout.push_str(&report::fit_text(&an));
-        for mode in [YamlMode::Compat, YamlMode::Continuous] {
-            let p = config.common.out_dir.join(mode.file_name(&config.name));
-            report::write_text(
-                outputs,
-                &p,
-                &opencv_yaml::yaml_text(&an, &config.name, mode),
-            )?;
-            files.push(p);
-        }
+        files.extend(write_yaml_files(
+            outputs,
+            &an,
+            config,
+            &Continuous {
+                prov: &prov,
+                caveats: Some(Vec::new()),
+            },
+        )?);
         analysis = Some(an);
     } else {
         notes.push(Note::info(format!(
@@ -510,7 +618,7 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let rostopic = config.common.named_topic();
-    files.extend(write_ieee952(outputs, &an, config, rostopic)?);
+    files.extend(write_ieee952(outputs, &an, config, rostopic, &prov)?);
     let section = Section {
         notes,
         text: stdout,

@@ -10,6 +10,7 @@
 mod cli;
 mod common;
 mod curves;
+mod files;
 mod fit_reference;
 mod front;
 mod limits_and_messages;

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
 use crate::front::Section;
 use crate::input::{self, ImuData, RateChoice};
@@ -15,7 +16,7 @@ use crate::kalibr::curves;
 use crate::kalibr::estimator::{Estimator, sig2_curves};
 use crate::kalibr::grid::TauGrid;
 use crate::kalibr::report;
-use crate::yaml::ImuYaml;
+use crate::yaml::{ImuYaml, SectionFile};
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
@@ -150,6 +151,24 @@ impl crate::front::Job for Config {
     fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
         sections(self, outputs)
     }
+    fn output_names(&self) -> Vec<String> {
+        output_names()
+    }
+}
+
+/// Every file a run of allan_kalibr may write into an output folder.
+pub(crate) fn output_names() -> Vec<String> {
+    let mut v: Vec<String> = ["imu.yaml", "allan_curves.csv"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    for stem in ["allan_accel", "allan_gyro"] {
+        for ext in ["png", "svg"] {
+            v.push(format!("{stem}.{ext}"));
+        }
+    }
+    v.extend(crate::ieee952::files::file_names(""));
+    v
 }
 
 /// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
@@ -181,6 +200,45 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> 
         outs.push(run_on(&c, data, load, outputs)?);
     }
     Ok(outs)
+}
+
+/// The IEEE 952 analysis of `config`'s first topic, nothing written (what `allan_kalibr
+/// check --against LOG` compares with): the analysis, or why the record cannot have one.
+pub(crate) fn section_only(
+    config: &Config,
+) -> Result<Result<crate::ieee952::imu::ImuAnalysis, String>, Error> {
+    let mut datas = input::load_all(
+        config.common.samples_path(),
+        &config.common.topics,
+        config.common.time,
+        true,
+        &config.common.input_options,
+    )?;
+    if datas.is_empty() {
+        return Ok(Err("no IMU topic".into()));
+    }
+    let mut data = datas.swap_remove(0);
+    let mut notes = Vec::new();
+    if let Some(skip) = config.common.skip_start {
+        skip_start(&mut data, skip, &mut notes)?;
+    }
+    if data.len() < 3 {
+        return Err(Error::TooShort { n: data.len() });
+    }
+    let mut c = check_record(config, data, &mut notes)?;
+    if let Some(r) = &c.refusal {
+        return Ok(Err(format!(
+            "the record breaks the IEEE 952 analysis' assumptions ({}): nothing measured to compare with",
+            crate::front::refusal_text(r)
+        )));
+    }
+    let (curves, _) = section_curves(config, &mut c, &mut notes);
+    Ok(curves
+        .map(|cv| cv.finish(c.findings.clone(), &crate::ieee952::Config::default()))
+        .ok_or_else(|| {
+            let why: Vec<String> = notes.iter().map(|n| n.line()).collect();
+            format!("no IEEE 952 analysis of this record ({})", why.join("; "))
+        }))
 }
 
 /// The section's six series (gyro x y z, then acc x y z) of the `data_imu`-ordered columns.
@@ -216,6 +274,22 @@ fn run_on(
     // path turns them into prefix sums; its fits then run beside the compat path. Data too
     // short for it only cost the section, with a note.
     let (curves, curves_s) = section_curves(config, &mut c, &mut notes);
+    let section_file = match (&curves, &c.refusal) {
+        _ if !config.common.ieee952 => SectionFile::CompatOnly,
+        (Some(_), _) => SectionFile::Written,
+        (None, Some(r)) => SectionFile::NotComputed(format!(
+            "the IEEE 952 section was not computed, the record breaks its assumptions ({})",
+            crate::front::refusal_text(r)
+        )),
+        (None, None) => SectionFile::NotComputed(
+            "the IEEE 952 analysis could not run on this record (the warning says why)".into(),
+        ),
+    };
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), data_topic.as_deref()),
+        record_rate(config, &c.rate),
+    );
     let axes = compat_axes(c.data);
     let ((ieee, fits_s), analysis) = rayon::join(
         || {
@@ -242,9 +316,13 @@ fn run_on(
         outputs,
         config,
         &analysis,
-        ieee.as_ref(),
-        c.rate.used,
-        &topic,
+        Written {
+            ieee: ieee.as_ref(),
+            update_rate: c.rate.used,
+            topic: &topic,
+            prov: &prov,
+            section: &section_file,
+        },
     )?;
     let timings = Timings {
         load,
@@ -438,23 +516,42 @@ fn compat_axes(data: ImuData) -> [Vec<f64>; 6] {
     axes
 }
 
+/// The record's rate as the files state it: the stamps' nominal rate (the section's), or the
+/// rate given when the stamps give none.
+fn record_rate(config: &Config, rate: &RateChoice) -> RecordRate {
+    match (rate.measured, config.common.rate) {
+        (None, Some(g)) => RecordRate::Given(g),
+        _ => RecordRate::Measured(rate.section),
+    }
+}
+
+/// What a run's files are written from besides the compat analysis: the section, the
+/// compat imu.yaml's update_rate, the topic, the files' provenance, and what became of the
+/// section's Kalibr file (imu.yaml's header says it).
+struct Written<'a> {
+    ieee: Option<&'a crate::ieee952::imu::ImuAnalysis>,
+    update_rate: f64,
+    topic: &'a str,
+    prov: &'a Provenance,
+    section: &'a SectionFile,
+}
+
 /// Renders the yaml and the curves' CSV (before the output folder is touched), then writes
 /// them, the compat charts and the section's files and chart; returns the paths written.
 fn write_outputs(
     outputs: &Outputs,
     config: &Config,
     analysis: &Analysis,
-    ieee: Option<&crate::ieee952::imu::ImuAnalysis>,
-    update_rate: f64,
-    topic: &str,
+    w: Written<'_>,
 ) -> Result<Vec<PathBuf>, Error> {
+    let Written {
+        ieee,
+        update_rate,
+        topic,
+        prov,
+        section,
+    } = w;
     let absent = analysis.absent;
-    let source = config
-        .common
-        .samples_path()
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let yaml = ImuYaml {
         accelerometer_noise_density: analysis.accel.white,
         accelerometer_random_walk: analysis.accel.bias,
@@ -464,7 +561,7 @@ fn write_outputs(
         update_rate,
         absent,
     }
-    .render(&source);
+    .render(prov, section);
     let mut csv = Vec::new();
     curves::write_csv_of(
         &mut csv,
@@ -493,7 +590,7 @@ fn write_outputs(
             let Some(an) = ieee else {
                 return Ok(Vec::new());
             };
-            let mut w = crate::ieee952::files::write_outputs(outputs, an, dir, "", topic)?;
+            let mut w = crate::ieee952::files::write_outputs(outputs, an, dir, "", topic, prov)?;
             let truth = crate::ieee952::plot::find_truth(config.common.samples_path(), an);
             w.extend(crate::ieee952::plot::write_chart(
                 outputs,
@@ -553,7 +650,12 @@ pub fn run_curves(
     outputs.ensure_dir(dir)?;
     let title = chart_title(config);
     let rostopic = config.common.named_topic();
-    let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        curves_text(&curves.paths),
+        curves_rate(config.common.rate, &c),
+    );
+    let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic, &prov)?;
     written.extend(crate::ieee952::plot::write_chart(
         outputs, &an, &title, None, dir, "",
     )?);
@@ -562,6 +664,36 @@ pub fn run_curves(
         written,
         ..Default::default()
     })
+}
+
+/// "curves a.csv, b.csv": the input a file written from `--curves` names.
+pub fn curves_text(paths: &[PathBuf]) -> String {
+    let p: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    format!("the Allan curves {}", p.join(", "))
+}
+
+/// The record's rate behind curves read with `--curves`: `--rate`, else what the format says
+/// of the samples (a curve this project or imu_utils wrote starts at one sample; kalibr_allan's
+/// grid is in samples), else unknown — allan_variance_ros' 0.1 s bins and a plain CSV's first
+/// τ do not say the IMU's rate.
+pub fn curves_rate(given: Option<f64>, c: &crate::ieee952::curves_in::Curves) -> RecordRate {
+    use crate::ieee952::curves_in::Format;
+    if let Some(r) = given {
+        return RecordRate::Given(r);
+    }
+    match c.format {
+        Format::Ieee952 | Format::ImuUtils | Format::KalibrAllan => RecordRate::Curves {
+            // 1/τ0 of a printed τ: the round rate it stands for (0.005000000001 s is 200 Hz)
+            rate: input::snap_rate(c.rate),
+            how: format!(
+                "1/tau0 of the {} curves (their first point is one sample)",
+                c.format
+            ),
+        },
+        Format::AllanVarianceRos | Format::Plain => {
+            RecordRate::Unknown(format!("{} does not state the IMU's rate", c.format))
+        }
+    }
 }
 
 /// The charts' title: `--title`, else the input's file stem (upstream hard-codes its

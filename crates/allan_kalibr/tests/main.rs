@@ -3,14 +3,17 @@
 //! other tools' curves, warm-up and gap checks (ieee952.rs); the studies of the IEEE 952
 //! estimator on simulated and real data (studies.rs, the long ones `#[ignore]`d).
 
+mod check;
 mod cli;
 mod common;
 mod consumers;
+mod files;
 mod front;
 mod ieee952;
 mod logs;
 mod operating;
 mod outputs_and_messages;
+mod plan;
 mod record_checks;
 mod reference;
 mod studies;

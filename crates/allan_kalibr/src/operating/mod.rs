@@ -48,6 +48,7 @@ use bag2mat::Sensor;
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
+use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
 use crate::front::Section;
 use crate::ieee952::imu::{ImuAnalysis, ImuCurves};
@@ -570,7 +571,15 @@ fn run_topic(
         config.title.clone()
     };
     outputs.ensure_dir(dir)?;
-    let mut written = files::write(outputs, &op, dir, &topic)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), topic_name.as_deref()),
+        match config.common.rate {
+            Some(r) => RecordRate::Given(r),
+            None => RecordRate::Measured(rate),
+        },
+    );
+    let mut written = files::write(outputs, &op, dir, &topic, &prov)?;
     written.extend(plot::write(outputs, &op, &title, dir)?);
     Ok(Section {
         topic: topic_name,
