@@ -42,6 +42,8 @@
 //! per format (default 300), `FUZZ_SEED` the seed, `FUZZ_ONLY=FORMAT:VARIANT` runs one
 //! variant and keeps it, `FUZZ_VERBOSE=1` prints every variant that does not read clean.
 
+mod logs;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -607,7 +609,7 @@ fn make_clean(dir: &Path, f: Format, bin: &Path) -> Clean {
         }
     };
     let out = dir.join(format!("{name}.clean.csv"));
-    let r = run_child(bin, &input, &out);
+    let r = run_child(bin, &input, "imu", &out);
     let cut = matches!(f, Format::McapCut(_));
     assert!(
         r.code == Some(0) && (r.stderr.is_empty() || cut),
@@ -645,12 +647,12 @@ struct ChildRun {
     elapsed: Duration,
 }
 
-fn run_child(bin: &Path, input: &Path, out: &Path) -> ChildRun {
+fn run_child(bin: &Path, input: &Path, topic: &str, out: &Path) -> ChildRun {
     use std::os::unix::process::{CommandExt, ExitStatusExt};
     let _ = std::fs::remove_file(out);
     let mut cmd = Command::new(bin);
     cmd.arg(input)
-        .arg("imu")
+        .arg(topic)
         .arg("-o")
         .arg(out)
         .args(["--format", "csv", "--quiet"])
@@ -1013,6 +1015,14 @@ fn main() {
         Some((f.to_string(), k.parse().ok()?))
     });
     let verbose = std::env::var_os("FUZZ_VERBOSE").is_some();
+    // FUZZ_FORMATS=a,b: only these formats (by name)
+    let chosen: Option<Vec<String>> = std::env::var("FUZZ_FORMATS")
+        .ok()
+        .map(|v| v.split(',').map(str::to_string).collect());
+    let wanted = |name: &str| {
+        only.as_ref().is_none_or(|(f, _)| f == name)
+            && chosen.as_ref().is_none_or(|c| c.iter().any(|x| x == name))
+    };
     let dir = tempfile::tempdir().expect("temp dir");
     let formats = [
         Format::Ros1(Compression::None),
@@ -1038,9 +1048,7 @@ fn main() {
         .map(|n| n.get())
         .unwrap_or(2);
     for (fi, f) in formats.iter().enumerate() {
-        if let Some((fmt, _)) = &only
-            && *fmt != f.name()
-        {
+        if !wanted(&f.name()) {
             continue;
         }
         let t0 = Instant::now();
@@ -1120,7 +1128,7 @@ fn main() {
                                 }
                             }
                         }
-                        let r = run_child(bin, &input, &out);
+                        let r = run_child(bin, &input, "imu", &out);
                         let (outcome, ours) = classify(&expected, &r, &out);
                         if verbose && !matches!(outcome, Ok(Outcome::Clean)) {
                             let first = r
@@ -1226,6 +1234,43 @@ fn main() {
             t.altered,
             t.warned,
             t.uncounted,
+            t.duplicated,
+            t.error,
+            t.failed
+        ));
+    }
+    for (li, f) in logs::ALL.iter().enumerate() {
+        if !wanted(f.name()) {
+            continue;
+        }
+        let set = logs::Settings {
+            bin: &bin,
+            dir: dir.path(),
+            seed,
+            variants,
+            only: only.as_ref().map(|o| o.1),
+            verbose,
+        };
+        let t = logs::campaign(*f, li, &set);
+        failures += t.failed;
+        println!(
+            "{}: {variants} variants in {:.1} s (bag2mat and {}): {} clean, {} altered values, {} warned, {} duplicated, {} errors, {} FAILED",
+            f.name(),
+            t.secs,
+            f.reader_name(),
+            t.clean,
+            t.altered,
+            t.warned,
+            t.duplicated,
+            t.error,
+            t.failed
+        );
+        summary.push(format!(
+            "{} {}/{}/{}/0/{}/{}/{}",
+            f.name(),
+            t.clean,
+            t.altered,
+            t.warned,
             t.duplicated,
             t.error,
             t.failed
