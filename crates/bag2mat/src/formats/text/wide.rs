@@ -740,8 +740,8 @@ mod tests {
     fn same_reading(a: (&Summary, &Rows), b: (&Summary, &Rows), what: &str) {
         let ((ga, ra), (gb, rb)) = (a, b);
         assert_eq!(
-            (ga.filled, ga.lines, ga.bad, &ga.first_bad, ga.quoted),
-            (gb.filled, gb.lines, gb.bad, &gb.first_bad, gb.quoted),
+            (ga.filled, ga.lines, ga.bad, &ga.first_bad, ga.lost),
+            (gb.filled, gb.lines, gb.bad, &gb.first_bad, gb.lost),
             "{what}"
         );
         let (oa, ob) = (ga.order, gb.order);
