@@ -160,6 +160,11 @@ pub(crate) fn read(path: &Path, bytes: &[u8]) -> Result<DecodedSource, Error> {
     while i + 3 <= len {
         i = r.step(bytes, i);
     }
+    if i < len && HEAD.starts_with(&bytes[i..]) {
+        // the file ends inside a message's header: of any type (an IMU message may be it)
+        r.truncated = Some(i);
+        r.imu_unknown += 1;
+    }
     r.finish(path)
 }
 
@@ -305,9 +310,6 @@ impl Reader {
                 let to = (i + 1..len)
                     .find(|&j| self.whole_at(bytes, j))
                     .unwrap_or(len);
-                if to == len && self.header(bytes, i).is_none() && i + 3 > len {
-                    return len;
-                }
                 self.stretch(bytes, i, to);
                 to
             }
