@@ -4,6 +4,7 @@
 
 mod cli;
 mod common;
+mod damaged_logs;
 mod defects;
 mod defects19;
 mod issue18;

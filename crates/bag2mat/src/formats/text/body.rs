@@ -59,6 +59,10 @@ pub(super) fn num(s: &[u8]) -> Option<f64> {
     fast_float2::parse(trim(s)).ok()
 }
 
+/// Bytes a line may have and still be read as a row (a row of hundreds of columns takes a
+/// few kB; a longer line is damage, not parsed).
+pub(super) const MAX_LINE_BYTES: usize = 1 << 20;
+
 /// Bytes of a line a warning quotes at most.
 pub(super) const EXCERPT_BYTES: usize = 32;
 
@@ -568,6 +572,18 @@ impl<'t, 'a> Cursor<'t, 'a> {
     /// A line (`raw`; `cut`: the file ends inside it) [`fast_row`] did not take: read by the
     /// csv crate, its damage counted.
     fn read_line(&mut self, raw: &[u8], lay: &Layout, cols: &[Col], cut: bool) {
+        if raw.len() > MAX_LINE_BYTES {
+            // no row is this long: not parsed (the csv crate would hold it whole)
+            self.out.take(
+                self.line,
+                Err(BadRow(format!(
+                    "a line of {} bytes, longer than any row",
+                    raw.len()
+                ))),
+            );
+            self.out.malformed(self.line, raw, lay, cut);
+            return;
+        }
         if let Some((row, took)) = fast_row(raw, lay, cols)
             && took == raw.len()
         {

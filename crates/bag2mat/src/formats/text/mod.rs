@@ -26,6 +26,7 @@ mod decimal;
 mod layout;
 mod units;
 mod wide;
+mod window;
 
 use super::InputOptions;
 use crate::RosTime;
@@ -124,28 +125,18 @@ const MAX_HEAD_BYTES: usize = 16 << 20;
 pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
-    let map = crate::mapped::Mapped::of(&file, path)?;
-    let bytes = map.bytes();
-    let lay = match layout(
-        path,
-        &bytes[..bytes.len().min(SNIFF_BYTES)],
-        bytes.len() as u64,
-        opts,
-    ) {
-        Err(Error::NotABag { .. }) if bytes.len() > SNIFF_BYTES => layout(
-            path,
-            &bytes[..bytes.len().min(MAX_HEAD_BYTES)],
-            bytes.len() as u64,
-            opts,
-        )?,
-        r => r?,
+    let len = file.metadata().map_err(io)?.len();
+    // mapped whole where it fits the address space, else read window by window
+    let map = if crate::mapped::Mapped::fits(len) {
+        crate::mapped::Mapped::of(&file, path).ok()
+    } else {
+        None
+    };
+    let (lay, mut rows, chunks, cut) = match &map {
+        Some(m) => read_mapped(path, m.bytes(), opts)?,
+        None => window::read(path, &file, len, opts)?,
     };
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
-    // a last line without its line end whose last number is cut: not read
-    let cut = cut_last_line(bytes, &lay);
-    let body = &bytes[..bytes.len() - cut.map_or(0, |c| c.1)];
-    let cut = cut.map(|c| c.0);
-    let (mut rows, chunks) = read_body(body, &lay, RANGE_BYTES);
     let line_starts = line_starts(&chunks, lay.body_line);
     let mut notes = Vec::new();
     let mut lost = malformed_lines(path, &chunks, &line_starts)?;
@@ -193,6 +184,28 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
         notes,
         lost,
     })
+}
+
+/// What a mapped text log holds: its layout, rows and range summaries, and the line number
+/// of a last line cut inside its last number (not read).
+fn read_mapped(
+    path: &Path,
+    bytes: &[u8],
+    opts: &InputOptions,
+) -> Result<(Layout, Rows, Vec<Summary>, Option<u64>), Error> {
+    let head = |n: usize| &bytes[..bytes.len().min(n)];
+    let len = bytes.len() as u64;
+    let lay = match layout(path, head(SNIFF_BYTES), len, opts) {
+        Err(Error::NotABag { .. }) if bytes.len() > SNIFF_BYTES => {
+            layout(path, head(MAX_HEAD_BYTES), len, opts)?
+        }
+        r => r?,
+    };
+    // a last line without its line end whose last number is cut: not read
+    let cut = cut_last_line(bytes, &lay);
+    let body = &bytes[..bytes.len() - cut.map_or(0, |c| c.1)];
+    let (rows, chunks) = read_body(body, &lay, RANGE_BYTES);
+    Ok((lay, rows, chunks, cut.map(|c| c.0)))
 }
 
 /// Lines whose last field a cut last line is compared with.

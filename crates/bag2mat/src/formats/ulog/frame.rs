@@ -106,42 +106,56 @@ impl Ctx<'_> {
         }
     }
 
-    /// True when `at` is a message boundary: the end of the file, or `CHAIN` whole messages
-    /// follow (fewer when the file ends after them, or inside the next one). A data message of
-    /// an id no subscription names counts when whole messages of the format are among them
-    /// (a log whose subscription was lost has many); one of a re-bound id when it fits
-    /// either channel.
+    /// True when `at` is a message boundary: the end of the file, or `CHAIN` messages follow
+    /// (fewer when the file ends after them, or inside the next one) that are whole or may
+    /// be: a data message of an id no subscription names or of a channel whose format it
+    /// does not fit (a log whose subscription or format was lost has many), a subscription to
+    /// a format not defined (its definition damaged), one of a re-bound id that fits either
+    /// channel.
     pub(super) fn chain(&self, at: u64) -> bool {
         self.chain_from(at, false)
     }
 
-    /// [`Ctx::chain`]; `strict`: the first message must be whole (not a data message of an
-    /// id no subscription names, or that does not fit its format), as where a walk past
-    /// damage lands.
+    /// [`Ctx::chain`]; `strict`: the first message must be whole, as where a walk past damage
+    /// lands.
     fn chain_from(&self, at: u64, strict: bool) -> bool {
         let len = self.bytes.len() as u64;
-        let (mut p, mut whole, mut orphans) = (at, 0, 0);
+        let (mut p, mut seen, mut wholes) = (at, 0, 0);
+        // the ids of the data messages that may be whole: a run of them alone must be one
+        // topic's (whose format or subscription was lost), not bytes that happen to look so
+        let mut ids: Option<Option<u16>> = None;
         for _ in 0..CHAIN {
             if p == len {
                 return true;
             }
             let Some((size, ty)) = header(self.bytes, p) else {
-                return whole > 0;
+                return seen > 0;
             };
             let Some(b) = body(self.bytes, p, size as usize) else {
-                return whole > 0;
+                return seen > 0;
             };
             if self.whole(p, ty, b) || self.rebound_fits(b) {
-                whole += 1;
-            } else if ty == b'D' && b.len() >= 2 && !(strict && p == at) {
-                // of no subscription, or of a channel whose format it does not fit
-                orphans += 1;
+                wholes += 1;
             } else {
-                return false;
+                let maybe = match ty {
+                    b'D' => b.len() >= 2,
+                    b'A' => b.len() > 3 && b[3..].iter().all(|c| c.is_ascii_graphic()),
+                    _ => false,
+                };
+                if !maybe || (strict && p == at) {
+                    return false;
+                }
+                let id = (ty == b'D').then(|| u16::from_le_bytes([b[0], b[1]]));
+                ids = match ids {
+                    None => Some(id),
+                    Some(x) if x == id && id.is_some() => Some(x),
+                    Some(_) => Some(None),
+                };
             }
+            seen += 1;
             p += 3 + size as u64;
         }
-        whole > 0 && (orphans == 0 || whole + orphans == CHAIN)
+        wholes > 0 || ids.is_some_and(|x| x.is_some())
     }
 
     /// A data body whose id a subscription moved, fitting the channel it was moved from.

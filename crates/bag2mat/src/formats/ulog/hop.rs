@@ -456,13 +456,15 @@ impl Hop {
         };
         let next = at + 3 + size as u64;
         let body = frame::body(bytes, at, size as usize);
+        // whole messages start inside it: its size is damaged (it would swallow them)
+        let swallows = self.ctx(bytes, subs).resync(at) < next;
         if let Some(b) = body
             && b.len() >= 2
         {
             let id = u16::from_le_bytes([b[0], b[1]]);
             let stated = subs.get(id);
             let data_len = b.len() - 2;
-            let framed = self.ctx(bytes, subs).chain(next);
+            let framed = !swallows && self.ctx(bytes, subs).chain(next);
             if ty == b'D' && framed {
                 // its size frames it: its id, its subscription or its format is off
                 if stated != NO_CHANNEL {
@@ -540,7 +542,7 @@ impl Hop {
             }
         }
         let ctx = self.ctx(bytes, subs);
-        if ty != b'D' && ctx.skippable(at, ty, size) {
+        if ty != b'D' && !swallows && ctx.skippable(at, ty, size) {
             // a message of no known type, or a damaged one, skipped by its size (pyulog's
             // rule for a type it does not know)
             self.found.repair(
@@ -678,12 +680,13 @@ impl Hop {
         s.1 += to - at;
         let mut unaccounted = to - at;
         let mut q = at;
-        // the damaged message itself, when its header still names a channel
-        if let Some((_, b'D')) = frame::header(bytes, at)
+        // the damaged message itself, when its header still names a channel (its id, and
+        // a size its format allows)
+        if let Some((size, b'D')) = frame::header(bytes, at)
             && let Some(id) = bytes.get(at as usize + 3..at as usize + 5)
         {
             let ch = subs.get(u16::from_le_bytes([id[0], id[1]]));
-            if ch != NO_CHANNEL {
+            if ch != NO_CHANNEL && size >= 2 && self.fits(ch, size as usize - 2) {
                 let rows = self.rows_of(ch, None);
                 self.found.lose(ch, "are damaged beyond reading", rows, at);
                 let min = self.sizes[ch as usize].map_or(0, |s| s.0) as u64 + 5;
