@@ -5,6 +5,7 @@
 mod cli;
 mod common;
 mod damaged_logs;
+mod damaged_mcap;
 mod defects;
 mod defects19;
 mod issue18;
