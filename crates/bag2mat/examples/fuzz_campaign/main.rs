@@ -1,5 +1,6 @@
-//! The seeded corruption campaign of issues 12 and 19, run by `scripts/test.sh` after
-//! `cargo test`.
+//! The seeded corruption campaign of issues 12, 19 and 45, run by `scripts/test.sh` after
+//! `cargo test`: the bag formats here, the logs from outside ROS in [`logs`] (each also
+//! read by its independent reader).
 //!
 //! Inputs (each a small clean file of 1,000 Imu messages and a `/status` topic, several
 //! chunks or pages):
@@ -35,7 +36,8 @@
 //!
 //! Anything else fails the campaign: a panic or signal, a hang, an allocation past the
 //! limit, a row lost in silence or more rows lost than the warnings count, an exit code other
-//! than 0/1, an unclear error — and, on MCAP files, Foxglove's reader (CRCs checked,
+//! than 0/1, an unclear error — on MCAP files also an exact loss said above the rows lost
+//! (issue 45), and Foxglove's reader (CRCs checked,
 //! tests/py/mcap_recover.py) recovering more clean messages than bag2mat. A truncated file
 //! is expected to hold the rows of the chunks (pages) whose records start before the cut. The last
 //! printed line gives the counts per format. `FUZZ_VARIANTS` changes the number of variants

@@ -18,7 +18,15 @@ numpy.load.
 import contextlib
 import io
 import math
+import signal
 import sys
+
+# seconds the reader may take on one file: longer is a hang, counted as a failure to read
+TIMEOUT_S = 30
+
+
+def _timeout(signum, frame):
+    raise TimeoutError("the reader took too long")
 
 NAN = float("nan")
 
@@ -147,12 +155,16 @@ def main():
     for i, r in enumerate(clean):
         print(" ".join(repr(v) for v in r))
         index.setdefault(key(r), i)
+    signal.signal(signal.SIGALRM, _timeout)
     for p in sys.argv[4:]:
+        signal.alarm(TIMEOUT_S)
         try:
             got = rows_of(fmt, topic, p)
         except Exception as e:  # the reader gives up on the file: it recovers nothing
             print(f"E {type(e).__name__}")
             continue
+        finally:
+            signal.alarm(0)
         found, other = set(), 0
         for r in got:
             i = index.get(key(r))
