@@ -6,10 +6,10 @@
 mod cli;
 mod common;
 mod consumers;
-mod defects19;
 mod front;
 mod ieee952;
-mod issue18;
 mod logs;
+mod outputs_and_messages;
+mod record_checks;
 mod reference;
 mod studies;

@@ -49,7 +49,10 @@ impl Mapped {
             // SAFETY: getrlimit writes the struct it is given, which lives on this stack.
             let ok = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } == 0;
             if ok && lim.rlim_cur != libc::RLIM_INFINITY {
-                return len < lim.rlim_cur as u64 / 2;
+                // rlim_t is u64 on Linux, another width on some other unixes
+                #[allow(clippy::unnecessary_cast)]
+                let cur = lim.rlim_cur as u64;
+                return len < cur / 2;
             }
         }
         true

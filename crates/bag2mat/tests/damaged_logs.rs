@@ -149,7 +149,7 @@ impl Ulog {
         for f in formats {
             u.msg(b'F', f.as_bytes());
         }
-        let mut add = |u: &mut Ulog, id: u16, name: &str| {
+        let add = |u: &mut Ulog, id: u16, name: &str| {
             let mut a = vec![0u8];
             a.extend_from_slice(&id.to_le_bytes());
             a.extend_from_slice(name.as_bytes());
