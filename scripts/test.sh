@@ -66,12 +66,15 @@ cargo test -p allan_kalibr --test main -- --ignored --exact \
   studies::lines::lines_study studies::coverage::coverage_study \
   studies::plan::plan_study studies::operating::operating_interval_coverage_study
 
-# Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
-# with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,
-# and files written by rosbags and Foxglove's writer — through the real bag2mat binary, each
-# under an address-space limit and a timeout; rows compared by value with the generator's);
-# its last line gives the counts per format, and any panic, hang, memory blow-up, silent or
-# under-counted loss, or Foxglove's reader recovering more than bag2mat fails the run.
+# Issues 12, 19 and 45's seeded corruption campaign (300 variants per input format — ROS 1,
+# MCAP with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml
+# edits, files written by rosbags and Foxglove's writer, and the logs from outside ROS: ULog
+# with and without sync markers, DataFlash IMU and batch samples, CSV, EuRoC, npy — through
+# the real bag2mat binary, each under an address-space limit and a timeout; rows compared by
+# value with the generator's, and for the logs with pyulog's, DFReader's, pandas' or numpy's
+# read of the same variant); its last line gives the counts per format, and any panic, hang,
+# memory blow-up, silent, under-counted or (MCAP, logs) false loss, a refusal of a log the
+# independent reader reads, or an independent reader recovering more than bag2mat fails it.
 cargo build -q -p bag2mat --bin bag2mat --example fuzz_campaign
 "$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/debug/examples/fuzz_campaign"
 

@@ -4,6 +4,8 @@
 
 mod cli;
 mod common;
+mod damaged_logs;
+mod damaged_mcap;
 mod duplicated_rows;
 mod logs;
 mod poses;

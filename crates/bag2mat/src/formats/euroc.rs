@@ -156,9 +156,15 @@ pub(crate) fn open_files(
 ) -> Result<DecodedSource, Error> {
     let mut streams = Vec::new();
     let mut notes = Vec::new();
+    let mut losses = Vec::new();
     for (topic, f) in files {
         let p = super::text::parse(&f, &topic, opts)?;
         notes.extend(p.notes.into_iter().map(|n| format!("{topic}: {n}")));
+        if let Some((n, what)) = p.lost {
+            // one stream per topic: its channel is its place
+            let ch = streams.len() as u32;
+            losses.push(super::text::lost_rows(ch, (n, format!("{topic}: {what}"))));
+        }
         match sensor_yaml(&f) {
             Some(Ok(s)) if s != Stated::default() => notes.push(format!(
                 "{topic}: the dataset's sensor.yaml states {} (compare with the figures measured here)",
@@ -169,10 +175,7 @@ pub(crate) fn open_files(
         }
         streams.extend(p.streams);
     }
-    Ok(DecodedSource::new(
-        InputKind::EurocDir,
-        streams,
-        notes,
-        Vec::new(),
-    ))
+    let mut src = DecodedSource::new(InputKind::EurocDir, streams, notes, Vec::new());
+    src.add_losses(losses);
+    Ok(src)
 }

@@ -136,7 +136,9 @@ pub(crate) fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
     if head.starts_with(ULOG_MAGIC) {
         return Some(InputKind::Ulog);
     }
-    if head.starts_with(DATAFLASH_MAGIC) {
+    // the first message defines FMT itself (type 128, 89 bytes, "FMT"): recognised by
+    // those too, so that a damaged first byte does not hide a log DFReader reads
+    if head.starts_with(DATAFLASH_MAGIC) || head.get(3..8) == Some(b"\x80\x59FMT") {
         return Some(InputKind::DataFlash);
     }
     if head.starts_with(NPY_MAGIC) {

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use super::InputOptions;
 use super::units::{AccUnit, GyroUnit, TimeUnit};
-use super::{InputOptions, SNIFF_BYTES};
 use crate::error::Error;
 
 /// What a column holds.
@@ -132,6 +132,8 @@ pub(super) struct Layout {
     /// and checked for plausibility.
     pub(super) gyro_stated: bool,
     pub(super) acc_stated: bool,
+    /// Fields of a row (the first data line's): a line with another count is no row.
+    pub(super) n_cols: usize,
     /// Byte offset and 1-based line number of the first line after the preamble.
     pub(super) body: usize,
     pub(super) body_line: u64,
@@ -160,6 +162,7 @@ impl Layout {
             acc_si,
             gyro_stated: true,
             acc_stated: true,
+            n_cols: 1 + time.into_iter().chain(gyro).chain(acc).max().unwrap_or(0),
             body: 0,
             body_line: 1,
             what: String::new(),
@@ -231,7 +234,6 @@ pub(super) fn layout(
     file_len: u64,
     opts: &InputOptions,
 ) -> Result<Layout, Error> {
-    let head = &head[..head.len().min(SNIFF_BYTES)];
     let head = match std::str::from_utf8(head) {
         Ok(s) => s,
         Err(e) => std::str::from_utf8(&head[..e.valid_up_to()]).unwrap_or(""),
@@ -295,6 +297,7 @@ pub(super) fn layout(
         acc_si: acc_unit.map_or(1.0, AccUnit::si) / opts.acc_scale.unwrap_or(1.0),
         gyro_stated: gyro_unit.is_some(),
         acc_stated: acc_unit.is_some(),
+        n_cols,
         body: pre.body,
         body_line: pre.body_line,
         what,
@@ -351,8 +354,12 @@ struct Preamble<'h> {
 fn preamble<'h>(path: &Path, head: &'h str, file_len: u64) -> Result<Preamble<'h>, Error> {
     let mut offset = 0usize;
     let mut line_no = 0u64;
-    let mut last_comment: Option<&str> = None;
+    // the comment lines since the last other line (the header may be any of them: a
+    // comment right after EuRoC's is a comment)
+    let mut comments: Vec<&str> = Vec::new();
     let mut header: Option<&str> = None;
+    // the first line that is a data row with a damaged value: the body starts there
+    let mut damaged: Option<(usize, u64)> = None;
     for raw in head.split_inclusive('\n') {
         if !raw.ends_with('\n') && ((raw.len() + offset) as u64) < file_len {
             break; // cut by the sniff window
@@ -365,38 +372,51 @@ fn preamble<'h>(path: &Path, head: &'h str, file_len: u64) -> Result<Preamble<'h
             continue;
         }
         if is_comment(line) {
-            last_comment = Some(line);
+            comments.push(line);
             continue;
         }
         let fields = split_fields(line, pick_delim(line));
-        if fields.iter().all(|f| is_number(f)) {
-            // a comment right before the data with as many fields is its header (EuRoC)
-            if header.is_none()
-                && let Some(c) = last_comment
-            {
-                let c = strip_comment(c);
-                let cf = split_fields(c, pick_delim(c));
-                if cf.len() == fields.len() && cf.iter().any(|f| !is_number(f)) {
-                    header = Some(c);
-                }
+        // the fields a row has where a header (or a comment that may be one) says so: a
+        // line of numbers with another count is a damaged row (a line split in two)
+        let counts: Vec<usize> = match header {
+            Some(h) => vec![split_fields(h, pick_delim(h)).len()],
+            None => comments
+                .iter()
+                .map(|c| split_fields(strip_comment(c), pick_delim(strip_comment(c))))
+                .filter(|cf| cf.len() > 1 && cf.iter().any(|f| !is_number(f)))
+                .map(|cf| cf.len())
+                .collect(),
+        };
+        let fits = counts.is_empty() || counts.contains(&fields.len());
+        if fields.iter().all(|f| is_number(f)) && fits {
+            // a comment before the data with as many fields is its header (EuRoC)
+            if header.is_none() {
+                header = comments.iter().rev().map(|c| strip_comment(c)).find(|c| {
+                    let cf = split_fields(c, pick_delim(c));
+                    cf.len() == fields.len() && cf.iter().any(|f| !is_number(f))
+                });
             }
+            let (body, body_line) = damaged.unwrap_or((start, line_no));
             return Ok(Preamble {
                 header,
                 data: line,
-                body: start,
-                body_line: line_no,
+                body,
+                body_line,
             });
         }
-        if header.is_some() {
-            return Err(not_table(
-                path,
-                &format!(
-                    "line {line_no} is neither a number row nor a comment after the header line"
-                ),
-            ));
+        // after the header, or with most of its fields numbers: a data row with a damaged
+        // value or a damaged line, not a header (the first whole row gives the layout; the
+        // body, its malformed lines counted, starts here)
+        let numbers = fields.iter().filter(|f| is_number(f)).count();
+        if header.is_some()
+            || damaged.is_some()
+            || (fields.len() > 1 && 2 * numbers >= fields.len())
+        {
+            damaged.get_or_insert((start, line_no));
+            continue;
         }
         header = Some(line);
-        last_comment = None;
+        comments.clear();
     }
     Err(not_table(
         path,
