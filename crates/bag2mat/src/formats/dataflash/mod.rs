@@ -191,8 +191,9 @@ struct Reader {
     skip_runs: u64,
     first_skip: Option<usize>,
     orphan_isbd: u64,
-    short_batches: u64,
-    short_samples: u64,
+    /// Per batch topic (its stream): batches that hold fewer samples than their header
+    /// promises, and the samples they lack.
+    short: std::collections::BTreeMap<usize, (u64, u64)>,
     truncated: Option<usize>,
 }
 
@@ -216,8 +217,9 @@ impl Reader {
     /// header promised.
     fn close(&mut self, b: &Batch) {
         if b.got < b.count {
-            self.short_batches += 1;
-            self.short_samples += (b.count - b.got) as u64;
+            let e = self.short.entry(b.stream).or_default();
+            e.0 += 1;
+            e.1 += (b.count - b.got) as u64;
         }
     }
 
@@ -398,16 +400,23 @@ impl Reader {
                 self.orphan_isbd
             )));
         }
-        if self.short_batches > 0 {
+        // each batch topic's own loss: a channel's id is its stream's index (every stream
+        // here is a topic of its own, and the source numbers the channels in stream order)
+        for (&stream, &(batches, samples)) in &self.short {
             losses.push(Loss {
                 what: format!(
-                    "{} sensor batches (ISBH) hold fewer samples than their header promises",
-                    self.short_batches
+                    "{batches} sensor batch{} (ISBH) of '{}' hold{} fewer samples than {} header{} promise{}",
+                    if batches == 1 { "" } else { "es" },
+                    self.streams[stream].topic,
+                    if batches == 1 { "s" } else { "" },
+                    if batches == 1 { "its" } else { "their" },
+                    if batches == 1 { "" } else { "s" },
+                    if batches == 1 { "s" } else { "" },
                 ),
-                messages: Some(self.short_samples),
+                messages: Some(samples),
                 at_most: None,
                 span: None,
-                channel: None,
+                channel: Some(stream as u32),
             });
         }
         if let Some(at) = self.truncated {

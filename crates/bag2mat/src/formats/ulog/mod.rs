@@ -210,7 +210,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
-    check_header(path, map.bytes())?;
+    let start_us = check_header(path, map.bytes())?;
     // the page tables filled on the other core while the serial hop runs
     let (hop, ()) = rayon::join(|| hop(map.bytes()), || map.fill_pages());
     if hop.formats.defs.is_empty() && hop.channels.is_empty() {
@@ -241,6 +241,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     super::instance_topics(channels.iter_mut().map(|c| &mut c.topic));
     let mut contents = crate::source::Contents {
         losses: losses(&found),
+        log_start: Some(start_us.saturating_mul(1000)),
         ..Default::default()
     };
     if let Some(at) = found.truncated {
@@ -269,13 +270,29 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
             bytes: rows * crate::rows::ROW_LEN as u64,
         });
     }
+    contents.integration = integration(&counted);
     contents.channels = channels;
     reader.contents = contents;
     Ok(reader)
 }
 
-/// The file header: the magic, a version byte and the start time.
-fn check_header(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+/// The median integration intervals of each channel of deltas the parts counted.
+fn integration(counted: &[PartCount]) -> Vec<(u32, crate::Integration)> {
+    let mut by: std::collections::BTreeMap<u32, (Vec<f32>, Vec<f32>)> = Default::default();
+    for &(ch, a, v) in counted.iter().flat_map(|c| &c.deltas) {
+        let e = by.entry(ch).or_default();
+        e.0.push(a);
+        e.1.push(v);
+    }
+    by.into_iter()
+        .filter_map(|(ch, (mut a, mut v))| {
+            crate::Integration::of_us(&mut a, &mut v).map(|i| (ch, i))
+        })
+        .collect()
+}
+
+/// The file header: the magic, a version byte and the start time (µs, returned).
+fn check_header(path: &Path, bytes: &[u8]) -> Result<u64, Error> {
     let mut c = Cursor::new(&bytes[..bytes.len().min(HEADER_LEN)]);
     let magic = c
         .take(MAGIC.len(), "ULog magic")
@@ -284,9 +301,7 @@ fn check_header(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         return Err(corrupt(path, c.invalid("not a ULog file")));
     }
     c.le::<u8>("ULog version").map_err(|e| corrupt(path, e))?;
-    c.le::<u64>("ULog start time")
-        .map_err(|e| corrupt(path, e))?;
-    Ok(())
+    c.le::<u64>("ULog start time").map_err(|e| corrupt(path, e))
 }
 
 /// What the serial hop over the message headers finds.
@@ -455,6 +470,9 @@ struct PartCount {
     counts: Vec<u64>,
     /// The record times the part spans (a FIFO message from its oldest sample).
     span: Option<(u64, u64)>,
+    /// The integration intervals of each delta message (`vehicle_imu`): channel, the
+    /// gyroscope's and the accelerometer's, µs.
+    deltas: Vec<(u32, f32, f32)>,
 }
 
 /// What a data message was to the count.
@@ -488,6 +506,17 @@ impl PartCount {
                 let n = d.rows_in(data);
                 let dt = dt.get(data).unwrap_or(0.0).max(0.0);
                 (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
+            }
+            Some(Decoder::Deltas {
+                angle_dt, vel_dt, ..
+            }) => {
+                if let (Some(a), Some(v)) = (angle_dt.get(data), vel_dt.get(data))
+                    && a > 0.0
+                    && v > 0.0
+                {
+                    self.deltas.push((ch, a as f32, v as f32));
+                }
+                (1, t)
             }
             _ => (1, t),
         };
