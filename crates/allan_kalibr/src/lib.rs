@@ -69,7 +69,9 @@ mod yaml;
 pub use cli::{Args, TOOL};
 pub use error::Error;
 pub use front::CurvesInput;
-pub use front::{Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text};
+pub use front::{
+    Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text, topic_failed,
+};
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};
 pub use ieee952::ci::chi2_interval;
@@ -111,4 +113,4 @@ pub use kalibr::chart_fit::{ChartFit, gen_chart};
 pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 pub use kalibr::grid::TauGrid;
 pub use kalibr::report::{chart_lines, final_lines};
-pub use run::{Analysis, Config, RunOutput, analyse, run, sections};
+pub use run::{Analysis, Config, RunOutput, TopicRun, analyse, run, run_topics, sections};
