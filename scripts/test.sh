@@ -8,6 +8,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# Every `docs/…md §N` citation in the code names a section that exists (seconds, no build).
+/usr/bin/python3 scripts/doc_citations.py
+
 need=()
 command -v rosbag >/dev/null 2>&1 || need+=(python3-rosbag)
 command -v octave >/dev/null 2>&1 || need+=(octave)
@@ -36,6 +39,14 @@ if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, 
   /usr/bin/python3 -m venv "$venv"
   "$venv/bin/python" -m pip install -q "${pins[@]}"
 fi
+
+# House rules (ARCHITECTURE.md): formatted, clippy-clean with every lint an error (the
+# workspace's [workspace.lints] included: documented public items, SAFETY comments on unsafe
+# blocks), docs that build without a warning (broken and private links), no module cycles.
+cargo fmt --all -- --check
+cargo clippy --workspace --all-targets -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+# (module cycles: scripts/module_cycles.py joins this list once ieee952 has none)
 
 cargo test --workspace "$@"
 

@@ -1,4 +1,4 @@
-//! The offline part of imu_utils' run on collected samples (imu_utils.md §3–4): per axis the
+//! The offline part of imu_utils' run on collected samples (docs/upstream/imu_utils.md §3–4): per axis the
 //! `calc()` quantities (period, factors, taus, Allan variances), the gyro means, then the six
 //! fits. Gyro then acc, x, y, z, as upstream.
 
@@ -140,7 +140,7 @@ impl Analysis {
 }
 
 impl Analysis {
-    /// The analysis of curves read from an imu_utils data directory (imu_utils.md §5.2): the
+    /// The analysis of curves read from an imu_utils data directory (docs/upstream/imu_utils.md §5.2): the
     /// taus and deviations of its files (pseudo-deg/h for the gyro), the given fits, at the
     /// rate `freq`; sample-dependent fields (counts, stamps, gyro means) are unknown.
     pub fn from_curves(raw: &allan_kalibr::ImuUtilsRaw, fits: Vec<AxisFit>, freq: f64) -> Analysis {

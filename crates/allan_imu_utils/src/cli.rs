@@ -30,6 +30,7 @@ pub const TOOL: &str = "allan_imu_utils";
 #[derive(Debug, Clone, Parser)]
 #[command(name = "allan_imu_utils", version, allow_negative_numbers = true)]
 pub struct Args {
+    /// The flags both analysers share.
     #[command(flatten)]
     pub common: CommonArgs,
     /// The time the Allan variance and the stop rule use: header.stamp (imu_utils) or the

@@ -1,4 +1,4 @@
-//! Data collection as imu_utils' node does it (imu_utils.md §2): header stamps, message
+//! Data collection as imu_utils' node does it (docs/upstream/imu_utils.md §2): header stamps, message
 //! order, gyro in pseudo-deg/h (`(w·57.3)·3600`), accelerations unchanged, and the stop rule.
 //!
 //! Mirrors imu_utils `2cdda91` `imu_an.cpp` callback: the sample is pushed first, then
@@ -158,7 +158,7 @@ mod tests {
         }
     }
 
-    /// imu_utils.md §2: at rate f the stop rule keeps max_time_min·60·f + 2 samples.
+    /// docs/upstream/imu_utils.md §2: at rate f the stop rule keeps max_time_min·60·f + 2 samples.
     #[test]
     fn quirk_10_stop_rule_keeps_the_crossing_message() {
         let ser = series(200 * 60 + 50, 5_000_000);

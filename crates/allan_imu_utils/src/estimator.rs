@@ -1,4 +1,4 @@
-//! The overlapping Allan variance exactly as imu_utils computes it (imu_utils.md §3.2–3.6):
+//! The overlapping Allan variance exactly as imu_utils computes it (docs/upstream/imu_utils.md §3.2–3.6):
 //! mean-period frequency, integrated signal θ, then for each cluster size m
 //! `σ²(m) = Σ ((θ[k+2m] − 2θ[k+m]) + θ[k])² / ((2 (period·m)²) (N − 2m))`.
 //!
@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 
 /// Mean sample period: sequential sum of stamp differences over N−1 (`getAvgDt`).
-/// Jitter and gaps are ignored (quirk 8, imu_utils.md §6).
+/// Jitter and gaps are ignored (quirk 8, docs/upstream/imu_utils.md §6).
 pub fn mean_period(t: &[f64]) -> f64 {
     let mut sum_dt = 0.0;
     for w in t.windows(2) {
@@ -96,7 +96,7 @@ pub fn taus(period: f64, factors: &[usize]) -> Vec<f64> {
     factors.iter().map(|&m| period * m as f64).collect()
 }
 
-/// The divisor `(2 (period·m)²) (N − 2m)`; N − 2m may be zero or negative (imu_utils.md §3.4
+/// The divisor `(2 (period·m)²) (N − 2m)`; N − 2m may be zero or negative (docs/upstream/imu_utils.md §3.4
 /// edge cases: 0/0 → NaN, 0/negative → −0.0).
 pub fn divisor(n: usize, m: usize, period: f64) -> f64 {
     let cluster_period2 = (period * m as f64) * (period * m as f64);
@@ -118,7 +118,7 @@ const FACTORS_PER_SWEEP: usize = 8;
 /// Overlapping Allan variances of one axis for every factor, in factor order
 /// (`calcVariance`): groups of consecutive factors in parallel, each group in one
 /// cache-blocked sweep over θ (`allan_kalibr::second_diff_sums`, the same sums as
-/// [`second_diff_sum`] bit for bit).
+/// `second_diff_sum` bit for bit).
 pub fn allan_variance(theta: &[f64], factors: &[usize], period: f64) -> Vec<f64> {
     let n = theta.len();
     factors
@@ -221,7 +221,7 @@ mod tests {
         assert_eq!(thetas_checked(x.iter().copied(), x.len(), 1.0).2, Some(17));
     }
 
-    /// imu_utils.md §3.4/§3.7: N − 2m = 0 gives 0/0 = NaN, N − 2m < 0 gives −0.0.
+    /// docs/upstream/imu_utils.md §3.4/§3.7: N − 2m = 0 gives 0/0 = NaN, N − 2m < 0 gives −0.0.
     #[test]
     fn quirk_degenerate_last_factor_nan_and_negative_zero() {
         let theta = thetas(&[1.0, 2.0], 100.0);

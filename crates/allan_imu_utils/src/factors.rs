@@ -1,7 +1,7 @@
 //! The cluster-size grid ("factors") of imu_utils: `max_cluster` log-spaced sizes from 1 to the
 //! largest power of two ≤ N/2, rounded up and de-duplicated.
 //!
-//! Mirrors imu_utils `2cdda91` `AllanGyr::initStrides` + `getLogSpace` (imu_utils.md §3.4),
+//! Mirrors imu_utils `2cdda91` `AllanGyr::initStrides` + `getLogSpace` (docs/upstream/imu_utils.md §3.4),
 //! including its single-precision quirks: the end exponent is passed as a `float`, the step
 //! exponent is a `float` division, and the grid is a cumulative product. Because of that the
 //! last factor can be `maxStride + 1` (quirk tests below).
@@ -58,7 +58,7 @@ pub fn factors(n: usize, max_cluster: usize) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    /// The table of imu_utils.md §3.4 (verified there against the upstream implementation).
+    /// The table of docs/upstream/imu_utils.md §3.4 (verified there against the upstream implementation).
     #[test]
     fn spec_table_of_grids() {
         let rows: &[(usize, usize, usize, usize, Option<usize>)] = &[
@@ -83,7 +83,7 @@ mod tests {
         }
     }
 
-    /// imu_utils.md §3.4: the raw last value is not exactly maxStride because of the f32
+    /// docs/upstream/imu_utils.md §3.4: the raw last value is not exactly maxStride because of the f32
     /// exponent; for N = 168 002 it is 65536.0339, so the grid ends at maxStride + 1.
     #[test]
     fn quirk_f32_exponent_last_factor_can_be_max_stride_plus_one() {

@@ -1,6 +1,6 @@
 //! Reads an imu_utils roslaunch file as it is (`<node …><param name=… type=… value=…/>`),
 //! so users can keep their launch files. Only the five parameters imu_utils reads are used
-//! (imu_utils.md §1). Substitutions such as `$(find imu_utils)` need ROS to resolve; they are
+//! (docs/upstream/imu_utils.md §1). Substitutions such as `$(find imu_utils)` need ROS to resolve; they are
 //! kept as [`LaunchValue::Unresolved`] and become an error naming the flag to give instead,
 //! unless that flag was given anyway.
 

@@ -3,13 +3,13 @@
 //! 5-term model the way Ceres 2.1's dogleg does, and writes the same stdout, curve files and
 //! OpenCV yaml — plus a yaml with the fit read correctly and plots.
 //!
-//! Specification: `imu_utils.md` (project specs). Modules, in pipeline order:
+//! Specification: `docs/upstream/imu_utils.md`. Modules, in pipeline order:
 //! `collect` (stop rule), `factors` (cluster grid), `estimator` (Allan variance),
 //! `fit` (start point, dogleg, derived values), `report` (stdout and curve files),
 //! `opencv_yaml` (both yaml files), `plot`; `launch` and `cli` turn the user's
 //! flags or roslaunch file into a [`Config`]; `run` ties them together.
 //!
-//! # Quirks reproduced on purpose (imu_utils.md §6)
+//! # Quirks reproduced on purpose (docs/upstream/imu_utils.md §6)
 //! 1. `*_n` is the fitted ADEV at 1 s times √freq (discrete), not a density.
 //! 2. `*_w` is the minimum of the fitted ADEV curve, not a random walk.
 //! 3. `findMinNum` starts at 1000.0 (gyro floor clamp).

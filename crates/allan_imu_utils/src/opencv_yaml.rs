@@ -1,11 +1,11 @@
-//! The two yaml files, written in OpenCV `cv::FileStorage` layout (imu_utils.md §5.3) so that
+//! The two yaml files, written in OpenCV `cv::FileStorage` layout (docs/upstream/imu_utils.md §5.3) so that
 //! VINS-style loaders (`cv::FileStorage`) read them: `%YAML:1.0`, `---`, 3-space indent,
 //! reals as `%.16e` (or `%d.` for exact ints, `.Nan`, `.Inf`), strings bare or quoted by
 //! OpenCV's rules.
 //!
 //! [`YamlMode::Compat`] is upstream's `<name>_imu_param.yaml` byte for byte (quirks 1, 2, 12:
 //! discrete `*_n`, curve-floor `*_w`, `" rad/s"` unit strings). [`YamlMode::Continuous`] is
-//! `<name>_imu_param_continuous.yaml`: the same fit read correctly (imu_utils.md §7) —
+//! `<name>_imu_param_continuous.yaml`: the same fit read correctly (docs/upstream/imu_utils.md §7) —
 //! continuous white-noise density |N|, random walk √3·|K| (Kalibr's units), bias instability
 //! |B|/0.664 — with the units spelled out.
 
@@ -187,7 +187,7 @@ pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode) -> String {
 mod tests {
     use super::*;
 
-    /// Examples of imu_utils.md §5.3 (verified there against OpenCV 4.6).
+    /// Examples of docs/upstream/imu_utils.md §5.3 (verified there against OpenCV 4.6).
     #[test]
     fn opencv_number_and_string_rules() {
         assert_eq!(real(0.0), "0.");

@@ -1,4 +1,4 @@
-//! Upstream's terminal output and curve files (imu_utils.md §5.1–5.2).
+//! Upstream's terminal output and curve files (docs/upstream/imu_utils.md §5.1–5.2).
 //!
 //! The stdout text is rebuilt line by line in upstream's order and iostream formats (`%g`,
 //! precision 6), including its typos and spacing: the double space after the axis name,

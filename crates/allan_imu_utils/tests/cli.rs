@@ -320,7 +320,7 @@ fn opencv_reads_both_yaml_files() {
 }
 
 #[test]
-fn defect_05_max_cluster_is_validated_against_the_data() {
+fn max_cluster_is_validated_against_the_data() {
     let bag = crate::common::testdata().join("p3_short_61s/p3_short_61s.bag");
     let dir = tempfile::tempdir().unwrap();
     for m in ["4294967296", "1000000000", "100000"] {
@@ -360,7 +360,7 @@ fn defect_05_max_cluster_is_validated_against_the_data() {
 }
 
 #[test]
-fn defect_14_one_error_convention() {
+fn one_error_convention() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.bag");
     let m = missing.to_str().unwrap();
@@ -407,7 +407,7 @@ fn run_compat(bag: &Path, out: &Path) -> std::process::Output {
 }
 
 #[test]
-fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
+fn a_gap_is_found_and_only_the_longest_stretch_analysed() {
     let dir = tempfile::tempdir().unwrap();
     const T0: u64 = 1_600_000_000_000_000_000;
     // 60 s at 200 Hz, a 1 h gap, 30 s more; and the first 60 s alone.
@@ -444,7 +444,7 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
 }
 
 #[test]
-fn defect_11_degenerate_values_are_explained() {
+fn degenerate_values_are_explained() {
     let dir = tempfile::tempdir().unwrap();
     // a 60 s, 200 Hz bag whose accelerometer noise is scaled by `value` (0: constant);
     // returns the run's output

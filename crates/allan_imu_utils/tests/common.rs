@@ -7,7 +7,7 @@ pub fn testdata() -> PathBuf {
     bag2mat::test_tools::testdata()
 }
 
-/// One reference case and the arguments upstream ran with (testdata/README.md, spec §8).
+/// One reference case and the arguments upstream ran with (testdata/README.md, docs/upstream/imu_utils.md §8).
 pub struct Case {
     pub dir: &'static str,
     pub topic: &'static str,

@@ -1,12 +1,12 @@
 //! The fit stage alone, fed with upstream's own Allan variances (`ref_dump_*_tau_var.txt`):
 //! the fitted white noise and bias-instability values must match the reference yaml values
-//! (`ref_dump_summary.txt`, full precision) within the spec's §8 tolerances.
+//! (`ref_dump_summary.txt`, full precision) within the docs/upstream/imu_utils.md §8 tolerances.
 
 use crate::common::{CASES, rel_err};
 use allan_imu_utils::AxisFit;
 use bag2mat::Sensor;
 
-/// yaml values: 1e-3 relative on every axis (imu_utils.md §8).
+/// yaml values: 1e-3 relative on every axis (docs/upstream/imu_utils.md §8).
 pub const YAML_REL_TOL: f64 = 1e-3;
 /// p2 gyro z: chaotic fit (a 1e-15 change of the start point moves gyr_w by 5e-5), §8.
 pub const CHAOTIC_W_REL_TOL: f64 = 5e-2;

@@ -16,7 +16,7 @@ fn run(dir: &Path, args: &[&str]) -> Output {
 }
 
 #[test]
-fn issue21_one_spelling_with_upstream_aliases() {
+fn one_spelling_with_upstream_aliases() {
     for s in ["-o", "--out-dir", "--data-save-path", "--outdir"] {
         let a = allan_imu_utils::Args::try_parse_from(["allan_imu_utils", "x.bag", s, "o"])
             .expect("parses");
@@ -26,7 +26,7 @@ fn issue21_one_spelling_with_upstream_aliases() {
 }
 
 #[test]
-fn issue21_results_go_to_a_folder_of_their_own_and_rate_with_a_bag_is_an_error() {
+fn results_go_to_a_folder_of_their_own_and_rate_with_a_bag_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("rec.bag");
     let src = crate::common::testdata().join("p3_short_61s/p3_short_61s.bag");

@@ -65,7 +65,7 @@ fn bag_to_csv_to_euroc_gives_the_bags_parameters() {
 /// files and yaml block the same samples get in a layout with both sensors (a EuRoC pairing
 /// of the two topics); the absent sensor's files, block and lines are left out.
 #[test]
-fn defect_20_1_one_sensor_ulog_topics_are_analysed_and_the_absent_sensor_left_out() {
+fn one_sensor_ulog_topics_are_analysed_and_the_absent_sensor_left_out() {
     let dir = tempfile::tempdir().unwrap();
     let log = bag2mat::test_tools::pyulog_imu_log(dir.path(), 600.0, 100.0);
     let run = |input: &std::path::Path, topic: &str, out: &std::path::Path| {

@@ -10,12 +10,12 @@
 mod cli;
 mod common;
 mod curves;
-mod defects19;
 mod fit_reference;
 mod front;
 mod integrated_deltas;
-mod issue18;
+mod limits_and_messages;
 mod logs;
+mod record_checks;
 mod reference;
 mod ros2;
 mod several_topics;

@@ -1,4 +1,4 @@
-//! End-to-end parity with upstream on every reference case (imu_utils.md §8): the library
+//! End-to-end parity with upstream on every reference case (docs/upstream/imu_utils.md §8): the library
 //! runs on the case's bag with the arguments upstream used, and every output is compared
 //! with `testdata/<case>/imu_utils/`. Each check collects all its failures (case, item,
 //! expected, actual, tolerance) and prints the parity figures.
@@ -164,7 +164,7 @@ fn reference_cases_end_to_end() {
         }
 
         // Continuous yaml: the corrected reading of upstream's own fitted parameters
-        // (imu_utils.md §7), |N|, √3·|K|, |B|/0.664 in SI units.
+        // (docs/upstream/imu_utils.md §7), |N|, √3·|K|, |B|/0.664 in SI units.
         let cont = std::fs::read_to_string(
             dir.path()
                 .join(format!("{}_imu_param_continuous.yaml", case.name)),

@@ -22,6 +22,7 @@ use crate::run::Config;
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {
+    /// The flags both analysers share.
     #[command(flatten)]
     pub common: CommonArgs,
     /// The time column the rate is estimated from: record (receive) time, as bagconvert

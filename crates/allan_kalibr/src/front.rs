@@ -25,6 +25,9 @@ pub const MAX_RATE_HZ: f64 = 1e7;
 pub const DEFAULT_TOPIC: &str = "imu";
 
 /// The arguments both analysers take, in one place.
+// The field docs are clap's help texts, which write defaults as `<input stem>_<tool>/`:
+// rustdoc would read those as HTML tags, and escaping them would show in `--help`.
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct CommonArgs {
     /// The input: a ROS 1 bag (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, an
@@ -86,6 +89,7 @@ pub struct CommonArgs {
     /// Only what the upstream tool produces: skip the IEEE 952 section and its files.
     #[arg(long)]
     pub compat_only: bool,
+    /// How the input is read (bag2mat's input flags: units, columns, time).
     #[command(flatten)]
     pub input_args: bag2mat::InputArgs,
 }
@@ -348,7 +352,7 @@ pub fn topic_failed(topic: &str, notes: Vec<Note>, error: &dyn std::fmt::Display
 /// A tool's settings as the front end runs them: the shared part, and the job that turns
 /// them into sections.
 pub trait Job {
-    /// The job's error (said once by [`finish`]).
+    /// The job's error (said once, at the end of [`main`]).
     type Error: std::fmt::Display;
     /// The settings both analysers share.
     fn common(&self) -> &Common;
@@ -357,7 +361,7 @@ pub trait Job {
 }
 
 /// A tool's whole `main`: the worker threads started, the arguments `A` parsed and resolved
-/// into the settings `C`, the job run inside its output stage and said ([`finish`]).
+/// into the settings `C`, the job run inside its output stage and said (`finish`).
 pub fn main<A, C>(tool: &str) -> ExitCode
 where
     A: clap::Parser,

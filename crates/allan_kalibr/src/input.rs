@@ -1,7 +1,7 @@
 //! Loading the samples (a `.mat` with `data_imu`, or a `.bag` read through bag2mat exactly
 //! as bagconvert does) and choosing the update rate that drives the τ grid.
 //!
-//! Upstream never looks at the timestamps except to count them (kalibr_allan.md §2): the
+//! Upstream never looks at the timestamps except to count them (docs/upstream/kalibr_allan.md §2): the
 //! user types the rate into the script. Here the rate is the stamps' nominal rate
 //! (`bag2mat::analyse_timing`: lost samples do not change it) when not given; a given rate the stamps
 //! contradict (`bag2mat::rate_argument`) still drives the upstream-compatible
@@ -442,7 +442,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn issue21_a_measured_rate_is_said_without_float_noise() {
+    fn a_measured_rate_is_said_without_float_noise() {
         assert_eq!(snap_rate(62.49998612009537), 62.5);
         assert_eq!(snap_rate(199.3), 199.0);
         assert_eq!(snap_rate(33.333333), 33.333333);

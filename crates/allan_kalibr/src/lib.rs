@@ -4,7 +4,7 @@
 //! `allan.m`, `SCRIPT_process_results.m`, `gen_chart.m`) in seconds instead of hours, and adds
 //! what users ask for: Kalibr's `imu.yaml`, the curves as CSV, readable plots, and an IEEE
 //! Std 952 analysis with intervals and verdicts (`ieee952`).
-//! The behaviour contract is `shared/specs/kalibr_allan.md`.
+//! The behaviour contract is `docs/upstream/kalibr_allan.md`.
 //!
 //! ## Brief overview
 //! The crate holds two analyses in two private module trees, `kalibr` and `ieee952`, no

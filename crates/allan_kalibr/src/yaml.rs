@@ -1,5 +1,5 @@
-//! Kalibr's `imu.yaml` (ethz-asl/kalibr working_directory/imu.yaml layout; kalibr_allan.md
-//! §5, field.md §2/§4): the four continuous-time values, `rostopic` and `update_rate`.
+//! Kalibr's `imu.yaml` (ethz-asl/kalibr working_directory/imu.yaml layout; docs/upstream/kalibr_allan.md
+//! §5, docs/noise_terms.md §2/§4): the four continuous-time values, `rostopic` and `update_rate`.
 //!
 //! Values are written with the shortest decimal that parses back to the same f64, always
 //! with a decimal point so YAML 1.1 readers (PyYAML, which Kalibr uses) see a float; NaN

@@ -10,7 +10,7 @@ use bag2mat::{DataImu, write_data_imu};
 use crate::common::{CASES, final_full, process_lines, rel_err};
 
 /// The four numbers read back from imu.yaml: they are written in shortest round-trip form,
-/// so they carry the run's value exactly; vs the reference the spec's 1e-9 applies.
+/// so they carry the run's value exactly; vs the reference the 1e-9 of docs/upstream/kalibr_allan.md §7 applies.
 const NUMBERS_REL_TOL: f64 = 1e-9;
 /// The outputs a successful run writes.
 const OUTPUTS: [&str; 6] = [
@@ -378,7 +378,7 @@ pub fn noise_mat_seeded(path: &Path, n: usize, seed: u64) {
 }
 
 #[test]
-fn defect_14_one_error_convention() {
+fn one_error_convention() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.bag");
     let m = missing.to_str().unwrap();
@@ -413,7 +413,7 @@ fn defect_14_one_error_convention() {
 }
 
 #[test]
-fn defect_11_update_rate_range_is_validated() {
+fn update_rate_range_is_validated() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("n.mat");
     noise_mat(&mat, 2000);
@@ -426,7 +426,7 @@ fn defect_11_update_rate_range_is_validated() {
 }
 
 #[test]
-fn defect_13_quiet_prints_only_errors_and_warnings() {
+fn quiet_prints_only_errors_and_warnings() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("n.mat");
     noise_mat(&mat, 2000);
@@ -449,7 +449,7 @@ fn defect_13_quiet_prints_only_errors_and_warnings() {
 }
 
 #[test]
-fn defect_08_outputs_are_all_or_none() {
+fn outputs_are_all_or_none() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("n.mat");
     noise_mat(&mat, 2000);
@@ -478,7 +478,7 @@ fn defect_08_outputs_are_all_or_none() {
 }
 
 #[test]
-fn defect_07_the_input_is_never_overwritten() {
+fn the_input_is_never_overwritten() {
     let dir = tempfile::tempdir().unwrap();
     // A bag named like an output, in the output directory: refused, not replaced.
     let bag = dir.path().join("allan_curves.csv");
@@ -532,7 +532,7 @@ fn mat_at(path: &Path, t: &[f64], scale: f64) {
 }
 
 #[test]
-fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
+fn a_gap_is_found_and_only_the_longest_stretch_analysed() {
     let dir = tempfile::tempdir().unwrap();
     // 60 s at 100 Hz, a 1 h gap, 30 s more; and the first 60 s alone.
     let first: Vec<f64> = (0..6000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
@@ -580,7 +580,7 @@ fn defect_10_a_gap_is_found_and_only_the_longest_stretch_analysed() {
 }
 
 #[test]
-fn defect_11_degenerate_values_are_explained() {
+fn degenerate_values_are_explained() {
     let dir = tempfile::tempdir().unwrap();
     let t: Vec<f64> = (0..3000).map(|i| 1.7e9 + i as f64 * 0.01).collect();
     // Constant accelerometer axes (scale 0): warned, with the reason for the NaN.

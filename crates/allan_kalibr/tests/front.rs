@@ -23,7 +23,7 @@ fn config(args: &[&str]) -> allan_kalibr::Config {
 }
 
 #[test]
-fn issue21_one_spelling_with_upstream_aliases() {
+fn one_spelling_with_upstream_aliases() {
     let spellings = ["-o", "--out-dir", "--outdir"];
     for s in spellings {
         assert_eq!(
@@ -38,7 +38,7 @@ fn issue21_one_spelling_with_upstream_aliases() {
 }
 
 #[test]
-fn issue21_results_go_to_a_folder_of_their_own_and_the_only_imu_topic_is_read() {
+fn results_go_to_a_folder_of_their_own_and_the_only_imu_topic_is_read() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("data");
     std::fs::create_dir(&data).unwrap();

@@ -103,7 +103,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
 /// topics), and the absent one gets no figures (left out of every file, said on stdout and
 /// stderr).
 #[test]
-fn defect_20_1_one_sensor_ulog_topics_are_analysed_and_the_absent_sensor_left_out() {
+fn one_sensor_ulog_topics_are_analysed_and_the_absent_sensor_left_out() {
     let dir = tempfile::tempdir().unwrap();
     let log = bag2mat::test_tools::pyulog_imu_log(dir.path(), 600.0, 100.0);
     let run = |input: &std::path::Path, topic: &str, out: &str| {

@@ -6,12 +6,12 @@
 mod cli;
 mod common;
 mod consumers;
-mod defects19;
 mod front;
 mod ieee952;
 mod integrated_deltas;
-mod issue18;
 mod logs;
+mod outputs_and_messages;
+mod record_checks;
 mod reference;
 mod several_topics;
 mod studies;

@@ -1,4 +1,4 @@
-//! Parity with the real kalibr_allan outputs (kalibr_allan.md §7): grid facts and tau1
+//! Parity with the real kalibr_allan outputs (docs/upstream/kalibr_allan.md §7): grid facts and tau1
 //! exact, the four numbers within 1e-9 relative, the curves within 1e-6 relative (fast path)
 //! or bit-identical (`--bit-exact`), NaN exactly where the reference has NaN, and the printed
 //! lines identical.
@@ -9,9 +9,9 @@ use allan_kalibr::{
 
 use crate::common::{CASES, Case, final_full, n_rows, process_lines, ref_curves, rel_err};
 
-/// The four numbers: spec §7 (the fast path agrees to ~5e-12; 1e-9 is the contract).
+/// The four numbers: docs/upstream/kalibr_allan.md §7 (the fast path agrees to ~5e-12; 1e-9 is the contract).
 const NUMBERS_REL_TOL: f64 = 1e-9;
-/// Curves from prefix sums: spec §7, upstream's own running-mean rounding reaches ~1e-7 on
+/// Curves from prefix sums: docs/upstream/kalibr_allan.md §7, upstream's own running-mean rounding reaches ~1e-7 on
 /// low-noise axes carrying gravity.
 const CURVES_REL_TOL: f64 = 1e-6;
 /// The fit fed with the reference curves themselves: only `log`/`exp`/`pow` rounding

@@ -1,6 +1,6 @@
 //! `sensor_msgs/msg/Imu` in CDR, the ROS 2 serialization (XCDR1, plain CDR encapsulation).
 //!
-//! Layout (rust_stack.md §9.2): a 4-byte encapsulation header (`00 01 00 00` little-endian,
+//! Layout (docs/formats.md §9.2): a 4-byte encapsulation header (`00 01 00 00` little-endian,
 //! `00 00 00 00` big-endian), then `header.stamp` (`int32 sec`, `uint32 nanosec`: ROS 2 has
 //! no `seq`), `header.frame_id` (`uint32` length counting the terminating NUL, the bytes, the
 //! NUL), zero padding to a multiple of 8 **counted from after the encapsulation header**,

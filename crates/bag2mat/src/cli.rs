@@ -1,6 +1,11 @@
 //! The `bag2mat` command line (what the user typed, clap derive) and the run it asks for:
 //! a conversion ([`crate::convert`]) or `bag2mat info` ([`crate::info`]).
 
+// The argument docs are clap's help texts, which write units as `[Hz]`, `[s]` and defaults
+// as `<stem>`: rustdoc would read those as links and HTML tags, and escaping them would
+// show the escapes in `--help`.
+#![allow(rustdoc::invalid_html_tags)]
+
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};

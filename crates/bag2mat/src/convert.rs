@@ -1,4 +1,4 @@
-//! The bagconvert rules (kalibr_allan `9d38ea9` `bagconvert/src/main.cpp`, kalibr_allan.md §1):
+//! The bagconvert rules (kalibr_allan `9d38ea9` `bagconvert/src/main.cpp`, docs/upstream/kalibr_allan.md §1):
 //! one row `[record time, acc x y z, gyro x y z]` per Imu message of the topic, in
 //! record-time order, `t = sec + 1e-9·nsec` in double; the output goes beside the bag as
 //! `<stem>.mat`. Unlike bagconvert, a missing topic is an error (bagconvert writes an empty
@@ -13,9 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::mat::{self, COLS, DataImu};
-use crate::series::{
-    ImuSeries, ReadOptions, TimeColumn, TopicSelector, read_imu_series, topic_folder_names,
-};
+use crate::series::{ImuSeries, ReadOptions, TimeColumn, TopicSelector, topic_folder_names};
 use crate::shared::output::Outputs;
 
 /// Output file formats.
@@ -111,7 +109,7 @@ pub struct Converted {
 
 /// Reads one topic straight into bagconvert's N×7 matrix (record time).
 pub fn bag_to_data_imu(bag_path: &Path, topic: &str, quiet: bool) -> Result<Converted, Error> {
-    let s = read_imu_series(bag_path, topic, &ReadOptions { quiet })?;
+    let s = crate::input::read_imu_series(bag_path, topic, &ReadOptions { quiet })?;
     let topic = s.topic.clone();
     let notes = s.notes.clone();
     Ok(Converted {
@@ -302,7 +300,7 @@ pub fn run(cfg: &Config, mut outputs: Outputs) -> Result<Vec<(PathBuf, usize)>, 
     }
     log("Reading in rosbag file...");
     outputs.protect_input(&cfg.bag);
-    let read = crate::series::read_imu_topics_with(
+    let read = crate::input::read_imu_topics_with(
         &cfg.bag,
         &cfg.topics,
         &ReadOptions { quiet: cfg.quiet },

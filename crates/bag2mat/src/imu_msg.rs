@@ -1,7 +1,7 @@
 //! `sensor_msgs/Imu`: the ROS 1 serialized layout, its md5 and its full message definition.
 //!
 //! The layout is fixed apart from `header.frame_id`, so encoding and decoding are written by
-//! hand (rust_stack.md §5.1): little-endian, no alignment padding, strings as a u32 length
+//! hand (docs/formats.md §5.1): little-endian, no alignment padding, strings as a u32 length
 //! plus bytes, fixed arrays without a length prefix. The definition text is genpy's
 //! `_full_text`, assembled from the four vendored `.msg` files exactly as genpy does (§5.3),
 //! and tested byte for byte against it.

@@ -1,9 +1,11 @@
 //! Opens any accepted input: [`crate::detect`] says what it is, and its reader opens it as
-//! a [`Source`].
+//! a [`Source`]; [`read_imu_topics`] opens it and reads its Imu topics through the one read
+//! path ([`crate::series`]).
 
 use std::path::Path;
 
 use crate::error::Error;
+use crate::series::{ImuRead, ImuSeries, ReadOptions, TopicSelector};
 use crate::source::{InputKind, Source};
 
 /// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
@@ -35,4 +37,30 @@ pub(crate) fn open_with(
         InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
         kind => crate::formats::open(kind, path, opts)?,
     })
+}
+
+/// Reads the selected Imu topics of `path` (any accepted input) in one pass.
+pub fn read_imu_topics(
+    path: &Path,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+) -> Result<ImuRead, Error> {
+    read_imu_topics_with(path, sel, opts, &crate::formats::InputOptions::default())
+}
+
+/// [`read_imu_topics`], with what the user said about a log whose content does not say it
+/// all (a text log's columns and units).
+pub fn read_imu_topics_with(
+    path: &Path,
+    sel: &TopicSelector,
+    opts: &ReadOptions,
+    input: &crate::formats::InputOptions,
+) -> Result<ImuRead, Error> {
+    crate::series::read_owned(open_with(path, input)?, sel, opts)
+}
+
+/// Reads one Imu topic (see [`read_imu_topics`] for the rules and errors).
+pub fn read_imu_series(path: &Path, topic: &str, opts: &ReadOptions) -> Result<ImuSeries, Error> {
+    let mut r = read_imu_topics(path, &TopicSelector::one(topic), opts)?;
+    Ok(r.series.remove(0))
 }

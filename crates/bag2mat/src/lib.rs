@@ -92,7 +92,7 @@ pub use formats::{AccUnit, GyroUnit, InputArgs, InputOptions, TimeUnit};
 pub use imu_msg::BadMessage;
 pub use imu_msg::{Imu, MD5 as IMU_MD5, definition as imu_definition};
 pub use info::{InfoReport, TopicInfo, info, info_with};
-pub use input::open as open_input;
+pub use input::{open as open_input, read_imu_series, read_imu_topics, read_imu_topics_with};
 pub use integrated::{CONTIGUOUS_TOL, DeadTime, Integration, check as check_integration};
 pub use mat::{DataImu, read_data_imu, write_data_imu};
 pub use mcap::{ChunkCompression, MAGIC as MCAP_MAGIC};
@@ -112,7 +112,7 @@ pub use rows::{ROW_LEN, Row, Rows, permute};
 pub use sensor::Sensor;
 pub use series::{
     ImuRead, ImuSeries, ReadOptions, StandIn, TimeColumn, TopicReport, TopicSelector,
-    absent_warning, read_imu_series, read_imu_topics, read_imu_topics_with, topic_folder_names,
+    absent_warning, topic_folder_names,
 };
 pub use source::{ACCEPTED, InputKind, Source};
 pub use source::{

@@ -1,7 +1,7 @@
 //! MATLAB Level-5 MAT files holding `data_imu`, the N×7 double matrix kalibr_allan's
 //! `bagconvert` writes (columns `t ax ay az wx wy wz`, `t` the bag record time in seconds).
 //!
-//! Writing produces the uncompressed v5 layout of rust_stack.md §6.2 (192 + 56·N bytes;
+//! Writing produces the uncompressed v5 layout of docs/formats.md §6.2 (192 + 56·N bytes;
 //! loads in MATLAB, GNU Octave and scipy). Reading accepts what MATLAB's `save`/libmat write by
 //! default: v5/v6 uncompressed elements and v7 zlib-compressed (`miCOMPRESSED`) elements,
 //! little-endian, with the real part stored as any numeric type. v7.3 files are HDF5 and are

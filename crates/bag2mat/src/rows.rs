@@ -236,8 +236,7 @@ impl RowsMut<'_> {
     }
 
     /// Sets row `i` to a decoded row logged at `t` ns (its seq stays 0).
-    // Inlined into the text reader's SIMD loop, where a call per row was 3–5 % of the read.
-    #[inline(always)]
+    #[inline]
     pub(crate) fn set_row(&mut self, i: usize, t: u64, r: &Row) {
         self.record_time[i] = RosTime::from_nanos(t);
         self.stamp[i] = RosTime::from_nanos(r.stamp);

@@ -249,7 +249,7 @@ pub trait Source: Sync {
     }
     /// The whole of an Imu channel's rows, moved out of a reader that decoded them on
     /// opening, for a read that owns the source and reads it once
-    /// ([`crate::series::read_owned`]): no part of the channel delivers rows afterwards.
+    /// (`series::read_owned`): no part of the channel delivers rows afterwards.
     /// `None`: the reader keeps no such columns (read the parts).
     fn take_rows(&self, _channel: u32) -> Option<crate::rows::Rows> {
         None

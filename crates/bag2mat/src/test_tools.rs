@@ -608,7 +608,7 @@ pub fn pyulog_imu_log(dir: &Path, seconds: f64, rate: f64) -> PathBuf {
 pub fn euroc_pairing(log: &Path, gyro: &str, acc: &str, dir: &Path) -> PathBuf {
     use std::fmt::Write as _;
     let read = |t: &str| {
-        crate::series::read_imu_topics_with(
+        crate::input::read_imu_topics_with(
             log,
             &crate::TopicSelector::one(t),
             &crate::ReadOptions { quiet: true },

@@ -31,7 +31,7 @@ impl RosTime {
 
     /// Seconds as a double, computed as `sec + 1e-9 * nsec`: the conversion of roscpp's
     /// `Time::toSec()` that kalibr_allan's bagconvert writes into the `t` column
-    /// (kalibr_allan.md §1). Other roundings differ in the last bit.
+    /// (docs/upstream/kalibr_allan.md §1). Other roundings differ in the last bit.
     pub fn to_sec(self) -> f64 {
         self.sec as f64 + 1e-9 * self.nsec as f64
     }

@@ -493,7 +493,7 @@ mod tests {
     }
 
     #[test]
-    fn issue18_9_a_rate_change_is_cut_at_the_exact_sample() {
+    fn a_rate_change_is_cut_at_the_exact_sample() {
         // 200 Hz for 5000 samples (not a multiple of the block), then 100 Hz
         for first in [5000usize, 5120, 5133] {
             let mut t = grid(first);
@@ -511,7 +511,7 @@ mod tests {
     }
 
     #[test]
-    fn issue18_9_every_clock_counts_the_same_gaps() {
+    fn every_clock_counts_the_same_gaps() {
         // intervals of exactly 2.5 and 3 periods at absolute times: the same gaps from the
         // stamps (ns) and from the seconds a .mat holds (before: 3 periods was a gap in one
         // tool and not in the other, float seconds against integer nanoseconds)

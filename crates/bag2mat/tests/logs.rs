@@ -136,7 +136,7 @@ fn ulog_topics_match_pyulog_bit_for_bit_also_on_pyulogs_own_rewrite() {
 /// `timestamp_sample`), on our writer's log and on pyulog's rewrite of it; `bag2mat info`
 /// lists them with the samples' rate.
 #[test]
-fn defect_20_2_ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() {
+fn ulog_fifo_topics_are_read_sample_by_sample_like_pyulogs_decode() {
     let dir = tempfile::tempdir().unwrap();
     let ours = dir.path().join("fifo.ulg");
     let f = std::io::BufWriter::new(std::fs::File::create(&ours).unwrap());

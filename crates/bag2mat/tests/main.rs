@@ -4,15 +4,15 @@
 
 mod cli;
 mod common;
-mod defects;
-mod defects19;
+mod duplicated_rows;
 mod info_report;
-mod issue18;
 mod logs;
 mod phone_exports;
 mod real_tools;
 mod reference;
+mod ros1_damage_and_outputs;
 mod ros2;
+mod ros2_damage_and_outputs;
 mod roundtrip;
 mod two_sensors;
 mod unit_physics;

@@ -44,7 +44,7 @@ fn definition_equals_genpy_full_text() {
     assert_eq!(imu_definition(), golden);
 }
 
-/// The ROS 1 md5 recipe (rust_stack.md §5.2) applied to the vendored .msg files.
+/// The ROS 1 md5 recipe (docs/formats.md §5.2) applied to the vendored .msg files.
 #[test]
 fn md5_recomputed_from_msg_files() {
     fn hash_text(msg: &str, deps: &[(&str, String)]) -> String {

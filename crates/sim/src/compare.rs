@@ -464,7 +464,7 @@ pub const KALIBR_N_REL_TOL: f64 = 0.15;
 /// τ = 1 s; measured within 3 %).
 pub const IMU_UTILS_N_REL_TOL: f64 = 0.10;
 /// imu_utils' `*_w` converted by /√Δt overstates the random walk: it is the bias-instability
-/// floor (imu_utils.md §6). The check pins the quirk: the ratio stays above this.
+/// floor (docs/upstream/imu_utils.md §6). The check pins the quirk: the ratio stays above this.
 pub const IMU_UTILS_W_MIN_RATIO: f64 = 3.0;
 
 /// The assertions of the CI comparison: how many were made, and one message per failure.

@@ -1,6 +1,6 @@
 //! Sample-time grids. Upstream builds its grids by accumulating a step in a loop; the count
 //! and the last time depend on the float type, so both accumulations are reproduced
-//! (spec §4, §8 item 1), next to an exact integer-index grid.
+//! (docs/upstream/vio_data_simulation.md §4, §8 item 1), next to an exact integer-index grid.
 
 /// How sample times are generated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,7 +86,7 @@ mod tests {
 
     #[test]
     fn quirk_01_ros_version_double_accumulation_counts_2880001() {
-        // Spec §4: 4 h at 200 Hz, double accumulation ⇒ 2 880 001 messages, last t just
+        // docs/upstream/vio_data_simulation.md §4: 4 h at 200 Hz, double accumulation ⇒ 2 880 001 messages, last t just
         // below 14400 (14399.99999916).
         let mut n = 0u64;
         let mut last = 0.0;
@@ -96,13 +96,13 @@ mod tests {
         }
         assert_eq!(n, 2_880_001);
         assert!((last - 14399.99999916).abs() < 1e-8, "last t = {last:.10}");
-        // The 2 h txt tool: 1 440 000 lines (spec §4).
+        // The 2 h txt tool: 1 440 000 lines (docs/upstream/vio_data_simulation.md §4).
         assert_eq!(Grid::AccumulatedF64.times(7200.0, 200.0).count(), 1_440_000);
     }
 
     #[test]
     fn quirk_02_master_float_grid() {
-        // Spec §8 item 1: 4001 IMU samples, t₂₀₀ = 0.999999, t₄₀₀₀ = 19.99965; 600 frames at
+        // docs/upstream/vio_data_simulation.md §8 item 1: 4001 IMU samples, t₂₀₀ = 0.999999, t₄₀₀₀ = 19.99965; 600 frames at
         // 30 Hz with t₁ = 0.033333335.
         let t: Vec<f64> = Grid::AccumulatedF32.times(20.0, 200.0).collect();
         assert_eq!(t.len(), 4001);

@@ -1,4 +1,4 @@
-//! Dead reckoning from IMU samples (vio_data_simulation.md §6): the upstream Euler scheme of
+//! Dead reckoning from IMU samples (docs/upstream/vio_data_simulation.md §6): the upstream Euler scheme of
 //! `testImu` and the midpoint scheme (PR #12 `testImuMidPoint`), with error statistics
 //! against the ground-truth poses stored in the same rows.
 //!
@@ -79,7 +79,7 @@ pub fn integrate(rows: &[PoseRow], init: State, dt: f64, method: Method) -> Vec<
         match method {
             Method::Euler => {
                 // Mirrors vio_data_simulation `master` c39cd69 `IMU::testImu`: sample i for
-                // interval i, P before V, dq normalised (spec §6; quirk_04).
+                // interval i, P before V, dq normalised (docs/upstream/vio_data_simulation.md §6; quirk_04).
                 let dq = half_angle_dq(&cur.gyro, dt);
                 let a_w = s.q * cur.acc + GRAVITY_W;
                 s.q *= dq;
@@ -391,7 +391,7 @@ mod tests {
         errors(&rows, &states)
     }
 
-    /// Spec §6's "robust assertions" on the clean default run: Euler 0.9–1.1 m, midpoint
+    /// docs/upstream/vio_data_simulation.md §6's "robust assertions" on the clean default run: Euler 0.9–1.1 m, midpoint
     /// ≤ 2 cm (the formulas give 1.038 m and 0.0093 m on the upstream float grid).
     #[test]
     fn quirk_04_euler_uses_right_sample_default_run_errors() {
@@ -407,7 +407,7 @@ mod tests {
             "midpoint final {:.4} m, expected ≤ 0.02 (spec 0.0093)",
             m.final_pos
         );
-        // Spec table: 1.038 m / 0.0215° and 0.0093 m / 0.0066°, quoted to 2–4 digits.
+        // docs/upstream/vio_data_simulation.md §6: 1.038 m / 0.0215° and 0.0093 m / 0.0066°, quoted to 2–4 digits.
         assert!(
             (e.final_pos - 1.038).abs() < 0.002,
             "euler final {:.5}",
@@ -445,7 +445,7 @@ mod tests {
     }
 
     /// Issue 5: halving the step halves Euler's error and quarters midpoint's (orders 1 and
-    /// 2). Observed ratios (spec §6: 2.08/1.04/0.52 m and 5.2/1.3/0.32 mm) are within a few
+    /// 2). Observed ratios (docs/upstream/vio_data_simulation.md §6: 2.08/1.04/0.52 m and 5.2/1.3/0.32 mm) are within a few
     /// percent of 2 and 4; the tolerance allows ±15 % for higher-order terms.
     const ORDER_RATIO_REL_TOL: f64 = 0.15;
 
@@ -468,7 +468,7 @@ mod tests {
                 );
             }
         }
-        // Spec §6 figures on the exact grid at 200 Hz: Euler 1.042 m, midpoint 1.3 mm.
+        // docs/upstream/vio_data_simulation.md §6 figures on the exact grid at 200 Hz: Euler 1.042 m, midpoint 1.3 mm.
         let e = run(Grid::Exact, 200.0, Method::Euler).final_pos;
         let m = run(Grid::Exact, 200.0, Method::Midpoint).final_pos;
         assert!(

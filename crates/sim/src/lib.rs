@@ -1,5 +1,5 @@
 //! `sim`: an IMU data simulator after HeYijia/vio_data_simulation
-//! (`../shared/specs/vio_data_simulation.md`), plus Spline-Fusion IMU synthesis from poses.
+//! (`docs/upstream/vio_data_simulation.md`), plus Spline-Fusion IMU synthesis from poses.
 //!
 //! * `noise`: continuous ↔ discrete noise parameters (THE place for these conversions in
 //!   the workspace), the seeded `addIMUnoise` generator, and the real-sensor model (every
@@ -21,21 +21,21 @@
 //!
 //! # Quirks reproduced on purpose
 //! * `quirk_01_ros_version_double_accumulation_counts_2880001` (`grid::Grid::AccumulatedF64`):
-//!   `for (double t = 0; t < 14400; t += 1.0/200)` gives 2 880 001 samples (spec §4).
+//!   `for (double t = 0; t < 14400; t += 1.0/200)` gives 2 880 001 samples (docs/upstream/vio_data_simulation.md §4).
 //! * `quirk_02_master_float_grid` (`grid::Grid::AccumulatedF32`): the `master` loops
-//!   accumulate in `float`: 4001 IMU samples, 600 camera frames (spec §8 item 1).
+//!   accumulate in `float`: 4001 IMU samples, 600 camera frames (docs/upstream/vio_data_simulation.md §8 item 1).
 //! * `quirk_03_topic_imu_without_slash`, seq 0, zero covariances, frame `base_link`
-//!   (`bag_sim`, spec §4).
+//!   (`bag_sim`, docs/upstream/vio_data_simulation.md §4).
 //! * `quirk_04_euler_uses_right_sample` (`integrate`): upstream `testImu` integrates
-//!   interval i with sample i (spec §6).
+//!   interval i with sample i (docs/upstream/vio_data_simulation.md §6).
 //! * `quirk_05_eigen_quaternion_sign` (`rotation::quat_from_matrix`): w may be negative.
 //! * `quirk_06_motion_model_float_locals` (`motion::Mode::CompatF32`, `--compat`): the
-//!   `float` constants of `MotionModel` (spec §8 item 2). Off by default (exact f64); with it,
+//!   `float` constants of `MotionModel` (docs/upstream/vio_data_simulation.md §8 item 2). Off by default (exact f64); with it,
 //!   `sim traj --compat` and `sim integrate --compat` reproduced upstream master's clean files
 //!   byte for byte when checked once against the real program's output (those outputs are
 //!   not committed: nothing built from fetched code is).
 //!
-//! Not reproduced: upstream noise (a fresh `std::random_device` per sample; spec §8 item 6);
+//! Not reproduced: upstream noise (a fresh `std::random_device` per sample; docs/upstream/vio_data_simulation.md §8 item 6);
 //! the uninitialised gyro/acc columns of `cam_pose.txt` (written as 0).
 
 #![deny(missing_docs)]

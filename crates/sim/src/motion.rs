@@ -1,10 +1,10 @@
-//! The analytic motion models of vio_data_simulation (spec §2): the `master` ellipse
+//! The analytic motion models of vio_data_simulation (docs/upstream/vio_data_simulation.md §2): the `master` ellipse
 //! trajectory and the `ros_version` static level IMU, with ground-truth pose, velocity,
 //! body-frame gyro and specific force.
 //!
 //! Differences from upstream: upstream's `MotionModel` keeps its constants in `float`
 //! (K = f32(π/10), f32 products such as `K1*K`); here every constant is an exact `f64`
-//! (spec §8 item 2: with f64 constants 2843 of the 4001 `imu_pose.txt` lines differ in some
+//! (docs/upstream/vio_data_simulation.md §8 item 2: with f64 constants 2843 of the 4001 `imu_pose.txt` lines differ in some
 //! printed 6-digit value). The model itself (formulas, ZYX Euler convention, gravity sign)
 //! is the same.
 
@@ -98,12 +98,12 @@ pub enum Mode {
     Double,
     /// Upstream's `float` locals: K = f32(π/10) and the f32 products `K1*K`, `K*K`,
     /// `-K*ellipse_x`, `K*ellipse_y`, `-z*K1*K1` (vio_data_simulation `master` 660dc72
-    /// `IMU::MotionModel`, spec §8 item 2). With the upstream float time grid this reproduces
+    /// `IMU::MotionModel`, docs/upstream/vio_data_simulation.md §8 item 2). With the upstream float time grid this reproduces
     /// upstream's clean text files digit for digit (`quirk_06_motion_model_float_locals`).
     CompatF32,
 }
 
-/// The `master` ellipse model at time `t` with exact f64 constants (spec §2.1).
+/// The `master` ellipse model at time `t` with exact f64 constants (docs/upstream/vio_data_simulation.md §2.1).
 pub fn ellipse(t: f64) -> MotionSample {
     ellipse_with(t, Mode::Double)
 }
@@ -175,7 +175,7 @@ fn with_attitude(
 }
 
 /// The `ros_version` model as its `main` uses it: `MotionModel(0)` for every sample
-/// (spec §2.2) — identity attitude at the origin, gyro 0, acc (0, 0, 9.81). `t` is only
+/// (docs/upstream/vio_data_simulation.md §2.2) — identity attitude at the origin, gyro 0, acc (0, 0, 9.81). `t` is only
 /// stored.
 pub fn static_level(t: f64) -> MotionSample {
     let z = Vector3::zeros();
@@ -195,7 +195,7 @@ mod tests {
     use super::*;
     use crate::rotation::quat_from_matrix;
 
-    /// The spec's sanity values are printed with 5–6 significant digits.
+    /// The sanity values of docs/upstream/vio_data_simulation.md §2.1 are printed with 5–6 significant digits.
     const SPEC_DIGITS_TOL: f64 = 1e-5;
     /// Finite-difference step and the resulting O(h²) central-difference error bound.
     const FD_H: f64 = 1e-5;
@@ -212,7 +212,7 @@ mod tests {
 
     #[test]
     fn sanity_values_at_t0() {
-        // Spec §2.1: p = (20, 5, 5), v = (0, 2π, π), q_wb = (w 0.99875, x 0.04998, 0, 0),
+        // docs/upstream/vio_data_simulation.md §2.1: p = (20, 5, 5), v = (0, 2π, π), q_wb = (w 0.99875, x 0.04998, 0, 0),
         // gyro = (0, 0.230364, 0.292623), acc = (−1.48044, 0.979366, 9.76099).
         let m = ellipse(0.0);
         close("p", m.p.as_slice(), &[20.0, 5.0, 5.0], 1e-12);
@@ -324,7 +324,7 @@ mod rotation_tests {
                 "sample {i}: |<q_eigen, q_nalgebra>| = {d}"
             );
         }
-        // Spec §5: along the 20 s run w < 0 for samples 2003–2672 (upstream float grid; on
+        // docs/upstream/vio_data_simulation.md §5: along the 20 s run w < 0 for samples 2003–2672 (upstream float grid; on
         // the exact grid the run is within a sample of that).
         assert!(
             (668..=672).contains(&negative_w),

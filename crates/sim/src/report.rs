@@ -88,7 +88,7 @@ pub fn spline_summary(s: &SplineSummary) -> String {
     o
 }
 
-/// Run the spline self-check (spec §7.5) and format it; returns (text, passed).
+/// Run the spline self-check (docs/upstream/vio_data_simulation.md §7.5) and format it; returns (text, passed).
 pub fn spline_self_check(pose_rate: f64) -> crate::Result<(String, bool)> {
     let c = self_check(pose_rate, Fit::Interp, 10)?;
     let pass = c.max_gyro_err <= SELF_CHECK_GYRO_TOL

@@ -1,12 +1,12 @@
 //! Rotation-matrix ↔ quaternion conversions with Eigen's sign rule, so quaternions printed to
-//! the text files have the same signs as upstream's (spec §5, §8 item 4).
+//! the text files have the same signs as upstream's (docs/upstream/vio_data_simulation.md §5, §8 item 4).
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion};
 
 /// Quaternion `[w, x, y, z]` of a rotation matrix by Eigen's `Quaternion(Matrix3)` rule
 /// (Shoemake): if the trace is positive, w > 0; otherwise the component with the largest
 /// diagonal entry is made positive — so w can be negative and the sign can jump along a
-/// smooth trajectory (upstream files do, e.g. at t ≈ 13.365 s; spec §5).
+/// smooth trajectory (upstream files do, e.g. at t ≈ 13.365 s; docs/upstream/vio_data_simulation.md §5).
 pub fn quat_from_matrix(m: &Matrix3<f64>) -> [f64; 4] {
     let trace = m[(0, 0)] + m[(1, 1)] + m[(2, 2)];
     if trace > 0.0 {

@@ -1,5 +1,5 @@
 //! `sim spline`: IMU data from a pose trajectory through a fitted split B-spline
-//! (vio_data_simulation.md §7.4). Inputs: a TUM file, or the analytic ellipse model's poses
+//! (docs/upstream/vio_data_simulation.md §7.4). Inputs: a TUM file, or the analytic ellipse model's poses
 //! (`--from-model`). Outputs: `imu_pose.txt` (spline pose + clean IMU, the 14-column layout
 //! of the main simulator, full precision), `imu_pose_noise.txt` (with the §3 noise model)
 //! and a bag (orientation = spline pose).
@@ -90,7 +90,7 @@ pub struct SplineSummary {
 }
 
 /// Knots trimmed at each end before comparing with the analytic model (the end conditions
-/// ring for a few knots, decaying by 2 − √3 per knot; spec §7.3 item 7).
+/// ring for a few knots, decaying by 2 − √3 per knot; docs/upstream/vio_data_simulation.md §7.3 item 7).
 pub const TRIM_KNOTS: i64 = 10;
 
 /// Run `sim spline`: checks, fit, emission, text files, bag, truth.
@@ -354,7 +354,7 @@ mod tests {
 
     #[test]
     fn nine_decimal_tum_round_trip_still_meets_the_self_check_limits() {
-        // Spec §7.5: the self-check via a 9-decimal TUM file gives 7.2e-7 rad/s and
+        // docs/upstream/vio_data_simulation.md §7.5: the self-check via a 9-decimal TUM file gives 7.2e-7 rad/s and
         // 3.6e-4 m/s² (input quantisation amplified ~1/Δt²) — still within the limits.
         let d = tempfile::tempdir().unwrap();
         let poses = model_poses(20.0, 200.0);

@@ -1,4 +1,4 @@
-//! The upstream text layouts (vio_data_simulation.md §5), read and written. Writers go
+//! The upstream text layouts (docs/upstream/vio_data_simulation.md §5), read and written. Writers go
 //! through bag2mat's atomic file helper; numbers use [`bag2mat::shared::cfmt`] for upstream parity
 //! (`%g`, 6 significant digits) or the shortest round-trip form for full precision.
 
@@ -194,7 +194,7 @@ pub(crate) fn parse_time_ns(s: &str) -> Option<i64> {
     Some(if neg { -v } else { v })
 }
 
-/// Maximum allowed deviation of an input quaternion's norm from 1 (spec §7.4 item 1).
+/// Maximum allowed deviation of an input quaternion's norm from 1 (docs/upstream/vio_data_simulation.md §7.4 item 1).
 pub const TUM_QUAT_NORM_TOL: f64 = 1e-3;
 
 /// Read a TUM trajectory `t tx ty tz qx qy qz qw` (`#` comments, any whitespace).

@@ -1,4 +1,4 @@
-//! `sim traj`: the text files of vio_data_simulation `master` (spec §5) from the analytic
+//! `sim traj`: the text files of vio_data_simulation `master` (docs/upstream/vio_data_simulation.md §5) from the analytic
 //! ellipse model — IMU poses (clean and noisy), camera poses (14-column and TUM), the house
 //! landmarks and the per-frame observations in normalised image coordinates.
 //!

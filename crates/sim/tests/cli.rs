@@ -162,7 +162,7 @@ fn traj_writes_the_upstream_files() {
             && o.join("keyframe/all_lines_0.txt").exists()
     );
     let first = std::fs::read_to_string(o.join("imu_pose.txt")).unwrap();
-    // Spec §2.1 sanity values at t = 0, as upstream prints them (%g, trailing space).
+    // docs/upstream/vio_data_simulation.md §2.1 sanity values at t = 0, as upstream prints them (%g, trailing space).
     assert_eq!(
         first.lines().next().unwrap(),
         "0 0.99875 0.0499792 0 0 20 5 5 0 0.230364 0.292623 -1.48044 0.979366 9.76099 "
@@ -193,7 +193,7 @@ fn integrate_prints_the_table_and_reads_traj_files() {
             .map(|x| x.parse().unwrap())
             .collect()
     };
-    // Reading the 6-digit text changes the results only in the 4th digit (spec §6).
+    // Reading the 6-digit text changes the results only in the 4th digit (docs/upstream/vio_data_simulation.md §6).
     let (e, m) = (row("clean", "euler"), row("clean", "midpoint"));
     assert!((0.9..=1.1).contains(&e[0]), "euler final {}", e[0]);
     assert!(m[0] <= 0.02, "midpoint final {}", m[0]);
@@ -275,7 +275,7 @@ fn spline_self_check_passes_and_from_model_writes_bag_and_text() {
 }
 
 #[test]
-fn defect_12_time_range_and_size_are_checked_up_front() {
+fn time_range_and_size_are_checked_up_front() {
     let d = tempfile::tempdir().unwrap();
     // The last stamp would pass 2^32 s (and saturate, jumping back): refused, exit 2.
     let out = crate::common::sim()
@@ -322,7 +322,7 @@ fn defect_12_time_range_and_size_are_checked_up_front() {
 }
 
 #[test]
-fn defect_14_one_error_convention() {
+fn one_error_convention() {
     let d = tempfile::tempdir().unwrap();
     let cases: [(&[&str], i32, &str); 4] = [
         (
@@ -363,7 +363,7 @@ fn defect_14_one_error_convention() {
 use bag2mat::test_tools::temp_files_in as temps;
 
 #[test]
-fn defect_08_sigterm_and_sigint_remove_temp_files() {
+fn sigterm_and_sigint_remove_temp_files() {
     let d = tempfile::tempdir().unwrap();
     for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGINT, 130)] {
         let mut child = crate::common::sim()

@@ -4,6 +4,6 @@
 
 mod cli;
 mod common;
-mod defects19;
 mod real_sensors;
 mod real_tools;
+mod refusals;

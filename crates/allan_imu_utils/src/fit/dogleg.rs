@@ -1,7 +1,7 @@
 //! Ceres 2.1's trust-region minimizer with the traditional dogleg strategy, as imu_utils runs
 //! it (all defaults except `DOGLEG`): Jacobi scaling, 50 step attempts, default tolerances.
 //! Many of upstream's fits stop at the attempt cap while still moving, so the yaml values
-//! depend on following Ceres' iterate path; every rule of imu_utils.md §4.4 (items 1–10) is
+//! depend on following Ceres' iterate path; every rule of docs/upstream/imu_utils.md §4.4 (items 1–10) is
 //! implemented here, in Ceres' order (`trust_region_minimizer.cc`, `dogleg_strategy.cc`).
 //!
 //! The problem is tiny (≤ ~100 residuals, 5 parameters), so the normal equations are formed
@@ -9,7 +9,7 @@
 
 use super::model::{self, Params};
 
-/// Ceres `Solver::Options` defaults that matter here (imu_utils.md §4.4).
+/// Ceres `Solver::Options` defaults that matter here (docs/upstream/imu_utils.md §4.4).
 #[derive(Debug, Clone, Copy)]
 pub struct Options {
     /// `max_num_iterations` (counts step attempts, item 10).
@@ -292,7 +292,7 @@ impl Dogleg {
         Some(self.traditional_step())
     }
 
-    /// `ComputeTraditionalDoglegStep` (imu_utils.md §4.4 item 5), result divided by D.
+    /// `ComputeTraditionalDoglegStep` (docs/upstream/imu_utils.md §4.4 item 5), result divided by D.
     fn traditional_step(&mut self) -> [f64; 5] {
         let gradient_norm = norm(&self.gradient);
         let gauss_newton_norm = norm(&self.gauss_newton);
@@ -608,7 +608,7 @@ mod tests {
         }
     }
 
-    /// imu_utils.md §4.4 item 10: the cap counts attempts, so at most 50 are made.
+    /// docs/upstream/imu_utils.md §4.4 item 10: the cap counts attempts, so at most 50 are made.
     #[test]
     fn quirk_07_fifty_attempt_cap() {
         let truth = [0.5, 30.0, 2.0, 0.3, 0.01];
@@ -631,7 +631,7 @@ mod tests {
         assert!(s.attempts <= 50, "{s:?}");
     }
 
-    /// imu_utils.md §3.7 / quirk 13: a NaN variance fails evaluation at iteration 0 and the
+    /// docs/upstream/imu_utils.md §3.7 / quirk 13: a NaN variance fails evaluation at iteration 0 and the
     /// start point comes back unchanged.
     #[test]
     fn quirk_13_nan_point_returns_start() {

@@ -1,4 +1,4 @@
-//! The start point of imu_utils' fit and its printed `C …` line (imu_utils.md §4.2):
+//! The start point of imu_utils' fit and its printed `C …` line (docs/upstream/imu_utils.md §4.2):
 //! linear least squares of the Allan *deviation* on the basis τ^(j−2)/2, j = 0..4, solved
 //! through the normal equations with an explicit inverse (Eigen `MatrixXd::inverse()`, i.e.
 //! a partial-pivoting LU), exactly the ill-conditioned route upstream takes. The fit starts
@@ -107,7 +107,7 @@ pub fn start_coefficients(sigma2: &[f64], taus: &[f64]) -> [f64; 5] {
 }
 
 /// Eigen's default print of a 1×5 row after `C `: each entry `%g`-6, right-aligned to the
-/// widest entry, one space between (imu_utils.md §4.2).
+/// widest entry, one space between (docs/upstream/imu_utils.md §4.2).
 pub fn c_line(c: &[f64; 5]) -> String {
     let items: Vec<String> = c.iter().map(|&v| bag2mat::shared::cfmt::g6(v)).collect();
     let width = items.iter().map(|s| s.len()).max().unwrap_or(0);

@@ -1,4 +1,4 @@
-//! imu_utils' per-axis model fit (`FitAllanGyr` / `FitAllanAcc`, imu_utils.md §4): the
+//! imu_utils' per-axis model fit (`FitAllanGyr` / `FitAllanAcc`, docs/upstream/imu_utils.md §4): the
 //! acc-only point filter, the linear start point (`C …` line), the Ceres dogleg fit of the
 //! log variance, and the values derived from the fitted parameters.
 
@@ -8,7 +8,7 @@ pub(crate) mod model;
 
 pub use model::Params;
 
-/// imu_utils' rad→deg constant: 57.3, not 180/π (quirk 4, imu_utils.md §0).
+/// imu_utils' rad→deg constant: 57.3, not 180/π (quirk 4, docs/upstream/imu_utils.md §0).
 pub const IMU_UTILS_DEG_PER_RAD: f64 = 57.3;
 /// Seconds per hour in the pseudo-deg/h gyro unit.
 pub const SECONDS_PER_HOUR: f64 = 3600.0;
@@ -22,7 +22,7 @@ pub const IMU_UTILS_MIN_START: f64 = 1000.0;
 /// `checkData` filter) — the workspace's one sensor type.
 use bag2mat::Sensor;
 
-/// Mirrors imu_utils `2cdda91` `FitAllanAcc::checkData` (imu_utils.md §4.1, quirk 6): among
+/// Mirrors imu_utils `2cdda91` `FitAllanAcc::checkData` (docs/upstream/imu_utils.md §4.1, quirk 6): among
 /// τ < 1 s points, each one that sets a new running maximum of σ² (starting from 0) is
 /// dropped. Returns the kept (taus, variances).
 pub fn acc_check_data(taus: &[f64], sigma2: &[f64]) -> (Vec<f64>, Vec<f64>) {
@@ -148,7 +148,7 @@ impl AxisFit {
         self.freq.sqrt() * ((n * n).sqrt() / 60.0) * 60.0 / IMU_UTILS_DEG_PER_RAD
     }
 
-    /// Corrected reading (imu_utils.md §7): continuous white-noise density |N| in SI units
+    /// Corrected reading (docs/upstream/imu_utils.md §7): continuous white-noise density |N| in SI units
     /// (rad/s/√Hz, m/s²/√Hz).
     pub fn continuous_white_noise(&self) -> f64 {
         self.params[1].abs() / self.unit_div()
@@ -177,7 +177,7 @@ impl AxisFit {
 mod tests {
     use super::*;
 
-    /// imu_utils.md §6 quirk 3: nothing below 1000 → the min is 1000 and the index 0.
+    /// docs/upstream/imu_utils.md §6 quirk 3: nothing below 1000 → the min is 1000 and the index 0.
     #[test]
     fn quirk_03_min_starts_at_1000() {
         assert_eq!(find_min_num(&[2000.0, 1500.0]), 1000.0);

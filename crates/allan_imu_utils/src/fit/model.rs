@@ -1,5 +1,5 @@
 //! The 5-term Allan-variance model and the per-point log residual of imu_utils' fit
-//! (imu_utils.md §4.3):
+//! (docs/upstream/imu_utils.md §4.3):
 //! `model(τ) = Q²/τ² + N²/τ + B² + K²·τ + R²·τ²`,
 //! `r = log10(model(τ)) − log10(σ²)` with `log10(x) = log(x)/log(10)`.
 //!

@@ -11,7 +11,7 @@
 //!
 //! Sample count: `--samples` or `--duration`, else inferred where the grid implies it (with a
 //! note saying how), else unknown: then the analysis gives no intervals and says so.
-//! * imu_utils: its grid ends at the largest power of two ≤ N/2 (imu_utils.md §3.4), so
+//! * imu_utils: its grid ends at the largest power of two ≤ N/2 (docs/upstream/imu_utils.md §3.4), so
 //!   2·maxStride ≤ N < 4·maxStride; the lower end is used (conservative intervals).
 //! * kalibr_allan: its grid ends at m = ⌊(N − 1)/2⌋, so N = 2m + 1 (to ±1).
 //! * allan_variance_ros: a period has a value only with ≥ 2 bins, so the record is about
@@ -28,7 +28,7 @@ use bag2mat::Sensor;
 mod imu_utils;
 use imu_utils::{imu_utils_name, read_imu_utils};
 
-/// imu_utils' rad→deg constant (imu_utils.md §0): its gyro curves are in (rad/s)·57.3·3600.
+/// imu_utils' rad→deg constant (docs/upstream/imu_utils.md §0): its gyro curves are in (rad/s)·57.3·3600.
 pub const IMU_UTILS_PSEUDO_DEG_H: f64 = 57.3 * 3600.0;
 /// allan_variance_ros' period step: period = 0.1·p s.
 pub const AVR_PERIOD_STEP: f64 = 0.1;
@@ -832,7 +832,7 @@ mod tests {
 }
 
 #[cfg(test)]
-mod tests_issue18 {
+mod tests_curves_without_a_sample_count {
     use super::*;
     use sim::white_rw_axis as simulate_axis;
 
@@ -841,7 +841,7 @@ mod tests_issue18 {
     /// count inferred as 2^(k+1) left no term at the last point and every axis without a
     /// reliable fit. The count must allow every point with a value, and every axis fit.
     #[test]
-    fn issue18_10_imu_utils_folders_without_a_sample_count_fit_every_axis() {
+    fn imu_utils_folders_without_a_sample_count_fit_every_axis() {
         let root = bag2mat::test_tools::testdata();
         for case in [
             "p1_high_200hz",
@@ -886,7 +886,7 @@ mod tests_issue18 {
     /// as what it is, every axis fits to the long end and resolves K (after the fix: all six
     /// fit the whole curve, K resolved and covered on 6/6).
     #[test]
-    fn issue18_10_allan_variance_ros_csv_of_a_noisy_record_fits_to_the_long_end() {
+    fn allan_variance_ros_csv_of_a_noisy_record_fits_to_the_long_end() {
         let (rate, secs) = (100.0, 7200.0);
         let (n_true, k_true) = (0.01, 1e-3); // K's +½ line crosses N's −½ line at 17 s
         let bin = (rate * AVR_PERIOD_STEP).round() as usize;

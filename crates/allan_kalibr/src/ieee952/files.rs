@@ -10,7 +10,7 @@
 //!   file back with intervals.
 //! * `kalibr_imu_ieee952.yaml`, `vins_imu_ieee952.yaml`, `orbslam3_imu_ieee952.yaml`: the
 //!   values users feed into Kalibr, VINS-Mono/VINS-Fusion and ORB-SLAM3, each saying that it
-//!   is continuous-time (field.md §3–4). One value per sensor (the largest axis); a term no
+//!   is continuous-time (docs/noise_terms.md §3–4). One value per sensor (the largest axis); a term no
 //!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
 //!   are left out (with a comment) rather than written as a number. Every warning of the

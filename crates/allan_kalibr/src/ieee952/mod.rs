@@ -434,7 +434,7 @@ mod tests {
     /// A curve so precise (10⁹ samples) that a ±4 % ripple is far beyond its statistics:
     /// χ²/dof in the thousands is never a plain "model fits" (issue 18, item 4).
     #[test]
-    fn issue18_4_no_fits_label_at_a_chi2_in_the_thousands() {
+    fn no_fits_label_at_a_chi2_in_the_thousands() {
         let (n, tau0) = (1_000_000_000, 0.005);
         let (nn, k) = (8e-4f64, 2e-5f64);
         let a = analyse_exact(&exact_curve(n, tau0, |t| rippled(nn, k, t)));

@@ -111,9 +111,9 @@ const BAND_TABLE: (f64, f64) = (1e-2, 10.0);
 /// Cells of the table: linear interpolation in ln x errs by < 2e-6.
 const BAND_TABLE_CELLS: usize = 2048;
 
-/// A vibration line of the model: its shape, known from the PSD ([`crate::ieee952::psd`]); its
+/// A vibration line of the model: its shape, known from the PSD (the `psd` module); its
 /// coefficient A² is fitted. The Allan variance per unit A² is the sampled sinusoid's
-/// (bandwidth 0) or the sampled resonance's ([`crate::ieee952::lines`]), at m = τ/τ₀.
+/// (bandwidth 0) or the sampled resonance's (the `lines` module), at m = τ/τ₀.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineShape {
     /// Frequency, Hz.
@@ -121,7 +121,7 @@ pub struct LineShape {
     /// −3 dB bandwidth, Hz (0: a sinusoid).
     pub bandwidth: f64,
     /// Standard error of the bandwidth as the PSD measured it, Hz (0 or NaN: none known);
-    /// the terms' intervals carry it ([`crate::ieee952::make_terms`]).
+    /// the terms' intervals carry it.
     pub bandwidth_se: f64,
     /// Sample period, s.
     pub tau0: f64,
@@ -165,14 +165,14 @@ impl LineShape {
 }
 
 /// The shape parameters of the non-power-law terms: the Gauss–Markov correlation time, the
-/// flicker floor's lower corner (see [`flicker_band`]) and the lines.
+/// flicker floor's lower corner (see `flicker_band`) and the lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shapes {
     /// Correlation time of the Gauss–Markov bias, s (NaN: not in the model).
     pub gm_t: f64,
     /// Shortest correlation time of the flicker floor, s (0: a flat floor, IEEE 952's B).
     pub b_lo: f64,
-    /// The lines of coefficients [`LINE0`]… (None: that slot is empty).
+    /// The lines of coefficients `LINE0`… (None: that slot is empty).
     pub lines: LineSlots,
 }
 

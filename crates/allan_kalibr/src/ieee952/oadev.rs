@@ -441,7 +441,7 @@ mod tests {
     const CURVE_ORACLE_REL_TOL: f64 = 1e-9;
 
     #[test]
-    fn issue17_3_the_curve_is_the_exact_overlapping_adev_at_every_cluster_size() {
+    fn the_curve_is_the_exact_overlapping_adev_at_every_cluster_size() {
         let n = 6_000;
         let tau0 = 0.01f64;
         // white noise (σ 1) plus a random walk (steps of σ 0.05) plus an offset

@@ -66,7 +66,7 @@ pub struct Psd {
     pub segments: usize,
     /// Sample rate, Hz.
     pub rate: f64,
-    /// The local floor ([`floor`]), U²/Hz.
+    /// The local floor (the PSD's running median, `floor`), U²/Hz.
     pub floor: Vec<f64>,
     /// Bins that belong to lines.
     marks: Vec<bool>,

@@ -149,7 +149,7 @@ pub struct Terms {
     /// Its correlation time, s (NaN when it is not in the model).
     pub g_time: f64,
     /// The flicker floor's lower corner T_lo, s: the shortest correlation time of its 1/f
-    /// spectrum (0: IEEE 952's flat floor; see [`fit::flicker_band`]). The floor is within
+    /// spectrum (0: IEEE 952's flat floor; see `model::flicker_band`). The floor is within
     /// 2 % of 0.664·B from τ ≈ 40·T_lo on.
     pub b_corner: f64,
     /// The lines in the model (IEEE 952 sinusoidal noise), by slot.

@@ -1,4 +1,4 @@
-//! The two charts of `gen_chart.m` (kalibr_allan.md §3.3), drawn with plotters and the
+//! The two charts of `gen_chart.m` (docs/upstream/kalibr_allan.md §3.3), drawn with plotters and the
 //! workspace's embedded font: log-log Allan deviation of x, y, z and their average against
 //! `tau1`, the −½ (red) and +½ (blue) fitted lines, the τ≈1 and τ≈3 read-off points, and
 //! the two values in the legend. PNG and SVG, both written atomically.

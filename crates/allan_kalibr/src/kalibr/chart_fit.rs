@@ -1,4 +1,4 @@
-//! `gen_chart.m`'s fixed-slope fits (kalibr_allan.md §3.1, checklist items 9–13).
+//! `gen_chart.m`'s fixed-slope fits (docs/upstream/kalibr_allan.md §3.1, checklist items 9–13).
 //!
 //! The three axis deviations are averaged per τ, the curve minimum `minid` splits the grid,
 //! a −½ line is fitted on grid indices `1 … minid−50` and a +½ line on `minid+50 … 2000`
@@ -18,11 +18,13 @@ pub struct ChartFit {
     pub sigavg: Vec<f64>,
     /// 1-based index of the NaN-ignoring minimum of `sigavg` (first if tied), if any.
     pub minid: Option<usize>,
-    /// 1-based first index of the grid τ nearest to 1 s, and that τ.
+    /// 1-based first index of the grid τ nearest to 1 s.
     pub tauid1: usize,
+    /// The grid τ nearest to 1 s, s.
     pub tau_at1: f64,
-    /// 1-based first index of the grid τ nearest to 3 s, and that τ.
+    /// 1-based first index of the grid τ nearest to 3 s.
     pub tauid2: usize,
+    /// The grid τ nearest to 3 s, s.
     pub tau_at2: f64,
     /// Intercept (natural log) of the −½ line; NaN when its window has no finite point.
     pub c1: f64,
@@ -90,7 +92,7 @@ pub fn gen_chart(tau: &[f64], sx: &[f64], sy: &[f64], sz: &[f64]) -> ChartFit {
 }
 
 /// `mean(log(y ./ tau(keep).^slope))` over the finite points of `window`; NaN if none
-/// (MATLAB `mean([])` = NaN, kalibr_allan.md §3.1 "NaN cases", issues #12/#13).
+/// (MATLAB `mean([])` = NaN, docs/upstream/kalibr_allan.md §3.1 "NaN cases", issues #12/#13).
 fn log_intercept(tau: &[f64], sigavg: &[f64], window: std::ops::Range<usize>, slope: f64) -> f64 {
     let mut sum = 0.0;
     let mut count = 0usize;

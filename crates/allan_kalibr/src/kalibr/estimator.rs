@@ -1,12 +1,12 @@
 //! The estimator `gen_chart` reads: `sig2`, the NON-overlapping Allan deviation on the
-//! cluster means D(1), D(1+m), D(1+2m), … of `allan.m` (allan_v3, kalibr_allan.md §2.1).
+//! cluster means D(1), D(1+m), D(1+2m), … of `allan.m` (allan_v3, docs/upstream/kalibr_allan.md §2.1).
 //!
 //! For K = floor(n/m) clusters: `sig2 = sqrt(0.5 * mean(diff(D)^2))`; m = 0 gives NaN.
 //! Three ways to compute it, all per distinct m only:
 //! * [`Estimator::PrefixSum`] (default): compensated prefix sums, O(n/m) per m, all m walked
 //!   together tile by tile so the samples stream through the cache once ([`sig2_prefix_fused`]).
 //!   Agrees with upstream within ~1e-9 relative on the reference cases (the gap is upstream's
-//!   own running-mean rounding, spec §2, which can reach ~1e-7 on low-noise axes).
+//!   own running-mean rounding, docs/upstream/kalibr_allan.md §2, which can reach ~1e-7 on low-noise axes).
 //! * [`Estimator::BitExact`]: replays upstream's recursive running mean, O(n) per m, so the
 //!   curves are bit-identical to the reference.
 //! * `sig2_oracle`: the textbook definition (each block summed directly), for tests.
@@ -295,13 +295,13 @@ impl TileWalk {
     }
 }
 
-/// `sig2` for cluster size `m` exactly as `allan.m` computes it (kalibr_allan.md §2.1):
+/// `sig2` for cluster size `m` exactly as `allan.m` computes it (docs/upstream/kalibr_allan.md §2.1):
 /// `D(1) = sum(x(1:m))/m` (sequential), `D(i) = D(i-1) + (x(i+m-1) - x(i-1))/m` for every
 /// i up to n−m+1 (the recursion is replayed in full: it is what makes the rounding match),
 /// then `sqrt(0.5*mean(diff(D(1:m:n-m+1)).^2))` with a sequential mean.
 ///
 /// Mirrors Octave squaring a single difference with glibc `pow(d, 2)` when there are
-/// exactly 2 clusters (spec §2.1; see `quirk_two_clusters_square_with_pow`).
+/// exactly 2 clusters (docs/upstream/kalibr_allan.md §2.1; see `quirk_two_clusters_square_with_pow`).
 pub(crate) fn sig2_recursive(x: &[f64], m: usize) -> f64 {
     let n = x.len();
     if m == 0 || m > n {
@@ -427,7 +427,7 @@ mod tests {
         }
     }
 
-    /// The hard case of spec §2: a low-noise axis carrying gravity, many samples, large m.
+    /// The hard case of docs/upstream/kalibr_allan.md §2: a low-noise axis carrying gravity, many samples, large m.
     /// The prefix-sum path must stay accurate there (the reference's own recursion does
     /// not); checked against block means of `x − x[0]` summed with Kahan compensation.
     #[test]
@@ -488,7 +488,7 @@ mod tests {
     }
 
     /// Mirrors Octave's `diff(D).^2` on a one-element array going through glibc `pow(d, 2)`
-    /// (kalibr_allan.md §2.1): with exactly 2 clusters the square is `pow(d, 2)`, which for
+    /// (docs/upstream/kalibr_allan.md §2.1): with exactly 2 clusters the square is `pow(d, 2)`, which for
     /// this d is one ulp away from d*d, and the difference survives the sqrt.
     #[test]
     fn quirk_two_clusters_square_with_pow() {

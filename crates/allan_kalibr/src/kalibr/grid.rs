@@ -1,7 +1,7 @@
 //! The 2000-point τ grid of `SCRIPT_allan_matparallel.m`, built with the same float
 //! operations as upstream so that every cluster size `m` comes out identical.
 //!
-//! Upstream (rpng/kalibr_allan `9d38ea9`, spec kalibr_allan.md §2 and §8 items 4–6):
+//! Upstream (rpng/kalibr_allan `9d38ea9`, spec docs/upstream/kalibr_allan.md §2 and §8 items 4–6):
 //! `delta = 1/update_rate`, `taumax = floor((N-1)/2)`,
 //! `tau = delta*logspace(log10(delta), log10(taumax), 2000)`, then in `allan.m`
 //! `m = floor(tau*rate)` and `tau1 = m/rate`. The grid therefore starts at δ² (issue #25),
@@ -85,7 +85,7 @@ impl TauGrid {
 }
 
 /// MATLAB's `linspace(d1, d2, n)`: `d1 + (i*(d2-d1))/(n-1)` with both end points set
-/// exactly (kalibr_allan.md §2 "The m grid"; Octave's symmetric formula gives the same m on
+/// exactly (docs/upstream/kalibr_allan.md §2 "The m grid"; Octave's symmetric formula gives the same m on
 /// every case in §7, MATLAB's is the contract).
 pub(crate) fn matlab_linspace(d1: f64, d2: f64, n: usize) -> Vec<f64> {
     let n1 = (n - 1) as f64;
@@ -103,7 +103,7 @@ pub(crate) fn matlab_linspace(d1: f64, d2: f64, n: usize) -> Vec<f64> {
 mod tests {
     use super::*;
 
-    /// Grid facts computed from the formulas alone (kalibr_allan.md §7, second table):
+    /// Grid facts computed from the formulas alone (docs/upstream/kalibr_allan.md §7, second table):
     /// (N, rate, taumax, m_end, m0 count, distinct m ≥ 1).
     const FORMULA_CASES: [(usize, f64, u64, u64, usize, usize); 8] = [
         (180_000, 200.0, 89_999, 89_999, 634, 912),
@@ -147,7 +147,7 @@ mod tests {
         );
     }
 
-    /// Mirrors the knife-edge last point (kalibr_allan.md §2): 10^log10(taumax) rounds
+    /// Mirrors the knife-edge last point (docs/upstream/kalibr_allan.md §2): 10^log10(taumax) rounds
     /// below taumax for 179999 (p4, m_end = taumax − 1) but not for 89999 (p1).
     #[test]
     fn quirk_knife_edge_last_point() {

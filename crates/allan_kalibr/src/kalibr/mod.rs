@@ -1,5 +1,5 @@
 //! The kalibr_allan reproduction: the MATLAB half of rpng/kalibr_allan (`9d38ea9`) bit for
-//! bit, and the upstream-compatible files written from it (spec `kalibr_allan.md`).
+//! bit, and the upstream-compatible files written from it (spec `docs/upstream/kalibr_allan.md`).
 //!
 //! * [`grid`]: the 2000-point τ grid exactly as `SCRIPT_allan_matparallel.m` builds it.
 //! * [`estimator`]: the non-overlapping `sig2` per axis of `allan.m` (prefix-sum fast path,

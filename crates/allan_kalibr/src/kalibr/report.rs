@@ -1,4 +1,4 @@
-//! The text `SCRIPT_process_results.m` prints (kalibr_allan.md §3.2), line for line, with
+//! The text `SCRIPT_process_results.m` prints (docs/upstream/kalibr_allan.md §3.2), line for line, with
 //! MATLAB's `fprintf` spelling of non-finite values (`NaN`, `Inf`, `-Inf`, not C's `nan`).
 
 use super::chart_fit::ChartFit;

@@ -164,7 +164,7 @@ fn print(c: &Case) {
 /// above the truth, and the line is reported at its frequency. (The study's bar, τ ≥ T/20,
 /// is counted there.)
 #[test]
-fn issue17_1_mid_curve_line_does_not_truncate_the_fit() {
+fn mid_curve_line_does_not_truncate_the_fit() {
     let c = run_case(0.002, 6.0, 0x17_01, 7200.0);
     print(&c);
     let bump = BUMP_X / (std::f64::consts::PI * c.f0);
@@ -202,7 +202,7 @@ fn issue17_1_mid_curve_line_does_not_truncate_the_fit() {
 /// vibration profile's 45 Hz gyro resonance (200 Hz): the verdict may not say band-limited
 /// (the curve is never below the white-noise line there), and the section names the line.
 #[test]
-fn issue17_2_a_short_tau_line_is_named_not_called_band_limited() {
+fn a_short_tau_line_is_named_not_called_band_limited() {
     let m = Profile::Vibration.model();
     let n = (3600.0 * RATE) as usize;
     let mut a = m.gyro.axes[0].clone();
@@ -312,7 +312,7 @@ fn lines_study() {
 /// τ ≈ 80–150 s, and the point-by-point range check ended the fit there, before T/20. The
 /// extension is now judged as a whole (fit::range_end): the fit reaches T/20.
 #[test]
-fn issue17_1b_a_dip_under_the_floor_does_not_end_the_range() {
+fn a_dip_under_the_floor_does_not_end_the_range() {
     let c = run_case(ISSUE17_1B_FRAC, ISSUE17_1B_K, 102, 7200.0);
     print(&c);
     assert!(
@@ -333,7 +333,7 @@ const ISSUE17_1B_K: f64 = 10.0;
 /// An interval must be as wide as the data's uncertainty at the τ that carries the term: no
 /// R is resolved, and every K is covered by its interval or bounded at or above the truth.
 #[test]
-fn issue18_5_clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
+fn clean_data_resolve_no_ramp_and_bound_k_above_the_truth() {
     let c = sim::Preset::High.params();
     let model = ImuModel::from_continuous("high", &c);
     let n = (1800.0 * RATE) as usize;

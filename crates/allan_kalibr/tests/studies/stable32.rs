@@ -341,7 +341,7 @@ fn check_against_allantools(label: &str, rate: &[f64], data: &[f64], data_type: 
 }
 
 #[test]
-fn issue17_3_the_curve_equals_allantools_oadev() {
+fn the_curve_equals_allantools_oadev() {
     let ocxo = ocxo_rate();
     check_against_allantools("OCXO (frequency)", &ocxo, &ocxo, "freq");
     let gps_phase = numbers("gps_1pps_phase_data.txt.gz");

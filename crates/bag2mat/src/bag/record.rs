@@ -2,7 +2,7 @@
 //!
 //! Every record is `u32 header_len | header | u32 data_len | data`; a header is a list of
 //! `u32 len | name=value` fields. Each record type has its op code and its fields here, so
-//! the byte layout is written down once (rust_stack.md §3.2–3.3). Bytes are read through
+//! the byte layout is written down once (docs/formats.md §3.2–3.3). Bytes are read through
 //! the crate's bounds-checked [`Cursor`]; what does not parse is a typed [`RecordError`],
 //! which the reader turns into the crate's error (or a note) with the file offset.
 //!

@@ -8,8 +8,6 @@
 //! sort by record time (as `rosbag::View` and rosbag2's reader deliver messages), and the
 //! accounting of what the container promised against what was delivered ([`TopicReport`]).
 
-use std::path::Path;
-
 use rayon::prelude::*;
 
 use crate::error::{Error, TopicSummary};
@@ -382,26 +380,6 @@ struct PartOut {
     read: source::PartRead,
 }
 
-/// Reads the selected Imu topics of `path` (any accepted input) in one pass.
-pub fn read_imu_topics(
-    path: &Path,
-    sel: &TopicSelector,
-    opts: &ReadOptions,
-) -> Result<ImuRead, Error> {
-    read_imu_topics_with(path, sel, opts, &crate::formats::InputOptions::default())
-}
-
-/// [`read_imu_topics`], with what the user said about a log whose content does not say it
-/// all (a text log's columns and units).
-pub fn read_imu_topics_with(
-    path: &Path,
-    sel: &TopicSelector,
-    opts: &ReadOptions,
-    input: &crate::formats::InputOptions,
-) -> Result<ImuRead, Error> {
-    read_owned(crate::input::open_with(path, input)?, sel, opts)
-}
-
 /// How part `i` routes a selected channel's messages: channel id → (topic, codec).
 type Lookup = Vec<Option<(usize, Codec)>>;
 
@@ -602,7 +580,7 @@ fn decode_windowed(
     (columns, outs)
 }
 
-/// [`read_imu_topics`] on an open source.
+/// [`crate::read_imu_topics`] on an open source.
 pub fn read_from(
     src: &dyn Source,
     sel: &TopicSelector,
@@ -869,12 +847,6 @@ pub fn topic_folder_names(topics: &[&str]) -> Vec<String> {
         out.push(name);
     }
     out
-}
-
-/// Reads one Imu topic (see [`read_imu_topics`] for the rules and errors).
-pub fn read_imu_series(path: &Path, topic: &str, opts: &ReadOptions) -> Result<ImuSeries, Error> {
-    let mut r = read_imu_topics(path, &TopicSelector::one(topic), opts)?;
-    Ok(r.series.remove(0))
 }
 
 #[cfg(test)]

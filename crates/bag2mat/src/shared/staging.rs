@@ -2,7 +2,7 @@
 //! directory and a kill during the commit.
 //!
 //! Every file the atomic outputs of [`super::output`] write through a staged
-//! [`super::output::Outputs`] (which holds a [`Staging`]) waits in a stage:
+//! [`super::output::Outputs`] (which holds a `Staging`) waits in a stage:
 //!
 //! * for a directory that does not exist yet: a hidden directory beside it
 //!   (`.<name>.<pid>.<n>.tmp`) that one rename turns into it;

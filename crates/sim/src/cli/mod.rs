@@ -3,6 +3,11 @@
 //! The shared noise flags are in `noise_args`, the real-sensor model flags of `sim bag` in
 //! `model_args` (built on them); both are re-exported here, the one path to them.
 
+// The argument docs are clap's help texts, which write units as `[Hz]`, `[s]` and defaults
+// as `<stem>`: rustdoc would read those as links and HTML tags, and escaping them would
+// show the escapes in `--help`.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use crate::bag_sim::{BagConfig, now_ns, parse_start_time};
 use crate::error::{Result, SimError};
 use crate::grid::Grid;

@@ -1,6 +1,11 @@
 //! The real-sensor noise flags of `sim bag` (clap derive) and their resolution into an
 //! [`ImuModel`]: profile or preset, then `--noise-spec`, then explicit flags.
 
+// The argument docs are clap's help texts, which write units as `[Hz]`, `[s]` and defaults
+// as `<stem>`: rustdoc would read those as links and HTML tags, and escaping them would
+// show the escapes in `--help`.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 use bag2mat::Sensor;
 use std::path::PathBuf;
 

@@ -16,8 +16,8 @@
 //! white noise:      σ_d  = σ / √Δt  = σ·√f     (std of the noise on one sample: rad/s, m/s²)
 //! bias random walk: σ_bd = σ_b · √Δt = σ_b/√f  (std of one bias increment: rad/s, m/s²)
 //! ```
-//! (field.md §3). [`NoiseGenerator`] applies them exactly as vio_data_simulation's
-//! `addIMUnoise` does (vio_data_simulation.md §3): measurement += σ_d·n + b (the bias *before*
+//! (docs/noise_terms.md §3). [`NoiseGenerator`] applies them exactly as vio_data_simulation's
+//! `addIMUnoise` does (docs/upstream/vio_data_simulation.md §3): measurement += σ_d·n + b (the bias *before*
 //! its update), then b += σ_bd·n'; twelve standard normals per sample in the order
 //! gyro white (x, y, z), acc white, gyro bias step, acc bias step; initial biases zero.
 //! Unlike upstream (a fresh `std::random_device` per call, not reproducible) one persistent
@@ -253,7 +253,7 @@ impl Preset {
 }
 
 /// vio_data_simulation `master` `param.h` (20 s trajectory run): gyro 0.015, 1e-5; acc 0.019,
-/// 1e-4 (vio_data_simulation.md §1). Used by `sim traj`/`sim spline` when no preset is given.
+/// 1e-4 (docs/upstream/vio_data_simulation.md §1). Used by `sim traj`/`sim spline` when no preset is given.
 pub const MASTER_PARAMS: ContinuousNoise = ContinuousNoise {
     gyro_noise: 0.015,
     gyro_bias_rw: 1e-5,
@@ -298,7 +298,7 @@ impl NoiseGenerator {
     }
 
     /// Add noise to one sample in place. Mirrors vio_data_simulation `addIMUnoise`
-    /// (`imu.cpp`, both branches; spec §3): white noise plus the bias *before* its update, then
+    /// (`imu.cpp`, both branches; docs/upstream/vio_data_simulation.md §3): white noise plus the bias *before* its update, then
     /// the bias random-walk step; draw order n1 (gyro xyz), n2 (acc), n3 (gyro bias), n4.
     #[inline]
     pub fn apply(&mut self, gyro: &mut [f64; 3], acc: &mut [f64; 3]) {
@@ -352,7 +352,7 @@ mod tests {
 
     #[test]
     fn field_md_examples() {
-        // field.md §3: σ = 0.03 at 200 Hz → 0.4243; σ_b = 1e-4 at 200 Hz → 7.07e-6;
+        // docs/noise_terms.md §3: σ = 0.03 at 200 Hz → 0.4243; σ_b = 1e-4 at 200 Hz → 7.07e-6;
         // at 100 Hz → 0.3 and 1e-5.
         let cases = [
             (0.03, 0.005, 0.42426406871192857, true),
@@ -375,7 +375,7 @@ mod tests {
 
     #[test]
     fn spec_per_sample_stds_master_and_ros_version() {
-        // vio_data_simulation.md §3: master gyro 0.2121, acc 0.2687, bias steps 7.07e-7 and
+        // docs/upstream/vio_data_simulation.md §3: master gyro 0.2121, acc 0.2687, bias steps 7.07e-7 and
         // 7.07e-6; ros_version bias steps 3.54e-6 and 3.54e-5 (4 significant digits).
         let m = MASTER_PARAMS.discretize(0.005);
         let r = Preset::Medium.params().discretize(0.005);
@@ -397,8 +397,8 @@ mod tests {
 
     #[test]
     fn allan_lines_read_off_at_1_and_3_seconds() {
-        // field.md §2: the white line read at τ = 1 s gives σ, the random-walk line at τ = 3 s
-        // gives σ_b; spec §3's check for the static bag: ADEV(1 s) ≈ 0.015 rad/s.
+        // docs/noise_terms.md §2: the white line read at τ = 1 s gives σ, the random-walk line at τ = 3 s
+        // gives σ_b; docs/upstream/vio_data_simulation.md §3's check for the static bag: ADEV(1 s) ≈ 0.015 rad/s.
         assert_eq!(adev_white(0.015, 1.0), 0.015);
         assert!(rel(adev_random_walk(5e-5, 3.0), 5e-5) < ROUND_TRIP_REL_TOL);
         assert!(rel(adev_white(0.02, 100.0), 0.002) < ROUND_TRIP_REL_TOL);
@@ -422,7 +422,7 @@ mod tests {
 
     #[test]
     fn allan_deviation_of_generated_noise_matches_the_continuous_parameters() {
-        // Spec §3 "Allan check for the port": ADEV(1 s) = σ for the white part and
+        // docs/upstream/vio_data_simulation.md §3 "Allan check for the port": ADEV(1 s) = σ for the white part and
         // ADEV(τ) = σ_b·√(τ/3) for the bias walk, when the generator discretises correctly.
         let rate = 200.0;
         let dt = 1.0 / rate;
@@ -549,7 +549,7 @@ mod tests {
 
     #[test]
     fn first_sample_carries_no_bias_and_bias_updates_after() {
-        // Spec §3: initial biases are zero, so sample 0 is pure white noise; the bias applied
+        // docs/upstream/vio_data_simulation.md §3: initial biases are zero, so sample 0 is pure white noise; the bias applied
         // to sample k is the one accumulated from steps 0..k-1.
         let d = DiscreteNoise {
             dt: 0.005,

@@ -347,7 +347,7 @@ impl FilteredWhite {
     /// cluster size m from `n` samples, for this Gaussian sequence plus independent white
     /// noise of variance `extra_white` (e.g. the LSB rounding): with d_k the second
     /// difference of m-sample sums and ρ(l) its autocovariance,
-    /// ν = 2·E[Â]²/Var(Â) = M²ρ(0)² / Σ_{|l|<M} (M − |l|)·ρ(l)², M = n − 2m + 1.
+    /// ν = 2·E\[Â\]²/Var(Â) = M²ρ(0)² / Σ_{|l|<M} (M − |l|)·ρ(l)², M = n − 2m + 1.
     /// ρ(l) = Σ_j g(|j|)·R(l − j) has support 2m + (filter lags), so this costs O(m²).
     pub fn edf(&self, m: usize, n: usize, extra_white: f64) -> f64 {
         if 2 * m > n {
@@ -427,7 +427,7 @@ pub const TERM_NAMES: [&str; 9] = [
 ];
 
 impl TermAvar {
-    /// Values in [`TERM_NAMES`] order.
+    /// Values in `TERM_NAMES` order (the file columns: white noise first, lines last).
     pub fn values(&self) -> [f64; 9] {
         [
             self.white,

@@ -1,6 +1,6 @@
 //! Spline Fusion: a uniform cumulative cubic B-spline on ℝ³ × SO(3) (the *split*
 //! representation, as basalt `Se3Spline` and kontiki `SplitTrajectory`), fitted to
-//! timestamped poses, and the IMU readings derived from it (vio_data_simulation.md §7).
+//! timestamped poses, and the IMU readings derived from it (docs/upstream/vio_data_simulation.md §7).
 //!
 //! Layers, as sophus-rs splits them: [`basis`] (the blending matrix C and its derivatives),
 //! [`segment`] (four control points at u ∈ [0, 1]), [`so3`] (exp/log), and here the spline
@@ -17,7 +17,7 @@
 //! accel = Rᵀ (p̈ − g_w),  g_w = (0, 0, −9.81)  ⇒ a level IMU at rest reads +9.81 on z
 //! ```
 //! Accel comes from the ℝ³ part, never from the body twist vee(T⁻¹Ṫ) (that would miss
-//! the −ω×(Rᵀṗ) term; spec §7.3 item 2).
+//! the −ω×(Rᵀṗ) term; docs/upstream/vio_data_simulation.md §7.3 item 2).
 //!
 //! End pads are second-order extrapolations: c₋₁ = 3c₀ − 3c₁ + c₂ and
 //! R₋₁ = R₀·exp(2·log(R₁ᵀR₀) − log(R₂ᵀR₁)), mirrored at the end. `Fit::Approx` uses the
@@ -55,7 +55,7 @@ pub enum Fit {
 /// Convergence threshold of the interpolation fit (m and rad): a few hundred ulps of the
 /// trajectory's coordinates (tens of metres).
 pub const FIT_TOLERANCE: f64 = 1e-12;
-/// The fit fails after this many iterations (typically 26–34 are needed; spec §7.4).
+/// The fit fails after this many iterations (typically 26–34 are needed; docs/upstream/vio_data_simulation.md §7.4).
 pub const FIT_MAX_ITER: usize = 200;
 /// Relaxation factor of the fixed-point fit: the knot operator's eigenvalues lie in
 /// [1/3, 1], so 1.5 gives a contraction factor ≤ 0.5.
@@ -244,7 +244,7 @@ impl SplitSpline {
     }
 
     /// Segment index j and u for time `t_ns`, clamped to the valid range (t = τ_last falls
-    /// in the last segment with u = 1; spec §7.3 item 4).
+    /// in the last segment with u = 1; docs/upstream/vio_data_simulation.md §7.3 item 4).
     pub fn index_and_u(&self, t_ns: i64) -> (usize, f64) {
         let (a, b) = self.range_ns();
         let t = t_ns.clamp(a, b) - self.t0_ns;
@@ -300,7 +300,7 @@ pub struct Knots {
 
 /// Choose the knot spacing (`knot_dt_ns` or the median input spacing) and, when the input is
 /// uniform at that spacing within max(1 µs, 1e-3·Δt), use the poses as knots; otherwise
-/// resample at τ_j = t₀ + j·Δt (spec §7.4 items 2–3).
+/// resample at τ_j = t₀ + j·Δt (docs/upstream/vio_data_simulation.md §7.4 items 2–3).
 pub fn knots_from_poses(poses: &[Pose], knot_dt_ns: Option<i64>) -> Result<Knots> {
     if poses.len() < 4 {
         return Err(SimError::Spline(format!(
@@ -389,13 +389,13 @@ pub struct SelfCheck {
 pub const SELF_CHECK_GYRO_TOL: f64 = 1e-5;
 /// Accel tolerance of the self-check (issue 5): m/s².
 pub const SELF_CHECK_ACC_TOL: f64 = 1e-3;
-/// Knot poses must be reproduced this closely by the interpolating fit (spec §7.5).
+/// Knot poses must be reproduced this closely by the interpolating fit (docs/upstream/vio_data_simulation.md §7.5).
 pub const SELF_CHECK_KNOT_TOL: f64 = 1e-9;
 
 /// Sample the analytic ellipse model's poses at `pose_rate` Hz on [0, 20] s (t_j = j/rate,
 /// in memory), fit, evaluate at twice the pose rate (knot and mid-knot times) with
 /// `trim_knots` knots trimmed at each end, and compare with the analytic gyro/acc
-/// (spec §7.5).
+/// (docs/upstream/vio_data_simulation.md §7.5).
 pub fn self_check(pose_rate: f64, fit: Fit, trim_knots: usize) -> Result<SelfCheck> {
     let poses = model_poses(20.0, pose_rate);
     let knots = knots_from_poses(&poses, None)?;
@@ -453,7 +453,7 @@ mod tests {
 
     #[test]
     fn self_check_interp_200hz_meets_issue_thresholds() {
-        // Issue 5 / spec §7.5: gyro ≤ 1e-5 rad/s, acc ≤ 1e-3 m/s², knots < 1e-9
+        // Issue 5 / docs/upstream/vio_data_simulation.md §7.5: gyro ≤ 1e-5 rad/s, acc ≤ 1e-3 m/s², knots < 1e-9
         // (the prototype reached 1.5e-10 and 2.0e-4).
         let c = self_check(200.0, Fit::Interp, 10).expect("fit");
         assert!(
@@ -477,7 +477,7 @@ mod tests {
 
     #[test]
     fn self_check_30hz_informative_tier() {
-        // Spec §7.5: interp with 30 Hz poses 8.4e-7 / 9.0e-3, tolerance 1e-5 / 2e-2.
+        // docs/upstream/vio_data_simulation.md §7.5: interp with 30 Hz poses 8.4e-7 / 9.0e-3, tolerance 1e-5 / 2e-2.
         let c = self_check(30.0, Fit::Interp, 10).expect("fit");
         assert!(c.max_gyro_err <= 1e-5, "gyro err {:.3e}", c.max_gyro_err);
         assert!(c.max_acc_err <= 2e-2, "acc err {:.3e}", c.max_acc_err);
@@ -487,7 +487,7 @@ mod tests {
     fn approx_smooths_and_is_worse_than_interp() {
         let a = self_check(200.0, Fit::Approx, 10).expect("fit");
         let i = self_check(200.0, Fit::Interp, 10).expect("fit");
-        // Spec §7.5: approx at 200 Hz 1.2e-6 / 5.1e-4.
+        // docs/upstream/vio_data_simulation.md §7.5: approx at 200 Hz 1.2e-6 / 5.1e-4.
         assert!(
             a.max_gyro_err > i.max_gyro_err,
             "approx {:.3e} vs interp {:.3e}",
@@ -503,7 +503,7 @@ mod tests {
 
     #[test]
     fn static_input_reads_gravity_only() {
-        // Spec §7.3 item 3 / §7.5: all poses equal ⇒ gyro 0, acc = Rᵀ(0, 0, 9.81) to 1e-12.
+        // docs/upstream/vio_data_simulation.md §7.3 item 3 / §7.5: all poses equal ⇒ gyro 0, acc = Rᵀ(0, 0, 9.81) to 1e-12.
         let r = so3::exp(&Vector3::new(0.3, -0.2, 1.0));
         let knots = vec![(Vector3::new(1.0, 2.0, 3.0), r); 10];
         let (s, _) = SplitSpline::fit(0, 5_000_000, &knots, Fit::Interp).expect("fit");
@@ -521,7 +521,7 @@ mod tests {
 
     #[test]
     fn knot_shift_is_caught() {
-        // Spec §7.3 item 4: an off-by-one knot shift gives ≈ Δt·jerk ≈ 0.157 m/s² — the
+        // docs/upstream/vio_data_simulation.md §7.3 item 4: an off-by-one knot shift gives ≈ Δt·jerk ≈ 0.157 m/s² — the
         // comparison against the truth must see it.
         let poses = model_poses(20.0, 200.0);
         let knots = knots_from_poses(&poses, None).unwrap();

@@ -191,7 +191,7 @@ fn imu_utils_n(
         }
         None => {
             // the last factor is the largest power of two ≤ N/2, or one more (quirk); a point
-            // with a value needs N − 2m ≥ 1 (imu_utils.md §3.4), so the last factor with one
+            // with a value needs N − 2m ≥ 1 (docs/upstream/imu_utils.md §3.4), so the last factor with one
             // bounds N from below too (issue 18.10: 2·maxStride alone is below it when the
             // grid ends at maxStride + 1)
             let last = *ms.last().unwrap_or(&1);

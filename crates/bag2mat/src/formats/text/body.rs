@@ -1,10 +1,8 @@
-//! A text log's body, a byte range at a time: the plainest lines by the SIMD scanner
-//! ([`wide`]), plain lines in one pass ([`fast_row`]), any other line by the `csv` crate;
-//! each range straight into its slot of the columns.
+//! A text log's body, a byte range at a time: plain lines in one pass ([`fast_row`]), any
+//! other line by the `csv` crate; each range straight into its slot of the columns.
 
 use super::layout::{Delim, Layout};
 use super::units::TimeUnit;
-use super::wide;
 use crate::rows::{Row, RowsMut};
 
 /// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
@@ -379,54 +377,16 @@ pub(super) fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usi
     (took > 0).then_some((row, took))
 }
 
-/// Parses the lines of each range of `texts` into its slot (room for every line of it),
-/// two ranges at a time where the SIMD scanner reads them ([`parse_pair`]).
-pub(super) fn parse_ranges<'a>(
-    texts: &[&[u8]],
-    lay: &Layout,
-    quoted: bool,
-    slots: Vec<RowsMut<'a>>,
-) -> Vec<Summary> {
-    let wide = wide::usable(lay);
-    let chunk = |slot| Chunk {
-        slot,
-        ..Chunk::default()
-    };
-    let mut work = texts.iter().copied().zip(slots.into_iter().map(chunk));
-    let mut got = Vec::with_capacity(texts.len());
-    while let Some((t, mut out)) = work.next() {
-        if quoted {
-            out.got.lines = parse_csv(t, lay, 1, &mut out);
-            got.push(out.got);
-        } else if wide && let Some((u, out_u)) = work.next() {
-            let (a, b) = parse_pair((t, u), lay, (out, out_u));
-            got.extend([a.got, b.got]);
-        } else {
-            got.push(parse_lines(t, lay, wide, out).got);
-        }
-    }
-    got
-}
-
 /// A range being read: its text, where reading is, the lines read so far and what it gave.
-pub(super) struct Cursor<'t, 'a> {
-    pub(super) text: &'t [u8],
-    pub(super) pos: usize,
-    pub(super) line: u64,
-    pub(super) out: Chunk<'a>,
+struct Cursor<'t, 'a> {
+    text: &'t [u8],
+    pos: usize,
+    line: u64,
+    out: Chunk<'a>,
 }
 
-impl<'t, 'a> Cursor<'t, 'a> {
-    pub(super) fn new(text: &'t [u8], out: Chunk<'a>) -> Self {
-        Cursor {
-            text,
-            pos: 0,
-            line: 0,
-            out,
-        }
-    }
-
-    pub(super) fn done(&self) -> bool {
+impl Cursor<'_, '_> {
+    fn done(&self) -> bool {
         self.pos >= self.text.len()
     }
 
@@ -447,57 +407,22 @@ impl<'t, 'a> Cursor<'t, 'a> {
         parse_csv(&rest[..end], lay, self.line, &mut self.out);
         self.pos += end;
     }
-
-    /// Reads the rest of the range: runs of lines by the SIMD scanner where `wide`, each
-    /// other line line by line.
-    fn read_on(&mut self, lay: &Layout, cols: &[Col], wide: bool) {
-        while !self.done() {
-            if wide {
-                wide::rows(self, lay, cols);
-                if self.done() {
-                    break;
-                }
-            }
-            self.line_by_line(lay, cols);
-        }
-    }
-
-    fn finish(mut self) -> Chunk<'a> {
-        self.out.got.lines = self.line;
-        self.out
-    }
 }
 
-/// One unquoted range: runs of lines by the SIMD scanner where `wide`,
-/// each other line by [`fast_row`], else by the csv crate.
-pub(super) fn parse_lines<'a>(text: &[u8], lay: &Layout, wide: bool, out: Chunk<'a>) -> Chunk<'a> {
-    let mut c = Cursor::new(text, out);
-    c.read_on(lay, &columns(lay), wide);
-    c.finish()
-}
-
-/// Two unquoted ranges read together, as [`parse_lines`] reads each: the SIMD scanner takes
-/// a line of each in turn, field by field, so that the two lines' chains of loads (each
-/// field starts where the one before it ended) overlap in the CPU. Only where the scanner
-/// is [`wide::usable`].
-pub(super) fn parse_pair<'a>(
-    (a, b): (&[u8], &[u8]),
-    lay: &Layout,
-    (out_a, out_b): (Chunk<'a>, Chunk<'a>),
-) -> (Chunk<'a>, Chunk<'a>) {
+/// One unquoted range: each line by [`fast_row`], else by the csv crate.
+pub(super) fn parse_lines<'a>(text: &[u8], lay: &Layout, out: Chunk<'a>) -> Chunk<'a> {
     let cols = columns(lay);
-    let (mut a, mut b) = (Cursor::new(a, out_a), Cursor::new(b, out_b));
-    while !a.done() && !b.done() {
-        let (stuck_a, stuck_b) = wide::rows2(&mut a, &mut b, lay, &cols);
-        for (c, stuck) in [(&mut a, stuck_a), (&mut b, stuck_b)] {
-            if stuck && !c.done() {
-                c.line_by_line(lay, &cols);
-            }
-        }
+    let mut c = Cursor {
+        text,
+        pos: 0,
+        line: 0,
+        out,
+    };
+    while !c.done() {
+        c.line_by_line(lay, &cols);
     }
-    a.read_on(lay, &cols, true);
-    b.read_on(lay, &cols, true);
-    (a.finish(), b.finish())
+    c.out.got.lines = c.line;
+    c.out
 }
 
 /// Rows a range of text can hold: one per line, as [`parse_lines`] counts them.
@@ -546,7 +471,6 @@ mod tests {
             let fast = parse_lines(
                 text.as_bytes(),
                 &l,
-                wide::usable(&l),
                 Chunk {
                     slot: fast_rows.split(&[n]).remove(0),
                     ..Chunk::default()

@@ -11,21 +11,17 @@
 //! naming its line number and the count of such lines; past [`MAX_BAD_FRACTION`] of the
 //! lines the file is refused. Stamps that go backwards or repeat are reported.
 //!
-//! The body is read a byte range at a time, the ranges in parallel (`body`; in a long file
-//! two ranges to a task, their lines read side by side): runs of the
-//! plainest lines by a SIMD scanner (`wide`, correctly rounded like `fast-float2`), other
-//! plain lines in one pass with `fast-float2`, any other line by the `csv` crate; times are
-//! parsed as decimals straight to nanoseconds, so `1403636579.758555` s keeps every digit.
+//! The body is read a byte range at a time, the ranges in parallel (`body`): plain lines in
+//! one pass with `fast-float2`, any other line by the `csv` crate; times are parsed as
+//! decimals straight to nanoseconds, so `1403636579.758555` s keeps every digit.
 
 use std::path::Path;
 
 use rayon::prelude::*;
 
 mod body;
-mod decimal;
 mod layout;
 mod units;
-mod wide;
 
 use super::InputOptions;
 use crate::RosTime;
@@ -36,7 +32,7 @@ use crate::source::InputKind;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
-use body::{Summary, line_range, parse_ranges, room};
+use body::{Chunk, Summary, line_range, parse_csv, parse_lines, room};
 use layout::{Delim, Layout, bad, layout};
 pub use units::{AccUnit, GyroUnit, TimeUnit};
 
@@ -164,21 +160,21 @@ fn read_body(bytes: &[u8], lay: &Layout, range_bytes: usize) -> (Rows, Vec<Summa
     let parse_into = |ranges: &[&[u8]], quoted: bool| {
         let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
         let mut rows = Rows::zeroed(room.iter().sum());
-        // two ranges to a task, which the SIMD scanner reads side by side, where that still
-        // leaves every thread several tasks (a short file keeps one range to a task)
-        let per_task = if ranges.len() >= 4 * rayon::current_num_threads() {
-            2
-        } else {
-            1
-        };
-        let mut slots = rows.split(&room).into_iter();
-        let tasks: Vec<(&[&[u8]], Vec<_>)> = ranges
-            .chunks(per_task)
-            .map(|r| (r, slots.by_ref().take(r.len()).collect()))
-            .collect();
-        let got: Vec<Summary> = tasks
-            .into_par_iter()
-            .flat_map_iter(|(r, slots)| parse_ranges(r, lay, quoted, slots))
+        let got: Vec<Summary> = ranges
+            .par_iter()
+            .zip(rows.split(&room))
+            .map(|(text, slot)| {
+                let mut out = Chunk {
+                    slot,
+                    ..Chunk::default()
+                };
+                if quoted {
+                    out.got.lines = parse_csv(text, lay, 1, &mut out);
+                    out.got
+                } else {
+                    parse_lines(text, lay, out).got
+                }
+            })
             .collect();
         // the rows of each range follow those of the ranges before it
         let mut n = 0;
@@ -574,7 +570,7 @@ mod tests {
     /// Bytes per range that make a test body of a few hundred kB many ranges.
     const SMALL_RANGE: usize = 4096;
 
-    /// A body read in many small ranges (two to a task, side by side) gives what it gives
+    /// A body read in many small ranges, in parallel, gives what it gives
     /// read as one range: the same rows bit for bit, lines, malformed lines and stamp notes.
     #[test]
     fn a_body_in_many_ranges_reads_as_in_one() {

@@ -1,8 +1,10 @@
-//! Issue 18: the record must be what the analysis assumes. Each item on records written by
-//! an independent writer (Debian's python3-rosbag, Foxglove's mcap_ros2 writer with header
-//! jitter and transport latency; `tests/py/odd_records.py` in bag2mat), run through the
-//! `allan_kalibr` binary as a user would: the finding on stderr (also with `-q`), what the
-//! IEEE 952 section and its yaml files do with it, and the numbers against the truth.
+//! The record must be what the analysis assumes: dropped samples, a wrong update rate,
+//! warm-up, motion, clock steps and duplicates, spikes, other tools' curves. Each on records
+//! written by an independent writer (Debian's python3-rosbag, Foxglove's mcap_ros2 writer
+//! with header jitter and transport latency; `tests/py/odd_records.py` in bag2mat), run
+//! through the `allan_kalibr` binary as a user would: the finding on stderr (also with
+//! `-q`), what the IEEE 952 section and its yaml files do with it, and the numbers against
+//! the truth.
 
 use std::path::Path;
 
@@ -59,7 +61,7 @@ fn advised_skip(line: &str) -> f64 {
 }
 
 #[test]
-fn issue18_1_dropped_samples_keep_the_nominal_rate() {
+fn dropped_samples_keep_the_nominal_rate() {
     // 2 % of the messages lost one at a time (a USB IMU), MCAP with header jitter and latency
     let tmp = tempfile::tempdir().unwrap();
     let mcap = tmp.path().join("drop.mcap");
@@ -88,7 +90,7 @@ fn issue18_1_dropped_samples_keep_the_nominal_rate() {
 }
 
 #[test]
-fn issue18_2_a_wrong_update_rate_drives_only_the_compat_part() {
+fn a_wrong_update_rate_drives_only_the_compat_part() {
     let tmp = tempfile::tempdir().unwrap();
     let bag = tmp.path().join("clean.bag");
     let truth = odd_record(OddWriter::Rosbag, &bag, "wrong_rate", 300.0, 200.0);
@@ -130,7 +132,7 @@ fn warm_ups(err: &str) -> Vec<(String, f64)> {
 }
 
 #[test]
-fn issue18_3_warm_up_is_flagged_on_every_axis_and_the_skip_outlasts_it() {
+fn warm_up_is_flagged_on_every_axis_and_the_skip_outlasts_it() {
     let tmp = tempfile::tempdir().unwrap();
     // 0.02 rad/s·exp(−t/100 s) on the three gyro axes, 30 min at 100 Hz
     let bag = tmp.path().join("warm.bag");
@@ -209,7 +211,7 @@ fn sim_ellipse_bag(path: &Path) {
 }
 
 #[test]
-fn issue18_4_a_moving_record_refuses_the_corrected_section() {
+fn a_moving_record_refuses_the_corrected_section() {
     let tmp = tempfile::tempdir().unwrap();
     let hand = tmp.path().join("hand.bag");
     odd_record(OddWriter::Rosbag, &hand, "handheld", 600.0, 100.0);
@@ -233,7 +235,7 @@ fn issue18_4_a_moving_record_refuses_the_corrected_section() {
 }
 
 #[test]
-fn issue18_6_a_clock_step_and_duplicates_are_found_not_sorted_in() {
+fn a_clock_step_and_duplicates_are_found_not_sorted_in() {
     let tmp = tempfile::tempdir().unwrap();
     // the clock steps back by 100 s halfway through 300 s at 200 Hz
     let bag = tmp.path().join("step.bag");
@@ -284,7 +286,7 @@ fn issue18_6_a_clock_step_and_duplicates_are_found_not_sorted_in() {
 }
 
 #[test]
-fn issue18_8_one_spike_is_reported_with_its_time_and_dropped_on_request() {
+fn one_spike_is_reported_with_its_time_and_dropped_on_request() {
     let tmp = tempfile::tempdir().unwrap();
     // angular_velocity.x = 1e6 rad/s in one message of 60,000, at t = 120 s
     let bag = tmp.path().join("spike.bag");
@@ -321,7 +323,7 @@ fn issue18_8_one_spike_is_reported_with_its_time_and_dropped_on_request() {
 const MAX_CLEAN_CHI2: f64 = 3.0;
 
 #[test]
-fn issue18_10_allan_variance_ros_curves_fit_like_the_samples() {
+fn allan_variance_ros_curves_fit_like_the_samples() {
     // 30 min at 100 Hz of white noise + random walk (python3-rosbag), and the
     // allan_variance.csv allan_variance_ros computes from that bag (tests/py/avr_curve.py:
     // its algorithm, independently written; non-overlapping, every 0.1 s to 999.9 s)

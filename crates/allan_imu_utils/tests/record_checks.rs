@@ -1,8 +1,9 @@
-//! Issue 18 on `allan_imu_utils` (header.stamp, as imu_utils reads it) and across the tools:
-//! records written by an independent writer (Debian's python3-rosbag, Foxglove's mcap_ros2
-//! writer with header jitter and transport latency; bag2mat's `tests/py/odd_records.py`),
-//! the binary run as a user would, and `allan_kalibr` and `bag2mat info` through their
-//! libraries where the same record must give the same finding.
+//! The record must be what the analysis assumes, on `allan_imu_utils` (header.stamp, as
+//! imu_utils reads it) and across the tools: records written by an independent writer
+//! (Debian's python3-rosbag, Foxglove's mcap_ros2 writer with header jitter and transport
+//! latency; bag2mat's `tests/py/odd_records.py`), the binary run as a user would, and
+//! `allan_kalibr` and `bag2mat info` through their libraries where the same record must give
+//! the same finding.
 
 use std::path::Path;
 use std::process::Command;
@@ -46,7 +47,7 @@ fn n_ratios(section: &str, truth: &OddRecord) -> Vec<f64> {
 }
 
 #[test]
-fn issue18_1_dropped_samples_keep_the_nominal_rate_in_imu_utils() {
+fn dropped_samples_keep_the_nominal_rate_in_imu_utils() {
     // 2 % of the messages lost one at a time, MCAP with header jitter and latency
     let tmp = tempfile::tempdir().unwrap();
     let mcap = tmp.path().join("drop.mcap");
@@ -67,7 +68,7 @@ fn issue18_1_dropped_samples_keep_the_nominal_rate_in_imu_utils() {
 }
 
 #[test]
-fn issue18_7_header_and_record_clocks_are_cross_checked() {
+fn header_and_record_clocks_are_cross_checked() {
     // record time at 100 Hz, header.stamp advancing at 200 Hz
     let tmp = tempfile::tempdir().unwrap();
     let bag = tmp.path().join("h2x.bag");
@@ -102,7 +103,7 @@ fn issue18_7_header_and_record_clocks_are_cross_checked() {
 }
 
 #[test]
-fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
+fn missing_samples_are_counted_exactly_in_every_tool() {
     // 2 % single-sample dropouts: 1,200-odd missing of 60,000
     let tmp = tempfile::tempdir().unwrap();
     let bag = tmp.path().join("drop.bag");
@@ -142,7 +143,7 @@ fn issue18_9_missing_samples_are_counted_exactly_in_every_tool() {
 }
 
 #[test]
-fn issue18_9_a_header_that_steps_back_is_a_clock_step_not_a_gap() {
+fn a_header_that_steps_back_is_a_clock_step_not_a_gap() {
     let tmp = tempfile::tempdir().unwrap();
     let bag = tmp.path().join("hstep.bag");
     odd_record(OddWriter::Rosbag, &bag, "headerstep", 300.0, 200.0);

@@ -1,5 +1,6 @@
-//! Issue 19's numbered defects in allan_kalibr's outputs and messages (the reader's are in
-//! bag2mat's tests), each kept fixed by the test named after it.
+//! allan_kalibr's outputs and messages (the reader's are in bag2mat's tests): a run's files
+//! are all there or none (concurrent runs, a kill mid-commit, a full disk), the flags are
+//! checked, warnings go to stderr in lowercase.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
@@ -148,7 +149,7 @@ fn one_complete_set(s: &Sets, dir: &Path, extra: &[&str], settled: bool, what: &
 /// its commit leaves the old set or the new one, never a mix; the next run leaves no
 /// temporary path behind.
 #[test]
-fn defect_19_5_all_or_none_across_concurrent_runs_and_a_kill() {
+fn all_or_none_across_concurrent_runs_and_a_kill() {
     let s = sets();
     let root = s.dir.path();
     // Concurrent runs into a new directory, then into it again, then with a foreign file.
@@ -228,7 +229,7 @@ const DISK_KIB: [u64; 8] = [2, 16, 64, 128, 256, 400, 700, 1200];
 /// `ImageError(IoError(Custom {…}))`, no "os error" — and leaves no output directory and no
 /// temporary path; a missing --curves path is described plainly.
 #[test]
-fn defect_19_9_10_a_full_disk_is_a_plain_error_and_leaves_nothing() {
+fn a_full_disk_is_a_plain_error_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("n.mat");
     noise_mat(&mat, 6000, 0x5EED);
@@ -295,7 +296,7 @@ fn defect_19_9_10_a_full_disk_is_a_plain_error_and_leaves_nothing() {
 /// not 10 samples analysed into plausible yaml; --duration, --units, --samples without
 /// --curves are a usage error, not ignored.
 #[test]
-fn defect_19_10_skip_start_and_curve_flags_are_checked() {
+fn skip_start_and_curve_flags_are_checked() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("n.mat");
     noise_mat(&mat, 3000, 0x5EED); // 30 s at 100 Hz
@@ -332,7 +333,7 @@ fn defect_19_10_skip_start_and_curve_flags_are_checked() {
 /// 9: a warm-up and a gap in the stamps are warned on stderr as lowercase `warning:` lines;
 /// stdout (the report) holds no `WARNING:` and no warning line (it names them as findings).
 #[test]
-fn defect_19_9_warnings_go_to_stderr_in_lowercase() {
+fn warnings_go_to_stderr_in_lowercase() {
     let dir = tempfile::tempdir().unwrap();
     let mat = dir.path().join("w.mat");
     bag2mat::write_data_imu(

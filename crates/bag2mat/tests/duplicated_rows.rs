@@ -1,7 +1,7 @@
-//! Issue 18 item 6 on the container side: rows stored twice — a chunk recorded twice in a
-//! ROS 1 bag Debian's python3-rosbag wrote, a storage file listed twice in a rosbags-written
-//! ROS 2 bag's `metadata.yaml` (more rows than the container promises) — are reported by
-//! `bag2mat info` as duplicated samples, with the rate of those it keeps.
+//! Rows stored twice, on the container side — a chunk recorded twice in a ROS 1 bag Debian's
+//! python3-rosbag wrote, a storage file listed twice in a rosbags-written ROS 2 bag's
+//! `metadata.yaml` (more rows than the container promises) — are reported by `bag2mat info`
+//! as duplicated samples, with the rate of those it keeps.
 
 use std::path::Path;
 
@@ -9,7 +9,7 @@ use bag2mat::test_tools::BagOp;
 use bag2mat::test_tools::{OddWriter, ROS2_MODES, odd_record, rosbags_convert};
 use bag2mat::{Finding, FindingKind};
 
-use crate::defects::{field, records};
+use crate::ros1_damage_and_outputs::{field, records};
 
 /// Messages of the clean record: 300 s at 200 Hz.
 const N: usize = 60_000;
@@ -59,7 +59,7 @@ fn record_last_chunk_twice(bag: &Path) -> usize {
 }
 
 #[test]
-fn issue18_6_rows_stored_twice_are_more_than_the_container_promises() {
+fn rows_stored_twice_are_more_than_the_container_promises() {
     let tmp = tempfile::tempdir().unwrap();
     let bag = tmp.path().join("chunk_twice.bag");
     odd_record(OddWriter::Rosbag, &bag, "clean", 300.0, 200.0);

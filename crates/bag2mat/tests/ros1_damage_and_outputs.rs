@@ -1,6 +1,8 @@
-//! Issue 12's numbered defects, each kept fixed by the test named after it (silent data loss
-//! #1–#5, outputs that never clobber #6–#9, messages #13–#15). The fuzz campaign that sweeps
-//! the same failure classes over every format is `bag2mat::fuzz` (run by scripts/test.sh).
+//! Damaged ROS 1 bags lose nothing in silence (flipped chunk info, damaged message headers,
+//! resynchronising, bad index bytes, counts that never size memory), outputs never clobber
+//! (devices and links, the input, temporary files, the format from the extension), and the
+//! messages follow one convention. The fuzz campaign that sweeps the same failure classes
+//! over every format is `examples/fuzz_campaign.rs` (run by scripts/test.sh).
 
 use std::path::Path;
 use std::process::Command;
@@ -107,7 +109,7 @@ fn check_complete_or_reported(path: &Path, what: &str) {
 }
 
 #[test]
-fn defect_01_flipped_chunk_info_is_reported_or_read() {
+fn flipped_chunk_info_is_reported_or_read() {
     let dir = tempfile::tempdir().unwrap();
     for c in [Compression::None, Compression::Lz4] {
         let path = dir.path().join(format!("d1_{}.bag", c.name()));
@@ -180,7 +182,7 @@ fn message_header(bytes: &[u8], k: usize) -> std::ops::Range<usize> {
 }
 
 #[test]
-fn defect_02_damaged_message_header_is_reported() {
+fn damaged_message_header_is_reported() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("d2.bag");
     write_synthetic(&path, "imu", N, Compression::None, false);
@@ -243,7 +245,7 @@ fn defect_02_damaged_message_header_is_reported() {
 }
 
 #[test]
-fn defect_03_all_lost_is_an_error_and_recovery_resynchronises() {
+fn all_lost_is_an_error_and_recovery_resynchronises() {
     let dir = tempfile::tempdir().unwrap();
     // Every message of the topic lost: an error, no 0x7 file.
     let path = dir.path().join("d3.bag");
@@ -282,7 +284,7 @@ fn defect_03_all_lost_is_an_error_and_recovery_resynchronises() {
 }
 
 #[test]
-fn defect_04_bad_index_byte_still_reads_every_chunk() {
+fn bad_index_byte_still_reads_every_chunk() {
     let dir = tempfile::tempdir().unwrap();
     for c in [Compression::None, Compression::Bz2] {
         let path = dir.path().join(format!("d4_{}.bag", c.name()));
@@ -334,7 +336,7 @@ fn limited(mb: u64, cmd: &str) -> (bool, String, String) {
 }
 
 #[test]
-fn defect_05_counts_never_size_memory() {
+fn counts_never_size_memory() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("d5.bag");
     write_synthetic(&path, "imu", N, Compression::None, false);
@@ -381,7 +383,7 @@ fn small_bag(dir: &Path) -> (std::path::PathBuf, Vec<u8>) {
 }
 
 #[test]
-fn defect_06_outputs_write_through_devices_and_links() {
+fn outputs_write_through_devices_and_links() {
     let dir = tempfile::tempdir().unwrap();
     let (bag, want) = small_bag(dir.path());
     // A FIFO (what /dev/null and /dev/stdout are to a rename: not regular files, which a
@@ -478,7 +480,7 @@ fn stdout_closed_by_the_reader_is_not_an_error() {
 }
 
 #[test]
-fn defect_07_the_input_is_never_overwritten() {
+fn the_input_is_never_overwritten() {
     let dir = tempfile::tempdir().unwrap();
     let (bag, _) = small_bag(dir.path());
     // A bag named .mat: the default output is the input itself.
@@ -512,7 +514,7 @@ fn defect_07_the_input_is_never_overwritten() {
 use bag2mat::test_tools::temp_files_in as temps;
 
 #[test]
-fn defect_08_failed_outputs_leave_no_temp_files() {
+fn failed_outputs_leave_no_temp_files() {
     let dir = tempfile::tempdir().unwrap();
     let (bag, _) = small_bag(dir.path());
     // The output name is a directory.
@@ -562,7 +564,7 @@ fn defect_08_failed_outputs_leave_no_temp_files() {
 }
 
 #[test]
-fn defect_09_format_follows_the_extension() {
+fn format_follows_the_extension() {
     let dir = tempfile::tempdir().unwrap();
     let (bag, _) = small_bag(dir.path());
     let csv = dir.path().join("x.csv");
@@ -603,7 +605,7 @@ fn status(cmd: &mut Command) -> (Option<i32>, String) {
 }
 
 #[test]
-fn defect_14_one_error_convention() {
+fn one_error_convention() {
     let dir = tempfile::tempdir().unwrap();
     // Failures: exit 1, one line "bag2mat: error: <what>: <cause>", no OS error numbers.
     let missing = dir.path().join("missing.bag");
@@ -640,7 +642,7 @@ fn defect_14_one_error_convention() {
 }
 
 #[test]
-fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
+fn imu_plus_another_type_on_one_topic_converts_the_imu() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("mixed.bag");
     {
@@ -673,7 +675,7 @@ fn defect_15_imu_plus_another_type_on_one_topic_converts_the_imu() {
 }
 
 #[test]
-fn defect_13_messages_a_person_can_act_on() {
+fn messages_a_person_can_act_on() {
     let dir = tempfile::tempdir().unwrap();
     // Control bytes in a topic name from the file are escaped.
     let bag = dir.path().join("esc.bag");

@@ -1,5 +1,6 @@
-//! Issue 19's numbered defects in allan_imu_utils (out of memory, messages, --skip-start,
-//! flags that need --curves), each kept fixed by the test named after it.
+//! allan_imu_utils at its limits and in its messages: out of memory is an error, not an
+//! abort; warnings are lowercase on stderr and errors plain; --skip-start and the flags that
+//! need --curves are checked.
 
 use std::process::{Command, Output};
 
@@ -32,7 +33,7 @@ const LIMITS_KIB: [u64; 6] = [48_000, 40_000, 34_000, 30_000, 27_000, 24_000];
 /// `memory allocation of … failed` and SIGABRT — and leaves no output. The run is tried
 /// under shrinking address-space limits: each ends whole, or in that error.
 #[test]
-fn defect_19_7_out_of_memory_is_an_error_not_an_abort() {
+fn out_of_memory_is_an_error_not_an_abort() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("m.bag");
     write_bag(&bag, 300_000, None);
@@ -81,7 +82,7 @@ fn defect_19_7_out_of_memory_is_an_error_not_an_abort() {
 /// `WARNING:` (and, since issue 41, as information: every ordinary run prints it); a
 /// missing --curves path is described plainly (no "os error 2").
 #[test]
-fn defect_19_9_warnings_are_lowercase_on_stderr_and_errors_plain() {
+fn warnings_are_lowercase_on_stderr_and_errors_plain() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("s.bag");
     write_bag(&bag, 12_000, None);
@@ -118,7 +119,7 @@ fn defect_19_9_warnings_are_lowercase_on_stderr_and_errors_plain() {
 /// not 10 samples analysed into plausible yaml; --duration, --units, --samples, --rate
 /// without --curves are a usage error, not ignored.
 #[test]
-fn defect_19_10_skip_start_and_curve_flags_are_checked() {
+fn skip_start_and_curve_flags_are_checked() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("t.bag");
     write_bag(&bag, 6000, None); // 30 s at 200 Hz

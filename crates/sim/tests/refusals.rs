@@ -1,4 +1,5 @@
-//! Issue 19's numbered defects in `sim`, each kept fixed by the test named after it.
+//! `sim` refuses what it cannot do at once and in the house style: huge durations, bad
+//! command lines.
 
 use std::process::Stdio;
 use std::time::{Duration, Instant};
@@ -35,7 +36,7 @@ fn code_within_timeout(dir: &std::path::Path, args: &[&str]) -> (Option<i32>, St
 /// 6: a duration past what a bag can stamp (1e16, 1e17 s and more) is refused at once,
 /// exit 2 with `sim: error:` — it used to spin forever (or overflow).
 #[test]
-fn defect_19_6_huge_durations_are_refused_at_once() {
+fn huge_durations_are_refused_at_once() {
     let d = tempfile::tempdir().unwrap();
     for dur in ["1e16", "1e17", "1e19", "1e300"] {
         let (code, err) = code_within_timeout(d.path(), &["bag", "--duration", dur, "-o", "x.bag"]);
@@ -54,7 +55,7 @@ fn defect_19_6_huge_durations_are_refused_at_once() {
 /// after `sim: error:`); a negative `--seed` or `--gyro-lpf` gets its own message, not
 /// "unexpected argument"; `--gyro-warmup`'s usage shows the one form it takes (`A,T`).
 #[test]
-fn defect_19_9_command_line_messages_follow_the_convention() {
+fn command_line_messages_follow_the_convention() {
     let d = tempfile::tempdir().unwrap();
     let (code, err) = code_within_timeout(d.path(), &[]);
     assert_eq!(code, Some(2), "{err}");

@@ -1,6 +1,7 @@
-//! Issue 19's numbered defects (no silent loss in ROS 2 files, all-or-none outputs, no
-//! abort or hang), each kept fixed by the test named after it. The fuzz campaign
-//! (`examples/fuzz_campaign.rs`, run by scripts/test.sh) sweeps the same classes.
+//! No silent loss in damaged ROS 2 files (sqlite3 pages and row ids, MCAP cut short or with
+//! damaged records), exact and bounded loss counts, all-or-none outputs, no abort or hang.
+//! The fuzz campaign (`examples/fuzz_campaign.rs`, run by scripts/test.sh) sweeps the same
+//! classes.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -140,7 +141,7 @@ fn db3_case(dir: &Path) -> (PathBuf, Vec<String>, Vec<u8>, Vec<BtreePage>) {
 /// 1a: one damaged page of the timestamp index (its last leaf's cell count, its
 /// right-most pointer, garbage in its cells) costs no row: the table itself is read.
 #[test]
-fn defect_19_1a_db3_damaged_timestamp_index_page_costs_no_row() {
+fn db3_damaged_timestamp_index_page_costs_no_row() {
     let dir = tempfile::tempdir().unwrap();
     let (bare, clean, bytes, pages) = db3_case(dir.path());
     let leaves = pages_of(&pages, "timestamp_idx", 0x0A);
@@ -191,7 +192,7 @@ fn defect_19_1a_db3_damaged_timestamp_index_page_costs_no_row() {
 /// 1b: one damaged row id (the range scan used to stop there, 1,496 of 3,000 rows): the
 /// row is read where its id belongs, every row is delivered.
 #[test]
-fn defect_19_1b_db3_damaged_row_id_costs_no_row() {
+fn db3_damaged_row_id_costs_no_row() {
     let dir = tempfile::tempdir().unwrap();
     let (_bare, clean, bytes, pages) = db3_case(dir.path());
     let leaves = pages_of(&pages, "messages", 0x0D);
@@ -221,7 +222,7 @@ fn defect_19_1b_db3_damaged_row_id_costs_no_row() {
 /// table and at its end (where only the timestamp index still lists them), bare and in
 /// the bag directory.
 #[test]
-fn defect_19_1c_db3_lowered_cell_count_is_reported_with_count_and_span() {
+fn db3_lowered_cell_count_is_reported_with_count_and_span() {
     let dir = tempfile::tempdir().unwrap();
     let (bare, clean, bytes, pages) = db3_case(dir.path());
     let leaves = pages_of(&pages, "messages", 0x0D);
@@ -301,7 +302,7 @@ fn chunks(records: &[McapRecord]) -> Vec<&McapRecord> {
 /// opcode in mid-file, a message whose channel id changed — each is counted (or read),
 /// never a silent loss of a chunk, a message or the rest of the file.
 #[test]
-fn defect_19_2_mcap_cut_short_opcode_and_channel_damage_is_counted() {
+fn mcap_cut_short_opcode_and_channel_damage_is_counted() {
     let dir = tempfile::tempdir().unwrap();
     let (_bare, clean, bytes, records) = mcap_case(dir.path());
     let ch = chunks(&records);
@@ -368,7 +369,7 @@ fn defect_19_2_mcap_cut_short_opcode_and_channel_damage_is_counted() {
 /// first one too) does not abandon the rest of the file — the summary locates every chunk,
 /// and bag2mat recovers at least what Foxglove's reader does.
 #[test]
-fn defect_19_3_mcap_damaged_record_header_does_not_abandon_the_file() {
+fn mcap_damaged_record_header_does_not_abandon_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let (bare, clean, bytes, records) = mcap_case(dir.path());
     let ch = chunks(&records);
@@ -430,7 +431,7 @@ fn defect_19_3_mcap_damaged_record_header_does_not_abandon_the_file() {
 /// message index lists), and counts a damaged index states are bounded by what the file
 /// can hold (a message index count of 0x08000000, a metadata.yaml count of i64::MAX).
 #[test]
-fn defect_19_4_loss_counts_are_exact_and_bounded() {
+fn loss_counts_are_exact_and_bounded() {
     let dir = tempfile::tempdir().unwrap();
     let (_bare, clean, bytes, records) = mcap_case(dir.path());
     let ch = chunks(&records);
@@ -502,7 +503,7 @@ fn defect_19_4_loss_counts_are_exact_and_bounded() {
 /// 8: a symlink loop given as the output is refused (an error, nothing written, the links
 /// left as they are), not turned into a regular file.
 #[test]
-fn defect_19_8_a_symlink_loop_as_output_is_refused() {
+fn a_symlink_loop_as_output_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let db = ros2_bag(&dir.path().join("bag"), Storage::Sqlite3);
     let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
@@ -528,7 +529,7 @@ fn defect_19_8_a_symlink_loop_as_output_is_refused() {
 /// 9: a damaged metadata.yaml is said in one line (no doubled "error:", no excerpt of the
 /// file), and the storage files beside it are still read.
 #[test]
-fn defect_19_9_a_damaged_metadata_yaml_is_one_plain_line() {
+fn a_damaged_metadata_yaml_is_one_plain_line() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("bag");
     ros2_bag(&bag, Storage::Sqlite3);
