@@ -245,8 +245,14 @@ fn check_imu_topics(src: &dyn source::Source, by: &mut BTreeMap<(String, String)
         // topic's, as its findings count them (a record cut to its longest stretch has none
         // left in it, but they are the topic's)
         e.rate = c.rate;
-        e.findings = c.findings;
         e.refused = s.check_integration().err().map(|e| e.to_string());
+        e.findings = c.findings;
+        if e.refused.is_some() {
+            // rows that are no samples say nothing of the sensor through the checks that
+            // read values as samples (a noise density read at the rows' spacing came out
+            // as "deg/s read as rad/s?"): the refusal says what they are
+            e.findings.retain(|f| !f.kind.judges_values_as_samples());
+        }
     }
 }
 

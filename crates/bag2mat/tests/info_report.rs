@@ -146,6 +146,11 @@ fn receive_time_jitter_at_400_hz_is_no_lost_sample() {
     let t = topic(&bag, "imu");
     // before: hundreds of "missing" samples
     assert_eq!((t.missing, t.gaps), (0, 0), "{:?}", t.findings);
+    // and the sensor's rate (before: 401.1 Hz, each jittered interval rounded to periods);
+    // the span's ends are late by a receive delay each, a few ms over 60 s
+    const RATE_REL_TOL: f64 = 1e-4;
+    let rate = t.rate.expect("a rate");
+    assert!((rate / 400.0 - 1.0).abs() < RATE_REL_TOL, "{rate} Hz");
     assert!(
         !t.findings.iter().any(|f| f.kind == FindingKind::Gaps),
         "{:?}",
@@ -179,6 +184,13 @@ fn integrated_deltas_far_apart_are_said_to_be_no_samples_by_info_and_the_convert
     assert!(
         refused.contains("4.9 ms") && refused.contains("500.0 ms apart"),
         "{refused}"
+    );
+    // and the checks that read values as samples say nothing of rows that are none
+    // (before: "deg/s read as rad/s?" on each gyro axis, the white noise read at 2 Hz)
+    assert!(
+        !t.findings.iter().any(|f| f.kind == FindingKind::Units),
+        "{:?}",
+        t.findings
     );
     assert!(topic(&log, "sensor_combined").refused.is_none());
     let out = dir.path().join("v.csv");

@@ -90,6 +90,15 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// True for the checks that read the values as samples of the sensor at the stamps'
+    /// rate (spikes, warm-up, motion, units, two sensors), false for the clock's.
+    pub(crate) fn judges_values_as_samples(self) -> bool {
+        matches!(
+            self,
+            Kind::Outlier | Kind::WarmUp | Kind::Motion | Kind::Units | Kind::Interleaved
+        )
+    }
+
     /// The name the section and the yaml caveats use.
     pub(crate) fn name(self) -> &'static str {
         match self {
