@@ -66,6 +66,11 @@ cargo test -p allan_kalibr --test main -- --ignored --exact \
   studies::lines::lines_study studies::coverage::coverage_study \
   studies::plan::plan_study studies::operating::operating_interval_coverage_study
 
+# The warm-up detector's power study (issue 41): detections of drifts of 6–14 σ of the
+# detection window's mean, time constants of one window to an eighth of the record, and false
+# alarms on drift-free white noise and random walk, from 10 min to 24 h (a few minutes).
+cargo test -p bag2mat --test main -- --ignored --exact warmup_power::warmup_power_study
+
 # Issues 12, 19 and 45's seeded corruption campaign (300 variants per input format — ROS 1,
 # MCAP with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml
 # edits, files written by rosbags and Foxglove's writer, and the logs from outside ROS: ULog

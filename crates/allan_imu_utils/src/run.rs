@@ -126,10 +126,29 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
         return Ok(vec![run_curves(config, outputs)?.section]);
     }
-    Ok(run(config, outputs)?
+    let topics = run_topics(config, outputs)?;
+    let several = topics.len() > 1;
+    topics
         .into_iter()
-        .map(|o| o.section)
-        .collect())
+        .map(|t| match t.result {
+            Ok(o) => Ok(o.section),
+            // one topic of several: said as its error, the others still written (the rule
+            // allan_kalibr follows too)
+            Err(e) if several => Ok(allan_kalibr::topic_failed(&t.topic, t.notes, &e)),
+            Err(e) => Err(e),
+        })
+        .collect()
+}
+
+/// One topic's outcome in a run of several ([`run_topics`]).
+#[derive(Debug)]
+pub struct TopicRun {
+    /// The topic.
+    pub topic: String,
+    /// What its reader said (repeated for a topic that failed, whose section has no other).
+    pub notes: Vec<Note>,
+    /// Its analysis, or why it failed.
+    pub result: Result<Outcome, Error>,
 }
 
 impl allan_kalibr::Job for Config {
@@ -168,6 +187,15 @@ pub fn output_names(name: &str) -> Vec<String> {
 /// selected topic is read in one pass and analysed on its own. With one topic the outputs go
 /// into `out_dir`; with several, into `out_dir/<topic folder>`; every file among `outputs`.
 pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<Outcome>, Error> {
+    run_topics(config, outputs)?
+        .into_iter()
+        .map(|t| t.result)
+        .collect()
+}
+
+/// [`run`] with each topic's outcome on its own: a topic that fails does not stop the
+/// others (what the binary does with a run of several topics).
+pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, Error> {
     let t0 = Instant::now();
     let read = bag2mat::read_imu_topics_with(
         config.common.samples_path(),
@@ -188,7 +216,13 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<Outcome>, Error> {
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        outs.push(run_series(&c, series, read_time, outputs)?);
+        let topic = series.topic.clone();
+        let notes = bag2mat::shared::note::warnings(&series.notes);
+        outs.push(TopicRun {
+            topic,
+            notes,
+            result: run_series(&c, series, read_time, outputs),
+        });
     }
     Ok(outs)
 }
@@ -203,20 +237,29 @@ fn run_series(
     let mut timings: Vec<(&str, Duration)> = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
     let mut notes = bag2mat::shared::note::warnings(&series.notes);
+    // integrated deltas far apart are no samples to analyse
+    series.check_integration()?;
     let absent = stand_in_and_skip(config, &mut series, &mut notes)?;
     let collected = collect::collect(&series, config.max_time_min, config.common.time);
-    notes.extend(end_of_bag_note(&collected, config));
-    // The record check (bag2mat::check_record) on the collected messages: duplicates, a
-    // clock that steps back and a record that is not one continuous stretch are cut, spikes
-    // dropped when asked; what the record breaks of the analysis' assumptions is found.
+    notes.extend(stop_note(&collected, &series, config));
     let (n, stop) = (collected.len(), collected.stop);
     drop(collected);
+    // The record check (bag2mat::check_record) on the whole record: duplicates, a clock
+    // that steps back and a record that is not one continuous stretch are cut, spikes
+    // dropped when asked; what the record breaks of the analysis' assumptions is found.
     let t1 = Instant::now();
-    let mut check = check_record(&series, n, config);
+    let whole_n = series.len();
+    let mut check = check_record(&series, whole_n, config);
     bag2mat::drop_absent(&mut check.findings, absent);
     timings.push(("record_check", t1.elapsed()));
-    let series = kept_series(series, &check, n, absent);
-    let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
+    let series = kept_series(series, &check, whole_n, absent);
+    // The upstream-compatible part: the kept messages among the first `n`, where imu_utils'
+    // stop rule (max_time_min) ends its collection.
+    let n_compat = match &check.keep {
+        bag2mat::KeepRows::All => n,
+        bag2mat::KeepRows::Rows(rows) => rows.partition_point(|&i| i < n),
+    };
+    let collected = collect::Collected::first(&series, n_compat, config.common.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     check_values(&collected, absent, &mut notes)?;
     let t1 = Instant::now();
@@ -228,15 +271,32 @@ fn run_series(
         .rate
         .map(allan_kalibr::snap_rate)
         .unwrap_or(axes[0].freq);
-    let ieee = ieee952_section(
-        config,
-        &check,
-        &axes,
-        &collected,
-        absent,
-        section_rate,
-        &mut notes,
-    );
+    // This tool's own section uses the whole record: past the stop rule, the Allan step runs
+    // again on every kept message.
+    let ieee = if n_compat < series.len() && config.common.ieee952 && check.refusal().is_none() {
+        let all = collect::Collected::first(&series, series.len(), config.common.time, stop);
+        check_values(&all, absent, &mut Vec::new())?;
+        let (all_axes, _) = analysis::allan_step(&all, config.max_cluster, true)?;
+        ieee952_section(
+            config,
+            &check,
+            &all_axes,
+            &all,
+            absent,
+            section_rate,
+            &mut notes,
+        )
+    } else {
+        ieee952_section(
+            config,
+            &check,
+            &axes,
+            &collected,
+            absent,
+            section_rate,
+            &mut notes,
+        )
+    };
     timings.push(("ieee952", t1.elapsed()));
     let prov = Provenance::new(
         crate::cli::TOOL,
@@ -296,6 +356,7 @@ fn run_series(
             .iter()
             .map(|(phase, d)| format!("timing {phase} {:.3} s", d.as_secs_f64()))
             .collect(),
+        error: None,
     };
     Ok(Outcome {
         section,
@@ -326,19 +387,44 @@ fn stand_in_and_skip(
     Ok(absent)
 }
 
-/// imu_utils' own words on stderr (the reference runs' stderr.txt) when the bag ended
-/// before `max_time_min`.
-fn end_of_bag_note(collected: &collect::Collected, config: &Config) -> Option<Note> {
-    (collected.stop == Stop::EndOfBag).then(|| {
-        Note::upstream_warning(
+/// What the stop rule did. The bag ended before `max_time_min` (every record shorter than
+/// it): imu_utils' own words (the reference runs' stderr.txt), said as information — every
+/// ordinary run prints it, so it is no warning. The rule fired: a warning, since the
+/// upstream-compatible part then leaves the rest of the record out (the IEEE 952 section
+/// uses all of it).
+fn stop_note(
+    collected: &collect::Collected,
+    series: &bag2mat::ImuSeries,
+    config: &Config,
+) -> Option<Note> {
+    match collected.stop {
+        Stop::EndOfBag => Some(Note::upstream_info(
             "WARNING: ",
             format!(
-            "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
-            collected.len(),
-            config.max_time_min
-        ),
-        )
-    })
+                "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
+                collected.len(),
+                config.max_time_min
+            ),
+        )),
+        Stop::Fired { .. } => {
+            let t = series.time(config.common.time);
+            let minutes = |k: usize| (t[k].to_sec() - t[0].to_sec()) / 60.0;
+            let (used, total) = (minutes(collected.len() - 1), minutes(series.len() - 1));
+            let section = if config.common.ieee952 {
+                "; the IEEE 952 section and its record-length advice use the whole record"
+            } else {
+                ""
+            };
+            Some(Note::warning(format!(
+                "max_time_min {}: imu_utils stops at the first stamp past it, so the upstream-compatible part (its report, {name}_imu_param.yaml, {name}_imu_param_continuous.yaml, the data_{name}_*.txt curves and plots) uses the first {used:.1} min ({} of {} messages) of this {total:.1} min record (--max-time-min {} uses all of it){section}",
+                config.max_time_min,
+                collected.len(),
+                series.len(),
+                total.floor() as u64 + 1,
+                name = config.name,
+            )))
+        }
+    }
 }
 
 /// The messages of the first `n` that the record check keeps; for a one-sensor topic the

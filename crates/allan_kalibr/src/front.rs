@@ -217,8 +217,13 @@ pub(crate) fn default_topics() -> bag2mat::TopicSelector {
 }
 
 /// The default output folder of `tool` for `input`: `<stem>_<tool>` beside it (a bag
-/// directory's or curves directory's name stands for the stem), never the data folder.
+/// directory's or curves directory's name stands for the stem), never the data folder; for
+/// an input inside an EuRoC/ASL dataset, beside the dataset's root
+/// ([`bag2mat::euroc_output_base`]: `MH_01_easy_imu0_<tool>` for `MH_01_easy/mav0/imu0`).
 pub(crate) fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
+    if let Some((parent, stem)) = bag2mat::euroc_output_base(input) {
+        return parent.join(format!("{stem}_{tool}"));
+    }
     let input = if input.file_name().is_some_and(|n| n == "metadata.yaml") {
         input.parent().unwrap_or(Path::new("."))
     } else {
@@ -341,6 +346,20 @@ pub struct Section {
     pub written: Vec<PathBuf>,
     /// Phase timings, one line each (with --timings).
     pub timings: Vec<String>,
+    /// Why this topic could not be analysed, when the run read several and this one failed
+    /// ([`topic_failed`]): said once as an error, the other topics still written.
+    pub error: Option<String>,
+}
+
+/// The section of a topic that failed in a run of several topics: its reader's `notes`
+/// and the error (the run goes on with the other topics, and exits 1).
+pub fn topic_failed(topic: &str, notes: Vec<Note>, error: &dyn std::fmt::Display) -> Section {
+    Section {
+        topic: Some(topic.to_string()),
+        notes,
+        error: Some(error.to_string()),
+        ..Section::default()
+    }
 }
 
 /// A tool's settings as the front end runs them: the shared part, and the job that turns
@@ -466,7 +485,10 @@ fn removed_lines(removed: &[PathBuf]) -> Vec<String> {
 /// an earlier run left in the run's folders and this run does not write; then says
 /// what it found: per section its notes (warnings always, information without --quiet),
 /// the record check's findings, the results on stdout, the files written (and replaced), the
-/// files removed, and the timings. The exit code: 0, or 1 with the error said once.
+/// files removed, and the timings. The exit code: 0, or 1 with the error said once. A run
+/// of several topics in which a topic failed ([`Section::error`]) writes the others, says
+/// that topic's error once in its place (`<tool>: error: topic '<topic>': …`) and exits 1:
+/// the same rule in both tools.
 fn finish<E: std::fmt::Display>(
     tool: &str,
     common: &Common,
@@ -503,11 +525,23 @@ fn finish<E: std::fmt::Display>(
     }
     let several = sections.iter().filter(|s| s.topic.is_some()).count() > 1;
     let mut printing = true;
+    let mut failed = false;
     for s in &sections {
         for n in &s.notes {
             if n.is_warning() || !common.quiet {
                 eprintln!("{}", n.line());
             }
+        }
+        if let Some(e) = &s.error {
+            failed = true;
+            // the topic named once: most errors about a topic name it already
+            let topic = bag2mat::escape_printable(s.topic.as_deref().unwrap_or(""));
+            if e.contains(&format!("'{topic}'")) {
+                eprintln!("{tool}: error: {e}");
+            } else {
+                eprintln!("{tool}: error: topic '{topic}': {e}");
+            }
+            continue;
         }
         let topic = s.topic.as_deref().filter(|_| several);
         for f in &s.findings {
@@ -539,7 +573,11 @@ fn finish<E: std::fmt::Display>(
     if common.timings {
         eprintln!("timing total {:.3} s", started.elapsed().as_secs_f64());
     }
-    ExitCode::SUCCESS
+    if failed {
+        ExitCode::from(cli::EXIT_FAILURE)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
 
 /// "wrote N files to DIR/: a, b, …", one line per folder, in the order written; "(K of
@@ -613,6 +651,37 @@ mod tests {
             default_out_dir(Path::new("x.mat"), "allan_kalibr"),
             PathBuf::from("x_allan_kalibr")
         );
+    }
+
+    /// An EuRoC/ASL dataset's IMU (its data.csv, its folder, or mav0) is analysed into a
+    /// folder beside the dataset, never inside its tree.
+    #[test]
+    fn a_euroc_dataset_s_output_folder_is_beside_the_dataset_never_in_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let imu0 = dir.path().join("MH_01_easy/mav0/imu0");
+        std::fs::create_dir_all(&imu0).unwrap();
+        std::fs::write(
+            imu0.join("data.csv"),
+            "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n1,0,0,0,0,0,9.8\n",
+        )
+        .unwrap();
+        let canon = std::fs::canonicalize(dir.path()).unwrap();
+        for (input, out) in [
+            (imu0.join("data.csv"), "MH_01_easy_imu0_allan_kalibr"),
+            (imu0.clone(), "MH_01_easy_imu0_allan_kalibr"),
+            (
+                dir.path().join("MH_01_easy/mav0"),
+                "MH_01_easy_allan_kalibr",
+            ),
+            (dir.path().join("MH_01_easy"), "MH_01_easy_allan_kalibr"),
+        ] {
+            assert_eq!(
+                default_out_dir(&input, "allan_kalibr"),
+                canon.join(out),
+                "{}",
+                input.display()
+            );
+        }
     }
 
     #[test]

@@ -84,7 +84,7 @@ pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
     Common, CommonArgs, Input, Job, Section, command_line, main as analyser_main, rate_for_text,
-    refusal_text, run_job,
+    refusal_text, run_job, topic_failed,
 };
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};
@@ -128,4 +128,7 @@ pub use kalibr::chart_fit::{ChartFit, gen_chart};
 pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 pub use kalibr::grid::TauGrid;
 pub use kalibr::report::{chart_lines, final_lines};
-pub use run::{Analysis, Config, RunOutput, analyse, curves_rate, curves_text, run, sections};
+pub use run::{
+    Analysis, Config, RunOutput, TopicRun, analyse, curves_rate, curves_text, run, run_topics,
+    sections,
+};

@@ -137,10 +137,28 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if let Some(s) = &config.operating {
         return crate::operating::sections(config, s, outputs);
     }
-    Ok(run(config, outputs)?
+    let topics = run_topics(config, outputs)?;
+    let several = topics.len() > 1;
+    topics
         .into_iter()
-        .map(|out| out.section)
-        .collect())
+        .map(|t| match t.result {
+            Ok(out) => Ok(out.section),
+            // one topic of several: said as its error, the others still written
+            Err(e) if several => Ok(crate::front::topic_failed(&t.topic, t.notes, &e)),
+            Err(e) => Err(e),
+        })
+        .collect()
+}
+
+/// One topic's outcome in a run of several ([`run_topics`]).
+#[derive(Debug)]
+pub struct TopicRun {
+    /// The topic.
+    pub topic: String,
+    /// What its reader said (repeated for a topic that failed, whose section has no other).
+    pub notes: Vec<Note>,
+    /// Its analysis, or why it failed.
+    pub result: Result<RunOutput, Error>,
 }
 
 impl crate::front::Job for Config {
@@ -175,6 +193,15 @@ pub(crate) fn output_names() -> Vec<String> {
 /// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`;
 /// every file among `outputs`.
 pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> {
+    run_topics(config, outputs)?
+        .into_iter()
+        .map(|t| t.result)
+        .collect()
+}
+
+/// [`run`] with each topic's outcome on its own: a topic that fails does not stop the
+/// others (what the binary does with a run of several topics).
+pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, Error> {
     let start = Instant::now();
     let datas = input::load_all(
         config.common.samples_path(),
@@ -197,7 +224,16 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> 
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        outs.push(run_on(&c, data, load, outputs)?);
+        let topic = data
+            .topic
+            .clone()
+            .unwrap_or_else(|| config.common.named_topic().to_string());
+        let notes = bag2mat::shared::note::warnings(&data.notes);
+        outs.push(TopicRun {
+            topic,
+            notes,
+            result: run_on(&c, data, load, outputs),
+        });
     }
     Ok(outs)
 }
@@ -257,6 +293,12 @@ fn run_on(
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
+    // integrated deltas far apart are no samples to analyse
+    bag2mat::check_integration(
+        data_topic.as_deref().unwrap_or(""),
+        data.integration,
+        &data.clock.t_ns,
+    )?;
     if let Some(skip) = config.common.skip_start {
         skip_start(&mut data, skip, &mut notes)?;
     }
@@ -341,6 +383,7 @@ fn run_on(
             .map(|a| crate::ieee952::stated::section_text(a, config.common.samples_path(), &topic)),
         written,
         timings: vec![timings.to_string()],
+        error: None,
     };
     Ok(RunOutput {
         section,

@@ -480,7 +480,9 @@ pub(crate) fn sections(
         } else {
             config.common.out_dir.clone()
         };
-        out.push(run_topic(
+        let topic = data.topic.clone().unwrap_or_default();
+        let notes = bag2mat::shared::note::warnings(&data.notes);
+        match run_topic(
             config,
             s,
             data,
@@ -488,7 +490,13 @@ pub(crate) fn sections(
             static_an.as_ref(),
             &dir,
             outputs,
-        )?);
+        ) {
+            Ok(section) => out.push(section),
+            // one topic of several: said as its error, the others still written (the rule
+            // of both analysers' own runs, `crate::run::sections`)
+            Err(e) if several => out.push(crate::front::topic_failed(&topic, notes, &e)),
+            Err(e) => return Err(e),
+        }
     }
     Ok(out)
 }
@@ -589,6 +597,7 @@ fn run_topic(
         ieee952_text: None,
         written,
         timings: Vec::new(),
+        error: None,
     })
 }
 

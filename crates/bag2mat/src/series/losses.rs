@@ -154,7 +154,10 @@ pub(super) fn loss_notes(
     if missing > 0 {
         notes.push(format!(
             "{missing} of {} messages on '{}' were lost{}{tail}",
-            r.promised.unwrap_or(r.delivered + missing),
+            // a loss a reader counted beyond its promise (a batch short of its header)
+            // belongs to the total too
+            r.promised
+                .map_or(r.delivered + missing, |p| p.max(r.delivered + missing)),
             topic,
             if more > 0 {
                 format!(", and up to {more} more{why}")

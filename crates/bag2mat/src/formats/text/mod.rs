@@ -34,7 +34,7 @@ use crate::source::InputKind;
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
 use body::{Chunk, Summary, line_range, parse_lines, room};
-use layout::{Layout, bad, layout};
+use layout::{Delim, Layout, bad, layout};
 pub use units::{AccUnit, GyroUnit, TimeUnit};
 
 /// Bytes looked at to decide whether a file is text, and to find its header.
@@ -134,7 +134,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     };
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
     let line_starts = line_starts(&chunks, lay.body_line);
-    let mut notes = Vec::new();
+    let mut notes = lay.warnings.clone();
     let mut lost = malformed_lines(path, &chunks, &line_starts)?;
     if let Some(line) = cut {
         let what = format!(
@@ -161,6 +161,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
         notes.extend(stamp_order(&chunks, &line_starts));
     }
     check_plausible(path, &lay, &rows)?;
+    check_physics(path, &lay, &rows, opts)?;
     let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
     if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
         notes.push(format!("{}: {}", path.display(), lay.what));
@@ -191,12 +192,18 @@ fn read_mapped(
 ) -> Result<(Layout, Rows, Vec<Summary>, Option<u64>), Error> {
     let head = |n: usize| &bytes[..bytes.len().min(n)];
     let len = bytes.len() as u64;
-    let lay = match layout(path, head(SNIFF_BYTES), len, opts) {
+    let mut lay = match layout(path, head(SNIFF_BYTES), len, opts) {
         Err(Error::NotABag { .. }) if bytes.len() > SNIFF_BYTES => {
             layout(path, head(MAX_HEAD_BYTES), len, opts)?
         }
         r => r?,
     };
+    // a decimal-comma file or one sensor of several: a copy of the body to read, byte for
+    // byte where it is read (line numbers and offsets stay the file's)
+    let mut copy_notes = Vec::new();
+    let copy = body_copy(path, bytes, &lay, opts, &mut copy_notes)?;
+    lay.warnings.extend(copy_notes);
+    let bytes = copy.as_deref().unwrap_or(bytes);
     // a last line without its line end whose last number is cut: not read
     let cut = cut_last_line(bytes, &lay);
     let body = &bytes[..bytes.len() - cut.map_or(0, |c| c.1)];
@@ -391,6 +398,217 @@ fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<String> {
         ));
     }
     notes
+}
+
+/// The body of a file to read in place of its bytes, when they cannot be read as they are:
+/// decimal commas as points (the fields are separated by `;` or tabs), and, in a file of
+/// several sensors (a sensor column), every other sensor's lines turned into comment lines
+/// of the same length. `None`: read the file as it is. A file of several sensors without
+/// `--sensor-id` is an error that says what they are; `--sensor-id` on a file without a
+/// sensor column, or naming no sensor it has, too.
+fn body_copy(
+    path: &Path,
+    bytes: &[u8],
+    lay: &Layout,
+    opts: &InputOptions,
+    notes: &mut Vec<String>,
+) -> Result<Option<Vec<u8>>, Error> {
+    let ids = lay
+        .sensor_column
+        .as_ref()
+        .map(|(col, name)| (*col, name, sensor_ids(bytes, lay, *col)));
+    let keep: Option<(usize, &str)> = match (&ids, &opts.sensor_id) {
+        (None, Some(id)) => {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "--sensor-id {id}: the file has no column saying which sensor a row is from ({})",
+                    layout::SENSOR_ID_NAMES.join(", ")
+                ),
+            ));
+        }
+        (Some((_, name, found)), Some(id)) if !found.iter().any(|(v, _)| v == id) => {
+            return Err(layout::bad(
+                path,
+                format!("--sensor-id {id}: column '{name}' holds {}", id_list(found)),
+            ));
+        }
+        (Some((col, name, found)), Some(id)) => {
+            let n: u64 = found.iter().map(|(_, c)| c).sum();
+            let mine = found.iter().find(|(v, _)| v == id).map_or(0, |x| x.1);
+            notes.push(format!(
+                "--sensor-id {id}: {mine} of the {n} rows (column '{name}'; the file holds {})",
+                id_list(found)
+            ));
+            Some((*col, id.as_str()))
+        }
+        (Some((_, name, found)), None) if found.len() > 1 => {
+            let first = &found[0].0;
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the rows come from {} sensors (column '{name}' holds {}), one row each in turn: each is an IMU of its own, with its own bias and noise, and read together they are neither (at {}× the rate): pick one with --sensor-id {first}",
+                    found.len(),
+                    id_list(found),
+                    found.len()
+                ),
+            ));
+        }
+        _ => None,
+    };
+    if !lay.decimal_comma && keep.is_none() {
+        return Ok(None);
+    }
+    let mut copy = bytes.to_vec();
+    let body = &mut copy[lay.body..];
+    if lay.decimal_comma {
+        for b in body.iter_mut().filter(|b| **b == b',') {
+            *b = b'.';
+        }
+    }
+    if let Some((col, id)) = keep {
+        let mut at = 0;
+        while at < body.len() {
+            let end = memchr::memchr(b'\n', &body[at..]).map_or(body.len(), |p| at + p + 1);
+            let line = &body[at..end];
+            if !line.starts_with(b"#") && field(line, lay, col).is_some_and(|f| f != id.as_bytes())
+            {
+                // blanked, not commented out: a comment holding a row's numbers is a
+                // damaged row (`body::comment_row`), a blank line is no row
+                let text_end = at
+                    + line
+                        .iter()
+                        .take_while(|&&b| b != b'\n' && b != b'\r')
+                        .count();
+                body[at..text_end].fill(b' ');
+            }
+            at = end;
+        }
+    }
+    Ok(Some(copy))
+}
+
+/// Field `col` of a line (without the line end), trimmed of blanks and quotes.
+fn field<'l>(line: &'l [u8], lay: &Layout, col: usize) -> Option<&'l [u8]> {
+    let line = line.strip_suffix(b"\n").unwrap_or(line);
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let f = match lay.delim {
+        Delim::Byte(d) => line.split(|b| *b == d).nth(col),
+        Delim::Whitespace(_) => line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|f| !f.is_empty())
+            .nth(col),
+    }?;
+    Some(body::trim(f))
+}
+
+/// The values of the sensor column `col` over the body, with how many rows each has, in
+/// the order first met (at most [`MAX_SENSOR_IDS`] values).
+fn sensor_ids(bytes: &[u8], lay: &Layout, col: usize) -> Vec<(String, u64)> {
+    let mut found: Vec<(String, u64)> = Vec::new();
+    for line in bytes[lay.body..].split(|b| *b == b'\n') {
+        if line.is_empty() || line.starts_with(b"#") {
+            continue;
+        }
+        let Some(f) = field(line, lay, col).filter(|f| !f.is_empty()) else {
+            continue;
+        };
+        if let Some(e) = found.iter_mut().find(|(v, _)| v.as_bytes() == f) {
+            e.1 += 1;
+        } else if found.len() < MAX_SENSOR_IDS {
+            found.push((String::from_utf8_lossy(f).into_owned(), 1));
+        }
+    }
+    found
+}
+
+/// Distinct sensor ids listed at most.
+const MAX_SENSOR_IDS: usize = 16;
+
+/// `0 (5000 rows), 1 (5000 rows)`.
+fn id_list(found: &[(String, u64)]) -> String {
+    found
+        .iter()
+        .map(|(v, n)| format!("{v} ({n} rows)"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The physics of what the layout read, whatever units it was told (the rules:
+/// `crate::record_check::units`): a median specific force another accelerometer unit puts at
+/// gravity, a rate another time unit puts among IMUs', or an unstated gyroscope unit whose
+/// noise no rad/s gyroscope has, are errors that name the flag to fix (it overrides the
+/// header). What no other unit explains is left to the record check's warnings.
+fn check_physics(path: &Path, lay: &Layout, rows: &Rows, opts: &InputOptions) -> Result<(), Error> {
+    use crate::record_check::units;
+    let over = |stated: bool| {
+        if stated {
+            " (it overrides the header)"
+        } else {
+            ""
+        }
+    };
+    // (raw counts with a scale are the scale's to get right: no unit explains them)
+    if lay.acc.is_some()
+        && opts.acc_scale.is_none()
+        && let Some(m) = units::median_norm([&rows.acc[0], &rows.acc[1], &rows.acc[2]])
+    {
+        let given = lay.acc_unit.unwrap_or(AccUnit::Ms2);
+        if let Some(v) = units::gravity_unit_fix(m, given) {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the accelerometer read in {} has a median magnitude of {m:.4} m/s^2, not gravity's 9.81: in {} it is {:.4} m/s^2: give --acc-unit {}{}",
+                    given.name(),
+                    v.name(),
+                    m / given.si() * v.si(),
+                    v.name(),
+                    over(lay.acc_stated && opts.acc_unit.is_none())
+                ),
+            ));
+        }
+    }
+    if lay.time.is_some() {
+        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
+        if let Some(rate) = crate::timing::nominal_rate(&t)
+            && let Some((u, r)) = units::rate_unit_fix(rate, lay.time_unit)
+        {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the time column read in {} gives a sample rate of {rate:.4} Hz, outside what IMUs have ({} Hz – {} kHz); in {} it gives {r:.1} Hz: give --time-unit {}{}",
+                    lay.time_unit.name(),
+                    units::IMU_RATE_HZ.0,
+                    units::IMU_RATE_HZ.1 / 1e3,
+                    u.name(),
+                    u.name(),
+                    over(!lay.time_from_flag && lay.time_stated)
+                ),
+            ));
+        }
+    }
+    if lay.gyro.is_some() && !lay.gyro_stated && opts.gyro_scale.is_none() {
+        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
+        let rate = crate::timing::nominal_rate(&t);
+        for (k, axis) in rows.gyro.iter().enumerate() {
+            let sigma = crate::record_check::outliers::noise_scale(axis);
+            let Some(n) = rate.map(|r| units::gyro_density(sigma, r)) else {
+                break;
+            };
+            if n > units::MAX_GYRO_DENSITY {
+                return Err(layout::bad(
+                    path,
+                    format!(
+                        "the gyroscope columns state no unit, and read as rad/s their white noise is {n:.3e} rad/s/sqrt(Hz) (gyro {}), more than any IMU gyroscope has (at most {:.0e}); in deg/s it is {:.3e}: give --gyro-unit deg/s (or --gyro-unit rad/s if that is right)",
+                        ['x', 'y', 'z'][k],
+                        units::MAX_GYRO_DENSITY,
+                        n * std::f64::consts::PI / 180.0
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Values stated in no unit must be plausible in SI: else the error says which unit to add.

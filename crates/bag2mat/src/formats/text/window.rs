@@ -42,6 +42,26 @@ pub(super) fn read(
         }
         r => r?,
     };
+    // a decimal-comma file or one of several sensors is read from a copy of its body
+    // (`super::body_copy`), which a file past the memory limit cannot have
+    if lay.decimal_comma || lay.sensor_column.is_some() {
+        return Err(super::layout::bad(
+            path,
+            format!(
+                "a {} file of {len} bytes is larger than the memory limit lets it be read whole, which its {} needs: raise the limit (ulimit -v) or convert it first",
+                if lay.decimal_comma {
+                    "decimal-comma"
+                } else {
+                    "several-sensor"
+                },
+                if lay.decimal_comma {
+                    "decimal commas"
+                } else {
+                    "sensor column"
+                },
+            ),
+        ));
+    }
     // room for a row per line, counted first (the rows are never copied to grow)
     let mut lines = 0usize;
     let mut at = lay.body as u64;

@@ -64,6 +64,9 @@ pub(super) struct PartCount {
     pub(super) counts: Vec<u64>,
     /// The record times the part spans (a FIFO message from its oldest sample).
     pub(super) span: Option<(u64, u64)>,
+    /// The integration intervals of each delta message (`vehicle_imu`): channel, the
+    /// gyroscope's and the accelerometer's, µs.
+    pub(super) deltas: Vec<(u32, f32, f32)>,
 }
 
 impl PartCount {
@@ -79,6 +82,17 @@ impl PartCount {
                 let n = d.rows_in(data);
                 let dt = dt.get(data).unwrap_or(0.0).max(0.0);
                 (n as u64, t.saturating_sub(fifo_offset_ns(n.max(1), 0, dt)))
+            }
+            Some(Decoder::Deltas {
+                angle_dt, vel_dt, ..
+            }) => {
+                if let (Some(a), Some(v)) = (angle_dt.get(data), vel_dt.get(data))
+                    && a > 0.0
+                    && v > 0.0
+                {
+                    self.deltas.push((ch, a as f32, v as f32));
+                }
+                (1, t)
             }
             _ => (1, t),
         };

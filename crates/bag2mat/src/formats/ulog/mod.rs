@@ -46,7 +46,7 @@ use crate::source::{InputKind, Loss};
 
 use decoder::Decoder;
 use format::Slot;
-use hop::{Event, Found};
+use hop::{Event, Found, PartCount};
 
 /// The file's first 7 bytes (then a version byte and the start time, µs).
 pub const MAGIC: &[u8] = super::ULOG_MAGIC;
@@ -143,7 +143,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
     let map = crate::mapped::Mapped::of(&file, path)?;
-    check_header(path, map.bytes())?;
+    let start_us = check_header(path, map.bytes())?;
     // the page tables filled on the other core while the serial hop runs
     let (hop, ()) = rayon::join(|| hop::hop(map.bytes()), || map.fill_pages());
     if let Some(f) = hop.found.unknown_incompat {
@@ -197,6 +197,7 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
     let mut contents = crate::source::Contents {
         losses: losses(&found, &channels),
         notes: notes(&found),
+        log_start: Some(start_us.saturating_mul(1000)),
         ..Default::default()
     };
     for (p, c) in reader.parts.iter().zip(&counted) {
@@ -220,13 +221,29 @@ pub(crate) fn open(path: &Path) -> Result<UlogReader, Error> {
             bytes: rows * crate::rows::ROW_LEN as u64,
         });
     }
+    contents.integration = integration(&counted);
     contents.channels = channels;
     reader.contents = contents;
     Ok(reader)
 }
 
-/// The file header: the magic, a version byte and the start time.
-fn check_header(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+/// The median integration intervals of each channel of deltas the parts counted.
+fn integration(counted: &[PartCount]) -> Vec<(u32, crate::Integration)> {
+    let mut by: std::collections::BTreeMap<u32, (Vec<f32>, Vec<f32>)> = Default::default();
+    for &(ch, a, v) in counted.iter().flat_map(|c| &c.deltas) {
+        let e = by.entry(ch).or_default();
+        e.0.push(a);
+        e.1.push(v);
+    }
+    by.into_iter()
+        .filter_map(|(ch, (mut a, mut v))| {
+            crate::Integration::of_us(&mut a, &mut v).map(|i| (ch, i))
+        })
+        .collect()
+}
+
+/// The file header: the magic, a version byte and the start time (µs, returned).
+fn check_header(path: &Path, bytes: &[u8]) -> Result<u64, Error> {
     let mut c = Cursor::new(&bytes[..bytes.len().min(HEADER_LEN)]);
     let magic = c
         .take(MAGIC.len(), "ULog magic")
@@ -235,9 +252,7 @@ fn check_header(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         return Err(corrupt(path, c.invalid("not a ULog file")));
     }
     c.le::<u8>("ULog version").map_err(|e| corrupt(path, e))?;
-    c.le::<u64>("ULog start time")
-        .map_err(|e| corrupt(path, e))?;
-    Ok(())
+    c.le::<u64>("ULog start time").map_err(|e| corrupt(path, e))
 }
 
 fn corrupt(path: &Path, e: CursorError) -> Error {
