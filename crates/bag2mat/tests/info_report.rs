@@ -96,14 +96,15 @@ fn batch_sample_losses_are_the_batch_topics_own() {
     for s in &read.series {
         let notes = s.notes.join("\n");
         if s.topic.starts_with("ISB_") {
-            // each batch topic's last batch is short by 32 samples: its own, said on it
+            // each batch topic's last batch is short by 32 samples: its own, said on it (as
+            // a bound: the log may have stopped before the batch was written whole)
             let other = if s.topic == "ISB_ACC" {
                 "ISB_GYR"
             } else {
                 "ISB_ACC"
             };
             assert!(
-                notes.contains(&format!("32 of 4608 messages on '{}' were lost", s.topic))
+                notes.contains(&format!("up to 32 messages on '{}' were lost", s.topic))
                     && !notes.contains(other),
                 "{}: {notes}",
                 s.topic
