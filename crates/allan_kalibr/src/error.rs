@@ -30,7 +30,7 @@ pub enum Error {
     /// The input is neither a `.mat` nor a bag bag2mat reads.
     #[error(
         "{path}: unknown input type (expected a .mat file or a bag: {})",
-        bag2mat::ACCEPTED
+        bag2mat::accepted()
     )]
     UnknownInput {
         /// The file.

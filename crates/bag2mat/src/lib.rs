@@ -120,11 +120,11 @@ pub use series::{
     ImuRead, ImuSeries, ReadOptions, StandIn, TimeColumn, TopicReport, TopicSelector,
     absent_warning, topic_folder_names,
 };
-pub use source::{ACCEPTED, InputKind, Source};
 pub use source::{
     Channel as SourceChannel, Contents as SourceContents, Encoding as MessageEncoding,
     Loss as SourceLoss, Part as SourcePart, PartRead,
 };
+pub use source::{InputKind, KindFacts, Source, accepted};
 pub use time::RosTime;
 pub use timing::{Gap as TimingGap, Segment as TimingSegment};
 pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};

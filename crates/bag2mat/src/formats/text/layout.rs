@@ -418,7 +418,7 @@ fn not_table(path: &Path, why: &str) -> Error {
         path: path.to_path_buf(),
         what: format!(
             "it is text, but {why}. Accepted: {}",
-            crate::source::ACCEPTED
+            crate::source::accepted()
         ),
     }
 }
