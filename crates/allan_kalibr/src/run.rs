@@ -135,7 +135,13 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
         return Ok(vec![run_curves(config, curves, outputs)?]);
     }
     if let Some(s) = &config.operating {
-        return crate::operating::sections(&config.common, &config.title, s, outputs);
+        return crate::operating::sections(
+            crate::cli::TOOL,
+            &config.common,
+            &config.title,
+            s,
+            outputs,
+        );
     }
     let topics = run_topics(config, outputs)?;
     let several = topics.len() > 1;

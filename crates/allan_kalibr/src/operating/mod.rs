@@ -50,7 +50,7 @@ use bag2mat::shared::output::Outputs;
 
 use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
-use crate::error::OperatingError;
+pub use crate::error::OperatingError;
 use crate::front::Common;
 use crate::front::Section;
 use crate::ieee952::imu::{ImuAnalysis, ImuCurves};
@@ -419,9 +419,29 @@ fn static_of(an: &ImuAnalysis, sensor: Sensor, axis: usize) -> Option<StaticValu
     }
 }
 
+/// What every topic of one run shares: the run's settings, the reference and static
+/// analysis read once, and where the files go.
+struct RunContext<'a> {
+    /// The tool writing the files (their provenance).
+    tool: &'a str,
+    /// The settings both analysers share.
+    common: &'a Common,
+    /// The chart title (empty: the input's file stem).
+    title: &'a str,
+    /// The analysis' own settings.
+    settings: &'a Settings,
+    /// The reference trajectory (`--reference`).
+    reference: Option<&'a bag2mat::PoseSeries>,
+    /// The static record's IEEE 952 analysis (`--static LOG`).
+    static_an: Option<&'a ImuAnalysis>,
+    /// The run's output stage.
+    outputs: &'a Outputs,
+}
+
 /// Runs the analysis on every selected topic; each gets its own folder when there are
-/// several. Every file among `outputs`.
+/// several. Every file among `outputs`, said as written by `tool`.
 pub(crate) fn sections(
+    tool: &str,
     common: &Common,
     title: &str,
     s: &Settings,
@@ -461,6 +481,15 @@ pub(crate) fn sections(
         .collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let folders = bag2mat::topic_folder_names(&names);
+    let ctx = RunContext {
+        tool,
+        common,
+        title,
+        settings: s,
+        reference: reference.as_ref(),
+        static_an: static_an.as_ref(),
+        outputs,
+    };
     let mut out = Vec::new();
     for (data, folder) in datas.into_iter().zip(folders) {
         let dir = if several {
@@ -470,16 +499,7 @@ pub(crate) fn sections(
         };
         let topic = data.topic.clone().unwrap_or_default();
         let notes = bag2mat::shared::note::warnings(&data.notes);
-        match run_topic(
-            common,
-            title,
-            s,
-            data,
-            reference.as_ref(),
-            static_an.as_ref(),
-            &dir,
-            outputs,
-        ) {
+        match run_topic(&ctx, data, &dir) {
             Ok(section) => out.push(section),
             // one topic of several: said as its error, the others still written (the rule
             // of both analysers' own runs, `crate::run::sections`)
@@ -491,16 +511,16 @@ pub(crate) fn sections(
 }
 
 /// One topic: checks, the analysis, its files and its text.
-fn run_topic(
-    common: &Common,
-    title: &str,
-    s: &Settings,
-    data: ImuData,
-    reference: Option<&bag2mat::PoseSeries>,
-    static_an: Option<&ImuAnalysis>,
-    dir: &Path,
-    outputs: &Outputs,
-) -> Result<Section, Error> {
+fn run_topic(ctx: &RunContext, data: ImuData, dir: &Path) -> Result<Section, Error> {
+    let RunContext {
+        tool,
+        common,
+        title,
+        settings: s,
+        reference,
+        static_an,
+        outputs,
+    } = *ctx;
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let topic_name = data.topic.clone();
     let topic = data
@@ -569,7 +589,7 @@ fn run_topic(
     };
     outputs.ensure_dir(dir)?;
     let prov = Provenance::new(
-        crate::cli::TOOL,
+        tool,
         input_text(common.samples_path(), topic_name.as_deref()),
         match common.rate {
             Some(r) => RecordRate::Given(r),
