@@ -20,6 +20,12 @@ use crate::yaml::{ImuYaml, SectionFile};
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
+/// The tool's name: its default output folder is `<input stem>_allan_kalibr/`, its files'
+/// provenance and its messages name it. Here, with the job, so that the commands above the
+/// job (`cli`, `check`, `plan`) and the job itself read one name; the analyses below it
+/// (`operating`) are given it.
+pub const TOOL: &str = "allan_kalibr";
+
 /// What the program runs with (resolved from the command line in `cli`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
@@ -135,13 +141,7 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
         return Ok(vec![run_curves(config, curves, outputs)?]);
     }
     if let Some(s) = &config.operating {
-        return crate::operating::sections(
-            crate::cli::TOOL,
-            &config.common,
-            &config.title,
-            s,
-            outputs,
-        );
+        return crate::operating::sections(TOOL, &config.common, &config.title, s, outputs);
     }
     let topics = run_topics(config, outputs)?;
     let several = topics.len() > 1;
@@ -334,7 +334,7 @@ fn run_on(
         ),
     };
     let prov = Provenance::new(
-        crate::cli::TOOL,
+        TOOL,
         input_text(config.common.samples_path(), data_topic.as_deref()),
         record_rate(config, &c.rate),
     );
@@ -663,7 +663,7 @@ pub fn run_curves(
     let title = chart_title(config);
     let rostopic = config.common.named_topic();
     let prov = Provenance::new(
-        crate::cli::TOOL,
+        TOOL,
         curves_text(&curves.paths),
         curves_rate(config.common.rate, &c),
     );
