@@ -15,8 +15,8 @@ use crate::kalibr::chart_fit::{ChartFit, gen_chart};
 use crate::kalibr::curves;
 use crate::kalibr::estimator::{Estimator, sig2_curves};
 use crate::kalibr::grid::TauGrid;
+use crate::kalibr::imu_yaml::{ImuYaml, SectionFile};
 use crate::kalibr::report;
-use crate::yaml::{ImuYaml, SectionFile};
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
