@@ -304,7 +304,8 @@ fn run_on(
         data_topic.as_deref().unwrap_or(""),
         data.integration,
         &data.clock.t_ns,
-    )?;
+    )
+    .map_err(bag2mat::Error::from)?;
     if let Some(skip) = config.common.skip_start {
         input::skip_start(&mut data, skip, &mut notes)?;
     }
