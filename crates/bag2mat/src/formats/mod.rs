@@ -24,7 +24,7 @@ use std::path::Path;
 use crate::error::Error;
 use crate::source::Source;
 
-pub use text::{AccUnit, GyroUnit, TimeUnit};
+use crate::units::{AccUnit, GyroUnit, TimeUnit};
 
 /// What the user said about an input whose content does not say it all (text logs).
 #[derive(Debug, Clone, Default, PartialEq)]

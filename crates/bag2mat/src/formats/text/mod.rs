@@ -21,7 +21,6 @@ use rayon::prelude::*;
 
 mod body;
 mod layout;
-mod units;
 mod window;
 
 use super::InputOptions;
@@ -30,12 +29,12 @@ use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
 use crate::rows::{Row, Rows};
 use crate::source::InputKind;
+use crate::units::AccUnit;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
 use body::{Chunk, Summary, line_range, parse_lines, room};
 use layout::{Delim, Layout, bad, layout};
-pub use units::{AccUnit, GyroUnit, TimeUnit};
 
 /// Bytes looked at to decide whether a file is text, and to find its header.
 pub const SNIFF_BYTES: usize = 64 * 1024;
@@ -44,8 +43,6 @@ pub const SNIFF_BYTES: usize = 64 * 1024;
 pub const MAX_BAD_FRACTION: f64 = 0.01;
 /// Malformed lines always tolerated (with warnings), whatever the file's length.
 pub const MIN_BAD_LIMIT: u64 = 10;
-/// Standard gravity, m/s² (the `g` unit; CGPM 1901).
-pub const STANDARD_GRAVITY: f64 = 9.80665;
 /// Bytes per parallel parse range.
 const RANGE_BYTES: usize = 4 << 20;
 /// Rows sampled for the unit plausibility checks.
