@@ -122,8 +122,11 @@ fn check_takes_a_random_walk_inside_the_records_bound_as_allowed() {
             ("gtsam_imu_params_ieee952.yaml", "biasOmegaCovariance"),
         ] {
             let l = line_of(&lines, &out.join(file), key);
+            // the section's own files carry the bound itself (an unresolved K is written
+            // as its 95 % upper bound): at it, or within it after a consumer's rounding
             assert!(
-                l.contains(": ok: ") && l.contains("within the bound"),
+                l.contains(": ok: ")
+                    && (l.contains("within the bound") || l.contains("at the bound")),
                 "{l}"
             );
         }
