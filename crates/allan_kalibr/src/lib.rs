@@ -82,6 +82,7 @@ pub mod spline;
 mod yaml;
 
 pub use cli::{Args, Cli, Command, Run, command_main};
+pub use consumers::SensorValue;
 pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
@@ -103,7 +104,6 @@ pub use ieee952::files::{
     write_outputs as write_ieee952_files,
 };
 pub use ieee952::fit::GM;
-pub use ieee952::imu::SensorValue;
 pub use ieee952::imu::{
     AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
     summary_text as ieee952_summary_text,

@@ -32,7 +32,7 @@ pub(crate) mod values;
 
 pub use header::{Provenance, RecordRate, input_text, utc_now};
 pub use render::render;
-pub use values::{AxisValue, ConfigValues, Origin};
+pub use values::{AxisValue, ConfigValues, Origin, SensorValue};
 
 use bag2mat::Sensor;
 
