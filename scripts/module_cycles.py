@@ -78,7 +78,9 @@ PATH = re.compile(r'\b((?:crate|super|self)(?:::\w+)+)')
 
 
 def paths_of(text):
-    """(path, is_pub_use) for every path the code names; use trees expanded."""
+    """(path, is_pub_use) for every path the code names; use trees expanded. An import for
+    the docs only (`#[cfg(doc)] use …;`, the targets of intra-doc links) is no dependency."""
+    text = re.sub(r'#\[cfg\(doc\)\]\s*(?:pub(?:\([^)]*\))?\s+)?use\s[^;]*;', ' ', text)
     out = []
     for m in USE.finditer(text):
         for p in expand_use(m.group(2)):

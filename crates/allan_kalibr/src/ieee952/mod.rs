@@ -127,6 +127,7 @@ pub(crate) mod config_values;
 mod curve_data;
 mod declare;
 mod pipeline;
+mod point;
 mod result;
 mod terms;
 
@@ -144,10 +145,9 @@ pub use tau_grid::GridSpec;
 pub use curve_data::{CurveData, CurvePoint};
 pub use pipeline::analyse;
 pub use pipeline::analyse_curve;
+pub use point::{AlphaSource, Point};
 pub use result::short;
-pub use result::{
-    AlphaSource, Analysis, AxisVerdict, FitSummary, LineTerm, Point, Term, Terms, Verdict,
-};
+pub use result::{Analysis, AxisVerdict, FitSummary, LineTerm, Term, Terms, Verdict};
 
 /// The model may miss a curve point by this fraction (ADEV) where the point's own 95 % band
 /// is narrower: the bar for "the model describes the curve".
