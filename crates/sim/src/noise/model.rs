@@ -30,6 +30,7 @@ use std::fmt::Write as _;
 use crate::error::{Result, SimError};
 
 /// The two sensors of an IMU (the workspace's one sensor type, with the units of each term).
+use allan_kalibr::NoiseTerm;
 use bag2mat::Sensor;
 
 /// Axis names.
@@ -428,9 +429,9 @@ impl AxisModel {
             o,
             "    {axis}: N {:.4e} {}, K {:.4e} {}",
             self.white_noise,
-            s.term_unit("white_noise"),
+            NoiseTerm::WhiteNoise.unit(s),
             self.random_walk,
-            s.term_unit("random_walk")
+            NoiseTerm::RandomWalk.unit(s)
         );
         if let Some(bi) = self.bias_instability {
             let _ = write!(
@@ -446,14 +447,14 @@ impl AxisModel {
             let _ = write!(o, ", GM {:.4e} {} / {} s", gm.sigma, s.unit(), gm.tau);
         }
         if self.rate_ramp != 0.0 {
-            let _ = write!(o, ", R {:.4e} {}", self.rate_ramp, s.term_unit("rate_ramp"));
+            let _ = write!(o, ", R {:.4e} {}", self.rate_ramp, NoiseTerm::Ramp.unit(s));
         }
         if self.quantization != 0.0 {
             let _ = write!(
                 o,
                 ", Q {:.4e} {} (step {:.4e})",
                 self.quantization,
-                s.term_unit("quantization"),
+                NoiseTerm::Quantization.unit(s),
                 super::quantization_step(self.quantization)
             );
         }
