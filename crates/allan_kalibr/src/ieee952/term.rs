@@ -42,7 +42,7 @@ pub enum AvarBasis {
     /// A power law of τ alone: the basis function g(τ), AVAR = c·g(τ).
     PowerLaw(fn(f64) -> f64),
     /// A shape with parameters of its own (the Gauss–Markov time, a line's frequency and
-    /// width): [`crate::ieee952::fit::basis_at`] evaluates it with the fit's shapes.
+    /// width): `fit::basis_at` evaluates it with the fit's shapes.
     Shaped,
 }
 
@@ -249,7 +249,7 @@ impl NoiseTerm {
     }
 
     /// Its power-law Allan variance per unit coefficient at τ (0 for a shaped term, whose
-    /// basis needs its shape: [`crate::ieee952::fit::basis_at`]).
+    /// basis needs its shape: `fit::basis_at`).
     pub fn power_law_avar(self, tau: f64) -> f64 {
         match self.facts().avar {
             AvarBasis::PowerLaw(g) => g(tau),
