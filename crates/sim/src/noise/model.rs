@@ -375,9 +375,9 @@ impl AxisModel {
     /// `output_rate` Hz); `at` names sensor, axis and field in the error.
     fn validate(&self, output_rate: f64, at: FieldError<'_>) -> Result<()> {
         for (field, v) in [
-            ("white_noise", self.white_noise),
-            ("random_walk", self.random_walk),
-            ("quantization", self.quantization),
+            (NoiseTerm::WhiteNoise.name(), self.white_noise),
+            (NoiseTerm::RandomWalk.name(), self.random_walk),
+            (NoiseTerm::Quantization.name(), self.quantization),
             ("resolution", self.resolution),
         ] {
             if !(v.is_finite() && v >= 0.0) {
@@ -386,7 +386,7 @@ impl AxisModel {
         }
         if !self.rate_ramp.is_finite() {
             return Err(at(
-                "rate_ramp",
+                NoiseTerm::Ramp.name(),
                 format!("must be finite, got {}", self.rate_ramp),
             ));
         }
@@ -396,7 +396,7 @@ impl AxisModel {
         for gm in &self.gauss_markov {
             if !(gm.sigma.is_finite() && gm.sigma >= 0.0 && gm.tau.is_finite() && gm.tau > 0.0) {
                 return Err(at(
-                    "gauss_markov",
+                    NoiseTerm::GaussMarkov.name(),
                     format!(
                         "sigma must be >= 0 and tau > 0 s, got sigma {} tau {}",
                         gm.sigma, gm.tau
@@ -498,7 +498,7 @@ impl BiasInstability {
         let min_tau = MIN_TAU_SAMPLES / output_rate;
         if !(self.b.is_finite() && self.b >= 0.0) {
             return Err(at(
-                "bias_instability",
+                NoiseTerm::BiasInstability.name(),
                 format!("B must be a non-negative number, got {}", self.b),
             ));
         }
@@ -508,7 +508,7 @@ impl BiasInstability {
             && self.tau_hi > self.tau_lo)
         {
             return Err(at(
-                "bias_instability",
+                NoiseTerm::BiasInstability.name(),
                 format!(
                     "corner times must satisfy {min_tau} s ({} output samples) <= tau_lo < tau_hi, got {} .. {}",
                     MIN_TAU_SAMPLES, self.tau_lo, self.tau_hi
@@ -532,7 +532,7 @@ impl Line {
             && self.bandwidth < self.frequency)
         {
             return Err(at(
-                "lines",
+                NoiseTerm::Line(0).name(),
                 format!(
                     "a line needs 0 < frequency < {} Hz (half the output rate), amplitude >= 0 and 0 <= bandwidth < frequency (lightly damped), got frequency {} Hz, amplitude {}, bandwidth {} Hz",
                     0.5 * output_rate,
