@@ -30,10 +30,11 @@ fi
 # The independent readers the cross-checks run, pinned (bag2mat::test_tools finds them
 # here): the ROS 2 implementations; for the logs from outside ROS pyulog (ULog, also its
 # writer), pymavlink's DFReader (DataFlash) and pandas/numpy (CSV layouts); allantools (the
-# IEEE 952 curve against its oadev).
+# IEEE 952 curve against its oadev); GTSAM's Python bindings (the GTSAM file read back through
+# PreintegrationCombinedParams' setters and getters).
 venv=target/py-venv
-pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6)
-if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools" >/dev/null 2>&1 \
+pins=(rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 pyulog==1.3.0 pymavlink==2.4.50 pandas==3.1.1 numpy==2.4.6 allantools==2024.6 gtsam==4.3.0)
+if ! "$venv/bin/python" -c "import rosbags, mcap, mcap_ros2, pyulog, pymavlink, pandas, numpy, allantools, gtsam" >/dev/null 2>&1 \
    || [ "$("$venv/bin/python" -m pip freeze 2>/dev/null | grep -icxF "$(printf '%s\n' "${pins[@]}")")" != ${#pins[@]} ]; then
   echo "installing ${pins[*]} into $venv"
   /usr/bin/python3 -m venv "$venv"
@@ -56,20 +57,29 @@ cargo test --workspace "$@"
 # → 400 Hz through low-pass corners 0.05–0.45 of the output rate, one of them via a .mat).
 # Issue 17's line study (a line from 0.002 to 0.45 of the rate, 3× and 10× the floor, 3 seeds)
 # runs beside them, issue 40's coverage study (126 axes of known truth: how often each
-# interval, bound and band holds it; about a minute) and issue 42's coverage count of the
-# operating-noise interval (80 seeded hand-held records with a reference, through the
-# allan_kalibr binary: 249 s measured on two cores shared with other builds).
+# interval, bound and band holds it; about a minute), `allan_kalibr plan` against the
+# analysis' advice on four simulated sensors × 5 seeds (issue 43), and issue 42's coverage
+# count of the operating-noise interval (80 seeded hand-held records with a reference,
+# through the allan_kalibr binary: 249 s measured on two cores shared with other builds).
 cargo test -p allan_kalibr --test main -- --ignored --exact \
   studies::profiles::profiles_study studies::bandlimited::bandlimited_study \
   studies::lines::lines_study studies::coverage::coverage_study \
-  studies::operating::operating_interval_coverage_study
+  studies::plan::plan_study studies::operating::operating_interval_coverage_study
 
-# Issues 12 and 19's seeded corruption campaign (300 variants per input format — ROS 1, MCAP
-# with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml edits,
-# and files written by rosbags and Foxglove's writer — through the real bag2mat binary, each
-# under an address-space limit and a timeout; rows compared by value with the generator's);
-# its last line gives the counts per format, and any panic, hang, memory blow-up, silent or
-# under-counted loss, or Foxglove's reader recovering more than bag2mat fails the run.
+# The warm-up detector's power study (issue 41): detections of drifts of 6–14 σ of the
+# detection window's mean, time constants of one window to an eighth of the record, and false
+# alarms on drift-free white noise and random walk, from 10 min to 24 h (a few minutes).
+cargo test -p bag2mat --test main -- --ignored --exact warmup_power::warmup_power_study
+
+# Issues 12, 19 and 45's seeded corruption campaign (300 variants per input format — ROS 1,
+# MCAP with its summary and cut short, sqlite3 bare and in its bag directory, metadata.yaml
+# edits, files written by rosbags and Foxglove's writer, and the logs from outside ROS: ULog
+# with and without sync markers, DataFlash IMU and batch samples, CSV, EuRoC, npy — through
+# the real bag2mat binary, each under an address-space limit and a timeout; rows compared by
+# value with the generator's, and for the logs with pyulog's, DFReader's, pandas' or numpy's
+# read of the same variant); its last line gives the counts per format, and any panic, hang,
+# memory blow-up, silent, under-counted or (MCAP, logs) false loss, a refusal of a log the
+# independent reader reads, or an independent reader recovering more than bag2mat fails it.
 cargo build -q -p bag2mat --bin bag2mat --example fuzz_campaign
 "$(cargo metadata --format-version 1 --no-deps | /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')/debug/examples/fuzz_campaign"
 

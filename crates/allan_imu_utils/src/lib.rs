@@ -53,4 +53,4 @@ pub use estimator::{allan_variance, mean_period, thetas};
 pub use factors::factors;
 pub use fit::AxisFit;
 pub use fit::dogleg::{Summary as DoglegSummary, Termination as DoglegTermination};
-pub use run::{CurvesOutcome, Outcome, run, run_curves, sections};
+pub use run::{CurvesOutcome, Outcome, TopicRun, run, run_curves, run_topics, sections};

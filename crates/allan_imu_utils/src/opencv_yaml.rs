@@ -107,9 +107,27 @@ fn push_block(out: &mut String, b: &Block<'_>) {
     }
 }
 
-/// The yaml text for `mode`.
-pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode) -> String {
-    let mut out = String::from("%YAML:1.0\n---\ntype: IMU\n");
+/// What the continuous file (this project's, not upstream's) says besides the fit: `#`
+/// lines after its `---` (the tool, version, input and time, caveats) and the record's rate.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Extra {
+    /// Comment lines.
+    pub comments: Vec<String>,
+    /// The record's rate, Hz (the stamps' nominal rate, not imu_utils' mean period).
+    pub rate: Option<f64>,
+}
+
+/// The yaml text for `mode`: upstream's file as upstream writes it; the continuous one with
+/// `extra` (its `update_rate` the record's rate, else imu_utils' own).
+pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode, extra: &Extra) -> String {
+    let comments = &extra.comments;
+    let mut out = String::from("%YAML:1.0\n---\n");
+    if mode == YamlMode::Continuous {
+        for c in comments {
+            let _ = writeln!(out, "# {c}");
+        }
+    }
+    out.push_str("type: IMU\n");
     let _ = writeln!(out, "name: {}", string(name));
     let blocks = match mode {
         YamlMode::Compat => {
@@ -141,7 +159,11 @@ pub fn yaml_text(an: &Analysis, name: &str, mode: YamlMode) -> String {
                 out,
                 "convention: \"continuous-time noise densities (Kalibr / OpenVINS / ORB-SLAM3); fit of imu_utils read as |N|, sqrt(3)|K|, |B|/0.664\""
             );
-            let _ = writeln!(out, "update_rate: {}", real(an.axes[0].freq));
+            let _ = writeln!(
+                out,
+                "update_rate: {}",
+                real(extra.rate.unwrap_or(an.axes[0].freq))
+            );
             let v = |base: usize| {
                 [0, 1, 2].map(|k| {
                     let f = &an.fits[base + k];
@@ -203,6 +225,41 @@ mod tests {
         assert_eq!(string(" rad/s"), "\" rad/s\"");
         assert_eq!(string("a:b"), "\"a:b\"");
         assert_eq!(string(""), "\"\"");
+    }
+
+    /// The continuous file's numbers, OpenCV's `%.16e`, read back by OpenCV itself
+    /// (`cv2.FileStorage`, what VINS-style loaders use) bit for bit, from 1e-12 to 1e3, with
+    /// the file's `#` comment lines after its `---`.
+    #[test]
+    fn opencv_reads_the_continuous_numbers_from_1e_12_to_1e3() {
+        let mut values = vec![1e-12, 1e3, 200.0, 1.0];
+        let mut x = 1.3e-12_f64;
+        while x < 1e3 {
+            values.push(x * std::f64::consts::E);
+            x *= 9.7;
+        }
+        let mut text = String::from("%YAML:1.0\n---\n# a comment line, as the file has\n");
+        for (i, v) in values.iter().enumerate() {
+            text.push_str(&format!("v{i}: {}\n", real(*v)));
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("c.yaml");
+        std::fs::write(&f, text).unwrap();
+        let o = std::process::Command::new("/usr/bin/python3")
+            .arg("-c")
+            .arg(format!(
+                "import cv2; fs = cv2.FileStorage('{}', cv2.FILE_STORAGE_READ); print(' '.join(repr(fs.getNode('v%d' % i).real()) for i in range({})))",
+                f.display(),
+                values.len()
+            ))
+            .output()
+            .expect("python3 with OpenCV (scripts/test.sh installs it)");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let got: Vec<f64> = String::from_utf8_lossy(&o.stdout)
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(got, values);
     }
 
     /// Quirk 12: the leading space of upstream's unit strings makes OpenCV quote them.

@@ -8,6 +8,7 @@ use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 use rayon::prelude::*;
 
+use allan_kalibr::consumers::{Provenance, RecordRate, input_text};
 use allan_kalibr::{
     CurveData, CurvePoint, ImuAnalysis, Overlap, Section, analyse_imu_curves, ieee952_summary_text,
     read_curves, write_ieee952_files,
@@ -125,10 +126,29 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
         return Ok(vec![run_curves(config, outputs)?.section]);
     }
-    Ok(run(config, outputs)?
+    let topics = run_topics(config, outputs)?;
+    let several = topics.len() > 1;
+    topics
         .into_iter()
-        .map(|o| o.section)
-        .collect())
+        .map(|t| match t.result {
+            Ok(o) => Ok(o.section),
+            // one topic of several: said as its error, the others still written (the rule
+            // allan_kalibr follows too)
+            Err(e) if several => Ok(allan_kalibr::topic_failed(&t.topic, t.notes, &e)),
+            Err(e) => Err(e),
+        })
+        .collect()
+}
+
+/// One topic's outcome in a run of several ([`run_topics`]).
+#[derive(Debug)]
+pub struct TopicRun {
+    /// The topic.
+    pub topic: String,
+    /// What its reader said (repeated for a topic that failed, whose section has no other).
+    pub notes: Vec<Note>,
+    /// Its analysis, or why it failed.
+    pub result: Result<Outcome, Error>,
 }
 
 impl allan_kalibr::Job for Config {
@@ -139,12 +159,43 @@ impl allan_kalibr::Job for Config {
     fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
         sections(self, outputs)
     }
+    fn output_names(&self) -> Vec<String> {
+        output_names(&self.name)
+    }
+}
+
+/// Every file a run of allan_imu_utils with IMU name `name` may write into an output folder
+/// (another name's files are another IMU's, kept: imu_utils' `data_save_path` holds several).
+pub fn output_names(name: &str) -> Vec<String> {
+    let mut v = Vec::new();
+    for sensor in ["gyr", "acc"] {
+        for part in ["t", "x", "y", "z"] {
+            v.push(format!("data_{name}_sim_{sensor}_{part}.txt"));
+            v.push(format!("data_{name}_{sensor}_{part}.txt"));
+        }
+        for ext in ["png", "svg"] {
+            v.push(format!("allan_{sensor}.{ext}"));
+        }
+    }
+    v.push(YamlMode::Compat.file_name(name));
+    v.push(YamlMode::Continuous.file_name(name));
+    v.extend(allan_kalibr::ieee952_file_names(&format!("{name}_")));
+    v
 }
 
 /// Runs the whole pipeline for `config` (a bag; see [`run_curves`] for `--curves`): every
 /// selected topic is read in one pass and analysed on its own. With one topic the outputs go
 /// into `out_dir`; with several, into `out_dir/<topic folder>`; every file among `outputs`.
 pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<Outcome>, Error> {
+    run_topics(config, outputs)?
+        .into_iter()
+        .map(|t| t.result)
+        .collect()
+}
+
+/// [`run`] with each topic's outcome on its own: a topic that fails does not stop the
+/// others (what the binary does with a run of several topics).
+pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, Error> {
     let t0 = Instant::now();
     let read = bag2mat::read_imu_topics_with(
         config.common.samples_path(),
@@ -165,7 +216,13 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<Outcome>, Error> {
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        outs.push(run_series(&c, series, read_time, outputs)?);
+        let topic = series.topic.clone();
+        let notes = bag2mat::shared::note::warnings(&series.notes);
+        outs.push(TopicRun {
+            topic,
+            notes,
+            result: run_series(&c, series, read_time, outputs),
+        });
     }
     Ok(outs)
 }
@@ -180,20 +237,29 @@ fn run_series(
     let mut timings: Vec<(&str, Duration)> = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
     let mut notes = bag2mat::shared::note::warnings(&series.notes);
+    // integrated deltas far apart are no samples to analyse
+    series.check_integration()?;
     let absent = stand_in_and_skip(config, &mut series, &mut notes)?;
     let collected = collect::collect(&series, config.max_time_min, config.common.time);
-    notes.extend(end_of_bag_note(&collected, config));
-    // The record check (bag2mat::check_record) on the collected messages: duplicates, a
-    // clock that steps back and a record that is not one continuous stretch are cut, spikes
-    // dropped when asked; what the record breaks of the analysis' assumptions is found.
+    notes.extend(stop_note(&collected, &series, config));
     let (n, stop) = (collected.len(), collected.stop);
     drop(collected);
+    // The record check (bag2mat::check_record) on the whole record: duplicates, a clock
+    // that steps back and a record that is not one continuous stretch are cut, spikes
+    // dropped when asked; what the record breaks of the analysis' assumptions is found.
     let t1 = Instant::now();
-    let mut check = check_record(&series, n, config);
+    let whole_n = series.len();
+    let mut check = check_record(&series, whole_n, config);
     bag2mat::drop_absent(&mut check.findings, absent);
     timings.push(("record_check", t1.elapsed()));
-    let series = kept_series(series, &check, n, absent);
-    let collected = collect::Collected::first(&series, series.len(), config.common.time, stop);
+    let series = kept_series(series, &check, whole_n, absent);
+    // The upstream-compatible part: the kept messages among the first `n`, where imu_utils'
+    // stop rule (max_time_min) ends its collection.
+    let n_compat = match &check.keep {
+        bag2mat::KeepRows::All => n,
+        bag2mat::KeepRows::Rows(rows) => rows.partition_point(|&i| i < n),
+    };
+    let collected = collect::Collected::first(&series, n_compat, config.common.time, stop);
     analysis::check_enough(&collected, config.max_cluster)?;
     check_values(&collected, absent, &mut notes)?;
     let t1 = Instant::now();
@@ -201,8 +267,56 @@ fn run_series(
         analysis::allan_step(&collected, config.max_cluster, config.common.ieee952)?;
     timings.push(("allan", t1.elapsed()));
     let t1 = Instant::now();
-    let ieee = ieee952_section(config, &check, &axes, &collected, absent, &mut notes);
+    let section_rate = check
+        .rate
+        .map(allan_kalibr::snap_rate)
+        .unwrap_or(axes[0].freq);
+    // This tool's own section uses the whole record: past the stop rule, the Allan step runs
+    // again on every kept message.
+    let ieee = if n_compat < series.len() && config.common.ieee952 && check.refusal().is_none() {
+        let all = collect::Collected::first(&series, series.len(), config.common.time, stop);
+        check_values(&all, absent, &mut Vec::new())?;
+        let (all_axes, _) = analysis::allan_step(&all, config.max_cluster, true)?;
+        ieee952_section(
+            config,
+            &check,
+            &all_axes,
+            &all,
+            absent,
+            section_rate,
+            &mut notes,
+        )
+    } else {
+        ieee952_section(
+            config,
+            &check,
+            &axes,
+            &collected,
+            absent,
+            section_rate,
+            &mut notes,
+        )
+    };
     timings.push(("ieee952", t1.elapsed()));
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), Some(&topic)),
+        RecordRate::Measured(section_rate),
+    );
+    let motion = check.refusal().map(allan_kalibr::refusal_text);
+    if let Some(m) = &motion {
+        notes.push(Note::warning(format!(
+            "{} not written: the record breaks the analysis' assumptions ({m}); imu_utils' own {} is written as upstream writes it, but its numbers describe this record, not the IMU's noise",
+            YamlMode::Continuous.file_name(&config.name),
+            YamlMode::Compat.file_name(&config.name)
+        )));
+    }
+    let caveats: Vec<String> = check
+        .findings
+        .iter()
+        .filter(|f| f.level >= bag2mat::FindingLevel::Warning)
+        .map(|f| format!("RECORD CHECK: {}; the values below carry it.", f.short()))
+        .collect();
     drop(collected);
     drop(series);
     let t1 = Instant::now();
@@ -216,7 +330,17 @@ fn run_series(
     };
     timings.push(("fit", t1.elapsed()));
     let t2 = Instant::now();
-    let files = write_outputs(outputs, &analysis, ieee.as_ref(), config, &topic)?;
+    let files = write_outputs(
+        outputs,
+        &analysis,
+        ieee.as_ref(),
+        config,
+        &topic,
+        &Continuous {
+            prov: &prov,
+            caveats: (motion.is_none()).then_some(caveats),
+        },
+    )?;
     timings.push(("write_outputs", t2.elapsed()));
     let ieee952_text = ieee
         .as_ref()
@@ -232,6 +356,7 @@ fn run_series(
             .iter()
             .map(|(phase, d)| format!("timing {phase} {:.3} s", d.as_secs_f64()))
             .collect(),
+        error: None,
     };
     Ok(Outcome {
         section,
@@ -262,19 +387,44 @@ fn stand_in_and_skip(
     Ok(absent)
 }
 
-/// imu_utils' own words on stderr (the reference runs' stderr.txt) when the bag ended
-/// before `max_time_min`.
-fn end_of_bag_note(collected: &collect::Collected, config: &Config) -> Option<Note> {
-    (collected.stop == Stop::EndOfBag).then(|| {
-        Note::upstream_warning(
+/// What the stop rule did. The bag ended before `max_time_min` (every record shorter than
+/// it): imu_utils' own words (the reference runs' stderr.txt), said as information — every
+/// ordinary run prints it, so it is no warning. The rule fired: a warning, since the
+/// upstream-compatible part then leaves the rest of the record out (the IEEE 952 section
+/// uses all of it).
+fn stop_note(
+    collected: &collect::Collected,
+    series: &bag2mat::ImuSeries,
+    config: &Config,
+) -> Option<Note> {
+    match collected.stop {
+        Stop::EndOfBag => Some(Note::upstream_info(
             "WARNING: ",
             format!(
-            "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
-            collected.len(),
-            config.max_time_min
-        ),
-        )
-    })
+                "bag ended after {} messages before max_time_min ({}) was exceeded; the ROS node would wait forever. Processing what was read.",
+                collected.len(),
+                config.max_time_min
+            ),
+        )),
+        Stop::Fired { .. } => {
+            let t = series.time(config.common.time);
+            let minutes = |k: usize| (t[k].to_sec() - t[0].to_sec()) / 60.0;
+            let (used, total) = (minutes(collected.len() - 1), minutes(series.len() - 1));
+            let section = if config.common.ieee952 {
+                "; the IEEE 952 section and its record-length advice use the whole record"
+            } else {
+                ""
+            };
+            Some(Note::warning(format!(
+                "max_time_min {}: imu_utils stops at the first stamp past it, so the upstream-compatible part (its report, {name}_imu_param.yaml, {name}_imu_param_continuous.yaml, the data_{name}_*.txt curves and plots) uses the first {used:.1} min ({} of {} messages) of this {total:.1} min record (--max-time-min {} uses all of it){section}",
+                config.max_time_min,
+                collected.len(),
+                series.len(),
+                total.floor() as u64 + 1,
+                name = config.name,
+            )))
+        }
+    }
 }
 
 /// The messages of the first `n` that the record check keeps; for a one-sensor topic the
@@ -307,12 +457,9 @@ fn ieee952_section(
     axes: &[AxisAllan],
     collected: &collect::Collected,
     absent: Option<Sensor>,
+    section_rate: f64,
     notes: &mut Vec<Note>,
 ) -> Option<ImuAnalysis> {
-    let section_rate = check
-        .rate
-        .map(allan_kalibr::snap_rate)
-        .unwrap_or(axes[0].freq);
     if let (true, Some(r)) = (config.common.ieee952, check.refusal()) {
         notes.push(Note::warning(format!(
             "IEEE 952 section not computed: the record breaks its assumptions ({})",
@@ -403,6 +550,53 @@ fn section(
     an
 }
 
+/// What `<name>_imu_param_continuous.yaml` (this project's file) is written with: the files'
+/// provenance, and the record check's caveats — `None` when the record is not fit for a
+/// noise analysis at all (a moving record), and the file is not written.
+struct Continuous<'a> {
+    prov: &'a Provenance,
+    caveats: Option<Vec<String>>,
+}
+
+impl Continuous<'_> {
+    /// The record's rate the files state.
+    fn rate(&self) -> Option<f64> {
+        self.prov.rate.hz()
+    }
+}
+
+/// Writes imu_utils' two yaml files: upstream's as upstream writes it, the continuous one
+/// as `c` says; returns the paths.
+fn write_yaml_files(
+    outputs: &Outputs,
+    analysis: &Analysis,
+    config: &Config,
+    c: &Continuous<'_>,
+) -> Result<Vec<PathBuf>, Error> {
+    let mut files = Vec::new();
+    for mode in [YamlMode::Compat, YamlMode::Continuous] {
+        let caveats = match (mode, &c.caveats) {
+            (YamlMode::Compat, _) => Vec::new(),
+            (YamlMode::Continuous, Some(v)) => v.clone(),
+            (YamlMode::Continuous, None) => continue,
+        };
+        let mut comments = vec![c.prov.line(), c.prov.rate_line()];
+        comments.extend(caveats);
+        let extra = opencv_yaml::Extra {
+            comments,
+            rate: c.rate(),
+        };
+        let p = config.common.out_dir.join(mode.file_name(&config.name));
+        report::write_text(
+            outputs,
+            &p,
+            &opencv_yaml::yaml_text(analysis, &config.name, mode, &extra),
+        )?;
+        files.push(p);
+    }
+    Ok(files)
+}
+
 /// imu_utils' files (curves, both yaml modes, plots) and the section's.
 fn write_outputs(
     outputs: &Outputs,
@@ -410,19 +604,12 @@ fn write_outputs(
     ieee: Option<&ImuAnalysis>,
     config: &Config,
     topic: &str,
+    c: &Continuous<'_>,
 ) -> Result<Vec<PathBuf>, Error> {
     outputs.ensure_dir(&config.common.out_dir)?;
     let mut files =
         report::write_curve_files(outputs, analysis, &config.name, &config.common.out_dir)?;
-    for mode in [YamlMode::Compat, YamlMode::Continuous] {
-        let p = config.common.out_dir.join(mode.file_name(&config.name));
-        report::write_text(
-            outputs,
-            &p,
-            &opencv_yaml::yaml_text(analysis, &config.name, mode),
-        )?;
-        files.push(p);
-    }
+    files.extend(write_yaml_files(outputs, analysis, config, c)?);
     if config.plots {
         files.extend(plot::write_plots(
             outputs,
@@ -432,7 +619,7 @@ fn write_outputs(
         )?);
     }
     if let Some(an) = ieee {
-        files.extend(write_ieee952(outputs, an, config, topic)?);
+        files.extend(write_ieee952(outputs, an, config, topic, c.prov)?);
     }
     Ok(files)
 }
@@ -443,9 +630,11 @@ fn write_ieee952(
     an: &ImuAnalysis,
     config: &Config,
     rostopic: &str,
+    prov: &Provenance,
 ) -> Result<Vec<PathBuf>, Error> {
     let prefix = format!("{}_", config.name);
-    let mut out = write_ieee952_files(outputs, an, &config.common.out_dir, &prefix, rostopic)?;
+    let mut out =
+        write_ieee952_files(outputs, an, &config.common.out_dir, &prefix, rostopic, prov)?;
     if config.plots {
         let truth = allan_kalibr::find_truth(config.common.samples_path(), an);
         out.extend(allan_kalibr::write_ieee952_chart(
@@ -468,6 +657,11 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
         return Err(Error::Config("no --curves given".into()));
     };
     let c = read_curves(&input.paths, &input.options)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        allan_kalibr::curves_text(&input.paths),
+        allan_kalibr::curves_rate(config.common.rate, &c),
+    );
     let mut notes = Vec::new();
     let mut stdout = String::new();
     let mut files = Vec::new();
@@ -485,15 +679,15 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
             .collect();
         let an = Analysis::from_curves(raw, fits, freq);
         stdout.push_str(&report::fit_text(&an));
-        for mode in [YamlMode::Compat, YamlMode::Continuous] {
-            let p = config.common.out_dir.join(mode.file_name(&config.name));
-            report::write_text(
-                outputs,
-                &p,
-                &opencv_yaml::yaml_text(&an, &config.name, mode),
-            )?;
-            files.push(p);
-        }
+        files.extend(write_yaml_files(
+            outputs,
+            &an,
+            config,
+            &Continuous {
+                prov: &prov,
+                caveats: Some(Vec::new()),
+            },
+        )?);
         analysis = Some(an);
     } else {
         notes.push(Note::info(format!(
@@ -510,7 +704,7 @@ pub fn run_curves(config: &Config, outputs: &Outputs) -> Result<CurvesOutcome, E
     an.notes = vec![format!("curves: {}", c.format)];
     an.notes.extend(c.notes.iter().cloned());
     let rostopic = config.common.named_topic();
-    files.extend(write_ieee952(outputs, &an, config, rostopic)?);
+    files.extend(write_ieee952(outputs, &an, config, rostopic, &prov)?);
     let section = Section {
         notes,
         text: stdout,

@@ -10,10 +10,14 @@
 mod cli;
 mod common;
 mod curves;
+mod files;
 mod fit_reference;
 mod front;
+mod integrated_deltas;
 mod limits_and_messages;
 mod logs;
 mod record_checks;
 mod reference;
 mod ros2;
+mod several_topics;
+mod stop_rule;

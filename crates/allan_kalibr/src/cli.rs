@@ -1,13 +1,17 @@
-//! The command line as the user typed it ([`Args`]) and its resolution into a [`Config`].
+//! The command line as the user typed it ([`Cli`]: an analysis, [`Args`], or one of the
+//! [`Command`]s `check` and `plan`) and its resolution into what runs ([`Run`]: a [`Config`]
+//! for an analysis).
 
-use clap::Parser;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
 
 use crate::front::CommonArgs;
 use crate::kalibr::estimator::Estimator;
 use crate::run::Config;
 
 /// kalibr_allan's Allan-deviation results (rpng/kalibr_allan 9d38ea9), in seconds, without
-/// MATLAB or ROS.
+/// MATLAB or ROS; `allan_kalibr check` and `allan_kalibr plan` (below).
 ///
 /// Reads IMU samples from any input bag2mat reads (ROS 1 and ROS 2 bags, a bagconvert .mat,
 /// EuRoC/ASL, CSV/TSV, PX4 ULog, ArduPilot DataFlash, NumPy), computes the non-overlapping
@@ -18,7 +22,77 @@ use crate::run::Config;
 /// Then the IEEE 952 section (unless --compat-only): terms with 95 % intervals, the fitted
 /// range and fit quality per axis, recording-length advice, record checks, its CSVs and
 /// charts, and kalibr_imu_ieee952.yaml — the file to give Kalibr — with the VINS, ORB-SLAM3,
-/// OpenVINS and Basalt files. With --curves it analyses Allan curves another tool wrote.
+/// OpenVINS, Basalt, PX4 EKF2, ArduPilot EKF3 and GTSAM files. With --curves it analyses Allan
+/// curves another tool wrote.
+///
+/// `allan_kalibr check CONFIG…` says what each noise value of the config files you have is
+/// and what is wrong with it (--against an analysis folder or a log: measured ratios);
+/// `allan_kalibr plan --rate HZ …` plans a record from datasheet figures and converts them
+/// for every consumer. (An input file named `check` or `plan`: give it as ./check.)
+#[derive(Debug, Clone, Parser)]
+#[command(
+    name = "allan_kalibr",
+    version,
+    allow_negative_numbers = true,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Cli {
+    /// `check` or `plan`; none: an analysis.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// The analysis' arguments.
+    #[command(flatten)]
+    pub analyse: Args,
+}
+
+/// allan_kalibr's other commands.
+#[derive(Debug, Clone, Subcommand, PartialEq)]
+pub enum Command {
+    /// Say what each IMU noise value of your config files is (Kalibr imu.yaml or imu_chain,
+    /// OpenVINS, VINS, ORB-SLAM3, Basalt JSON, PX4 .params, ArduPilot .param, GTSAM,
+    /// imu_utils' yaml) and what is wrong with it: one line per key on stdout, exit 0.
+    Check(crate::consumers::check::CheckArgs),
+    /// Plan a static record from an IMU's figures (Kalibr units or datasheet units): the
+    /// record for +-25 % / +-10 % on each term, whether B can be resolved, an honest bound
+    /// on K where the datasheet has none, and every consumer's parameters (-o DIR: files).
+    Plan(crate::consumers::plan::PlanArgs),
+}
+
+/// What a command line runs.
+#[derive(Debug, Clone)]
+pub enum Run {
+    /// An analysis.
+    Analyse(Box<Config>),
+    /// `check`.
+    Check(crate::consumers::check::CheckArgs),
+    /// `plan`.
+    Plan(crate::consumers::plan::PlanArgs),
+}
+
+impl TryFrom<Cli> for Run {
+    type Error = bag2mat::shared::cli::UsageError;
+
+    fn try_from(c: Cli) -> Result<Run, Self::Error> {
+        Ok(match c.command {
+            Some(Command::Check(a)) => Run::Check(a),
+            Some(Command::Plan(a)) => Run::Plan(a),
+            None => Run::Analyse(Box::new(Config::try_from(c.analyse)?)),
+        })
+    }
+}
+
+/// allan_kalibr's `main`: the command line parsed, then the analysis, `check` or `plan`.
+pub fn command_main() -> ExitCode {
+    match crate::front::command_line::<Cli, Run>(TOOL) {
+        Ok(Run::Analyse(config)) => crate::front::run_job(TOOL, config.as_ref()),
+        Ok(Run::Check(a)) => crate::consumers::check::main(&a),
+        Ok(Run::Plan(a)) => crate::consumers::plan::main(&a),
+        Err(code) => code,
+    }
+}
+
+/// The analysis' arguments (`allan_kalibr INPUT …`).
 #[derive(Debug, Clone, Parser, PartialEq)]
 #[command(name = "allan_kalibr", version, allow_negative_numbers = true)]
 pub struct Args {

@@ -3,6 +3,11 @@
 //! [`Common`] settings, and the one [`finish`] that runs a job inside an all-or-none output
 //! stage and says its results, notes, findings and timings the same way for both tools.
 //!
+//! A run leaves in each output folder only its own set of files: files of the tool's names
+//! ([`Job::output_names`]) that an earlier run left there and this run does not write are
+//! removed by the same all-or-none commit, and said (a `warning:` line naming them); files
+//! this run writes replace the earlier run's, said in the "wrote" lines.
+//!
 //! One spelling for both tools: `-o/--out-dir` (kalibr_allan's `--outdir` and imu_utils'
 //! `data_save_path` as aliases), `--rate` (`--update-rate` as alias). A flag that would do
 //! nothing for the input is an error, never ignored. Results go to a folder of their own
@@ -95,7 +100,7 @@ pub struct CommonArgs {
 }
 
 /// `--rate`: a positive number of Hz within [`MIN_RATE_HZ`, `MAX_RATE_HZ`].
-fn rate_hz(s: &str) -> Result<f64, cli::UsageError> {
+pub(crate) fn rate_hz(s: &str) -> Result<f64, cli::UsageError> {
     let v = cli::positive_f64(s)?;
     if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&v) {
         return Err(cli::UsageError(format!(
@@ -212,8 +217,13 @@ pub(crate) fn default_topics() -> bag2mat::TopicSelector {
 }
 
 /// The default output folder of `tool` for `input`: `<stem>_<tool>` beside it (a bag
-/// directory's or curves directory's name stands for the stem), never the data folder.
+/// directory's or curves directory's name stands for the stem), never the data folder; for
+/// an input inside an EuRoC/ASL dataset, beside the dataset's root
+/// ([`bag2mat::euroc_output_base`]: `MH_01_easy_imu0_<tool>` for `MH_01_easy/mav0/imu0`).
 pub(crate) fn default_out_dir(input: &Path, tool: &str) -> PathBuf {
+    if let Some((parent, stem)) = bag2mat::euroc_output_base(input) {
+        return parent.join(format!("{stem}_{tool}"));
+    }
     let input = if input.file_name().is_some_and(|n| n == "metadata.yaml") {
         input.parent().unwrap_or(Path::new("."))
     } else {
@@ -311,6 +321,14 @@ pub fn rate_for_text(input: Option<&Path>, rate: Option<f64>) -> Option<f64> {
     rate.filter(|_| text)
 }
 
+/// Why a record the check refuses gets no IEEE 952 section, for the files' words: the
+/// finding in short and its first clause ("motion (1.2e1 m/s^2, …): the IMU is not static:
+/// in 120 of 120 windows …").
+pub fn refusal_text(f: &Finding) -> String {
+    let first = f.text.split(';').next().unwrap_or("").trim();
+    format!("{}: {first}", f.short())
+}
+
 /// What a run says about one topic (or about the curves it read).
 #[derive(Debug, Default)]
 pub struct Section {
@@ -328,33 +346,68 @@ pub struct Section {
     pub written: Vec<PathBuf>,
     /// Phase timings, one line each (with --timings).
     pub timings: Vec<String>,
+    /// Why this topic could not be analysed, when the run read several and this one failed
+    /// ([`topic_failed`]): said once as an error, the other topics still written.
+    pub error: Option<String>,
+}
+
+/// The section of a topic that failed in a run of several topics: its reader's `notes`
+/// and the error (the run goes on with the other topics, and exits 1).
+pub fn topic_failed(topic: &str, notes: Vec<Note>, error: &dyn std::fmt::Display) -> Section {
+    Section {
+        topic: Some(topic.to_string()),
+        notes,
+        error: Some(error.to_string()),
+        ..Section::default()
+    }
 }
 
 /// A tool's settings as the front end runs them: the shared part, and the job that turns
 /// them into sections.
 pub trait Job {
-    /// The job's error (said once, at the end of [`main`]).
+    /// The job's error (said once by `finish`).
     type Error: std::fmt::Display;
     /// The settings both analysers share.
     fn common(&self) -> &Common;
     /// The whole job, every file among `outputs`.
     fn sections(&self, outputs: &output::Outputs) -> Result<Vec<Section>, Self::Error>;
+    /// The names of every file a run of the tool may write into an output folder: what an
+    /// earlier run of it left there and this run does not write is removed at the commit.
+    fn output_names(&self) -> Vec<String>;
 }
 
 /// A tool's whole `main`: the worker threads started, the arguments `A` parsed and resolved
-/// into the settings `C`, the job run inside its output stage and said (`finish`).
+/// into the settings `C` ([`command_line`]), the job run inside its output stage and said
+/// ([`run_job`]).
 pub fn main<A, C>(tool: &str) -> ExitCode
 where
     A: clap::Parser,
     C: Job + TryFrom<A>,
     <C as TryFrom<A>>::Error: std::fmt::Display,
 {
+    match command_line::<A, C>(tool) {
+        Ok(config) => run_job(tool, &config),
+        Err(code) => code,
+    }
+}
+
+/// The worker threads started, the arguments `A` parsed and resolved into the settings `C`;
+/// or the exit code of `--help`/`--version` (0) or of a command line that cannot be run (2).
+pub fn command_line<A, C>(tool: &str) -> Result<C, ExitCode>
+where
+    A: clap::Parser,
+    C: TryFrom<A>,
+    <C as TryFrom<A>>::Error: std::fmt::Display,
+{
     bag2mat::shared::alloc::start_threads(tool);
-    let config = match parse::<A, C, _>(tool, C::try_from) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
-    finish(tool, config.common(), |outputs| config.sections(outputs))
+    parse::<A, C, _>(tool, C::try_from)
+}
+
+/// Runs the job `config` inside its output stage and says what it found (`finish`).
+pub fn run_job<C: Job>(tool: &str, config: &C) -> ExitCode {
+    finish(tool, config.common(), &config.output_names(), |outputs| {
+        config.sections(outputs)
+    })
 }
 
 /// Parses the tool's arguments into its settings: `--help`/`--version` print and exit 0,
@@ -374,14 +427,72 @@ fn parse<A: clap::Parser, C, E: std::fmt::Display>(
     resolve(args).map_err(|e| cli::usage(tool, &e.to_string()))
 }
 
+/// The files of the tool's `names` in the folders a run writes into (`out_dir` and each
+/// written file's folder) that the run does not write: an earlier run's, to retire.
+fn stale_files(out_dir: &Path, sections: &[Section], names: &[String]) -> Vec<PathBuf> {
+    let written: Vec<&PathBuf> = sections.iter().flat_map(|s| s.written.iter()).collect();
+    let mut folders: Vec<PathBuf> = vec![out_dir.to_path_buf()];
+    for p in &written {
+        let dir = p.parent().unwrap_or(Path::new("")).to_path_buf();
+        if !folders.contains(&dir) {
+            folders.push(dir);
+        }
+    }
+    let mut stale = Vec::new();
+    for dir in &folders {
+        for n in names {
+            let p = dir.join(n);
+            let is_file = std::fs::symlink_metadata(&p).is_ok_and(|m| m.file_type().is_file());
+            if is_file && !written.iter().any(|w| **w == p) {
+                stale.push(p);
+            }
+        }
+    }
+    stale
+}
+
+/// "removed 2 files an earlier run left in DIR/ (this run does not write them): a, b", one
+/// line per folder.
+fn removed_lines(removed: &[PathBuf]) -> Vec<String> {
+    let mut folders: Vec<(&Path, Vec<String>)> = Vec::new();
+    for p in removed {
+        let dir = p.parent().unwrap_or(Path::new(""));
+        let name = p.file_name().map_or_else(
+            || p.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        match folders.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, names)) => names.push(name),
+            None => folders.push((dir, vec![name])),
+        }
+    }
+    folders
+        .into_iter()
+        .map(|(dir, names)| {
+            let files = if names.len() == 1 { "file" } else { "files" };
+            format!(
+                "removed {} {files} an earlier run left in {}/ (this run does not write them; they described another run): {}",
+                names.len(),
+                dir.display(),
+                names.join(", ")
+            )
+        })
+        .collect()
+}
+
 /// Runs `job` with its outputs staged (all of them or none are put in place, never over an
-/// input: [`output::Outputs::staged`]), then says
+/// input: [`output::Outputs::staged`]), retiring with them the files of the tool's `names`
+/// an earlier run left in the run's folders and this run does not write; then says
 /// what it found: per section its notes (warnings always, information without --quiet),
-/// the record check's findings, the results on stdout, the files written and the timings.
-/// The exit code: 0, or 1 with the error said once.
+/// the record check's findings, the results on stdout, the files written (and replaced), the
+/// files removed, and the timings. The exit code: 0, or 1 with the error said once. A run
+/// of several topics in which a topic failed ([`Section::error`]) writes the others, says
+/// that topic's error once in its place (`<tool>: error: topic '<topic>': …`) and exits 1:
+/// the same rule in both tools.
 fn finish<E: std::fmt::Display>(
     tool: &str,
     common: &Common,
+    names: &[String],
     job: impl FnOnce(&output::Outputs) -> Result<Vec<Section>, E>,
 ) -> ExitCode {
     let mut outputs = output::Outputs::staged();
@@ -393,16 +504,44 @@ fn finish<E: std::fmt::Display>(
         Ok(s) => s,
         Err(e) => return cli::fail(tool, &e),
     };
+    let mut removed = Vec::new();
+    for p in stale_files(&common.out_dir, &sections, names) {
+        // an input is never removed (nor written): it is left as it is
+        if outputs.remove_at_commit(&p).is_ok() {
+            removed.push(p);
+        }
+    }
+    let replaced: Vec<PathBuf> = sections
+        .iter()
+        .flat_map(|s| s.written.iter())
+        .filter(|p| p.exists())
+        .cloned()
+        .collect();
     if let Err(e) = outputs.commit() {
         return cli::fail(tool, &e);
     }
+    for line in removed_lines(&removed) {
+        eprintln!("{}", Note::warning(line).line());
+    }
     let several = sections.iter().filter(|s| s.topic.is_some()).count() > 1;
     let mut printing = true;
+    let mut failed = false;
     for s in &sections {
         for n in &s.notes {
             if n.is_warning() || !common.quiet {
                 eprintln!("{}", n.line());
             }
+        }
+        if let Some(e) = &s.error {
+            failed = true;
+            // the topic named once: most errors about a topic name it already
+            let topic = bag2mat::escape_printable(s.topic.as_deref().unwrap_or(""));
+            if e.contains(&format!("'{topic}'")) {
+                eprintln!("{tool}: error: {e}");
+            } else {
+                eprintln!("{tool}: error: topic '{topic}': {e}");
+            }
+            continue;
         }
         let topic = s.topic.as_deref().filter(|_| several);
         for f in &s.findings {
@@ -421,7 +560,7 @@ fn finish<E: std::fmt::Display>(
             }
         }
         if !common.quiet {
-            for line in wrote_lines(&s.written) {
+            for line in wrote_lines(&s.written, &replaced) {
                 eprintln!("{line}");
             }
         }
@@ -434,11 +573,16 @@ fn finish<E: std::fmt::Display>(
     if common.timings {
         eprintln!("timing total {:.3} s", started.elapsed().as_secs_f64());
     }
-    ExitCode::SUCCESS
+    if failed {
+        ExitCode::from(cli::EXIT_FAILURE)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
 
-/// "wrote N files to DIR/: a, b, …", one line per folder, in the order written.
-fn wrote_lines(written: &[PathBuf]) -> Vec<String> {
+/// "wrote N files to DIR/: a, b, …", one line per folder, in the order written; "(K of
+/// them replacing an earlier run's)" when files of these names were there before.
+fn wrote_lines(written: &[PathBuf], replaced: &[PathBuf]) -> Vec<String> {
     let mut folders: Vec<(&Path, Vec<String>)> = Vec::new();
     for p in written {
         let dir = p.parent().unwrap_or(Path::new(""));
@@ -454,14 +598,23 @@ fn wrote_lines(written: &[PathBuf]) -> Vec<String> {
     folders
         .into_iter()
         .map(|(dir, names)| {
+            let again = replaced
+                .iter()
+                .filter(|p| p.parent().unwrap_or(Path::new("")) == dir)
+                .count();
             let dir = if dir.as_os_str().is_empty() {
                 ".".to_string()
             } else {
                 dir.display().to_string()
             };
             let files = if names.len() == 1 { "file" } else { "files" };
+            let again = match again {
+                0 => String::new(),
+                k if k == names.len() => " (replacing an earlier run's)".to_string(),
+                k => format!(" ({k} of them replacing an earlier run's)"),
+            };
             format!(
-                "wrote {} {files} to {dir}/: {}",
+                "wrote {} {files} to {dir}/{again}: {}",
                 names.len(),
                 names.join(", ")
             )
@@ -500,15 +653,50 @@ mod tests {
         );
     }
 
+    /// An EuRoC/ASL dataset's IMU (its data.csv, its folder, or mav0) is analysed into a
+    /// folder beside the dataset, never inside its tree.
+    #[test]
+    fn a_euroc_dataset_s_output_folder_is_beside_the_dataset_never_in_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let imu0 = dir.path().join("MH_01_easy/mav0/imu0");
+        std::fs::create_dir_all(&imu0).unwrap();
+        std::fs::write(
+            imu0.join("data.csv"),
+            "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n1,0,0,0,0,0,9.8\n",
+        )
+        .unwrap();
+        let canon = std::fs::canonicalize(dir.path()).unwrap();
+        for (input, out) in [
+            (imu0.join("data.csv"), "MH_01_easy_imu0_allan_kalibr"),
+            (imu0.clone(), "MH_01_easy_imu0_allan_kalibr"),
+            (
+                dir.path().join("MH_01_easy/mav0"),
+                "MH_01_easy_allan_kalibr",
+            ),
+            (dir.path().join("MH_01_easy"), "MH_01_easy_allan_kalibr"),
+        ] {
+            assert_eq!(
+                default_out_dir(&input, "allan_kalibr"),
+                canon.join(out),
+                "{}",
+                input.display()
+            );
+        }
+    }
+
     #[test]
     fn the_files_written_are_said_once_per_folder() {
         let w = ["o/a.yaml", "o/b.csv", "o/s/c.png"].map(PathBuf::from);
         assert_eq!(
-            wrote_lines(&w),
+            wrote_lines(&w, &[]),
             [
                 "wrote 2 files to o/: a.yaml, b.csv",
                 "wrote 1 file to o/s/: c.png"
             ]
+        );
+        assert_eq!(
+            wrote_lines(&w, &[PathBuf::from("o/b.csv")])[0],
+            "wrote 2 files to o/ (1 of them replacing an earlier run's): a.yaml, b.csv"
         );
     }
 }

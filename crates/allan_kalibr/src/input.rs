@@ -32,6 +32,9 @@ pub struct ImuData {
     /// instance): its columns hold zeros as a stand-in (`bag2mat::StandIn::Zeros`),
     /// never analysed nor written.
     pub absent: Option<bag2mat::Sensor>,
+    /// For a topic of integrated deltas, its rows' integration intervals (whether they are
+    /// samples: [`bag2mat::check_integration`]).
+    pub integration: Option<bag2mat::Integration>,
 }
 
 /// The clock side of [`ImuData`], for `bag2mat::check_record`: the time column in exact
@@ -66,6 +69,7 @@ impl ImuData {
     /// record time by default), through bag2mat's one series-to-matrix conversion.
     pub(crate) fn from_series(mut s: bag2mat::ImuSeries, time: bag2mat::TimeColumn) -> Self {
         let absent = s.stand_in_absent(bag2mat::StandIn::Zeros);
+        let integration = s.integration;
         let topic = s.topic.clone();
         let notes = s.notes.clone();
         let (used, other) = match time {
@@ -87,6 +91,7 @@ impl ImuData {
             notes,
             clock,
             absent,
+            integration,
         }
     }
 
@@ -109,6 +114,7 @@ impl ImuData {
                 promised: c.promised,
             },
             absent: self.absent,
+            integration: self.integration,
         }
     }
 
@@ -223,6 +229,7 @@ fn load_mat(path: &Path) -> Result<ImuData, Error> {
         notes: Vec::new(),
         clock,
         absent: None,
+        integration: None,
     })
 }
 

@@ -22,6 +22,11 @@
 //! * [`spline`]: the workspace's one continuous-time B-spline (Spline Fusion), which the
 //!   operating analysis predicts the IMU with and `sim spline` synthesises it with.
 //! * `yaml`: Kalibr imu.yaml and the YAML spelling both halves write.
+//! * [`consumers`]: every estimator users feed the figures into (Kalibr, OpenVINS, VINS,
+//!   ORB-SLAM3, Basalt, PX4 EKF2, ArduPilot EKF3, GTSAM), each described once — keys, units,
+//!   convention, the source it was read from — and the config files written for them,
+//!   `allan_kalibr check` ([`consumers::check`]) and `allan_kalibr plan`
+//!   ([`consumers::plan`]).
 //! * `input`: `.mat`/`.bag` loading and the update-rate check ([`load_input`],
 //!   [`snap_rate`]); `run`: the whole job ([`run()`], [`Config`]).
 //! * `ieee952`: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
@@ -63,6 +68,7 @@
 //!   and a warning printed, which upstream never does).
 
 mod cli;
+pub mod consumers;
 mod error;
 mod front;
 mod ieee952;
@@ -73,10 +79,13 @@ mod run;
 pub mod spline;
 mod yaml;
 
-pub use cli::{Args, TOOL};
+pub use cli::{Args, Cli, Command, Run, TOOL, command_main};
 pub use error::Error;
 pub use front::CurvesInput;
-pub use front::{Common, CommonArgs, Input, Job, Section, main as analyser_main, rate_for_text};
+pub use front::{
+    Common, CommonArgs, Input, Job, Section, command_line, main as analyser_main, rate_for_text,
+    refusal_text, run_job, topic_failed,
+};
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};
 pub use ieee952::ci::chi2_interval;
@@ -88,7 +97,8 @@ pub use ieee952::edf::greenhall_edf;
 pub use ieee952::files::{
     COL_AXIS, COL_CHI2_DOF, COL_CI95_HI, COL_CI95_LO, COL_FIT, COL_FIT_TAU_HI, COL_RESOLVED,
     COL_SENSOR, COL_TERM, COL_VALUE, COL_VERDICT, CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU,
-    CURVES_FILE, TERMS_FILE, write_outputs as write_ieee952_files,
+    CURVES_FILE, TERMS_FILE, file_names as ieee952_file_names,
+    write_outputs as write_ieee952_files,
 };
 pub use ieee952::imu::SensorValue;
 pub use ieee952::imu::{
@@ -120,4 +130,7 @@ pub use kalibr::chart_fit::{ChartFit, gen_chart};
 pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_tiled};
 pub use kalibr::grid::TauGrid;
 pub use kalibr::report::{chart_lines, final_lines};
-pub use run::{Analysis, Config, RunOutput, analyse, run, sections};
+pub use run::{
+    Analysis, Config, RunOutput, TopicRun, analyse, curves_rate, curves_text, run, run_topics,
+    sections,
+};

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
 use crate::front::Section;
 use crate::input::{self, ImuData, RateChoice};
@@ -15,7 +16,7 @@ use crate::kalibr::curves;
 use crate::kalibr::estimator::{Estimator, sig2_curves};
 use crate::kalibr::grid::TauGrid;
 use crate::kalibr::report;
-use crate::yaml::ImuYaml;
+use crate::yaml::{ImuYaml, SectionFile};
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
@@ -136,10 +137,28 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if let Some(s) = &config.operating {
         return crate::operating::sections(config, s, outputs);
     }
-    Ok(run(config, outputs)?
+    let topics = run_topics(config, outputs)?;
+    let several = topics.len() > 1;
+    topics
         .into_iter()
-        .map(|out| out.section)
-        .collect())
+        .map(|t| match t.result {
+            Ok(out) => Ok(out.section),
+            // one topic of several: said as its error, the others still written
+            Err(e) if several => Ok(crate::front::topic_failed(&t.topic, t.notes, &e)),
+            Err(e) => Err(e),
+        })
+        .collect()
+}
+
+/// One topic's outcome in a run of several ([`run_topics`]).
+#[derive(Debug)]
+pub struct TopicRun {
+    /// The topic.
+    pub topic: String,
+    /// What its reader said (repeated for a topic that failed, whose section has no other).
+    pub notes: Vec<Note>,
+    /// Its analysis, or why it failed.
+    pub result: Result<RunOutput, Error>,
 }
 
 impl crate::front::Job for Config {
@@ -150,12 +169,39 @@ impl crate::front::Job for Config {
     fn sections(&self, outputs: &Outputs) -> Result<Vec<Section>, Error> {
         sections(self, outputs)
     }
+    fn output_names(&self) -> Vec<String> {
+        output_names()
+    }
+}
+
+/// Every file a run of allan_kalibr may write into an output folder.
+pub(crate) fn output_names() -> Vec<String> {
+    let mut v: Vec<String> = ["imu.yaml", "allan_curves.csv"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    for stem in ["allan_accel", "allan_gyro"] {
+        for ext in ["png", "svg"] {
+            v.push(format!("{stem}.{ext}"));
+        }
+    }
+    v.extend(crate::ieee952::files::file_names(""));
+    v
 }
 
 /// Runs the whole job for `config`, one analysis per topic, all topics read in one pass.
 /// With one topic the outputs go into `outdir`; with several, into `outdir/<topic folder>`;
 /// every file among `outputs`.
 pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> {
+    run_topics(config, outputs)?
+        .into_iter()
+        .map(|t| t.result)
+        .collect()
+}
+
+/// [`run`] with each topic's outcome on its own: a topic that fails does not stop the
+/// others (what the binary does with a run of several topics).
+pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, Error> {
     let start = Instant::now();
     let datas = input::load_all(
         config.common.samples_path(),
@@ -178,9 +224,57 @@ pub fn run(config: &Config, outputs: &Outputs) -> Result<Vec<RunOutput>, Error> 
         if several {
             c.common.out_dir = config.common.out_dir.join(folder);
         }
-        outs.push(run_on(&c, data, load, outputs)?);
+        let topic = data
+            .topic
+            .clone()
+            .unwrap_or_else(|| config.common.named_topic().to_string());
+        let notes = bag2mat::shared::note::warnings(&data.notes);
+        outs.push(TopicRun {
+            topic,
+            notes,
+            result: run_on(&c, data, load, outputs),
+        });
     }
     Ok(outs)
+}
+
+/// The IEEE 952 analysis of `config`'s first topic, nothing written (what `allan_kalibr
+/// check --against LOG` compares with): the analysis, or why the record cannot have one.
+pub(crate) fn section_only(
+    config: &Config,
+) -> Result<Result<crate::ieee952::imu::ImuAnalysis, String>, Error> {
+    let mut datas = input::load_all(
+        config.common.samples_path(),
+        &config.common.topics,
+        config.common.time,
+        true,
+        &config.common.input_options,
+    )?;
+    if datas.is_empty() {
+        return Ok(Err("no IMU topic".into()));
+    }
+    let mut data = datas.swap_remove(0);
+    let mut notes = Vec::new();
+    if let Some(skip) = config.common.skip_start {
+        skip_start(&mut data, skip, &mut notes)?;
+    }
+    if data.len() < 3 {
+        return Err(Error::TooShort { n: data.len() });
+    }
+    let mut c = check_record(config, data, &mut notes)?;
+    if let Some(r) = &c.refusal {
+        return Ok(Err(format!(
+            "the record breaks the IEEE 952 analysis' assumptions ({}): nothing measured to compare with",
+            crate::front::refusal_text(r)
+        )));
+    }
+    let (curves, _) = section_curves(config, &mut c, &mut notes);
+    Ok(curves
+        .map(|cv| cv.finish(c.findings.clone(), &crate::ieee952::Config::default()))
+        .ok_or_else(|| {
+            let why: Vec<String> = notes.iter().map(|n| n.line()).collect();
+            format!("no IEEE 952 analysis of this record ({})", why.join("; "))
+        }))
 }
 
 /// The section's six series (gyro x y z, then acc x y z) of the `data_imu`-ordered columns.
@@ -199,6 +293,12 @@ fn run_on(
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let data_topic = data.topic.clone();
+    // integrated deltas far apart are no samples to analyse
+    bag2mat::check_integration(
+        data_topic.as_deref().unwrap_or(""),
+        data.integration,
+        &data.clock.t_ns,
+    )?;
     if let Some(skip) = config.common.skip_start {
         skip_start(&mut data, skip, &mut notes)?;
     }
@@ -216,6 +316,22 @@ fn run_on(
     // path turns them into prefix sums; its fits then run beside the compat path. Data too
     // short for it only cost the section, with a note.
     let (curves, curves_s) = section_curves(config, &mut c, &mut notes);
+    let section_file = match (&curves, &c.refusal) {
+        _ if !config.common.ieee952 => SectionFile::CompatOnly,
+        (Some(_), _) => SectionFile::Written,
+        (None, Some(r)) => SectionFile::NotComputed(format!(
+            "the IEEE 952 section was not computed, the record breaks its assumptions ({})",
+            crate::front::refusal_text(r)
+        )),
+        (None, None) => SectionFile::NotComputed(
+            "the IEEE 952 analysis could not run on this record (the warning says why)".into(),
+        ),
+    };
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), data_topic.as_deref()),
+        record_rate(config, &c.rate),
+    );
     let axes = compat_axes(c.data);
     let ((ieee, fits_s), analysis) = rayon::join(
         || {
@@ -242,9 +358,13 @@ fn run_on(
         outputs,
         config,
         &analysis,
-        ieee.as_ref(),
-        c.rate.used,
-        &topic,
+        Written {
+            ieee: ieee.as_ref(),
+            update_rate: c.rate.used,
+            topic: &topic,
+            prov: &prov,
+            section: &section_file,
+        },
     )?;
     let timings = Timings {
         load,
@@ -263,6 +383,7 @@ fn run_on(
             .map(|a| crate::ieee952::stated::section_text(a, config.common.samples_path(), &topic)),
         written,
         timings: vec![timings.to_string()],
+        error: None,
     };
     Ok(RunOutput {
         section,
@@ -438,23 +559,42 @@ fn compat_axes(data: ImuData) -> [Vec<f64>; 6] {
     axes
 }
 
+/// The record's rate as the files state it: the stamps' nominal rate (the section's), or the
+/// rate given when the stamps give none.
+fn record_rate(config: &Config, rate: &RateChoice) -> RecordRate {
+    match (rate.measured, config.common.rate) {
+        (None, Some(g)) => RecordRate::Given(g),
+        _ => RecordRate::Measured(rate.section),
+    }
+}
+
+/// What a run's files are written from besides the compat analysis: the section, the
+/// compat imu.yaml's update_rate, the topic, the files' provenance, and what became of the
+/// section's Kalibr file (imu.yaml's header says it).
+struct Written<'a> {
+    ieee: Option<&'a crate::ieee952::imu::ImuAnalysis>,
+    update_rate: f64,
+    topic: &'a str,
+    prov: &'a Provenance,
+    section: &'a SectionFile,
+}
+
 /// Renders the yaml and the curves' CSV (before the output folder is touched), then writes
 /// them, the compat charts and the section's files and chart; returns the paths written.
 fn write_outputs(
     outputs: &Outputs,
     config: &Config,
     analysis: &Analysis,
-    ieee: Option<&crate::ieee952::imu::ImuAnalysis>,
-    update_rate: f64,
-    topic: &str,
+    w: Written<'_>,
 ) -> Result<Vec<PathBuf>, Error> {
+    let Written {
+        ieee,
+        update_rate,
+        topic,
+        prov,
+        section,
+    } = w;
     let absent = analysis.absent;
-    let source = config
-        .common
-        .samples_path()
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let yaml = ImuYaml {
         accelerometer_noise_density: analysis.accel.white,
         accelerometer_random_walk: analysis.accel.bias,
@@ -464,7 +604,7 @@ fn write_outputs(
         update_rate,
         absent,
     }
-    .render(&source);
+    .render(prov, section);
     let mut csv = Vec::new();
     curves::write_csv_of(
         &mut csv,
@@ -493,7 +633,7 @@ fn write_outputs(
             let Some(an) = ieee else {
                 return Ok(Vec::new());
             };
-            let mut w = crate::ieee952::files::write_outputs(outputs, an, dir, "", topic)?;
+            let mut w = crate::ieee952::files::write_outputs(outputs, an, dir, "", topic, prov)?;
             let truth = crate::ieee952::plot::find_truth(config.common.samples_path(), an);
             w.extend(crate::ieee952::plot::write_chart(
                 outputs,
@@ -553,7 +693,12 @@ pub fn run_curves(
     outputs.ensure_dir(dir)?;
     let title = chart_title(config);
     let rostopic = config.common.named_topic();
-    let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        curves_text(&curves.paths),
+        curves_rate(config.common.rate, &c),
+    );
+    let mut written = crate::ieee952::files::write_outputs(outputs, &an, dir, "", rostopic, &prov)?;
     written.extend(crate::ieee952::plot::write_chart(
         outputs, &an, &title, None, dir, "",
     )?);
@@ -562,6 +707,36 @@ pub fn run_curves(
         written,
         ..Default::default()
     })
+}
+
+/// "curves a.csv, b.csv": the input a file written from `--curves` names.
+pub fn curves_text(paths: &[PathBuf]) -> String {
+    let p: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    format!("the Allan curves {}", p.join(", "))
+}
+
+/// The record's rate behind curves read with `--curves`: `--rate`, else what the format says
+/// of the samples (a curve this project or imu_utils wrote starts at one sample; kalibr_allan's
+/// grid is in samples), else unknown — allan_variance_ros' 0.1 s bins and a plain CSV's first
+/// τ do not say the IMU's rate.
+pub fn curves_rate(given: Option<f64>, c: &crate::ieee952::curves_in::Curves) -> RecordRate {
+    use crate::ieee952::curves_in::Format;
+    if let Some(r) = given {
+        return RecordRate::Given(r);
+    }
+    match c.format {
+        Format::Ieee952 | Format::ImuUtils | Format::KalibrAllan => RecordRate::Curves {
+            // 1/τ0 of a printed τ: the round rate it stands for (0.005000000001 s is 200 Hz)
+            rate: input::snap_rate(c.rate),
+            how: format!(
+                "1/tau0 of the {} curves (their first point is one sample)",
+                c.format
+            ),
+        },
+        Format::AllanVarianceRos | Format::Plain => {
+            RecordRate::Unknown(format!("{} does not state the IMU's rate", c.format))
+        }
+    }
 }
 
 /// The charts' title: `--title`, else the input's file stem (upstream hard-codes its

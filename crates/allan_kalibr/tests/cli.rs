@@ -54,7 +54,7 @@ fn assert_no_outputs(dir: &Path) {
 /// The line that opens the IEEE 952 section after upstream's text.
 const IEEE_MARKER: &str = "\n=> IEEE 952 noise terms";
 /// What the IEEE 952 section writes beside the compat outputs.
-const IEEE_OUTPUTS: [&str; 12] = [
+const IEEE_OUTPUTS: [&str; 15] = [
     "ieee952_terms.csv",
     "ieee952_curves.csv",
     "ieee952_psd.csv",
@@ -63,6 +63,9 @@ const IEEE_OUTPUTS: [&str; 12] = [
     "orbslam3_imu_ieee952.yaml",
     "openvins_kalibr_imu_chain_ieee952.yaml",
     "basalt_imu_noise_ieee952.json",
+    "px4_ekf2_ieee952.params",
+    "ardupilot_ekf3_ieee952.param",
+    "gtsam_imu_params_ieee952.yaml",
     "ieee952_allan.png",
     "ieee952_allan.svg",
     "ieee952_psd.png",

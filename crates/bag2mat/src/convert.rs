@@ -259,6 +259,25 @@ pub fn output_paths(cfg: &Config, topics: &[&str]) -> Vec<PathBuf> {
         .collect()
 }
 
+/// What a converted topic holds that the analysers would refuse or drop, said by the
+/// converter too (which writes every row as read, bagconvert's rule): integrated deltas far
+/// apart, more rows than the container promises, samples stored twice.
+fn conversion_warnings(s: &crate::ImuSeries, time: TimeColumn) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Err(e) = s.check_integration() {
+        out.push(format!("{e}; converted as the rates the rows hold"));
+    }
+    let stored = crate::record_check::stored_twice(s, time);
+    if !stored.is_empty() {
+        out.extend(stored.iter().map(|f| f.text.clone()));
+        out.push(format!(
+            "the output keeps every row read on '{}' (bagconvert's rule); allan_kalibr and allan_imu_utils drop the samples stored twice",
+            crate::printable::escape(&s.topic)
+        ));
+    }
+    out
+}
+
 /// Runs the conversion, logging bagconvert's lines (on stderr) unless quiet, its outputs
 /// written among `outputs` and committed before the last line (the binary's are staged: all
 /// files or none; the input is protected here). Returns each output path with its number of
@@ -303,6 +322,9 @@ pub fn run(cfg: &Config, mut outputs: Outputs) -> Result<Vec<(PathBuf, usize)>, 
     for (s, out) in read.series.into_iter().zip(outs) {
         for n in &s.notes {
             eprintln!("warning: {n}");
+        }
+        for w in conversion_warnings(&s, cfg.time) {
+            eprintln!("warning: {w}");
         }
         let topic = s.topic.clone();
         if !single {

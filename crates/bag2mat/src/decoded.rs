@@ -194,6 +194,22 @@ impl DecodedSource {
     }
 }
 
+impl DecodedSource {
+    /// Adds what the reader found lost of its streams: a loss on a channel adds its
+    /// messages to the channel's count (they were promised, and the per-topic summary
+    /// says "N of M").
+    pub(crate) fn add_losses(&mut self, losses: Vec<Loss>) {
+        for l in &losses {
+            if let (Some(c), Some(n)) = (l.channel, l.messages)
+                && let Some(ch) = self.contents.channels.get_mut(c as usize)
+            {
+                ch.count = ch.count.map(|x| x.saturating_add(n));
+            }
+        }
+        self.contents.losses.extend(losses);
+    }
+}
+
 /// How a format's non-Imu topics' encoding is named.
 fn kind_encoding(kind: InputKind) -> &'static str {
     match kind {

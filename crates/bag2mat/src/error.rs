@@ -65,6 +65,9 @@ pub enum Error {
         /// The sensor it lacks.
         missing: crate::Sensor,
     },
+    /// A topic of integrated deltas whose rows do not tile the time: no samples to analyse.
+    #[error(transparent)]
+    DeadTime(#[from] crate::integrated::DeadTime),
     /// A storage file (sqlite3, metadata.yaml) could not be read.
     #[error("{path}: {what}")]
     Storage {

@@ -48,6 +48,13 @@ pub struct TopicInfo {
     pub longest_gap: Option<f64>,
     /// What the record check finds on an Imu topic (record time), as the analysers do.
     pub findings: Vec<Finding>,
+    /// Messages stamped before the log's own start ([`InfoReport::log_start`]), and the
+    /// span of the others, ns.
+    pub before_start: u64,
+    /// First and last record time of the messages from the log's start on, ns.
+    pub span_in_log: Option<(u64, u64)>,
+    /// Why the analysers refuse the topic, when they do (integrated deltas far apart).
+    pub refused: Option<String>,
 }
 
 /// What `bag2mat info` prints.
@@ -61,6 +68,8 @@ pub struct InfoReport {
     pub notes: Vec<String>,
     /// Data the container reports lost, and parts that could not be read.
     pub losses: Vec<Loss>,
+    /// When the log itself says it started, ns (a PX4 ULog's header), if it says.
+    pub log_start: Option<u64>,
 }
 
 /// Rate, median period, jitter, gaps, missing and longest interval of sorted times `t` (ns).
@@ -99,13 +108,15 @@ pub fn info_with(
 ) -> Result<InfoReport, Error> {
     let src = crate::input::open_with(path, opts)?;
     let (times, losses) = read_times(src.as_ref(), quiet);
-    let mut by = topic_infos(src.as_ref(), times);
+    let log_start = src.contents().log_start;
+    let mut by = topic_infos(src.as_ref(), times, log_start);
     check_imu_topics(src.as_ref(), &mut by);
     Ok(InfoReport {
         kind: src.kind(),
         topics: by.into_values().collect(),
         notes: src.notes().to_vec(),
         losses,
+        log_start,
     })
 }
 
@@ -147,10 +158,11 @@ fn read_times(src: &dyn source::Source, quiet: bool) -> (BTreeMap<u32, Vec<u64>>
 }
 
 /// One entry per topic and type: its channels' promised counts, and its record times'
-/// count, span, rate and gaps.
+/// count, span, rate and gaps (and which of them precede the log's own start).
 fn topic_infos(
     src: &dyn source::Source,
     mut times: BTreeMap<u32, Vec<u64>>,
+    log_start: Option<u64>,
 ) -> BTreeMap<(String, String), TopicInfo> {
     let mut by: BTreeMap<(String, String), TopicInfo> = BTreeMap::new();
     let mut topic_times: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
@@ -171,6 +183,9 @@ fn topic_infos(
         let ns: Vec<i64> = t.iter().map(|&x| x as i64).collect();
         let (rate, median, jitter, gaps, missing, longest) = stats(&ns);
         e.span = t.first().zip(t.last()).map(|(a, b)| (*a, *b));
+        let early = log_start.map_or(0, |s| t.partition_point(|&x| x < s));
+        e.before_start = early as u64;
+        e.span_in_log = t[early..].first().zip(t.last()).map(|(a, b)| (*a, *b));
         e.rate = rate;
         e.median_period = median;
         e.jitter = jitter;
@@ -199,6 +214,9 @@ impl TopicInfo {
             missing: 0,
             longest_gap: None,
             findings: Vec::new(),
+            before_start: 0,
+            span_in_log: None,
+            refused: None,
         }
     }
 }
@@ -223,10 +241,18 @@ fn check_imu_topics(src: &dyn source::Source, by: &mut BTreeMap<(String, String)
         let other = crate::timing::ns_of_times(&s.stamp);
         let rec = Record::of_series(s, crate::TimeColumn::Record, &t, &other);
         let c = record_check::check(&rec, &record_check::Options::default());
+        // the rate of what the analysers keep; the gaps and missing samples stay the whole
+        // topic's, as its findings count them (a record cut to its longest stretch has none
+        // left in it, but they are the topic's)
         e.rate = c.rate;
-        e.gaps = c.timing.gaps.len() as u64;
-        e.missing = c.timing.missing;
+        e.refused = s.check_integration().err().map(|e| e.to_string());
         e.findings = c.findings;
+        if e.refused.is_some() {
+            // rows that are no samples say nothing of the sensor through the checks that
+            // read values as samples (a noise density read at the rows' spacing came out
+            // as "deg/s read as rad/s?"): the refusal says what they are
+            e.findings.retain(|f| !f.kind.judges_values_as_samples());
+        }
     }
 }
 
@@ -238,7 +264,9 @@ impl InfoReport {
             path.display(),
             self.kind.describe()
         );
-        let spans: Vec<(u64, u64)> = self.topics.iter().filter_map(|t| t.span).collect();
+        // the log's own span: a message its logger wrote from before it started (a
+        // topic's last message at subscription) is listed with its topic, not spanned
+        let spans: Vec<(u64, u64)> = self.topics.iter().filter_map(|t| t.span_in_log).collect();
         if let (Some(a), Some(b)) = (
             spans.iter().map(|x| x.0).min(),
             spans.iter().map(|x| x.1).max(),
@@ -287,6 +315,9 @@ impl InfoReport {
                 t.missing,
                 opt(t.longest_gap, 4),
             ));
+            if let Some(r) = &t.refused {
+                s.push_str(&format!("    warning: the analysers refuse it: {r}\n"));
+            }
             for f in &t.findings {
                 s.push_str(&format!("    {f}\n"));
             }
@@ -301,6 +332,19 @@ impl InfoReport {
         }
         for n in &self.notes {
             s.push_str(&format!("note: {n}\n"));
+        }
+        if let Some(start) = self.log_start {
+            for t in self.topics.iter().filter(|t| t.before_start > 0) {
+                let first = t.span.map_or(start, |s| s.0);
+                s.push_str(&format!(
+                    "note: {} message{} of '{}' {} stamped before the log started (the first {:.3} s before it: the logger writes each topic's latest message when it starts): listed with the topic, left out of the duration\n",
+                    t.before_start,
+                    if t.before_start == 1 { "" } else { "s" },
+                    crate::printable::escape(&t.topic),
+                    if t.before_start == 1 { "is" } else { "are" },
+                    start.saturating_sub(first) as f64 * 1e-9
+                ));
+            }
         }
         for l in &self.losses {
             s.push_str(&format!("lost: {l}\n"));

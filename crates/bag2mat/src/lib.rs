@@ -57,6 +57,7 @@ mod formats;
 mod imu_msg;
 mod info;
 mod input;
+mod integrated;
 mod mapped;
 mod mat;
 mod mcap;
@@ -87,20 +88,26 @@ pub use convert::{
 };
 pub use detect::input_kind;
 pub use error::{Error, TopicSummary};
-pub use formats::euroc::{Stated as SensorYaml, stated_for as sensor_yaml_for};
+pub use formats::euroc::{
+    Stated as SensorYaml, output_base as euroc_output_base, stated_for as sensor_yaml_for,
+};
 pub use formats::text::STANDARD_GRAVITY;
 pub use formats::{AccUnit, GyroUnit, InputArgs, InputOptions, TimeUnit};
 pub use imu_msg::BadMessage;
 pub use imu_msg::{Imu, MD5 as IMU_MD5, definition as imu_definition};
 pub use info::{InfoReport, TopicInfo, info, info_with};
 pub use input::{open as open_input, read_imu_series, read_imu_topics, read_imu_topics_with};
+pub use integrated::{CONTIGUOUS_TOL, DeadTime, Integration, check as check_integration};
 pub use mat::{DataImu, read_data_imu, write_data_imu};
 pub use mcap::{ChunkCompression, MAGIC as MCAP_MAGIC};
 pub use poses::msg::{POSE_TYPES, PoseMsg, PoseType, Wire as PoseWire, decode as decode_pose};
 pub use poses::{PoseOptions, PoseSeries, QUAT_NORM_TOL, parse_time_ns, read_poses, read_tum};
 pub use printable::escape as escape_printable;
 pub use record_check::Axis as FindingAxis;
-pub use record_check::warmup::{Fit as WarmupFit, find as find_warmup};
+pub use record_check::warmup::{
+    DETECT_WINDOWS as WARMUP_DETECT_WINDOWS, Fit as WarmupFit, WARMUP_WINDOWS, WARMUP_Z,
+    find as find_warmup,
+};
 pub use record_check::{
     Check as RecordCheck, Finding, Keep as KeepRows, Kind as FindingKind, Level as FindingLevel,
     Options as CheckOptions, RATE_ARGUMENT_REL, Record as CheckInput, SkipError,

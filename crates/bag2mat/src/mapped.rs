@@ -36,6 +36,28 @@ impl Mapped {
         Ok(Mapped { map: Some(map) })
     }
 
+    /// True when a file of `len` bytes may be mapped whole: it takes under half the address
+    /// space a memory limit (`RLIMIT_AS`) leaves, so that the rows read from it fit too. A
+    /// reader that can read a file in windows does so otherwise.
+    pub(crate) fn fits(len: u64) -> bool {
+        #[cfg(unix)]
+        {
+            let mut lim = libc::rlimit {
+                rlim_cur: 0,
+                rlim_max: 0,
+            };
+            // SAFETY: getrlimit writes the struct it is given, which lives on this stack.
+            let ok = unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } == 0;
+            if ok && lim.rlim_cur != libc::RLIM_INFINITY {
+                // rlim_t is u64 on Linux, another width on some other unixes
+                #[allow(clippy::unnecessary_cast)]
+                let cur = lim.rlim_cur as u64;
+                return len < cur / 2;
+            }
+        }
+        true
+    }
+
     /// Fills the mapping's page tables from the page cache, in file order (Linux
     /// `MADV_POPULATE_READ`; elsewhere, or on a kernel without it, nothing). Run beside a
     /// one-threaded first pass over the file (the ULog hop), it takes the page faults off that

@@ -272,4 +272,11 @@ pub struct Contents {
     pub notes: Vec<String>,
     /// What opening found lost.
     pub losses: Vec<Loss>,
+    /// When the log itself says it started, ns (a PX4 ULog's header): a message stamped
+    /// before it is one its logger wrote when it subscribed (a topic's last message, maybe
+    /// long before), not part of the record's span.
+    pub log_start: Option<u64>,
+    /// Channels of integrated deltas (PX4 `vehicle_imu`), with their rows' median
+    /// integration intervals ([`crate::Integration`]).
+    pub integration: Vec<(u32, crate::Integration)>,
 }

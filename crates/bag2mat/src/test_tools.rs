@@ -79,6 +79,23 @@ pub fn run_ok(cmd: &mut Command) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// A log of `kind` at `out`, by an independent writer with a known truth
+/// (`tests/py/write_logs.py`: `ros1` through Debian's python rosbag, `ulog` through pyulog's
+/// writer), as its JSON `spec` describes.
+pub fn independent_log(kind: &str, out: &Path, spec: &str) {
+    let python = match kind {
+        "ros1" => PathBuf::from("/usr/bin/python3"),
+        _ => venv_python(),
+    };
+    run_ok(
+        Command::new(python)
+            .arg(workspace().join("crates/bag2mat/tests/py/write_logs.py"))
+            .arg(kind)
+            .arg(out)
+            .arg(spec),
+    );
+}
+
 /// `rosbags-convert --src SRC… --dst DST EXTRA…` from the venv.
 pub fn rosbags_convert(src: &[&Path], dst: &Path, extra: &[&str]) {
     let _ = venv_python();

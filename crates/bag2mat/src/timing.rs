@@ -7,11 +7,20 @@
 //!   duplicated stamps, leave it at the sensor's period).
 //! * Each interval is a whole number of periods `k = round(d / median)` (integer arithmetic:
 //!   an interval of exactly 2.5 periods is 3 the same way in every tool); `k − 1` samples are
-//!   missing behind it. A **gap** is an interval with at least one sample missing; the
+//!   missing behind it — unless the samples around it give the time back: a receive time
+//!   that jitters (a late sample then an early one, or a burst after a stall) puts a long
+//!   interval beside short ones, and no sample is missing. So each long interval is checked
+//!   against the [`JITTER_WINDOW`] samples on either side ([`confirmed_missing`]: the samples
+//!   after it must stay late by whole periods against the samples before it), and only what
+//!   stays missing counts. A **gap** is an interval with at least one sample missing; the
 //!   missing count is exact (2 % single-sample dropouts of 360,000 samples are 7,200 missing
-//!   in 7,200 gaps).
-//! * The **nominal period** is the span over the number of periods it holds, Σ k: the
-//!   sensor's sampling period, which lost samples do not change (the mean interval does).
+//!   in 7,200 gaps), and receive-time jitter of up to half a period is no gap.
+//! * The **nominal period** is the span over the number of periods it holds: the intervals
+//!   between the samples that arrived and the samples confirmed missing. It is the sensor's
+//!   sampling period, which lost samples do not change (the mean interval does), nor
+//!   receive-time jitter (rounding each jittered interval to whole periods does: a 400 Hz
+//!   queue read 401.1 Hz that way). Equal stamps are samples here; samples stored twice are
+//!   dropped before the gap rule ([`crate::record_check`]).
 //! * A **rate change** is a block of [`RATE_BLOCK`] intervals whose median differs from the
 //!   series' by more than [`RATE_CHANGE_REL`]; the change is placed at the exact interval
 //!   where the period changes (not at the block boundary).
@@ -24,6 +33,9 @@
 /// A gap longer than this many nominal periods (more than two samples lost in a row) is a
 /// "long gap": it may break the record (see [`MAX_GAP_FRACTION`]).
 pub const GAP_FACTOR: u64 = 3;
+/// Samples on either side of a long interval that may give its time back (receive-time
+/// jitter, a burst after a stall of up to this many samples) before it counts as a gap.
+pub const JITTER_WINDOW: usize = 32;
 /// Intervals per block when looking for a rate change.
 pub const RATE_BLOCK: usize = 256;
 /// A block whose median period differs from the series' by more than this (relative) is at
@@ -78,7 +90,8 @@ pub struct Timing {
     pub n: usize,
     /// Median positive interval, ns (`None` without one).
     pub median_period_ns: Option<i64>,
-    /// Nominal period of the whole series (span / Σ k), s; `None` without a period.
+    /// Nominal period of the whole series (span / its periods: intervals and samples
+    /// confirmed missing), s; `None` without a period.
     pub nominal_period: Option<f64>,
     /// Last minus first time, s.
     pub span: f64,
@@ -258,7 +271,7 @@ pub fn analyse(t: &[i64]) -> Timing {
             out.segments.push(Segment {
                 start,
                 end: c,
-                period: nominal_period(&t[start..c], &d[start..c - 1]),
+                period: segment_period(t, start, c, &out.gaps),
             });
             start = c;
         }
@@ -321,26 +334,49 @@ impl Timing {
             } else {
                 median_positive(inner).unwrap_or(p)
             };
-            for (j, &x) in inner.iter().enumerate() {
-                // most intervals are one period: no division for them
-                let k = if x.saturating_sub(ps).saturating_abs().saturating_mul(2) < ps {
+            // most intervals are one period: no division for them
+            let k_of = |x: i64| {
+                if x <= 0 {
+                    0 // equal or reversed stamps hold no period
+                } else if x.saturating_sub(ps).saturating_abs().saturating_mul(2) < ps {
                     1
                 } else {
                     periods(x, ps)
-                };
-                total_periods += k;
-                if k >= 2 {
-                    let i = a + j;
+                }
+            };
+            // the grid the missing samples are confirmed on: the stretch's span over its
+            // whole periods (the median of a jittery or lossy record is off by more than
+            // the lateness of a few dozen samples can bear)
+            let whole: u64 = inner.iter().map(|&x| k_of(x)).sum();
+            // the stretch's periods: each sample that arrived, and each confirmed missing
+            // (added below); Σ k over jittered intervals counts some twice and others not
+            total_periods += inner.len() as u64;
+            let grid = if whole > 0 && b > a + 1 {
+                (t[b - 1] - t[a]) as f64 / whole as f64
+            } else {
+                ps as f64
+            };
+            let mut from = a;
+            for (j, &x) in inner.iter().enumerate() {
+                let k = k_of(x);
+                if k < 2 {
+                    continue;
+                }
+                let i = a + j;
+                let missing = confirmed_missing(&t[..b], from, i, grid).min(k - 1);
+                if missing >= 1 {
                     self.gaps.push(Gap {
                         after: i,
                         at: (t[i] - t[0]) as f64 * NS,
                         length: x as f64 * NS,
-                        missing: k - 1,
+                        missing,
                     });
-                    self.missing += k - 1;
-                    if k > GAP_FACTOR {
+                    self.missing += missing;
+                    total_periods += missing;
+                    if missing + 1 > GAP_FACTOR {
                         long_cuts.push(i + 1);
                     }
+                    from = i + 1;
                 }
             }
         }
@@ -351,29 +387,47 @@ impl Timing {
     }
 }
 
-/// The nominal rate of `t` (ns, in order), Hz, without the rest of [`analyse`]: the span over
-/// the whole periods it holds (the cross-check of a second clock).
-pub fn nominal_rate(t: &[i64]) -> Option<f64> {
-    if t.len() < 2 {
-        return None;
-    }
-    let d: Vec<i64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let p = median_positive(&d)?;
-    let k: u64 = t.windows(2).map(|w| periods(w[1] - w[0], p)).sum();
-    let span = (t[t.len() - 1] - t[0]) as f64 * NS;
-    (k > 0 && span > 0.0).then(|| k as f64 / span)
+/// The samples missing behind interval `i` (between `t[i]` and `t[i + 1]`) of stamps `t`
+/// (ns) at period `p` ns, as the samples around it confirm them. Each stamp's lateness
+/// against the period grid, `t_j − j·p`: a sample lost leaves every later stamp a period
+/// late, while a receive delay makes single stamps late and is gone a few samples on. So
+/// the earliest of the [`JITTER_WINDOW`] samples after the interval is compared with the
+/// earliest of those before it (from `from` on: not across an earlier gap), in whole
+/// periods — the lower envelope of the stamps, which a delay, a late sample followed by
+/// on-time ones or a burst after a stall leave in place. Half a period less a thousandth
+/// counts as one, so that exactly half is one from every clock's rounding.
+pub(crate) fn confirmed_missing(t: &[i64], from: usize, i: usize, p: f64) -> u64 {
+    let late = |j: usize| (t[j] - t[i]) as f64 - (j as f64 - i as f64) * p;
+    let before = (from.max(i.saturating_sub(JITTER_WINDOW))..=i)
+        .map(late)
+        .fold(f64::INFINITY, f64::min);
+    let after = (i + 1..(i + 2 + JITTER_WINDOW).min(t.len()))
+        .map(late)
+        .fold(f64::INFINITY, f64::min);
+    let x = (after - before) / p - 0.5 + 1e-3;
+    if x > 0.0 { x.ceil() as u64 } else { 0 }
 }
 
-/// Span over Σ k of one stretch (its own median), s; 0 for fewer than two samples.
-fn nominal_period(t: &[i64], d: &[i64]) -> f64 {
-    let Some(p) = median_positive(d) else {
-        return 0.0;
-    };
-    let k: u64 = d.iter().map(|&x| periods(x, p)).sum();
-    if k == 0 {
+/// The nominal rate of `t` (ns, in order), Hz: [`analyse`]'s (the cross-check of a second
+/// clock, a text log's time unit).
+pub fn nominal_rate(t: &[i64]) -> Option<f64> {
+    analyse(t).nominal_rate()
+}
+
+/// The nominal period of the segment `start..end` of `t`, s: its span over its periods, the
+/// intervals between its samples and the samples confirmed missing in them (`gaps`); 0 for
+/// fewer than two samples.
+fn segment_period(t: &[i64], start: usize, end: usize, gaps: &[Gap]) -> f64 {
+    if end < start + 2 {
         return 0.0;
     }
-    (t[t.len() - 1] - t[0]) as f64 * NS / k as f64
+    let missing: u64 = gaps
+        .iter()
+        .filter(|g| g.after >= start && g.after + 1 < end)
+        .map(|g| g.missing)
+        .sum();
+    let periods = (end - start - 1) as u64 + missing;
+    (t[end - 1] - t[start]) as f64 * NS / periods as f64
 }
 
 /// Nanoseconds of each time (ROS time, exact).
@@ -499,14 +553,12 @@ mod tests {
     }
 
     #[test]
-    fn the_light_nominal_rate_is_the_analysis_one() {
+    fn lost_samples_leave_the_nominal_rate_alone() {
         let mut t = grid(300_000);
         for i in (1000..299_000).rev().step_by(97) {
             t.remove(i);
         }
-        let full = analyse(&t).nominal_rate().unwrap();
-        assert!((nominal_rate(&t).unwrap() - full).abs() < 1e-9 * full);
-        assert!((full - 200.0).abs() < 1e-9);
+        assert!((nominal_rate(&t).unwrap() - 200.0).abs() < 1e-9);
     }
 
     #[test]
@@ -516,8 +568,104 @@ mod tests {
         assert_eq!(tm.n, 5);
     }
 
+    /// Receive times that jitter by up to half a period (a late sample then on-time ones,
+    /// an exponential delay held in order as a queue delivers) lose no sample; real losses
+    /// among the jitter are still counted exactly.
     #[test]
-    fn duplicated_stamps_leave_the_period_alone() {
+    fn receive_time_jitter_is_no_gap_and_real_losses_beside_it_still_count() {
+        // SplitMix64, seeded: uniform delays in [0, P/2) and, for a queue, exponential ones
+        let mut st = 0x41_7177_u64;
+        let mut unit = || {
+            st = st.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = st;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        const P400: i64 = 2_500_000; // 400 Hz
+        let n = 40_000usize;
+        let uniform: Vec<i64> = (0..n as i64)
+            .map(|i| T0 + i * P400 + (unit() * P400 as f64 * 0.49) as i64)
+            .collect();
+        let mut queue: Vec<i64> = Vec::with_capacity(n);
+        for i in 0..n as i64 {
+            let d = (-unit().max(1e-12).ln() * 0.3e-3 * 1e9) as i64; // mean 0.3 ms
+            let t = T0 + i * P400 + d;
+            queue.push(queue.last().map_or(t, |&l: &i64| l.max(t)));
+        }
+        for (name, t) in [("uniform", &uniform), ("queue", &queue)] {
+            let tm = analyse(t);
+            assert_eq!((tm.missing, tm.gaps.len()), (0, 0), "{name}");
+            assert!(tm.is_continuous(), "{name}");
+            // a queue's equal receive times hold no period: its nominal rate is off by
+            // less than a thousandth (the analysers snap a rate within 0.5 % of a whole Hz)
+            const RATE_REL_TOL: f64 = 1e-3;
+            let rate = tm.nominal_rate().unwrap();
+            assert!(
+                (rate / 400.0 - 1.0).abs() < RATE_REL_TOL,
+                "{name}: {rate} Hz"
+            );
+            // 1 % of the samples lost, one at a time, among the same jitter
+            let lossy: Vec<i64> = t
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % 100 != 37)
+                .map(|(_, &x)| x)
+                .collect();
+            let tm = analyse(&lossy);
+            assert_eq!(tm.missing, 400, "{name}");
+            assert_eq!(tm.gaps.len(), 400, "{name}");
+        }
+    }
+
+    /// A 400 Hz sensor read through a queue (an exponential receive delay of a quarter
+    /// period on average, held in order: bursts of equal receive times after a stall) keeps
+    /// its rate: the samples that arrived, and the ones confirmed missing, are its periods.
+    /// Rounding each jittered interval to whole periods counted some twice and others not
+    /// at all (401.1 Hz for a bag at 400 Hz; the analysers wrote `update_rate: 401.0`).
+    #[test]
+    fn a_queues_receive_times_keep_the_sensors_rate() {
+        let mut st = 0x5157_0041_u64;
+        let mut unit = || {
+            st = st.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = st;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        const P400: i64 = 2_500_000;
+        // the span's two ends are late by a receive delay each (a few ms at most) over 60 s
+        const RATE_REL_TOL: f64 = 1e-4;
+        for mean_ms in [0.3, 0.6, 1.0] {
+            let mut t: Vec<i64> = Vec::with_capacity(24_000);
+            for i in 0..24_000 {
+                let d = (-unit().max(1e-12).ln() * mean_ms * 1e6) as i64;
+                let x = T0 + i * P400 + d;
+                t.push(t.last().map_or(x, |&l: &i64| l.max(x)));
+            }
+            let tm = analyse(&t);
+            let rate = tm.nominal_rate().unwrap();
+            assert!(
+                (rate / 400.0 - 1.0).abs() < RATE_REL_TOL,
+                "{mean_ms} ms: {rate} Hz"
+            );
+            // and with 1 % of the samples lost among the jitter
+            let lossy: Vec<i64> = t
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % 100 != 37)
+                .map(|(_, &x)| x)
+                .collect();
+            let rate = analyse(&lossy).nominal_rate().unwrap();
+            assert!(
+                (rate / 400.0 - 1.0).abs() < RATE_REL_TOL,
+                "{mean_ms} ms, lossy: {rate} Hz"
+            );
+        }
+    }
+
+    #[test]
+    fn equal_stamps_leave_the_median_alone_and_are_samples() {
         let mut t = grid(10_000);
         for i in (0..10_000).step_by(50).rev() {
             t.insert(i, t[i]);
@@ -525,6 +673,10 @@ mod tests {
         let tm = analyse(&t);
         assert_eq!(tm.not_increasing, 200);
         assert_eq!(tm.missing, 0);
-        assert!((tm.nominal_period.unwrap() - 0.005).abs() < 1e-15);
+        assert_eq!(tm.median_period_ns, Some(P));
+        // every stamp is a sample here (a coarse clock's, a queue's burst); samples stored
+        // twice are dropped before the gap rule (record_check::clock::duplicates)
+        let span = 9999.0 * 0.005;
+        assert!((tm.nominal_period.unwrap() - span / 10_199.0).abs() < 1e-15);
     }
 }

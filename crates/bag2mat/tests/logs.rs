@@ -220,12 +220,15 @@ fn dataflash_imu_and_batches_match_pymavlink_bit_for_bit() {
     let names: Vec<&str> = theirs.iter().map(|t| t.topic.as_str()).collect();
     assert_eq!(names, ["IMU:0", "IMU:1", "ISB_ACC", "ISB_GYR"]);
     let series = assert_same_rows(&log, &theirs);
-    // the last batch stops short of its header's count: said, with the samples missing
-    let notes = series[2].notes.join("\n");
-    assert!(
-        notes.contains("hold fewer samples than their header promises; 64 messages lost"),
-        "{notes}"
-    );
+    // the last batch of each sensor stops short of the others' count: said on each, with
+    // the samples it lacks as a bound (the log may have stopped before writing them)
+    for s in &series[2..4] {
+        let notes = s.notes.join("\n");
+        assert!(
+            notes.contains(&format!("up to 32 messages on '{}' were lost", s.topic)),
+            "{notes}"
+        );
+    }
 }
 
 /// A EuRoC/ASL `data.csv` with the decimal forms real datasets hold (17 digits, exponents,

@@ -4,8 +4,12 @@
 
 mod cli;
 mod common;
+mod damaged_logs;
+mod damaged_mcap;
 mod duplicated_rows;
+mod info_report;
 mod logs;
+mod phone_exports;
 mod poses;
 mod real_tools;
 mod reference;
@@ -13,3 +17,6 @@ mod ros1_damage_and_outputs;
 mod ros2;
 mod ros2_damage_and_outputs;
 mod roundtrip;
+mod two_sensors;
+mod unit_physics;
+mod warmup_power;

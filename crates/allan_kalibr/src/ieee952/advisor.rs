@@ -115,6 +115,48 @@ pub fn advise(a: &Analysis) -> Option<Advice> {
     })
 }
 
+/// The analysis and its advice for a record of `record` seconds at `rate` Hz whose Allan
+/// variance is exactly the model of white noise `n`, bias instability `b` and random walk `k`
+/// (one axis, the points where this analysis puts them): what [`advise`] says of such a
+/// record, by the very rule it applies to a measured one. `allan_kalibr plan` asks this, so
+/// that a plan and the advice of the analysis of a record of that sensor agree.
+pub(crate) fn expected(
+    n: f64,
+    b: f64,
+    k: f64,
+    rate: f64,
+    record: f64,
+) -> (Analysis, Option<Advice>) {
+    use super::model::basis;
+    use super::term::NoiseTerm;
+    use super::{CurveData, CurvePoint, IdMethod, Overlap};
+    let cfg = super::Config::default();
+    let tau0 = 1.0 / rate;
+    let samples = (record * rate).round().max(3.0) as usize;
+    let points = cfg
+        .grid
+        .cluster_sizes(samples)
+        .into_iter()
+        .map(|m| {
+            let tau = m as f64 * tau0;
+            CurvePoint {
+                m,
+                tau,
+                avar: n * n * basis(NoiseTerm::WhiteNoise, tau)
+                    + b * b * basis(NoiseTerm::BiasInstability, tau)
+                    + k * k * basis(NoiseTerm::RandomWalk, tau),
+                id: None,
+                id_method: IdMethod::None,
+            }
+        })
+        .collect();
+    let data = CurveData::from_points(tau0, Some(samples), Overlap::Overlapping, points);
+    let basis = data.basis(cfg.fit.per_octave);
+    let a = super::analyse_curve(&data, &cfg, basis.as_ref());
+    let advice = advise(&a);
+    (a, advice)
+}
+
 /// A duration in the unit that reads best (s, min, h, d).
 pub(crate) fn duration_text(s: f64) -> String {
     if !s.is_finite() {

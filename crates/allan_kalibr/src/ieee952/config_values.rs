@@ -1,53 +1,51 @@
-//! The values and caveats every configuration file of the section carries (Kalibr, VINS,
-//! ORB-SLAM3 in [`super::files`]; OpenVINS, Basalt in [`super::vio_files`]): one value per
-//! sensor and term, and the comments saying where each is not a plain fitted value.
+//! The figures and caveats every configuration file of the section carries
+//! ([`crate::consumers::ConfigValues`], rendered per consumer by `crate::consumers::render`):
+//! one value per sensor and quantity as [`ImuAnalysis`] chooses it
+//! ([`ImuAnalysis::noise_density`], [`ImuAnalysis::random_walk`]), each axis' own (resolved,
+//! else its 95 % upper bound) for a consumer that takes them, and the comments saying where a
+//! value is not a plain fitted value.
 
-use super::imu::{ImuAnalysis, SensorValue};
+use super::imu::ImuAnalysis;
+use crate::consumers::values::AxisValue;
+use crate::consumers::{ConfigValues, Origin, Quantity};
 use bag2mat::Sensor;
 
-fn note(name: &str, v: Option<SensorValue>) -> Option<String> {
-    let v = v?;
-    match (v.upper_bound, v.region) {
-        (true, false) => Some(format!(
-            "{name} is NOT RESOLVED by this record: 95 % upper bound."
-        )),
-        (true, true) => Some(format!(
-            "{name} is NOT RESOLVED (no reliable fit; IEEE 952 region rule): 95 % upper bound."
-        )),
-        (false, true) => Some(format!(
-            "{name} is an IEEE 952 region reading: the model did not fit an axis."
-        )),
-        (false, false) => None,
+/// A term per axis (x y z) of the quantity `q`: the resolved value, else its 95 % upper
+/// bound (so marked); `None` when the sensor is absent or an axis has neither.
+fn per_axis(a: &ImuAnalysis, q: Quantity) -> Option<[AxisValue; 3]> {
+    let mut v = [AxisValue {
+        value: f64::NAN,
+        upper_bound: false,
+    }; 3];
+    for ax in a.sensor_axes(q.sensor()) {
+        let t = if q.is_walk() {
+            &ax.analysis.terms.k
+        } else {
+            &ax.analysis.terms.n
+        };
+        v[ax.axis] = match t.reported() {
+            Some(x) => AxisValue {
+                value: x,
+                upper_bound: false,
+            },
+            None => AxisValue {
+                value: t.hi,
+                upper_bound: true,
+            },
+        };
     }
+    v.iter().all(|x| x.value.is_finite()).then_some(v)
 }
 
-pub(super) fn inline_note(v: Option<SensorValue>) -> &'static str {
-    match v {
-        Some(SensorValue {
-            upper_bound: true, ..
-        }) => " NOT RESOLVED: 95 % upper bound",
-        Some(SensorValue { region: true, .. }) => " IEEE 952 region reading (no reliable fit)",
-        _ => "",
-    }
-}
-
-/// The four values and the comments every configuration file carries.
-pub(super) struct FileValues {
-    pub(super) acc_n: Option<SensorValue>,
-    pub(super) acc_w: Option<SensorValue>,
-    pub(super) gyr_n: Option<SensorValue>,
-    pub(super) gyr_w: Option<SensorValue>,
-    pub(super) comments: Vec<String>,
-}
-
-pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
-    let v = FileValues {
-        acc_n: a.noise_density(Sensor::Acc),
-        acc_w: a.random_walk(Sensor::Acc),
-        gyr_n: a.noise_density(Sensor::Gyro),
-        gyr_w: a.random_walk(Sensor::Gyro),
-        comments: Vec::new(),
-    };
+/// The figures of the configuration files of `a`, with its caveats.
+pub(crate) fn file_values(a: &ImuAnalysis) -> ConfigValues {
+    let values = Quantity::ALL.map(|q| {
+        if q.is_walk() {
+            a.random_walk(q.sensor())
+        } else {
+            a.noise_density(q.sensor())
+        }
+    });
     let mut comments = Vec::new();
     for s in [Sensor::Gyro, Sensor::Acc] {
         if a.sensor_axes(s).next().is_none() {
@@ -79,9 +77,6 @@ pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
             ));
         }
     }
-    for (name, x) in names.iter().zip([v.acc_n, v.acc_w, v.gyr_n, v.gyr_w]) {
-        comments.extend(note(name, x));
-    }
     // what the record breaks of the analysis' assumptions (bag2mat::check_record)
     for f in a.warnings() {
         comments.push(format!(
@@ -89,5 +84,10 @@ pub(super) fn file_values(a: &ImuAnalysis, names: [&str; 4]) -> FileValues {
             f.short()
         ));
     }
-    FileValues { comments, ..v }
+    ConfigValues {
+        values,
+        axes: Quantity::ALL.map(|q| per_axis(a, q)),
+        comments,
+        origin: Origin::Measured,
+    }
 }

@@ -8,23 +8,25 @@
 //!   bounds, whether the point is in the fitted range, and the fitted model there; a first
 //!   comment line states the sample count (`# samples=N`) so that `--curves` can read the
 //!   file back with intervals.
-//! * `kalibr_imu_ieee952.yaml`, `vins_imu_ieee952.yaml`, `orbslam3_imu_ieee952.yaml`: the
-//!   values users feed into Kalibr, VINS-Mono/VINS-Fusion and ORB-SLAM3, each saying that it
-//!   is continuous-time (docs/noise_terms.md §3–4). One value per sensor (the largest axis); a term no
-//!   axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
+//! * one config file per consumer of `crate::consumers::CONSUMERS` (Kalibr, OpenVINS, VINS,
+//!   ORB-SLAM3, Basalt, PX4 EKF2, ArduPilot EKF3, GTSAM), rendered by
+//!   [`crate::consumers::render`] from the section's figures
+//!   ([`super::config_values::file_values`]): one value per sensor (the largest axis); a term
+//!   no axis resolves is its 95 % upper bound, marked; an axis without a reliable fit
 //!   contributes its IEEE 952 region readings, and the file says so. A missing sensor's keys
 //!   are left out (with a comment) rather than written as a number. Every warning of the
 //!   record check (`bag2mat::check_record`: warm-up, spike, gaps, clocks) is a caveat.
-//! * OpenVINS' `kalibr_imu_chain.yaml` and Basalt's calibration noise fields:
-//!   [`super::vio_files`].
+//!
+//! Every file names the tool, its version, the input and the time it was written
+//! ([`crate::consumers::Provenance`]); the CSVs in a comment line after their first.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::config_values::{file_values, inline_note};
-use super::imu::{AxisResult, ImuAnalysis, SensorValue};
+use super::config_values::file_values;
+use super::imu::{AxisResult, ImuAnalysis};
 use super::{AxisVerdict, Overlap, Term};
-use crate::yaml::yaml_float;
+use crate::consumers::{CONSUMERS, Provenance};
 
 /// `ieee952_terms.csv`: sensor name (`gyroscope`, `accelerometer`).
 pub const COL_SENSOR: &str = "sensor";
@@ -134,12 +136,6 @@ pub const PSD_FILE: &str = "ieee952_psd.csv";
 pub const TERMS_FILE: &str = "ieee952_terms.csv";
 /// Curves file name.
 pub const CURVES_FILE: &str = "ieee952_curves.csv";
-/// Kalibr yaml file name.
-pub const KALIBR_FILE: &str = "kalibr_imu_ieee952.yaml";
-/// VINS yaml file name.
-pub const VINS_FILE: &str = "vins_imu_ieee952.yaml";
-/// ORB-SLAM3 yaml file name.
-pub const ORBSLAM3_FILE: &str = "orbslam3_imu_ieee952.yaml";
 
 /// The sample count a curves file states in its `# samples=N` comment line.
 pub(crate) fn stated_samples(text: &str) -> Option<usize> {
@@ -152,14 +148,32 @@ pub(crate) fn stated_samples(text: &str) -> Option<usize> {
         })
 }
 
-/// Writes the terms and curves CSVs and the three configuration files into `dir`, each name
-/// prefixed with `prefix`, among the run's `outputs`; returns the paths.
+/// The names, each after `prefix`, of every file the section may write: [`write_outputs`]'
+/// and its charts' (`super::plot`).
+pub fn file_names(prefix: &str) -> Vec<String> {
+    let mut v: Vec<String> = [TERMS_FILE, CURVES_FILE, PSD_FILE]
+        .iter()
+        .chain(CONSUMERS.iter().map(|c| &c.file))
+        .map(|n| format!("{prefix}{n}"))
+        .collect();
+    for stem in [super::plot::STEM, super::psd_plot::STEM] {
+        for ext in ["png", "svg"] {
+            v.push(format!("{prefix}{stem}.{ext}"));
+        }
+    }
+    v
+}
+
+/// Writes the terms and curves CSVs (and the PSD's, from samples) and one configuration file
+/// per consumer into `dir`, each name prefixed with `prefix`, among the run's `outputs`, each
+/// saying `prov`; returns the paths.
 pub fn write_outputs(
     outputs: &bag2mat::shared::output::Outputs,
     a: &ImuAnalysis,
     dir: &Path,
     prefix: &str,
     rostopic: &str,
+    prov: &Provenance,
 ) -> Result<Vec<PathBuf>, bag2mat::Error> {
     let mut files = Vec::new();
     let mut put = |name: &str, text: String| -> Result<(), bag2mat::Error> {
@@ -168,23 +182,29 @@ pub fn write_outputs(
         files.push(p);
         Ok(())
     };
-    put(TERMS_FILE, terms_csv(a))?;
-    put(CURVES_FILE, curves_csv(a))?;
+    let stamp = format!("# {}\n", prov.line());
+    put(TERMS_FILE, with_line_after_first(&terms_csv(a), &stamp))?;
+    put(CURVES_FILE, with_line_after_first(&curves_csv(a), &stamp))?;
     if a.axes.iter().any(|x| x.analysis.psd.is_some()) {
-        put(PSD_FILE, psd_csv(a))?;
+        put(PSD_FILE, with_line_after_first(&psd_csv(a), &stamp))?;
     }
-    put(KALIBR_FILE, kalibr_yaml(a, rostopic))?;
-    put(VINS_FILE, vins_yaml(a))?;
-    put(ORBSLAM3_FILE, orbslam3_yaml(a))?;
-    put(
-        super::vio_files::OPENVINS_FILE,
-        super::vio_files::openvins_yaml(a, rostopic),
-    )?;
-    put(
-        super::vio_files::BASALT_FILE,
-        super::vio_files::basalt_json(a),
-    )?;
+    let values = file_values(a);
+    for c in &CONSUMERS {
+        put(
+            c.file,
+            crate::consumers::render(c.id, &values, prov, rostopic),
+        )?;
+    }
     Ok(files)
+}
+
+/// `text` with `line` inserted after its first line (the CSVs' first comment line is what
+/// readers of the files look at first: `# samples=…`).
+fn with_line_after_first(text: &str, line: &str) -> String {
+    match text.split_once('\n') {
+        Some((first, rest)) => format!("{first}\n{line}{rest}"),
+        None => format!("{text}{line}"),
+    }
 }
 
 fn fit_code(v: &AxisVerdict) -> &'static str {
@@ -406,168 +426,4 @@ pub(crate) fn psd_csv(a: &ImuAnalysis) -> String {
         }
     }
     s
-}
-
-fn key_line(o: &mut String, key: &str, v: Option<SensorValue>, comment: &str) {
-    if let Some(v) = v {
-        let c = format!("{comment}{}", inline_note(Some(v)));
-        o.push_str(&crate::yaml::key_line(key, &yaml_float(v.value), &c));
-    }
-}
-
-/// Kalibr `imu.yaml` (continuous-time, as Kalibr expects), in the layout of the compat file
-/// ([`crate::yaml::ImuYaml`]).
-pub(crate) fn kalibr_yaml(a: &ImuAnalysis, rostopic: &str) -> String {
-    let v = file_values(
-        a,
-        [
-            "accelerometer_noise_density",
-            "accelerometer_random_walk",
-            "gyroscope_noise_density",
-            "gyroscope_random_walk",
-        ],
-    );
-    let mut o = String::new();
-    for c in [
-        "IMU noise model for Kalibr from the IEEE 952 fit of the overlapping Allan deviation",
-        "(largest of the three axes). These are CONTINUOUS-TIME values; Kalibr discretises",
-        "them with update_rate. Values from static data are optimistic: users commonly",
-        "inflate them (x10 or more) before use.",
-        "This is the file to give Kalibr (imu.yaml beside it reproduces kalibr_allan's).",
-    ] {
-        let _ = writeln!(o, "# {c}");
-    }
-    for c in &v.comments {
-        let _ = writeln!(o, "# {c}");
-    }
-    o.push_str("#Accelerometers\n");
-    key_line(
-        &mut o,
-        "accelerometer_noise_density",
-        v.acc_n,
-        "Noise density (continuous-time)  [m/s^2/sqrt(Hz)]",
-    );
-    key_line(
-        &mut o,
-        "accelerometer_random_walk",
-        v.acc_w,
-        "Bias random walk                  [m/s^3/sqrt(Hz)]",
-    );
-    o.push_str("#Gyroscopes\n");
-    key_line(
-        &mut o,
-        "gyroscope_noise_density",
-        v.gyr_n,
-        "Noise density (continuous-time)  [rad/s/sqrt(Hz)]",
-    );
-    key_line(
-        &mut o,
-        "gyroscope_random_walk",
-        v.gyr_w,
-        "Bias random walk                  [rad/s^2/sqrt(Hz)]",
-    );
-    o.push_str(&crate::yaml::key_line(
-        "rostopic",
-        &crate::yaml::yaml_str(rostopic),
-        "the IMU ROS topic",
-    ));
-    o.push_str(&crate::yaml::key_line(
-        "update_rate",
-        &yaml_float(a.rate),
-        "Hz (for discretization of the values above)",
-    ));
-    o
-}
-
-/// VINS-Mono / VINS-Fusion keys. Their comments say "standard deviation"; VINS uses them as
-/// continuous-time densities (it multiplies by the integration period), so these are the
-/// continuous-time values, stated in the file.
-pub(crate) fn vins_yaml(a: &ImuAnalysis) -> String {
-    let v = file_values(a, ["acc_n", "acc_w", "gyr_n", "gyr_w"]);
-    let mut o = String::from("%YAML:1.0\n");
-    let _ = writeln!(
-        o,
-        "# VINS-Mono / VINS-Fusion IMU parameters from the IEEE 952 fit (largest of the three axes).\n\
-         # CONTINUOUS-TIME noise densities and random walks, not per-sample values at {} Hz.\n\
-         # Static data give optimistic values: inflate before use.",
-        a.rate
-    );
-    for c in &v.comments {
-        let _ = writeln!(o, "# {c}");
-    }
-    let line = |o: &mut String, key: &str, x: Option<SensorValue>, c: &str| {
-        if let Some(x) = x {
-            let _ = writeln!(
-                o,
-                "{key}: {}   # {c}{}",
-                yaml_float(x.value),
-                inline_note(Some(x))
-            );
-        }
-    };
-    line(
-        &mut o,
-        "acc_n",
-        v.acc_n,
-        "accelerometer noise density [m/s^2/sqrt(Hz)]",
-    );
-    line(
-        &mut o,
-        "gyr_n",
-        v.gyr_n,
-        "gyroscope noise density [rad/s/sqrt(Hz)]",
-    );
-    line(
-        &mut o,
-        "acc_w",
-        v.acc_w,
-        "accelerometer bias random walk [m/s^3/sqrt(Hz)]",
-    );
-    line(
-        &mut o,
-        "gyr_w",
-        v.gyr_w,
-        "gyroscope bias random walk [rad/s^2/sqrt(Hz)]",
-    );
-    o.push_str("g_norm: 9.81   # gravity magnitude [m/s^2]\n");
-    o
-}
-
-/// ORB-SLAM3 settings keys (continuous-time densities; ORB-SLAM3 discretises with
-/// IMU.Frequency).
-pub(crate) fn orbslam3_yaml(a: &ImuAnalysis) -> String {
-    let v = file_values(
-        a,
-        [
-            "IMU.NoiseAcc",
-            "IMU.AccWalk",
-            "IMU.NoiseGyro",
-            "IMU.GyroWalk",
-        ],
-    );
-    let mut o = String::from(
-        "%YAML:1.0\n\
-         # ORB-SLAM3 IMU noise from the IEEE 952 fit (largest of the three axes).\n\
-         # CONTINUOUS-TIME values; ORB-SLAM3 discretises them with IMU.Frequency.\n\
-         # Static data give optimistic values: inflate before use.\n",
-    );
-    for c in &v.comments {
-        let _ = writeln!(o, "# {c}");
-    }
-    let line = |o: &mut String, key: &str, x: Option<SensorValue>, c: &str| {
-        if let Some(x) = x {
-            let _ = writeln!(
-                o,
-                "{key}: {}   # {c}{}",
-                yaml_float(x.value),
-                inline_note(Some(x))
-            );
-        }
-    };
-    line(&mut o, "IMU.NoiseGyro", v.gyr_n, "[rad/s/sqrt(Hz)]");
-    line(&mut o, "IMU.NoiseAcc", v.acc_n, "[m/s^2/sqrt(Hz)]");
-    line(&mut o, "IMU.GyroWalk", v.gyr_w, "[rad/s^2/sqrt(Hz)]");
-    line(&mut o, "IMU.AccWalk", v.acc_w, "[m/s^3/sqrt(Hz)]");
-    let _ = writeln!(o, "IMU.Frequency: {}   # [Hz]", yaml_float(a.rate));
-    o
 }

@@ -124,10 +124,9 @@ pub(crate) mod region;
 pub(crate) mod stated;
 mod tau_grid;
 pub(crate) mod term;
-pub(crate) mod vio_files;
 
 pub(crate) mod chart_panels;
-mod config_values;
+pub(crate) mod config_values;
 mod curve_data;
 mod declare;
 mod pipeline;

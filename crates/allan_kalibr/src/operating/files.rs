@@ -9,8 +9,8 @@
 //! * `operating_phases.csv`: each phase's kind, span, density and lines per axis.
 //! * `operating_psd.csv`: the residual's PSD per axis with its floor and the spline error's.
 //! * `operating_calibration.yaml` (with a reference): the estimated calibration.
-//! * The configuration files with the operating values: the IEEE 952 section's writers
-//!   ([`crate::ieee952::files`], [`crate::ieee952::vio_files`]) run on an analysis whose
+//! * The configuration files with the operating values: one per consumer of
+//!   [`crate::consumers::CONSUMERS`], rendered by [`crate::consumers::render`] from an analysis whose
 //!   noise densities are the operating ones ([`operating_analysis`]), named `operating_…`,
 //!   each with a header saying what its values are; and, when there is a static analysis,
 //!   that analysis' own files and CSVs named `static_…` beside them.
@@ -22,6 +22,7 @@ use bag2mat::Sensor;
 use bag2mat::shared::output::Outputs;
 
 use super::Operating;
+use crate::consumers::{CONSUMERS, ConsumerId, Provenance};
 use crate::ieee952::imu::{ImuAnalysis, ImuCurves};
 use crate::ieee952::{AxisVerdict, Term, Verdict};
 
@@ -497,6 +498,7 @@ pub(crate) fn write(
     op: &Operating,
     dir: &Path,
     rostopic: &str,
+    prov: &Provenance,
 ) -> Result<Vec<PathBuf>, bag2mat::Error> {
     let mut files = Vec::new();
     let mut put = |name: &str, text: String| -> Result<(), bag2mat::Error> {
@@ -513,19 +515,13 @@ pub(crate) fn write(
         put(CALIBRATION_FILE, y)?;
     }
     if let Some(an) = &op.operating_an {
-        use crate::ieee952::files as f;
-        use crate::ieee952::vio_files as v;
-        for (name, text, json) in [
-            (f::KALIBR_FILE, f::kalibr_yaml(an, rostopic), false),
-            (f::VINS_FILE, f::vins_yaml(an), false),
-            (f::ORBSLAM3_FILE, f::orbslam3_yaml(an), false),
-            (v::OPENVINS_FILE, v::openvins_yaml(an, rostopic), false),
-            (v::BASALT_FILE, v::basalt_json(an), true),
-        ] {
-            let h = operating_header(op, name);
+        let values = crate::ieee952::config_values::file_values(an);
+        for c in &CONSUMERS {
+            let text = crate::consumers::render(c.id, &values, prov, rostopic);
+            let h = operating_header(op, c.file);
             put(
-                &format!("{OPERATING_PREFIX}{name}"),
-                relabel(&text, &h, json),
+                &format!("{OPERATING_PREFIX}{}", c.file),
+                relabel(&text, &h, c.id == ConsumerId::Basalt),
             )?;
         }
     }
@@ -536,6 +532,7 @@ pub(crate) fn write(
             dir,
             STATIC_PREFIX,
             rostopic,
+            prov,
         )?);
     }
     Ok(files)

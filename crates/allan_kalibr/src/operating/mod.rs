@@ -48,6 +48,7 @@ use bag2mat::Sensor;
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
 
+use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
 use crate::front::Section;
 use crate::ieee952::imu::{ImuAnalysis, ImuCurves};
@@ -479,7 +480,9 @@ pub(crate) fn sections(
         } else {
             config.common.out_dir.clone()
         };
-        out.push(run_topic(
+        let topic = data.topic.clone().unwrap_or_default();
+        let notes = bag2mat::shared::note::warnings(&data.notes);
+        match run_topic(
             config,
             s,
             data,
@@ -487,7 +490,13 @@ pub(crate) fn sections(
             static_an.as_ref(),
             &dir,
             outputs,
-        )?);
+        ) {
+            Ok(section) => out.push(section),
+            // one topic of several: said as its error, the others still written (the rule
+            // of both analysers' own runs, `crate::run::sections`)
+            Err(e) if several => out.push(crate::front::topic_failed(&topic, notes, &e)),
+            Err(e) => return Err(e),
+        }
     }
     Ok(out)
 }
@@ -570,7 +579,15 @@ fn run_topic(
         config.title.clone()
     };
     outputs.ensure_dir(dir)?;
-    let mut written = files::write(outputs, &op, dir, &topic)?;
+    let prov = Provenance::new(
+        crate::cli::TOOL,
+        input_text(config.common.samples_path(), topic_name.as_deref()),
+        match config.common.rate {
+            Some(r) => RecordRate::Given(r),
+            None => RecordRate::Measured(rate),
+        },
+    );
+    let mut written = files::write(outputs, &op, dir, &topic, &prov)?;
     written.extend(plot::write(outputs, &op, &title, dir)?);
     Ok(Section {
         topic: topic_name,
@@ -580,6 +597,7 @@ fn run_topic(
         ieee952_text: None,
         written,
         timings: Vec::new(),
+        error: None,
     })
 }
 

@@ -62,9 +62,10 @@ impl Stated {
     }
 }
 
-/// A `sensor.yaml` that does not parse: its path and the parser's message.
+/// A `sensor.yaml` that does not parse: its path and the parser's message (its first line:
+/// the rest draws the text around the error).
 #[derive(Debug, thiserror::Error)]
-#[error("{}: {source}", .path.display())]
+#[error("{}: {}", .path.display(), .source.to_string().lines().next().unwrap_or(""))]
 pub(crate) struct SensorYamlError {
     path: std::path::PathBuf,
     source: serde_saphyr::Error,
@@ -76,9 +77,19 @@ pub(crate) fn sensor_yaml(data_csv: &Path) -> Option<Result<Stated, SensorYamlEr
     let p = data_csv.parent()?.join("sensor.yaml");
     let text = std::fs::read_to_string(&p).ok()?;
     Some(
-        serde_saphyr::from_str::<Stated>(&text)
+        serde_saphyr::from_str::<Stated>(&plain_yaml(&text))
             .map_err(|source| SensorYamlError { path: p, source }),
     )
+}
+
+/// The YAML of a `sensor.yaml` as OpenCV's `FileStorage` writes it (`%YAML:1.0`, which a
+/// YAML 1.2 parser refuses as a directive, and `!!opencv-matrix` tags on matrices): the
+/// directive line dropped and the tags taken off; any other file as it is.
+fn plain_yaml(text: &str) -> String {
+    text.lines()
+        .filter(|l| !l.trim_start().starts_with("%YAML"))
+        .map(|l| l.replacen("!!opencv-matrix", "", 1) + "\n")
+        .collect()
 }
 
 /// The figures the `sensor.yaml` of topic `topic` of the input at `path` states (for the
@@ -93,6 +104,38 @@ pub fn stated_for(path: &Path, topic: &str) -> Option<Stated> {
     };
     let (_, f) = files.into_iter().find(|(t, _)| t == topic)?;
     sensor_yaml(&f)?.ok()
+}
+
+/// Where a tool's default output folder goes for an input inside an EuRoC/ASL dataset (a
+/// `data.csv` of an `imuN` folder, the folder, or its `mav0`): beside the dataset's root
+/// (the folder holding `mav0`), never inside the dataset tree, named after the root and,
+/// for one IMU's folder or file, that IMU (`MH_01_easy` + `imu0`). Returns the folder to
+/// put it in and the name's stem; `None` for any other input (a dataset root is a folder
+/// like any other: its output goes beside it already).
+pub fn output_base(path: &Path) -> Option<(PathBuf, String)> {
+    let path = std::fs::canonicalize(path).ok()?;
+    let (mav0, imu) = if path.is_dir() && path.file_name().is_some_and(|n| n == "mav0") {
+        (path.clone(), None)
+    } else {
+        let dir = if path.is_dir() {
+            is_imu_folder(&path).then_some(path.as_path())?
+        } else {
+            data_csv_folder(&path)?
+        };
+        (dir.parent()?.to_path_buf(), Some(folder_topic(dir)))
+    };
+    // the root holds mav0; an imuN folder outside a mav0 counts its parent as the root
+    let root = if mav0.file_name().is_some_and(|n| n == "mav0") {
+        mav0.parent()?.to_path_buf()
+    } else {
+        mav0
+    };
+    let name = root.file_name()?.to_string_lossy().into_owned();
+    let stem = match imu {
+        Some(t) => format!("{name}_{t}"),
+        None => name,
+    };
+    Some((root.parent()?.to_path_buf(), stem))
 }
 
 /// The topic of an `imuN` folder: its name.
@@ -156,9 +199,15 @@ pub(crate) fn open_files(
 ) -> Result<DecodedSource, Error> {
     let mut streams = Vec::new();
     let mut notes = Vec::new();
+    let mut losses = Vec::new();
     for (topic, f) in files {
         let p = super::text::parse(&f, &topic, opts)?;
         notes.extend(p.notes.into_iter().map(|n| format!("{topic}: {n}")));
+        if let Some((n, what)) = p.lost {
+            // one stream per topic: its channel is its place
+            let ch = streams.len() as u32;
+            losses.push(super::text::lost_rows(ch, (n, format!("{topic}: {what}"))));
+        }
         match sensor_yaml(&f) {
             Some(Ok(s)) if s != Stated::default() => notes.push(format!(
                 "{topic}: the dataset's sensor.yaml states {} (compare with the figures measured here)",
@@ -169,10 +218,39 @@ pub(crate) fn open_files(
         }
         streams.extend(p.streams);
     }
-    Ok(DecodedSource::new(
-        InputKind::EurocDir,
-        streams,
-        notes,
-        Vec::new(),
-    ))
+    let mut src = DecodedSource::new(InputKind::EurocDir, streams, notes, Vec::new());
+    src.add_losses(losses);
+    Ok(src)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An OpenCV-style sensor.yaml (`%YAML:1.0`, an `!!opencv-matrix`), as EuRoC-format
+    /// datasets written through OpenCV's FileStorage hold it, states its figures like a
+    /// plain one.
+    #[test]
+    fn an_opencv_style_sensor_yaml_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("sensor.yaml"),
+            "%YAML:1.0\n---\nsensor_type: imu\ncomment: VI-Sensor IMU (ADIS16448)\nT_BS: !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n   data: [ 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1. ]\nrate_hz: 200\ngyroscope_noise_density: 1.6968e-04\ngyroscope_random_walk: 1.9393e-05\naccelerometer_noise_density: 2.0000e-3\naccelerometer_random_walk: 3.0000e-3\n",
+        )
+        .unwrap();
+        let s = sensor_yaml(&dir.path().join("data.csv")).unwrap().unwrap();
+        assert_eq!(s.rate_hz, Some(200.0));
+        assert_eq!(s.gyroscope_noise_density, Some(1.6968e-4));
+        assert_eq!(s.accelerometer_random_walk, Some(3e-3));
+        // a file that does not parse is said in one line
+        std::fs::write(
+            dir.path().join("sensor.yaml"),
+            "rate_hz: [\n  1, 2\n gyro: x\n",
+        )
+        .unwrap();
+        let e = sensor_yaml(&dir.path().join("data.csv"))
+            .unwrap()
+            .unwrap_err();
+        assert_eq!(e.to_string().lines().count(), 1, "{e}");
+    }
 }

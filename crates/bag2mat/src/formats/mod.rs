@@ -44,6 +44,8 @@ pub struct InputOptions {
     pub gyro_scale: Option<f64>,
     /// Accelerometer columns in raw counts: LSB per acc unit.
     pub acc_scale: Option<f64>,
+    /// A text log of several sensors (a `sensor_id` column): the one to read.
+    pub sensor_id: Option<String>,
 }
 
 /// The input flags every tool shares (flattened into each binary's arguments). The rate
@@ -69,6 +71,10 @@ pub struct InputArgs {
     /// Text logs: the accelerometer columns are raw counts, this many LSB per --acc-unit.
     #[arg(long, value_name = "LSB", value_parser = crate::shared::cli::positive_f64)]
     pub acc_scale: Option<f64>,
+    /// Text logs of several sensors in one file (a column sensor_id, imu_id, device_id, …):
+    /// read only the rows of this sensor.
+    #[arg(long, value_name = "ID")]
+    pub sensor_id: Option<String>,
 }
 
 impl InputArgs {
@@ -82,6 +88,7 @@ impl InputArgs {
             rate,
             gyro_scale: self.gyro_scale,
             acc_scale: self.acc_scale,
+            sensor_id: self.sensor_id.clone(),
         }
     }
 }
@@ -136,7 +143,9 @@ pub(crate) fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
     if head.starts_with(ULOG_MAGIC) {
         return Some(InputKind::Ulog);
     }
-    if head.starts_with(DATAFLASH_MAGIC) {
+    // the first message defines FMT itself (type 128, 89 bytes, "FMT"): recognised by
+    // those too, so that a damaged first byte does not hide a log DFReader reads
+    if head.starts_with(DATAFLASH_MAGIC) || head.get(3..8) == Some(b"\x80\x59FMT") {
         return Some(InputKind::DataFlash);
     }
     if head.starts_with(NPY_MAGIC) {

@@ -96,19 +96,64 @@ pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
     let mut c = Cursor::new(&bytes);
     let h = header(path, &mut c)?;
     let data = c.rest();
-    let need = h.rows.checked_mul(COLS * 8);
-    if need != Some(data.len()) {
+    let row_bytes = COLS * 8;
+    let need = h.rows.checked_mul(row_bytes);
+    let whole = data.len() / row_bytes;
+    let mut notes = Vec::new();
+    let mut losses = Vec::new();
+    // the rows the file holds: as many as the header says where the data hold them (numpy
+    // reads no more), all of them where the data are whole rows and the header says
+    // otherwise (a damaged count), else the whole ones (a file cut short)
+    let rows = if need == Some(data.len()) {
+        h.rows
+    } else if h.fortran {
+        // column by column: a count that does not fit the data places no column
         return Err(Error::Corrupt {
             path: path.to_path_buf(),
             offset: c.offset(),
             what: format!(
-                "the header says {} rows of 7 doubles ({} bytes), the file holds {} bytes of data",
+                "the header says {} rows of 7 doubles in Fortran (column) order ({} bytes), the file holds {} bytes of data",
                 h.rows,
                 need.map_or("too many".to_string(), |n| n.to_string()),
                 data.len()
             ),
         });
-    }
+    } else if data.len().is_multiple_of(row_bytes) {
+        notes.push(format!(
+            "the header says {} rows, the data hold {whole} whole rows: all of them were read",
+            h.rows
+        ));
+        whole
+    } else if whole >= h.rows {
+        notes.push(format!(
+            "{} bytes after the {} rows the header says were not read",
+            data.len() - h.rows * row_bytes,
+            h.rows
+        ));
+        h.rows
+    } else {
+        // cut short: the row it ends inside is lost; the header promised the rest
+        losses.push(crate::source::Loss {
+            what: format!(
+                "the file ends inside row {} of the {} its header says (cut short)",
+                whole + 1,
+                h.rows
+            ),
+            messages: Some(1),
+            channel: Some(0),
+            ..Default::default()
+        });
+        if h.rows > whole + 1 {
+            losses.push(crate::source::Loss {
+                what: "rows the header counts past the end of the file".into(),
+                at_most: Some((h.rows - whole - 1) as u64),
+                channel: Some(0),
+                ..Default::default()
+            });
+        }
+        whole
+    };
+    let h = Header { rows, ..h };
     let at = |r: usize, k: usize| {
         let i = if h.fortran {
             k * h.rows + r
@@ -141,7 +186,6 @@ pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
             },
         );
     }
-    let mut losses = Vec::new();
     if let Some((r, t)) = bad_t {
         let n = h.rows - s.len();
         losses.push(crate::source::Loss {
@@ -152,10 +196,7 @@ pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
             channel: Some(0),
         });
     }
-    Ok(DecodedSource::new(
-        InputKind::Npy,
-        vec![s],
-        Vec::new(),
-        losses,
-    ))
+    let mut src = DecodedSource::new(InputKind::Npy, vec![s], notes, Vec::new());
+    src.add_losses(losses);
+    Ok(src)
 }

@@ -84,10 +84,73 @@ pub fn duplicates(r: &Record<'_>, keep: &mut Keep) -> Option<Finding> {
     )
 }
 
+/// Consecutive samples differ by more than this many times what every second sample does
+/// (medians of |x_i − x_{i−1}| and |x_i − x_{i−2}|), on [`INTERLEAVED_AXES`] axes or more:
+/// the rows alternate between two sensors. One sensor's white noise gives 1, a low-pass
+/// filtered one less; two IMUs whose biases differ by a few σ of their noise give the bias
+/// difference over the noise.
+pub const INTERLEAVED_RATIO: f64 = 3.0;
+/// Axes that must alternate ([`INTERLEAVED_RATIO`]) for two sensors (one axis alone may be a
+/// vibration at half the rate).
+pub const INTERLEAVED_AXES: usize = 3;
+/// Differences the alternation is measured on at most (evenly spread).
+const INTERLEAVED_SAMPLES: usize = 1 << 16;
+
+/// Rows that alternate between two sensors (two IMUs interleaved in one record, as a CSV
+/// with a sensor column holds them): the axes on which consecutive samples differ by more
+/// than [`INTERLEAVED_RATIO`] times what every second sample does. The corrected analysis
+/// is refused: the two sensors' samples read as one at twice the rate make every term
+/// meaningless.
+pub fn interleaved(r: &Record<'_>, keep: &Keep) -> Option<Finding> {
+    let n = keep.len(r.t.len());
+    if n < 16 {
+        return None;
+    }
+    let stride = (n / INTERLEAVED_SAMPLES).max(1);
+    let median = |mut v: Vec<f64>| {
+        let k = v.len() / 2;
+        *v.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    let mut axes: Vec<(usize, f64)> = Vec::new();
+    for (a, v) in r.values.iter().enumerate() {
+        let x = |i: usize| v[keep.row(i)];
+        let idx: Vec<usize> = (2..n).step_by(stride).collect();
+        let d1: Vec<f64> = idx.iter().map(|&i| (x(i) - x(i - 1)).abs()).collect();
+        let d2: Vec<f64> = idx.iter().map(|&i| (x(i) - x(i - 2)).abs()).collect();
+        let (m1, m2) = (median(d1), median(d2));
+        if !(m1.is_finite() && m2.is_finite()) || m1 == 0.0 {
+            continue;
+        }
+        let ratio = if m2 > 0.0 { m1 / m2 } else { f64::INFINITY };
+        if ratio > INTERLEAVED_RATIO {
+            axes.push((a, ratio));
+        }
+    }
+    if axes.len() < INTERLEAVED_AXES {
+        return None;
+    }
+    let list: Vec<String> = axes
+        .iter()
+        .map(|&(a, q)| format!("{} {q:.0}×", super::Axis::ALL[a].label()))
+        .collect();
+    Some(
+        Finding::new(
+            Level::Refusal,
+            Kind::Interleaved,
+            format!(
+                "the rows alternate between two sensors: consecutive samples differ by far more than every second sample does ({}) — two IMUs, each with its own bias, interleaved in one record (a log of several sensors, one row each in turn); analysed as one they are neither, at twice the rate: analyse one sensor's rows (a text log's sensor column: --sensor-id)",
+                list.join(", ")
+            ),
+        )
+        .counted(axes.len() as f64, "axes"),
+    )
+}
+
 /// Kept rows (in row order) that carry the stamp of the kept row before them with other
 /// values: kept, and said (checked after a clock step is cut, whose stretches may share
-/// stamps).
-pub fn equal_stamps(r: &Record<'_>, keep: &Keep) -> Option<Finding> {
+/// stamps). `two_sensors`: the rows alternate between two sensors ([`interleaved`]), which
+/// is why, not the clock.
+pub fn equal_stamps(r: &Record<'_>, keep: &Keep, two_sensors: bool) -> Option<Finding> {
     let n = keep.len(r.t.len());
     let equal: Vec<usize> = (1..n)
         .filter(|&i| r.t[keep.row(i)] == r.t[keep.row(i - 1)])
@@ -99,9 +162,14 @@ pub fn equal_stamps(r: &Record<'_>, keep: &Keep) -> Option<Finding> {
                 Level::Warning,
                 Kind::EqualStamps,
                 format!(
-                    "{} samples carry the stamp of the sample before them with other values (the first at t = {:.3} s, sample {first}): kept; the clock's resolution or the driver's stamping is coarser than the samples, so the rate from the stamps may be off",
+                    "{} samples carry the stamp of the sample before them with other values (the first at t = {:.3} s, sample {first}): kept; {}",
                     equal.len(),
-                    secs(r.t[keep.row(first)] - t0)
+                    secs(r.t[keep.row(first)] - t0),
+                    if two_sensors {
+                        "two sensors stamped alike (see 'two sensors')"
+                    } else {
+                        "the clock's resolution or the driver's stamping is coarser than the samples, so the rate from the stamps may be off"
+                    }
                 ),
             )
             .at(secs(r.t[keep.row(first)] - t0), first)
@@ -234,9 +302,7 @@ fn missing_samples(tm: &Timing, t: &[i64], cut_text: Option<&str>, rate: f64) ->
     let what = match (cut_text, tm.rate_changes.is_empty()) {
         (Some(c), true) => c.to_string(),
         (Some(_), false) => "cut with the rate change below".to_string(),
-        (None, _) => format!(
-            "bridged: analysed as one record at the nominal {rate:.4} Hz (lost samples do not change the rate of those that arrived)"
-        ),
+        (None, _) => bridged_text(tm, rate),
     };
     Finding::new(
         Level::Warning,
@@ -256,6 +322,30 @@ fn missing_samples(tm: &Timing, t: &[i64], cut_text: Option<&str>, rate: f64) ->
     )
     .at(longest.at, longest.after)
     .counted(tm.missing as f64, "samples missing")
+}
+
+/// Bridged gaps (none longer than [`GAP_FACTOR`] samples, and the long ones within
+/// [`timing::MAX_GAP_FRACTION`]): the samples that arrived are analysed as consecutive, so
+/// the analysis' time axis is the samples' count over the rate, not the record's span. Said
+/// with both lengths; past [`timing::MAX_GAP_FRACTION`] of the samples, with what it does
+/// to the terms (white noise N is unchanged; a drift term sees τ shortened by the share
+/// lost, so K reads up to √(span / analysed) high).
+fn bridged_text(tm: &Timing, rate: f64) -> String {
+    let analysed = tm.n.saturating_sub(1) as f64 / rate;
+    let f = tm.missing_fraction();
+    let base = format!(
+        "bridged: the {} samples that arrived are analysed as one record at the nominal {rate:.4} Hz (lost samples do not change the rate of those that arrived)",
+        tm.n
+    );
+    if f <= timing::MAX_GAP_FRACTION || !analysed.is_finite() || analysed <= 0.0 {
+        return base;
+    }
+    format!(
+        "{base}, so the analysis' time axis is {analysed:.1} s of samples for a {:.1} s record: {:.0} % of the time is gone from it; N is unchanged, but every τ beyond one sample is shorter than the time it spanned, so a random walk K or ramp R reads up to ×{:.2} high",
+        tm.span,
+        100.0 * f,
+        (tm.span / analysed).sqrt()
+    )
 }
 
 /// The finding on the sampling rate changing (the first ones listed), at the first change.

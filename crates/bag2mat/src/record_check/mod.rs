@@ -15,7 +15,9 @@
 //! * **warm-up** ([`warmup`]): a drift at the start, fitted as an exponential per axis, with
 //!   the `--skip-start` that outlasts it;
 //! * **motion** ([`motion`]): a record that is not static (gravity direction or magnitude,
-//!   angular rate beyond what the noise allows) refuses the corrected analysis.
+//!   angular rate beyond what the noise allows) refuses the corrected analysis;
+//! * **units** ([`units`]): gravity's magnitude, the rate and the gyroscope's noise against
+//!   what IMUs have, whatever unit the input claims.
 //!
 //! Its findings are typed ([`Finding`]: level, kind, axis, time, size), printed on stderr by
 //! every tool (also with `--quiet`), and named by the IEEE 952 section and its yaml files.
@@ -23,6 +25,7 @@
 pub(crate) mod clock;
 pub(crate) mod motion;
 pub(crate) mod outliers;
+pub(crate) mod units;
 pub(crate) mod warmup;
 
 use std::borrow::Cow;
@@ -80,9 +83,22 @@ pub enum Kind {
     WarmUp,
     /// The sensor moved.
     Motion,
+    /// A unit the physics contradicts (gravity, rate, noise density).
+    Units,
+    /// Rows that alternate between two sensors.
+    Interleaved,
 }
 
 impl Kind {
+    /// True for the checks that read the values as samples of the sensor at the stamps'
+    /// rate (spikes, warm-up, motion, units, two sensors), false for the clock's.
+    pub(crate) fn judges_values_as_samples(self) -> bool {
+        matches!(
+            self,
+            Kind::Outlier | Kind::WarmUp | Kind::Motion | Kind::Units | Kind::Interleaved
+        )
+    }
+
     /// The name the section and the yaml caveats use.
     pub(crate) fn name(self) -> &'static str {
         match self {
@@ -97,6 +113,8 @@ impl Kind {
             Kind::Outlier => "outlier",
             Kind::WarmUp => "warm-up",
             Kind::Motion => "motion",
+            Kind::Units => "units",
+            Kind::Interleaved => "two sensors",
         }
     }
 }
@@ -351,6 +369,7 @@ impl Keep {
             notes: s.notes.clone(),
             report: s.report.clone(),
             storage_order: None,
+            integration: s.integration,
         }
     }
 
@@ -424,7 +443,9 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
     findings.extend(clock::extra_rows(r));
     findings.extend(clock::duplicates(r, &mut keep));
     findings.extend(clock::steps(r, &mut keep));
-    findings.extend(clock::equal_stamps(r, &keep));
+    let two_sensors = clock::interleaved(r, &keep);
+    findings.extend(clock::equal_stamps(r, &keep, two_sensors.is_some()));
+    findings.extend(two_sensors);
     // the gap rule on what is left; a broken record is cut to its longest stretch
     let mut t = keep.apply(r.t);
     let mut tm = timing::analyse(&t);
@@ -460,6 +481,11 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
     for (a, sp) in Axis::ALL.iter().zip(&spikes) {
         findings.extend(outliers::findings(*a, sp, &t, opts.drop_outliers));
     }
+    {
+        let s6: [f64; 6] = std::array::from_fn(|k| sigma[k]);
+        let v6: [&[f64]; 6] = std::array::from_fn(|k| &cols[k][..]);
+        findings.extend(units::findings(v6, &s6, rate));
+    }
     let clean: Vec<Cow<[f64]>> = if spike_rows.is_empty() {
         cols
     } else if opts.drop_outliers {
@@ -492,6 +518,24 @@ pub fn check(r: &Record<'_>, opts: &Options) -> Check {
         timing: tm,
         rate,
     }
+}
+
+/// The findings on rows stored twice in a series as read (more rows than the container
+/// promises, samples with the stamps and values of an earlier one), on clock `time`: what
+/// the converter, which keeps every row, says.
+pub fn stored_twice(s: &crate::ImuSeries, time: TimeColumn) -> Vec<Finding> {
+    let (used, other) = match time {
+        TimeColumn::Record => (&s.record_time, &s.stamp),
+        TimeColumn::Header => (&s.stamp, &s.record_time),
+    };
+    let t = timing::ns_of_times(used);
+    let o = timing::ns_of_times(other);
+    let r = Record::of_series(s, time, &t, &o);
+    let mut keep = Keep::All;
+    clock::extra_rows(&r)
+        .into_iter()
+        .chain(clock::duplicates(&r, &mut keep))
+        .collect()
 }
 
 /// Drops the findings on the axes of a sensor the topic does not carry (its columns were a

@@ -225,6 +225,8 @@ impl BagDir {
                 parts,
                 notes,
                 losses,
+                log_start: None,
+                integration: Vec::new(),
             },
             info,
         }

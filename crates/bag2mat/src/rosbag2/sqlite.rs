@@ -205,6 +205,8 @@ impl Sqlite3Reader {
                 parts,
                 notes,
                 losses,
+                log_start: None,
+                integration: Vec::new(),
             },
         })
     }

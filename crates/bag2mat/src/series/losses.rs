@@ -10,6 +10,8 @@ pub(super) struct LossTally {
     pub(super) exact: u64,
     /// Of unknown topic (could be this one's), counted or bounded.
     pub(super) unknown_topic: u64,
+    /// This topic's, bounded (the damaged bytes can have held at most this many).
+    pub(super) bounded: u64,
     /// Some loss has no count at all.
     pub(super) uncounted: bool,
     /// A loss on no particular channel is this topic's: the source has no other.
@@ -21,6 +23,9 @@ impl LossTally {
         match (l.messages, l.at_most) {
             (Some(n), _) if mine || self.only_topic => self.exact = self.exact.saturating_add(n),
             (Some(n), _) => self.unknown_topic = self.unknown_topic.saturating_add(n),
+            (None, Some(n)) if mine && l.channel.is_some() => {
+                self.bounded = self.bounded.saturating_add(n)
+            }
             (None, Some(n)) => self.unknown_topic = self.unknown_topic.saturating_add(n),
             (None, None) => self.uncounted = true,
         }
@@ -122,10 +127,19 @@ pub(super) fn loss_notes(
         Some(_) => (
             tally
                 .unknown_topic
+                .saturating_add(tally.bounded)
                 .saturating_sub(missing.saturating_sub(exact)),
             false,
         ),
-        None => (tally.unknown_topic, tally.uncounted),
+        None => (
+            tally.unknown_topic.saturating_add(tally.bounded),
+            tally.uncounted,
+        ),
+    };
+    let why = if tally.unknown_topic > 0 {
+        " (messages of unknown topic were lost)"
+    } else {
+        ""
     };
     let see = if r.losses.is_empty() && no_container_loss {
         " (the container promises them; none of its parts could say where)"
@@ -140,17 +154,20 @@ pub(super) fn loss_notes(
     if missing > 0 {
         notes.push(format!(
             "{missing} of {} messages on '{}' were lost{}{tail}",
-            r.promised.unwrap_or(r.delivered + missing),
+            // a loss a reader counted beyond its promise (a batch short of its header)
+            // belongs to the total too
+            r.promised
+                .map_or(r.delivered + missing, |p| p.max(r.delivered + missing)),
             topic,
             if more > 0 {
-                format!(", and up to {more} more (messages of unknown topic were lost)")
+                format!(", and up to {more} more{why}")
             } else {
                 String::new()
             }
         ));
     } else if more > 0 {
         notes.push(format!(
-            "up to {more} messages on '{}' were lost (messages of unknown topic were lost){tail}",
+            "up to {more} messages on '{}' were lost{why}{tail}",
             topic
         ));
     } else if uncounted {

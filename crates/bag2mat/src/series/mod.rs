@@ -113,6 +113,9 @@ pub struct ImuSeries {
     /// Where each row was stored, when the rows were sorted by record time (`None`: row
     /// order is storage order); the record check finds a clock that steps back with it.
     pub storage_order: Option<Vec<u32>>,
+    /// For a topic of integrated deltas (PX4 `vehicle_imu`), its rows' integration
+    /// intervals: whether they are samples to analyse is [`ImuSeries::check_integration`]'s.
+    pub integration: Option<crate::Integration>,
 }
 
 impl ImuSeries {
@@ -179,6 +182,17 @@ impl ImuSeries {
             }),
             None => Ok(()),
         }
+    }
+
+    /// A topic of integrated deltas whose rows do not tile the time is no sequence of
+    /// samples: the [`crate::DeadTime`] error that says why (the rule:
+    /// [`crate::check_integration`]). Every other topic passes.
+    pub fn check_integration(&self) -> Result<(), Error> {
+        crate::integrated::check(
+            &self.topic,
+            self.integration,
+            &crate::timing::ns_of_times(&self.stamp),
+        )
     }
 
     /// The chosen time column.
@@ -738,6 +752,15 @@ fn topic_series(
         acc,
         gyro,
     } = rows;
+    let integration = match s.channels[..] {
+        [(id, _)] => src
+            .contents()
+            .integration
+            .iter()
+            .find(|(c, _)| *c == id)
+            .map(|(_, i)| *i),
+        _ => None,
+    };
     let mut out = ImuSeries {
         topic: s.topic.clone(),
         msg_type: s.msg_type.clone(),
@@ -747,6 +770,7 @@ fn topic_series(
         acc,
         gyro,
         storage_order,
+        integration,
         ..ImuSeries::default()
     };
     let r = &mut out.report;
@@ -777,12 +801,8 @@ fn topic_series(
     for o in outs {
         notes.extend(o.read.notes.iter().cloned());
     }
-    notes.extend(
-        src.losses()
-            .iter()
-            .chain(after.iter())
-            .map(|l| l.to_string()),
-    );
+    // the container's losses, but another topic's own (a loss that names its channel)
+    notes.extend(container.iter().map(|l| l.to_string()));
     notes.extend(s.note.iter().cloned());
     notes.extend(r.losses.iter().map(|l| l.to_string()));
     loss_notes(&mut notes, r, &s.topic, &tally, container.is_empty());

@@ -55,6 +55,16 @@ impl Note {
         }
     }
 
+    /// Information the upstream tool prints itself as a warning, after `prefix` (kept for
+    /// parity with upstream's stderr), which this tool says as information: a message that
+    /// every ordinary run would print is not a warning.
+    pub fn upstream_info(prefix: &'static str, text: impl Into<String>) -> Note {
+        Note {
+            upstream_prefix: Some(prefix),
+            ..Note::info(text)
+        }
+    }
+
     /// The line on stderr: `warning: <text>` or the text.
     pub fn line(&self) -> String {
         match self.level {

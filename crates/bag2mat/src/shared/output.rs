@@ -84,6 +84,24 @@ impl Outputs {
         f.commit()
     }
 
+    /// Removes `path`, a regular file an earlier run left that this run does not write
+    /// (never one of the run's inputs): in a staged run at the commit, with the run's
+    /// outputs (a failed run removes nothing); in a direct run now. A path that is missing
+    /// or not a regular file is left alone.
+    pub fn remove_at_commit(&self, path: &Path) -> Result<(), Error> {
+        let is_file = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_file());
+        if !is_file {
+            return Ok(());
+        }
+        check_not_input(self, path, path)?;
+        if let Some(stage) = self.stage()
+            && super::staging::remove_at_commit(stage, path)
+        {
+            return Ok(());
+        }
+        std::fs::remove_file(path).map_err(|e| Error::io(path, e))
+    }
+
     /// Makes sure the output directory `dir` can take outputs: in a staged run nothing is
     /// created (its commit makes the directory, so a failed run leaves none); otherwise the
     /// directory and its parents are created.
@@ -449,5 +467,56 @@ mod tests {
         out.write_atomic(&b, |w| w.write_all(b"b")).unwrap();
         out.commit().unwrap();
         assert_eq!(names(dir.path()), vec!["a", "b"]);
+    }
+
+    /// An earlier run's file this run retires goes at the commit, with the new files, and
+    /// stays when the run fails (its stage dropped).
+    #[test]
+    fn a_retired_file_goes_with_the_commit_and_only_then() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, old) = (dir.path().join("a"), dir.path().join("old"));
+        std::fs::write(&a, b"a0").unwrap();
+        std::fs::write(&old, b"old").unwrap();
+        {
+            let out = Outputs::staged();
+            out.write_atomic(&a, |w| w.write_all(b"a1")).unwrap();
+            out.remove_at_commit(&old).unwrap();
+            assert!(old.exists());
+        }
+        assert_eq!(
+            names(dir.path()),
+            vec!["a", "old"],
+            "a failed run removed a file"
+        );
+        assert_eq!(std::fs::read(&a).unwrap(), b"a0");
+        // the whole directory is replaced (the exchange) or filled (the moves): both paths
+        for extra in [false, true] {
+            std::fs::write(&old, b"old").unwrap();
+            if extra {
+                // a file of the user's: the directory cannot be exchanged whole
+                std::fs::write(dir.path().join("mine"), b"x").unwrap();
+            }
+            let out = Outputs::staged();
+            out.write_atomic(&a, |w| w.write_all(b"a2")).unwrap();
+            out.remove_at_commit(&old).unwrap();
+            out.commit().unwrap();
+            let mut want = vec!["a"];
+            if extra {
+                want.push("mine");
+            }
+            assert_eq!(names(dir.path()), want);
+            assert_eq!(std::fs::read(&a).unwrap(), b"a2");
+        }
+        // in a directory the run writes nothing into, and never an input
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        std::fs::write(sub.join("old"), b"old").unwrap();
+        std::fs::write(sub.join("input"), b"in").unwrap();
+        let mut out = Outputs::staged();
+        out.protect_input(&sub.join("input"));
+        assert!(out.remove_at_commit(&sub.join("input")).is_err());
+        out.remove_at_commit(&sub.join("old")).unwrap();
+        out.commit().unwrap();
+        assert_eq!(names(&sub), vec!["input"]);
     }
 }

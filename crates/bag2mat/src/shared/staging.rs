@@ -13,6 +13,12 @@
 //! * for the current directory (or one beside which no stage can be made): hidden temporary
 //!   files inside it, moved in the same way after a journal.
 //!
+//! A run may also retire files of an earlier run
+//! ([`super::output::Outputs::remove_at_commit`]): they are removed
+//! by the same commit (with the exchange, as the old directory goes; after the moves, named
+//! in the journal so that the next run finishes a killed commit's removals too), and not at
+//! all if the run fails.
+//!
 //! A commit holds an advisory lock (`flock`) on the directory that holds the stage, so
 //! concurrent runs commit one after the other and the directory ends with one run's
 //! complete set. Before committing, a run finishes the journaled commits of runs that are
@@ -66,6 +72,8 @@ struct Staged {
     pairs: Vec<(PathBuf, PathBuf)>,
     /// Output directories the run may create (the commit makes them).
     creatable: Vec<PathBuf>,
+    /// Files of an earlier run to remove at the commit (canonical directory, file name).
+    removals: Vec<(PathBuf, std::ffi::OsString)>,
 }
 
 /// A run's stage, shared by its [`Staging`] and the temporary paths written in it (which
@@ -132,6 +140,28 @@ pub(super) fn file_path(stage: &Stage, target: &Path) -> Result<Option<PathBuf>,
             t
         }
     }))
+}
+
+/// Declares `path` (a regular file that is not an output of this run) to be removed at the
+/// commit; false once the stage is gone.
+pub(super) fn remove_at_commit(stage: &Stage, path: &Path) -> bool {
+    let mut g = lock(&stage.0);
+    let Some(staged) = g.as_mut() else {
+        return false;
+    };
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
+        return true;
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        dir.to_path_buf()
+    };
+    let dir = std::fs::canonicalize(&dir).unwrap_or(dir);
+    if !staged.removals.iter().any(|(d, n)| *d == dir && n == name) {
+        staged.removals.push((dir, name.to_os_string()));
+    }
+    true
 }
 
 /// Records a committed staged file (`tmp` → `target`), or another temporary path to rename
@@ -281,8 +311,15 @@ fn recover(dir: &Path) {
             let j = dir.join(n);
             if let Ok(text) = std::fs::read_to_string(&j) {
                 for line in text.lines() {
-                    if let Some((tmp, target)) = line.split_once('\t') {
-                        let _ = std::fs::rename(dir.join(tmp), dir.join(target));
+                    match line.split_once('\t') {
+                        // a removal of an earlier run's file
+                        Some(("", target)) => {
+                            let _ = std::fs::remove_file(dir.join(target));
+                        }
+                        Some((tmp, target)) => {
+                            let _ = std::fs::rename(dir.join(tmp), dir.join(target));
+                        }
+                        None => {}
                     }
                 }
             }
@@ -305,7 +342,12 @@ fn recover(dir: &Path) {
                 .and_then(|x| x.strip_suffix(".tmp"))
                 .and_then(|x| x.rsplitn(3, '.').nth(2))
         {
-            let _ = move_into(&p, &dir.join(real), &mut |_| Ok(()));
+            let target = dir.join(real);
+            let removals = std::fs::read_to_string(p.join(JOURNAL)).unwrap_or_default();
+            let _ = move_into(&p, &target, &mut |_| Ok(()));
+            for name in removals.lines().filter(|l| !l.is_empty()) {
+                let _ = std::fs::remove_file(target.join(name));
+            }
         }
         remove(&p);
     }
@@ -374,8 +416,9 @@ fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
     }
 }
 
-/// Commits one area: one rename or exchange when it can, else the journaled moves.
-fn commit_area(a: &Area) -> Result<(), Error> {
+/// Commits one area: one rename or exchange when it can, else the journaled moves; the
+/// `removals` (file names in the area's directory) go with it.
+fn commit_area(a: &Area, removals: &[std::ffi::OsString]) -> Result<(), Error> {
     let holder = a
         .stage
         .as_ref()
@@ -389,7 +432,7 @@ fn commit_area(a: &Area) -> Result<(), Error> {
     }
     test_delay();
     let Some(stage) = &a.stage else {
-        return commit_in_place(a);
+        return commit_in_place(a, removals);
     };
     // A directory that did not exist becomes the stage.
     if !a.root.exists() {
@@ -403,7 +446,8 @@ fn commit_area(a: &Area) -> Result<(), Error> {
             Err(e) => return Err(Error::io(&a.root, e)),
         }
     }
-    let names: Vec<&std::ffi::OsStr> = a.files.iter().filter_map(|f| f.1.file_name()).collect();
+    let mut names: Vec<&std::ffi::OsStr> = a.files.iter().filter_map(|f| f.1.file_name()).collect();
+    names.extend(removals.iter().map(|n| n.as_os_str()));
     let same_owner = |p: &Path| {
         use std::os::unix::fs::MetadataExt;
         // SAFETY: geteuid has no preconditions.
@@ -418,7 +462,8 @@ fn commit_area(a: &Area) -> Result<(), Error> {
             if let Ok(rd) = std::fs::read_dir(stage) {
                 for e in rd.flatten() {
                     let dst = a.dir.join(e.file_name());
-                    if !dst.exists() {
+                    let retired = removals.iter().any(|n| *n == e.file_name());
+                    if !dst.exists() && !retired {
                         let _ = std::fs::rename(e.path(), dst);
                     }
                 }
@@ -428,19 +473,31 @@ fn commit_area(a: &Area) -> Result<(), Error> {
             return Ok(());
         }
     }
-    // The journal: from here on, a run that finds this stage dead finishes the moves.
-    std::fs::write(stage.join(JOURNAL), b"").map_err(|e| Error::io(&a.dir, e))?;
+    // The journal (naming the removals): from here on, a run that finds this stage dead
+    // finishes the moves and the removals.
+    let mut journal = String::new();
+    for n in removals {
+        journal.push_str(&n.to_string_lossy());
+        journal.push('\n');
+    }
+    std::fs::write(stage.join(JOURNAL), journal).map_err(|e| Error::io(&a.dir, e))?;
     let r = move_into(stage, &a.root, &mut |_| {
         test_delay();
         Ok(())
     });
+    if r.is_ok() {
+        for n in removals {
+            let _ = std::fs::remove_file(a.dir.join(n));
+        }
+    }
     remove(stage);
     unregister(stage);
     r.map_err(|e| Error::io(&a.dir, e))
 }
 
-/// Commits temporary files inside their directory: a journal, then the renames.
-fn commit_in_place(a: &Area) -> Result<(), Error> {
+/// Commits temporary files inside their directory: a journal, then the renames, then the
+/// `removals` (journaled as lines with no temporary name).
+fn commit_in_place(a: &Area, removals: &[std::ffi::OsString]) -> Result<(), Error> {
     let journal = a.dir.join(unique("bag2mat", JOURNAL_SUFFIX));
     let mut text = String::new();
     for (tmp, target) in &a.files {
@@ -451,6 +508,9 @@ fn commit_in_place(a: &Area) -> Result<(), Error> {
                 g.to_string_lossy()
             ));
         }
+    }
+    for n in removals {
+        text.push_str(&format!("\t{}\n", n.to_string_lossy()));
     }
     std::fs::write(&journal, text).map_err(|e| Error::io(&a.dir, e))?;
     let mut err = None;
@@ -465,6 +525,11 @@ fn commit_in_place(a: &Area) -> Result<(), Error> {
             remove(tmp);
         }
         unregister(tmp);
+    }
+    if err.is_none() {
+        for n in removals {
+            let _ = std::fs::remove_file(a.dir.join(n));
+        }
     }
     let _ = std::fs::remove_file(&journal);
     err.map_or(Ok(()), Err)
@@ -512,13 +577,25 @@ impl Staging {
         }
         let mut areas = staged.areas;
         areas.sort_by(|a, b| a.root.cmp(&b.root));
+        let mut removals = staged.removals;
         for a in &areas {
+            // the removals in this area's directory go with its commit
+            let (mine, rest): (Vec<_>, Vec<_>) =
+                removals.into_iter().partition(|(d, _)| *d == a.dir);
+            removals = rest;
+            let mine: Vec<std::ffi::OsString> = mine.into_iter().map(|(_, n)| n).collect();
             if err.is_none() {
-                if let Err(e) = commit_area(a) {
+                if let Err(e) = commit_area(a, &mine) {
                     err = Some(e);
                 }
             } else {
                 discard(a);
+            }
+        }
+        // removals in a directory this run writes nothing into
+        if err.is_none() {
+            for (d, n) in removals {
+                let _ = std::fs::remove_file(d.join(n));
             }
         }
         err.map_or(Ok(()), Err)

@@ -57,6 +57,45 @@ pub(super) fn num(s: &[u8]) -> Option<f64> {
     fast_float2::parse(trim(s)).ok()
 }
 
+/// Bytes a line may have and still be read as a row (a row of hundreds of columns takes a
+/// few kB; a longer line is damage, not parsed).
+pub(super) const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Bytes of a line a warning quotes at most.
+pub(super) const EXCERPT_BYTES: usize = 32;
+
+/// A short, printable excerpt of a field or line for a warning (never the whole of a long
+/// one).
+pub(super) fn excerpt(b: &[u8]) -> String {
+    let cut = b.len() > EXCERPT_BYTES;
+    let s: String = String::from_utf8_lossy(&b[..b.len().min(EXCERPT_BYTES)])
+        .chars()
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect();
+    if cut {
+        format!("{s}... ({} bytes)", b.len())
+    } else {
+        s
+    }
+}
+
+/// The fields of a raw line (delimiters counted, quotes not honoured) and how many of them
+/// are numbers.
+pub(super) fn raw_fields(line: &[u8], lay: &Layout) -> (usize, usize) {
+    let line = line.strip_suffix(b"\n").unwrap_or(line);
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let numeric = |f: &[u8]| usize::from(!trim(f).is_empty() && num(f).is_some());
+    match lay.delim {
+        Delim::Byte(d) => line
+            .split(|&c| c == d)
+            .fold((0, 0), |(n, k), f| (n + 1, k + numeric(f))),
+        Delim::Whitespace(_) => line
+            .split(|&c| c == b' ' || c == b'\t')
+            .filter(|f| !f.is_empty())
+            .fold((0, 0), |(n, k), f| (n + 1, k + numeric(f))),
+    }
+}
+
 /// What one byte range of the body gave; its rows are written into its slot of the
 /// topic's columns.
 #[derive(Default)]
@@ -64,6 +103,8 @@ pub(super) struct Chunk<'a> {
     /// The range's rows: its slot of the columns, filled from the start.
     pub(super) slot: RowsMut<'a>,
     pub(super) got: Summary,
+    /// The runs of malformed lines, counted at the range's end.
+    pub(super) runs: Vec<Run>,
 }
 
 /// What a range gave besides its rows.
@@ -76,9 +117,8 @@ pub(super) struct Summary {
     pub(super) bad: u64,
     /// Line (in the range, 1-based) and reason of the first malformed line.
     pub(super) first_bad: Option<(u64, String)>,
-    /// A line the csv crate read held a quote: a quoted field may hold a line break, so the
-    /// file is read by the csv crate whole.
-    pub(super) quoted: bool,
+    /// Rows the malformed lines held ([`Chunk::malformed`]).
+    pub(super) lost: u64,
     /// The order of the range's stamps.
     pub(super) order: Order,
 }
@@ -122,6 +162,12 @@ pub(super) fn row_of<'f>(
     n_fields: usize,
     get: impl Fn(usize) -> Option<&'f [u8]>,
 ) -> Result<Row, BadRow> {
+    if n_fields != lay.n_cols {
+        return Err(BadRow(format!(
+            "{n_fields} fields, the file's rows have {}",
+            lay.n_cols
+        )));
+    }
     let t = match lay.time {
         Some(i) => {
             let f = get(i)
@@ -129,7 +175,7 @@ pub(super) fn row_of<'f>(
             parse_time_ns(f, lay.time_unit).ok_or_else(|| {
                 BadRow(format!(
                     "time '{}' is not a non-negative number",
-                    String::from_utf8_lossy(f)
+                    excerpt(f)
                 ))
             })?
         }
@@ -148,7 +194,7 @@ pub(super) fn row_of<'f>(
                 BadRow(format!(
                     "field {} '{}' is not a number",
                     c[a] + 1,
-                    String::from_utf8_lossy(f)
+                    excerpt(f)
                 ))
             })? * si;
         }
@@ -187,10 +233,62 @@ impl Chunk<'_> {
             }
         }
     }
+
+    /// A malformed line `line` (raw bytes `raw`; `cut`: the file ends inside it, a row
+    /// however little of it is left): counted with the run of consecutive malformed lines it
+    /// belongs to ([`Summary::lost`]).
+    pub(super) fn malformed(&mut self, line: u64, raw: &[u8], lay: &Layout, cut: bool) {
+        let (_, numbers) = raw_fields(raw, lay);
+        let (numbers, bytes) = (numbers as u64, raw.len() as u64);
+        match self.runs.last_mut() {
+            Some(r) if r.last + 1 >= line => {
+                r.last = line;
+                r.numbers += numbers;
+                r.bytes += bytes;
+                r.cut |= cut;
+            }
+            _ => self.runs.push(Run {
+                last: line,
+                numbers,
+                bytes,
+                cut,
+            }),
+        }
+    }
+
+    /// The rows the runs of malformed lines held, from the numbers and bytes in them
+    /// against a row's (`row_bytes`: a row line's length in the range): a row whose value
+    /// is damaged holds most of a row's numbers and a row's bytes, two rows run together
+    /// twice as many, a row split in two has them across its two lines (a piece alone
+    /// is no row), a line with no number in it (junk inserted) held no row, and a long line
+    /// holds no more rows than its numbers fill.
+    pub(super) fn count_runs(&mut self, lay: &Layout, row_bytes: f64) {
+        let cols = lay.n_cols.max(1) as f64;
+        for r in self.runs.drain(..) {
+            if r.numbers == 0 {
+                continue;
+            }
+            let by_numbers = r.numbers as f64 / cols;
+            let by_bytes = r.bytes as f64 / row_bytes.max(1.0);
+            let rows = by_numbers.max(by_bytes.min(by_numbers.ceil())).round() as u64;
+            self.got.lost += if r.cut { rows.max(1) } else { rows };
+        }
+    }
 }
 
-/// Reads `text` with the `csv` crate (quoting, comments, flexible rows): for a range whose
-/// fields may be quoted, and for each line [`fast_row`] does not take.
+/// A run of consecutive malformed lines: its last line, the numbers and bytes in it, and
+/// whether it ends the file without a line end.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Run {
+    last: u64,
+    numbers: u64,
+    bytes: u64,
+    cut: bool,
+}
+
+/// Reads `text` with the `csv` crate (quoting, comments, flexible rows): each line
+/// [`fast_row`] does not take. A quoted field never runs past its line: a line is read on its
+/// own (a quote left open by damage costs that line only).
 pub(super) fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) -> u64 {
     let (delim, ws) = match lay.delim {
         Delim::Byte(b) => (b, false),
@@ -202,6 +300,8 @@ pub(super) fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) 
         .delimiter(delim)
         .comment(Some(b'#'))
         .quoting(!ws)
+        // a line ends at LF only: a CR inside a line is damage, not a line end
+        .terminator(csv::Terminator::Any(b'\n'))
         .from_reader(text);
     let mut rec = csv::ByteRecord::new();
     // a record's line: the line of the last byte the reader took for it (the csv crate's own
@@ -220,7 +320,10 @@ pub(super) fn parse_csv(text: &[u8], lay: &Layout, line0: u64, out: &mut Chunk) 
             Err(e) => {
                 let line = line_of(rdr.position().byte());
                 out.got.bad += 1;
-                out.got.first_bad.get_or_insert((line, e.to_string()));
+                let why = e.to_string();
+                out.got
+                    .first_bad
+                    .get_or_insert((line, excerpt(why.as_bytes())));
                 continue;
             }
         }
@@ -356,22 +459,30 @@ pub(super) fn fast_row(b: &[u8], lay: &Layout, cols: &[Col]) -> Option<(Row, usi
         }
     }
     // the line end, straight after the last column read (the usual case)
+    let extra = lay.n_cols.saturating_sub(cols.len());
     match (b.get(i), b.get(i + 1)) {
-        (None, _) => return (i > 0).then_some((row, i)),
-        (Some(b'\n'), _) => return Some((row, i + 1)),
-        (Some(b'\r'), Some(b'\n')) => return Some((row, i + 2)),
+        (None, _) if extra == 0 => return (i > 0).then_some((row, i)),
+        (Some(b'\n'), _) if extra == 0 => return Some((row, i + 1)),
+        (Some(b'\r'), Some(b'\n')) if extra == 0 => return Some((row, i + 2)),
         _ => {}
     }
-    // the rest of the line: further columns are skipped (no quote in them)
+    // the rest of the line: the further columns the file's rows have, skipped (no quote in
+    // them); a line with more or fewer is no row
     let rest = &b[i..];
-    let end = rest.iter().position(|&c| c == b'\n').unwrap_or(rest.len());
+    let end = memchr::memchr(b'\n', rest).unwrap_or(rest.len());
     let tail = &rest[..end];
-    if !tail.is_empty() {
-        let t = tail.strip_suffix(b"\r").unwrap_or(tail);
-        let ok = t.is_empty() || (ws && blank(t[0])) || (!ws && t[0] == d);
-        if !ok || t.contains(&b'"') || t.contains(&b'#') {
-            return None;
-        }
+    let t = tail.strip_suffix(b"\r").unwrap_or(tail);
+    let ok = t.is_empty() || (ws && blank(t[0])) || (!ws && t[0] == d);
+    if !ok || t.contains(&b'"') || t.contains(&b'#') {
+        return None;
+    }
+    let more = if ws {
+        t.split(|&c| blank(c)).filter(|f| !f.is_empty()).count()
+    } else {
+        memchr::memchr_iter(d, t).count()
+    };
+    if more != extra {
+        return None;
     }
     let took = i + end + usize::from(end < rest.len());
     (took > 0).then_some((row, took))
@@ -399,17 +510,70 @@ impl Cursor<'_, '_> {
             self.pos += took;
             return;
         }
-        let end = rest
-            .iter()
-            .position(|&c| c == b'\n')
-            .map_or(rest.len(), |p| p + 1);
-        self.out.got.quoted |= rest[..end].contains(&b'"');
-        parse_csv(&rest[..end], lay, self.line, &mut self.out);
+        let end = memchr::memchr(b'\n', rest).map_or(rest.len(), |p| p + 1);
+        let raw = &rest[..end];
+        // a CR inside the line: a line end too, as pandas reads it (a damaged LF of a CRLF
+        // file leaves one); each piece is read as a line of its own
+        let inner = raw.strip_suffix(b"\n").unwrap_or(raw);
+        let inner = inner.strip_suffix(b"\r").unwrap_or(inner);
+        // the file's last line, cut short
+        let cut = !raw.ends_with(b"\n");
+        if memchr::memchr(b'\r', inner).is_some() {
+            let pieces: Vec<&[u8]> = inner
+                .split(|&c| c == b'\r')
+                .filter(|p| !p.is_empty())
+                .collect();
+            for (k, piece) in pieces.iter().enumerate() {
+                self.read_line(piece, lay, cols, cut && k + 1 == pieces.len());
+            }
+            self.pos += end;
+            return;
+        }
+        self.read_line(raw, lay, cols, cut);
         self.pos += end;
+    }
+
+    /// A line (`raw`; `cut`: the file ends inside it) [`fast_row`] did not take: read by the
+    /// csv crate, its damage counted.
+    fn read_line(&mut self, raw: &[u8], lay: &Layout, cols: &[Col], cut: bool) {
+        if raw.len() > MAX_LINE_BYTES {
+            // no row is this long: not parsed (the csv crate would hold it whole)
+            self.out.take(
+                self.line,
+                Err(BadRow(format!(
+                    "a line of {} bytes, longer than any row",
+                    raw.len()
+                ))),
+            );
+            self.out.malformed(self.line, raw, lay, cut);
+            return;
+        }
+        if let Some((row, took)) = fast_row(raw, lay, cols)
+            && took == raw.len()
+        {
+            self.out.take(self.line, Ok(row));
+            return;
+        }
+        let bad = self.out.got.bad;
+        if comment_row(raw, lay) {
+            // a comment that holds a row's numbers: a row whose first byte is damaged
+            self.out.take(
+                self.line,
+                Err(BadRow(format!(
+                    "a comment line that holds a row's numbers: '{}'",
+                    excerpt(raw)
+                ))),
+            );
+        } else {
+            parse_csv(raw, lay, self.line, &mut self.out);
+        }
+        if self.out.got.bad > bad {
+            self.out.malformed(self.line, raw, lay, cut);
+        }
     }
 }
 
-/// One unquoted range: each line by [`fast_row`], else by the csv crate.
+/// One range: each line by [`fast_row`], else by the csv crate.
 pub(super) fn parse_lines<'a>(text: &[u8], lay: &Layout, out: Chunk<'a>) -> Chunk<'a> {
     let cols = columns(lay);
     let mut c = Cursor {
@@ -422,7 +586,21 @@ pub(super) fn parse_lines<'a>(text: &[u8], lay: &Layout, out: Chunk<'a>) -> Chun
         c.line_by_line(lay, &cols);
     }
     c.out.got.lines = c.line;
+    // a row line's length: the range's bytes over its lines
+    let row_bytes = c.text.len() as f64 / (c.line.max(1) as f64);
+    c.out.count_runs(lay, row_bytes);
     c.out
+}
+
+/// True for a comment line (`#`) whose fields are the row's count and mostly numbers: a
+/// data row whose first byte is damaged (a `#` comment in a log holds words).
+fn comment_row(raw: &[u8], lay: &Layout) -> bool {
+    let t = raw.trim_ascii_start();
+    let Some(rest) = t.strip_prefix(b"#") else {
+        return false;
+    };
+    let (n, numbers) = raw_fields(rest, lay);
+    n == lay.n_cols && 2 * numbers >= n
 }
 
 /// Rows a range of text can hold: one per line, as [`parse_lines`] counts them.

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use super::InputOptions;
 use super::units::{AccUnit, GyroUnit, TimeUnit};
-use super::{InputOptions, SNIFF_BYTES};
 use crate::error::Error;
 
 /// What a column holds.
@@ -132,6 +132,8 @@ pub(super) struct Layout {
     /// and checked for plausibility.
     pub(super) gyro_stated: bool,
     pub(super) acc_stated: bool,
+    /// Fields of a row (the first data line's): a line with another count is no row.
+    pub(super) n_cols: usize,
     /// Byte offset and 1-based line number of the first line after the preamble.
     pub(super) body: usize,
     pub(super) body_line: u64,
@@ -139,6 +141,19 @@ pub(super) struct Layout {
     pub(super) what: String,
     /// The EuRoC/ASL header was found.
     pub(super) euroc: bool,
+    /// Numbers are written with a decimal comma (`3,82E-2`; a `;` or tab between fields, as
+    /// phyphox's and European spreadsheets' exports): the body is read with points.
+    pub(super) decimal_comma: bool,
+    /// A column that says which sensor each row is from (`sensor_id`, …): index and name.
+    pub(super) sensor_column: Option<(usize, String)>,
+    /// What deciding the layout found worth a warning (a flag over the header's unit).
+    pub(super) warnings: Vec<String>,
+    /// The accelerometer's unit (stated, given or known; `None`: none, SI assumed).
+    pub(super) acc_unit: Option<AccUnit>,
+    /// The time unit came from the flag.
+    pub(super) time_from_flag: bool,
+    /// The header states a time unit (in its text or its name).
+    pub(super) time_stated: bool,
 }
 
 #[cfg(test)]
@@ -160,10 +175,17 @@ impl Layout {
             acc_si,
             gyro_stated: true,
             acc_stated: true,
+            n_cols: 1 + time.into_iter().chain(gyro).chain(acc).max().unwrap_or(0),
             body: 0,
             body_line: 1,
             what: String::new(),
             euroc: false,
+            decimal_comma: false,
+            sensor_column: None,
+            warnings: Vec::new(),
+            acc_unit: None,
+            time_from_flag: false,
+            time_stated: false,
         }
     }
 }
@@ -193,6 +215,25 @@ pub(super) fn strip_comment(line: &str) -> &str {
     l.trim_start_matches('#')
         .trim_start_matches('%')
         .trim_start_matches("//")
+}
+
+/// The delimiter and number style of a line of numbers, or `None` when it is no such
+/// line: the delimiter [`pick_delim`] finds with decimal points, else a `;` or tab with
+/// decimal commas (`3,822818600E-2;1,573801041E-2`: phyphox's "semicolon, decimal comma"
+/// export, a European spreadsheet's CSV).
+pub(super) fn data_line(line: &str) -> Option<(Delim, bool)> {
+    let d = pick_delim(line);
+    if split_fields(line, d).iter().all(|f| is_number(f)) {
+        return Some((d, false));
+    }
+    let d = [b';', b'\t']
+        .into_iter()
+        .find(|b| line.as_bytes().contains(b))
+        .map(Delim::Byte)?;
+    split_fields(line, d)
+        .iter()
+        .all(|f| f.contains(',') && is_number(&f.replace(',', ".")) || is_number(f))
+        .then_some((d, true))
 }
 
 pub(super) fn pick_delim(line: &str) -> Delim {
@@ -231,22 +272,29 @@ pub(super) fn layout(
     file_len: u64,
     opts: &InputOptions,
 ) -> Result<Layout, Error> {
-    let head = &head[..head.len().min(SNIFF_BYTES)];
     let head = match std::str::from_utf8(head) {
         Ok(s) => s,
         Err(e) => std::str::from_utf8(&head[..e.valid_up_to()]).unwrap_or(""),
     };
     let pre = preamble(path, head, file_len)?;
-    let delim = delimiter(pre.header, pre.data);
+    let (delim, decimal_comma) = match data_line(pre.data) {
+        Some((d, true)) => (d, true),
+        _ => (delimiter(pre.header, pre.data), false),
+    };
     let n_cols = split_fields(pre.data, delim).len();
-    let named = Named::of(path, opts, pre.header, delim, n_cols)?;
+    let mut named = Named::of(path, opts, pre.header, delim, n_cols)?;
     let own_layout = !named.from_flag && pre.header.map(str::trim) == Some(BAG2MAT_CSV_HEADER);
     let euroc = !named.from_flag
         && pre
             .header
             .is_some_and(|h| h.contains("w_RS_S_x") && h.contains("a_RS_S_x"));
+    let phone = named.phone_app(path, pre.header)?;
     let (time, gyro, acc) = named.place(path, opts)?;
-    let time_unit = named.time_unit(path, time, opts, own_layout)?;
+    let mut warnings = Vec::new();
+    let time_unit = named.time_unit(path, time, opts, own_layout, phone, &mut warnings)?;
+    let time_stated = time.is_some_and(|i| {
+        !named.stated(&[i]).is_empty() || named.roles[i].is_some_and(|r| r.1.is_some())
+    });
     let gyro_unit = match gyro {
         Some(c) => resolve_unit(
             path,
@@ -254,8 +302,11 @@ pub(super) fn layout(
             opts.gyro_unit,
             &named.stated(&c),
             GyroUnit::parse,
-            own_layout.then_some(GyroUnit::RadS),
+            own_layout
+                .then_some(GyroUnit::RadS)
+                .or(phone.and_then(|p| p.gyro)),
             GyroUnit::name,
+            &mut warnings,
         )?,
         None => None,
     };
@@ -266,8 +317,11 @@ pub(super) fn layout(
             opts.acc_unit,
             &named.stated(&c),
             AccUnit::parse,
-            own_layout.then_some(AccUnit::Ms2),
+            own_layout
+                .then_some(AccUnit::Ms2)
+                .or(phone.and_then(|p| p.acc)),
             AccUnit::name,
+            &mut warnings,
         )?,
         None => None,
     };
@@ -277,7 +331,7 @@ pub(super) fn layout(
         gyro_unit.is_some() || gyro.is_none(),
         acc_unit.is_some() || acc.is_none(),
     )?;
-    let what = layout_text(
+    let mut what = layout_text(
         n_cols,
         delim,
         time.map(|_| time_unit),
@@ -285,6 +339,13 @@ pub(super) fn layout(
         gyro.map(|_| gyro_unit.map(GyroUnit::name)),
         acc.map(|_| acc_unit.map(AccUnit::name)),
     );
+    if decimal_comma {
+        what.push_str(", decimal commas");
+    }
+    if let Some(p) = phone {
+        what = format!("{} export; {what}", p.app);
+    }
+    let sensor_column = named.sensor_column();
     Ok(Layout {
         delim,
         time,
@@ -295,12 +356,38 @@ pub(super) fn layout(
         acc_si: acc_unit.map_or(1.0, AccUnit::si) / opts.acc_scale.unwrap_or(1.0),
         gyro_stated: gyro_unit.is_some(),
         acc_stated: acc_unit.is_some(),
+        n_cols,
         body: pre.body,
         body_line: pre.body_line,
         what,
         euroc,
+        decimal_comma,
+        sensor_column,
+        warnings,
+        acc_unit,
+        time_from_flag: opts.time_unit.is_some(),
+        time_stated,
     })
 }
+
+/// A phone app's export whose header does not say everything ([`Named::phone_app`]): the
+/// app, and the units it writes.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PhoneApp {
+    app: &'static str,
+    time: Option<TimeUnit>,
+    gyro: Option<GyroUnit>,
+    acc: Option<AccUnit>,
+}
+
+/// Sensor Logger's header (every sensor's CSV): `time` in ns since the epoch,
+/// `seconds_elapsed` in s, then the axes in z, y, x order.
+pub const SENSOR_LOGGER_HEADER: [&str; 5] = ["time", "seconds_elapsed", "z", "y", "x"];
+
+/// Column names that say which sensor a row is from (a log of several IMUs in one file).
+pub(super) const SENSOR_ID_NAMES: [&str; 9] = [
+    "sensorid", "sensor", "imuid", "imu", "deviceid", "device", "id", "instance", "source",
+];
 
 /// A raw-count scale (`--gyro-scale`, `--acc-scale`) needs the unit it counts in
 /// (`gyro_ok`, `acc_ok`: the unit is known, or the sensor has no columns).
@@ -351,8 +438,12 @@ struct Preamble<'h> {
 fn preamble<'h>(path: &Path, head: &'h str, file_len: u64) -> Result<Preamble<'h>, Error> {
     let mut offset = 0usize;
     let mut line_no = 0u64;
-    let mut last_comment: Option<&str> = None;
+    // the comment lines since the last other line (the header may be any of them: a
+    // comment right after EuRoC's is a comment)
+    let mut comments: Vec<&str> = Vec::new();
     let mut header: Option<&str> = None;
+    // the first line that is a data row with a damaged value: the body starts there
+    let mut damaged: Option<(usize, u64)> = None;
     for raw in head.split_inclusive('\n') {
         if !raw.ends_with('\n') && ((raw.len() + offset) as u64) < file_len {
             break; // cut by the sniff window
@@ -365,38 +456,55 @@ fn preamble<'h>(path: &Path, head: &'h str, file_len: u64) -> Result<Preamble<'h
             continue;
         }
         if is_comment(line) {
-            last_comment = Some(line);
+            comments.push(line);
             continue;
         }
-        let fields = split_fields(line, pick_delim(line));
-        if fields.iter().all(|f| is_number(f)) {
-            // a comment right before the data with as many fields is its header (EuRoC)
-            if header.is_none()
-                && let Some(c) = last_comment
-            {
-                let c = strip_comment(c);
-                let cf = split_fields(c, pick_delim(c));
-                if cf.len() == fields.len() && cf.iter().any(|f| !is_number(f)) {
-                    header = Some(c);
-                }
+        // a line of numbers (a decimal-comma export's too: `data_line`) or not
+        let (fields, numbers_only) = match data_line(line) {
+            Some((d, _)) => (split_fields(line, d), true),
+            None => (split_fields(line, pick_delim(line)), false),
+        };
+        // the fields a row has where a header (or a comment that may be one) says so: a
+        // line of numbers with another count is a damaged row (a line split in two)
+        let counts: Vec<usize> = match header {
+            Some(h) => vec![split_fields(h, pick_delim(h)).len()],
+            None => comments
+                .iter()
+                .map(|c| split_fields(strip_comment(c), pick_delim(strip_comment(c))))
+                .filter(|cf| cf.len() > 1 && cf.iter().any(|f| !is_number(f)))
+                .map(|cf| cf.len())
+                .collect(),
+        };
+        let fits = counts.is_empty() || counts.contains(&fields.len());
+        if numbers_only && fits {
+            // a comment before the data with as many fields is its header (EuRoC)
+            if header.is_none() {
+                header = comments.iter().rev().map(|c| strip_comment(c)).find(|c| {
+                    let cf = split_fields(c, pick_delim(c));
+                    cf.len() == fields.len() && cf.iter().any(|f| !is_number(f))
+                });
             }
+            let (body, body_line) = damaged.unwrap_or((start, line_no));
             return Ok(Preamble {
                 header,
                 data: line,
-                body: start,
-                body_line: line_no,
+                body,
+                body_line,
             });
         }
-        if header.is_some() {
-            return Err(not_table(
-                path,
-                &format!(
-                    "line {line_no} is neither a number row nor a comment after the header line"
-                ),
-            ));
+        // after the header, or with most of its fields numbers: a data row with a damaged
+        // value or a damaged line, not a header (the first whole row gives the layout; the
+        // body, its malformed lines counted, starts here)
+        let numbers = fields.iter().filter(|f| is_number(f)).count();
+        if header.is_some()
+            || damaged.is_some()
+            || (fields.len() > 1 && 2 * numbers >= fields.len())
+        {
+            damaged.get_or_insert((start, line_no));
+            continue;
         }
         header = Some(line);
-        last_comment = None;
+        comments.clear();
     }
     Err(not_table(
         path,
@@ -457,8 +565,20 @@ impl Named {
                         )
                     })?));
                 }
-                named.units.push(None);
             }
+            // --columns renames the columns; the units a header states stay stated
+            let header_units: Vec<Option<String>> = header
+                .map(|h| {
+                    split_fields(h, delim)
+                        .iter()
+                        .map(|f| name_and_unit(f).1.map(str::to_string))
+                        .collect::<Vec<_>>()
+                })
+                .filter(|u| u.len() == n_cols)
+                .unwrap_or_default();
+            named.units = (0..named.names.len())
+                .map(|i| header_units.get(i).cloned().flatten())
+                .collect();
             if named.names.len() > n_cols {
                 return Err(bad(
                     path,
@@ -475,7 +595,7 @@ impl Named {
                 .collect();
             for f in &named.names {
                 let (n, u) = name_and_unit(f);
-                named.roles.push(role_of(n));
+                named.roles.push(role_of(n).or_else(|| axis_by_unit(n, u)));
                 named.units.push(u.map(str::to_string));
             }
         } else {
@@ -487,6 +607,65 @@ impl Named {
             ));
         }
         Ok(named)
+    }
+
+    /// A phone app's export whose header names its axes but not its sensor, recognised
+    /// from the header (not from `--columns`): Sensor Logger's `time,seconds_elapsed,z,y,x`
+    /// (`time` in ns, axes in z, y, x order), whose file name says the sensor
+    /// (`Gyroscope*.csv` in rad/s, `TotalAcceleration.csv` or `Accelerometer*.csv` in
+    /// m/s²). Sets the columns' roles; returns the app and its units.
+    fn phone_app(&mut self, path: &Path, header: Option<&str>) -> Result<Option<PhoneApp>, Error> {
+        let Some(h) = header.filter(|_| !self.from_flag) else {
+            return Ok(None);
+        };
+        let fields: Vec<String> = split_fields(h, pick_delim(h))
+            .iter()
+            .map(|f| f.trim().trim_matches('"').to_ascii_lowercase())
+            .collect();
+        if fields.len() < SENSOR_LOGGER_HEADER.len()
+            || fields[..SENSOR_LOGGER_HEADER.len()] != SENSOR_LOGGER_HEADER
+        {
+            return Ok(None);
+        }
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let gyro = stem.starts_with("gyroscope");
+        if !gyro && !stem.starts_with("totalacceleration") && !stem.starts_with("accelerometer") {
+            return Err(bad(
+                path,
+                format!(
+                    "a Sensor Logger export (time,seconds_elapsed,z,y,x) says its sensor by its file name, and '{}' is not Gyroscope.csv, TotalAcceleration.csv nor Accelerometer.csv: name the columns with --columns (e.g. t,_,gz,gy,gx) and their units",
+                    path.file_name()
+                        .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+                ),
+            ));
+        }
+        let role = |a: usize| Some((if gyro { Role::Gyro(a) } else { Role::Acc(a) }, None));
+        self.roles = vec![Some((Role::Time, None)), None, role(2), role(1), role(0)];
+        self.roles.resize(fields.len(), None);
+        Ok(Some(PhoneApp {
+            app: "Sensor Logger",
+            time: Some(TimeUnit::Ns),
+            gyro: gyro.then_some(GyroUnit::RadS),
+            acc: (!gyro).then_some(AccUnit::Ms2),
+        }))
+    }
+
+    /// The column that says which sensor each row is from, if the header names one.
+    fn sensor_column(&self) -> Option<(usize, String)> {
+        self.names.iter().enumerate().find_map(|(i, f)| {
+            let n: String = name_and_unit(f)
+                .0
+                .chars()
+                .filter(|c| c.is_ascii_alphanumeric())
+                .map(|c| c.to_ascii_lowercase())
+                .collect();
+            (self.roles.get(i).is_some_and(|r| r.is_none())
+                && SENSOR_ID_NAMES.contains(&n.as_str()))
+            .then(|| (i, name_and_unit(f).0.to_string()))
+        })
     }
 
     /// The time column and the three axis columns of each sensor, checked: one column per
@@ -576,14 +755,18 @@ impl Named {
         u
     }
 
-    /// The time column's unit: stated by the header, the flag, or the layout; a
-    /// contradiction or no unit at all is an error (no time column: ns, unused).
+    /// The time column's unit: stated by the header, the flag, or the layout (bag2mat's own
+    /// CSV, a phone app's export); a flag over another unit in the header wins, with a
+    /// warning in `warnings` (a header can be wrong: the physics checks say so); no unit at
+    /// all is an error (no time column: ns, unused).
     fn time_unit(
         &self,
         path: &Path,
         time: Option<usize>,
         opts: &InputOptions,
         own_layout: bool,
+        phone: Option<PhoneApp>,
+        warnings: &mut Vec<String>,
     ) -> Result<TimeUnit, Error> {
         let Some(i) = time else {
             return Ok(TimeUnit::Ns);
@@ -595,16 +778,19 @@ impl Named {
             ),
             (None, u) => u,
         };
-        let known = own_layout.then_some(TimeUnit::S);
+        let known = own_layout
+            .then_some(TimeUnit::S)
+            .or(phone.and_then(|p| p.time));
         match (opts.time_unit, header_unit.or(known)) {
-            (Some(f), Some(h)) if f != h => Err(bad(
-                path,
-                format!(
-                    "the header says the time is in {}, --time-unit says {}",
+            (Some(f), Some(h)) if f != h => {
+                warnings.push(format!(
+                    "the header says the time is in {}, --time-unit says {}: read in {}",
                     h.name(),
+                    f.name(),
                     f.name()
-                ),
-            )),
+                ));
+                Ok(f)
+            }
             (Some(f), _) => Ok(f),
             (None, Some(h)) => Ok(h),
             (None, None) => Err(bad(
@@ -618,8 +804,29 @@ impl Named {
     }
 }
 
+/// A column named only by its axis (`X (rad/s)`, as phyphox's newer exports write), whose
+/// unit says the sensor: a gyroscope unit, or an accelerometer one.
+fn axis_by_unit(name: &str, unit: Option<&str>) -> Option<(Role, Option<TimeUnit>)> {
+    let a = match name.trim().to_ascii_lowercase().as_str() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        _ => return None,
+    };
+    let u = unit?;
+    if GyroUnit::parse(u).is_ok() {
+        Some((Role::Gyro(a), None))
+    } else if AccUnit::parse(u).is_ok() {
+        Some((Role::Acc(a), None))
+    } else {
+        None
+    }
+}
+
 /// A sensor's unit from its flag, the units its header states and the layout's known
-/// unit: one of them, or the same from several; a contradiction is an error.
+/// unit: one of them, or the same from several; a flag over another unit in the header
+/// wins, with a warning in `warnings`.
+#[allow(clippy::too_many_arguments)]
 fn resolve_unit<U: Copy + PartialEq>(
     path: &Path,
     what: &str,
@@ -628,6 +835,7 @@ fn resolve_unit<U: Copy + PartialEq>(
     parse: fn(&str) -> Result<U, super::units::UnknownUnit>,
     known: Option<U>,
     name: fn(U) -> &'static str,
+    warnings: &mut Vec<String>,
 ) -> Result<Option<U>, Error> {
     if header.len() > 1 {
         return Err(bad(
@@ -643,14 +851,15 @@ fn resolve_unit<U: Copy + PartialEq>(
         None => known,
     };
     match (flag, h) {
-        (Some(f), Some(h)) if f != h => Err(bad(
-            path,
-            format!(
-                "the header says the {what} is in {}, the flag says {}",
+        (Some(f), Some(h)) if f != h => {
+            warnings.push(format!(
+                "the header says the {what} is in {}, the flag says {}: read in {}",
                 name(h),
+                name(f),
                 name(f)
-            ),
-        )),
+            ));
+            Ok(Some(f))
+        }
         (Some(f), _) => Ok(Some(f)),
         (None, h) => Ok(h),
     }

@@ -22,6 +22,7 @@ use rayon::prelude::*;
 mod body;
 mod layout;
 mod units;
+mod window;
 
 use super::InputOptions;
 use crate::RosTime;
@@ -32,7 +33,7 @@ use crate::source::InputKind;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
-use body::{Chunk, Summary, line_range, parse_csv, parse_lines, room};
+use body::{Chunk, Summary, line_range, parse_lines, room};
 use layout::{Delim, Layout, bad, layout};
 pub use units::{AccUnit, GyroUnit, TimeUnit};
 
@@ -59,7 +60,13 @@ pub const G_LIKE_BAND: (f64, f64) = (0.3, 3.0);
 /// or raw counts.
 pub const MAX_PLAUSIBLE_M_S2: f64 = 200.0;
 
-/// True when the first bytes of `path` are text (UTF-8, no control bytes but tab, CR, LF).
+/// Bytes that are no text (control bytes but tab, CR, LF; bytes of no UTF-8 character) a
+/// text log may hold in its first [`SNIFF_BYTES`], per this many: a few damaged bytes do not
+/// make a log unreadable (pandas reads it), a binary file holds far more.
+pub const MAX_NON_TEXT_PER_MILLE: usize = 2;
+
+/// True when the first bytes of `path` are text: UTF-8 without control bytes but tab, CR
+/// and LF, up to [`MAX_NON_TEXT_PER_MILLE`] damaged bytes, its first line whole text.
 pub(crate) fn looks_like_text(path: &Path) -> bool {
     let Ok(head) = read_head(path) else {
         return false;
@@ -67,15 +74,24 @@ pub(crate) fn looks_like_text(path: &Path) -> bool {
     if head.is_empty() {
         return false;
     }
-    let valid = match std::str::from_utf8(&head) {
-        Ok(_) => true,
-        // a multi-byte character cut by the sniff window
-        Err(e) => e.error_len().is_none() && head.len() == SNIFF_BYTES,
-    };
-    valid
-        && !head
-            .iter()
-            .any(|&b| b < 0x20 && b != b'\t' && b != b'\n' && b != b'\r')
+    let control = |b: u8| (b < 0x20 && b != b'\t' && b != b'\n' && b != b'\r') || b == 0x7F;
+    let mut bad = head.iter().filter(|&&b| control(b)).count();
+    let mut rest: &[u8] = &head;
+    loop {
+        match std::str::from_utf8(rest) {
+            Ok(_) => break,
+            // a multi-byte character cut by the sniff window
+            Err(e) if e.error_len().is_none() => break,
+            Err(e) => {
+                bad += 1;
+                rest = &rest[e.valid_up_to() + e.error_len().unwrap_or(1)..];
+            }
+        }
+    }
+    let first_line = &head[..memchr::memchr(b'\n', &head).unwrap_or(head.len())];
+    let first_ok =
+        std::str::from_utf8(first_line).is_ok() && !first_line.iter().any(|&b| control(b));
+    first_ok && bad * 1000 <= head.len() * MAX_NON_TEXT_PER_MILLE
 }
 
 fn read_head(path: &Path) -> std::io::Result<Vec<u8>> {
@@ -93,21 +109,47 @@ pub struct Parsed {
     pub streams: Vec<Stream>,
     /// Notes (units assumed, stamps out of order, malformed lines).
     pub notes: Vec<String>,
+    /// The rows the malformed lines held, and why they were lost (the stream's loss).
+    pub lost: Option<(u64, String)>,
 }
+
+/// Bytes of the file looked at for its header and first data line when its first
+/// [`SNIFF_BYTES`] hold none (a long damaged line right after the header).
+const MAX_HEAD_BYTES: usize = 16 << 20;
 
 /// Parses the text log at `path` into a stream named `topic`.
 pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Parsed, Error> {
     let io = |e| Error::io(path, e);
     let file = std::fs::File::open(path).map_err(io)?;
-    let map = crate::mapped::Mapped::of(&file, path)?;
-    let bytes = map.bytes();
-    let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
-    let lay = layout(path, head, bytes.len() as u64, opts)?;
+    let len = file.metadata().map_err(io)?.len();
+    // mapped whole where it fits the address space, else read window by window
+    let map = if crate::mapped::Mapped::fits(len) {
+        crate::mapped::Mapped::of(&file, path).ok()
+    } else {
+        None
+    };
+    let (lay, mut rows, chunks, cut) = match &map {
+        Some(m) => read_mapped(path, m.bytes(), opts)?,
+        None => window::read(path, &file, len, opts)?,
+    };
     let msg_type = if lay.euroc { "euroc/imu" } else { "text/imu" };
-    let (mut rows, chunks) = read_body(bytes, &lay, RANGE_BYTES);
     let line_starts = line_starts(&chunks, lay.body_line);
-    let mut notes = Vec::new();
-    notes.extend(malformed_lines(path, &chunks, &line_starts)?);
+    let mut notes = lay.warnings.clone();
+    let mut lost = malformed_lines(path, &chunks, &line_starts)?;
+    if let Some(line) = cut {
+        let what = format!(
+            "the last line ({line}) has no line end and its last number is shorter than in the lines before it: the file was cut inside it, and its row is not read"
+        );
+        lost = Some(match lost {
+            Some((k, w)) => (k + 1, format!("{w}; {what}")),
+            None => (1, what),
+        });
+    }
+    // malformed lines that held no row (junk): a note
+    if let Some((0, what)) = &lost {
+        notes.push(what.clone());
+        lost = None;
+    }
     if lay.time.is_none() {
         // no time column: the rows are numbered at the given rate
         let rate = opts.rate.unwrap_or(1.0);
@@ -119,6 +161,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
         notes.extend(stamp_order(&chunks, &line_starts));
     }
     check_plausible(path, &lay, &rows)?;
+    check_physics(path, &lay, &rows, opts)?;
     let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
     if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
         notes.push(format!("{}: {}", path.display(), lay.what));
@@ -136,14 +179,93 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     Ok(Parsed {
         streams: vec![Stream::of_rows(topic, msg_type, rows)],
         notes,
+        lost,
     })
 }
 
+/// What a mapped text log holds: its layout, rows and range summaries, and the line number
+/// of a last line cut inside its last number (not read).
+fn read_mapped(
+    path: &Path,
+    bytes: &[u8],
+    opts: &InputOptions,
+) -> Result<(Layout, Rows, Vec<Summary>, Option<u64>), Error> {
+    let head = |n: usize| &bytes[..bytes.len().min(n)];
+    let len = bytes.len() as u64;
+    let mut lay = match layout(path, head(SNIFF_BYTES), len, opts) {
+        Err(Error::NotABag { .. }) if bytes.len() > SNIFF_BYTES => {
+            layout(path, head(MAX_HEAD_BYTES), len, opts)?
+        }
+        r => r?,
+    };
+    // a decimal-comma file or one sensor of several: a copy of the body to read, byte for
+    // byte where it is read (line numbers and offsets stay the file's)
+    let mut copy_notes = Vec::new();
+    let copy = body_copy(path, bytes, &lay, opts, &mut copy_notes)?;
+    lay.warnings.extend(copy_notes);
+    let bytes = copy.as_deref().unwrap_or(bytes);
+    // a last line without its line end whose last number is cut: not read
+    let cut = cut_last_line(bytes, &lay);
+    let body = &bytes[..bytes.len() - cut.map_or(0, |c| c.1)];
+    let (rows, chunks) = read_body(body, &lay, RANGE_BYTES);
+    Ok((lay, rows, chunks, cut.map(|c| c.0)))
+}
+
+/// Lines whose last field a cut last line is compared with.
+const CUT_CHECK_LINES: usize = 16;
+
+/// The last line of `bytes` when it has no line end while the lines before it have, its
+/// last field is a column read, and that field is shorter than it is in every one of the
+/// [`CUT_CHECK_LINES`] lines before it (a number cut by the end of the file): its line
+/// number and length.
+fn cut_last_line(bytes: &[u8], lay: &Layout) -> Option<(u64, usize)> {
+    if bytes.last().is_none_or(|&b| b == b'\n') || body::columns(lay).len() != lay.n_cols {
+        return None;
+    }
+    let start = memchr::memrchr(b'\n', bytes)? + 1;
+    if start <= lay.body {
+        return None;
+    }
+    let last_field = |line: &[u8]| -> usize {
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let line = line.trim_ascii_end();
+        let from = match lay.delim {
+            layout::Delim::Byte(d) => memchr::memrchr(d, line).map_or(0, |p| p + 1),
+            layout::Delim::Whitespace(_) => line
+                .iter()
+                .rposition(|&c| c == b' ' || c == b'\t')
+                .map_or(0, |p| p + 1),
+        };
+        line.len() - from
+    };
+    let mine = last_field(&bytes[start..]);
+    let mut end = start - 1;
+    let mut shortest = usize::MAX;
+    for _ in 0..CUT_CHECK_LINES {
+        if end <= lay.body {
+            break;
+        }
+        let s = memchr::memrchr(b'\n', &bytes[..end])
+            .map_or(0, |p| p + 1)
+            .max(lay.body);
+        let line = &bytes[s..end];
+        if !line.trim_ascii().is_empty() {
+            shortest = shortest.min(last_field(line));
+        }
+        end = s.saturating_sub(1);
+        if s == 0 {
+            break;
+        }
+    }
+    let lines_before = memchr::memchr_iter(b'\n', &bytes[lay.body..start]).count() as u64;
+    (shortest != usize::MAX && mine < shortest)
+        .then_some((lay.body_line + lines_before, bytes.len() - start))
+}
+
 /// The body of a file (`bytes`, laid out as `lay` says) in ranges of about `range_bytes`
-/// ([`RANGE_BYTES`]; the tests' are smaller) parsed in parallel, each
-/// straight into its slot of the topic's columns (room for one row per line: no copy of
-/// the file nor of the rows), and what each range found. A quoted field may hold a line
-/// break: a file whose lines hold quotes is read by the csv crate whole instead.
+/// ([`RANGE_BYTES`]; the tests' are smaller) parsed in parallel, each straight into its slot
+/// of the topic's columns (room for one row per line: no copy of the file nor of the rows),
+/// and what each range found. A line is read on its own: a quote never runs past it.
 fn read_body(bytes: &[u8], lay: &Layout, range_bytes: usize) -> (Rows, Vec<Summary>) {
     let ranges: Vec<&[u8]> = (lay.body..bytes.len())
         .step_by(range_bytes)
@@ -152,44 +274,32 @@ fn read_body(bytes: &[u8], lay: &Layout, range_bytes: usize) -> (Rows, Vec<Summa
             &bytes[s..e]
         })
         .collect();
-    let parse_into = |ranges: &[&[u8]], quoted: bool| {
-        let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
-        let mut rows = Rows::zeroed(room.iter().sum());
-        let got: Vec<Summary> = ranges
-            .par_iter()
-            .zip(rows.split(&room))
-            .map(|(text, slot)| {
-                let mut out = Chunk {
-                    slot,
-                    ..Chunk::default()
-                };
-                if quoted {
-                    out.got.lines = parse_csv(text, lay, 1, &mut out);
-                    out.got
-                } else {
-                    parse_lines(text, lay, out).got
-                }
-            })
-            .collect();
-        // the rows of each range follow those of the ranges before it
-        let mut n = 0;
-        for (g, at) in got.iter().zip(room.iter().scan(0, |a, r| {
-            *a += r;
-            Some(*a - r)
-        })) {
-            if at != n {
-                rows.move_down(at, g.filled, n);
-            }
-            n += g.filled;
+    let room: Vec<usize> = ranges.par_iter().map(|r| room(r)).collect();
+    let mut rows = Rows::zeroed(room.iter().sum());
+    let got: Vec<Summary> = ranges
+        .par_iter()
+        .zip(rows.split(&room))
+        .map(|(text, slot)| {
+            let out = Chunk {
+                slot,
+                ..Chunk::default()
+            };
+            parse_lines(text, lay, out).got
+        })
+        .collect();
+    // the rows of each range follow those of the ranges before it
+    let mut n = 0;
+    for (g, at) in got.iter().zip(room.iter().scan(0, |a, r| {
+        *a += r;
+        Some(*a - r)
+    })) {
+        if at != n {
+            rows.move_down(at, g.filled, n);
         }
-        rows.truncate(n);
-        (rows, got)
-    };
-    let (rows, chunks) = parse_into(&ranges, false);
-    if chunks.iter().any(|c| c.quoted) && !matches!(lay.delim, Delim::Whitespace(_)) {
-        return parse_into(&[&bytes[lay.body..]], true);
+        n += g.filled;
     }
-    (rows, chunks)
+    rows.truncate(n);
+    (rows, got)
 }
 
 /// The 1-based line number of each range's first line, the first range's being `first`.
@@ -204,13 +314,14 @@ fn line_starts(chunks: &[Summary], first: u64) -> Vec<u64> {
         .collect()
 }
 
-/// The note on malformed lines (their count and the first, by its line number), or the
-/// error when more than [`MAX_BAD_FRACTION`] of the lines are malformed.
+/// The rows the malformed lines held and what they were (their count and the first, by its
+/// line number), or the error when more than [`MAX_BAD_FRACTION`] of the lines are
+/// malformed.
 fn malformed_lines(
     path: &Path,
     chunks: &[Summary],
     line_starts: &[u64],
-) -> Result<Option<String>, Error> {
+) -> Result<Option<(u64, String)>, Error> {
     let total_bad: u64 = chunks.iter().map(|c| c.bad).sum();
     if total_bad == 0 {
         return Ok(None);
@@ -239,7 +350,8 @@ fn malformed_lines(
             ),
         });
     }
-    Ok(Some(msg))
+    let lost: u64 = chunks.iter().map(|c| c.lost).sum();
+    Ok(Some((lost, msg)))
 }
 
 /// The notes on stamps that go backwards or repeat, with the line of the first of each,
@@ -286,6 +398,217 @@ fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<String> {
         ));
     }
     notes
+}
+
+/// The body of a file to read in place of its bytes, when they cannot be read as they are:
+/// decimal commas as points (the fields are separated by `;` or tabs), and, in a file of
+/// several sensors (a sensor column), every other sensor's lines turned into comment lines
+/// of the same length. `None`: read the file as it is. A file of several sensors without
+/// `--sensor-id` is an error that says what they are; `--sensor-id` on a file without a
+/// sensor column, or naming no sensor it has, too.
+fn body_copy(
+    path: &Path,
+    bytes: &[u8],
+    lay: &Layout,
+    opts: &InputOptions,
+    notes: &mut Vec<String>,
+) -> Result<Option<Vec<u8>>, Error> {
+    let ids = lay
+        .sensor_column
+        .as_ref()
+        .map(|(col, name)| (*col, name, sensor_ids(bytes, lay, *col)));
+    let keep: Option<(usize, &str)> = match (&ids, &opts.sensor_id) {
+        (None, Some(id)) => {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "--sensor-id {id}: the file has no column saying which sensor a row is from ({})",
+                    layout::SENSOR_ID_NAMES.join(", ")
+                ),
+            ));
+        }
+        (Some((_, name, found)), Some(id)) if !found.iter().any(|(v, _)| v == id) => {
+            return Err(layout::bad(
+                path,
+                format!("--sensor-id {id}: column '{name}' holds {}", id_list(found)),
+            ));
+        }
+        (Some((col, name, found)), Some(id)) => {
+            let n: u64 = found.iter().map(|(_, c)| c).sum();
+            let mine = found.iter().find(|(v, _)| v == id).map_or(0, |x| x.1);
+            notes.push(format!(
+                "--sensor-id {id}: {mine} of the {n} rows (column '{name}'; the file holds {})",
+                id_list(found)
+            ));
+            Some((*col, id.as_str()))
+        }
+        (Some((_, name, found)), None) if found.len() > 1 => {
+            let first = &found[0].0;
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the rows come from {} sensors (column '{name}' holds {}), one row each in turn: each is an IMU of its own, with its own bias and noise, and read together they are neither (at {}× the rate): pick one with --sensor-id {first}",
+                    found.len(),
+                    id_list(found),
+                    found.len()
+                ),
+            ));
+        }
+        _ => None,
+    };
+    if !lay.decimal_comma && keep.is_none() {
+        return Ok(None);
+    }
+    let mut copy = bytes.to_vec();
+    let body = &mut copy[lay.body..];
+    if lay.decimal_comma {
+        for b in body.iter_mut().filter(|b| **b == b',') {
+            *b = b'.';
+        }
+    }
+    if let Some((col, id)) = keep {
+        let mut at = 0;
+        while at < body.len() {
+            let end = memchr::memchr(b'\n', &body[at..]).map_or(body.len(), |p| at + p + 1);
+            let line = &body[at..end];
+            if !line.starts_with(b"#") && field(line, lay, col).is_some_and(|f| f != id.as_bytes())
+            {
+                // blanked, not commented out: a comment holding a row's numbers is a
+                // damaged row (`body::comment_row`), a blank line is no row
+                let text_end = at
+                    + line
+                        .iter()
+                        .take_while(|&&b| b != b'\n' && b != b'\r')
+                        .count();
+                body[at..text_end].fill(b' ');
+            }
+            at = end;
+        }
+    }
+    Ok(Some(copy))
+}
+
+/// Field `col` of a line (without the line end), trimmed of blanks and quotes.
+fn field<'l>(line: &'l [u8], lay: &Layout, col: usize) -> Option<&'l [u8]> {
+    let line = line.strip_suffix(b"\n").unwrap_or(line);
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let f = match lay.delim {
+        Delim::Byte(d) => line.split(|b| *b == d).nth(col),
+        Delim::Whitespace(_) => line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|f| !f.is_empty())
+            .nth(col),
+    }?;
+    Some(body::trim(f))
+}
+
+/// The values of the sensor column `col` over the body, with how many rows each has, in
+/// the order first met (at most [`MAX_SENSOR_IDS`] values).
+fn sensor_ids(bytes: &[u8], lay: &Layout, col: usize) -> Vec<(String, u64)> {
+    let mut found: Vec<(String, u64)> = Vec::new();
+    for line in bytes[lay.body..].split(|b| *b == b'\n') {
+        if line.is_empty() || line.starts_with(b"#") {
+            continue;
+        }
+        let Some(f) = field(line, lay, col).filter(|f| !f.is_empty()) else {
+            continue;
+        };
+        if let Some(e) = found.iter_mut().find(|(v, _)| v.as_bytes() == f) {
+            e.1 += 1;
+        } else if found.len() < MAX_SENSOR_IDS {
+            found.push((String::from_utf8_lossy(f).into_owned(), 1));
+        }
+    }
+    found
+}
+
+/// Distinct sensor ids listed at most.
+const MAX_SENSOR_IDS: usize = 16;
+
+/// `0 (5000 rows), 1 (5000 rows)`.
+fn id_list(found: &[(String, u64)]) -> String {
+    found
+        .iter()
+        .map(|(v, n)| format!("{v} ({n} rows)"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The physics of what the layout read, whatever units it was told (the rules:
+/// `crate::record_check::units`): a median specific force another accelerometer unit puts at
+/// gravity, a rate another time unit puts among IMUs', or an unstated gyroscope unit whose
+/// noise no rad/s gyroscope has, are errors that name the flag to fix (it overrides the
+/// header). What no other unit explains is left to the record check's warnings.
+fn check_physics(path: &Path, lay: &Layout, rows: &Rows, opts: &InputOptions) -> Result<(), Error> {
+    use crate::record_check::units;
+    let over = |stated: bool| {
+        if stated {
+            " (it overrides the header)"
+        } else {
+            ""
+        }
+    };
+    // (raw counts with a scale are the scale's to get right: no unit explains them)
+    if lay.acc.is_some()
+        && opts.acc_scale.is_none()
+        && let Some(m) = units::median_norm([&rows.acc[0], &rows.acc[1], &rows.acc[2]])
+    {
+        let given = lay.acc_unit.unwrap_or(AccUnit::Ms2);
+        if let Some(v) = units::gravity_unit_fix(m, given) {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the accelerometer read in {} has a median magnitude of {m:.4} m/s^2, not gravity's 9.81: in {} it is {:.4} m/s^2: give --acc-unit {}{}",
+                    given.name(),
+                    v.name(),
+                    m / given.si() * v.si(),
+                    v.name(),
+                    over(lay.acc_stated && opts.acc_unit.is_none())
+                ),
+            ));
+        }
+    }
+    if lay.time.is_some() {
+        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
+        if let Some(rate) = crate::timing::nominal_rate(&t)
+            && let Some((u, r)) = units::rate_unit_fix(rate, lay.time_unit)
+        {
+            return Err(layout::bad(
+                path,
+                format!(
+                    "the time column read in {} gives a sample rate of {rate:.4} Hz, outside what IMUs have ({} Hz – {} kHz); in {} it gives {r:.1} Hz: give --time-unit {}{}",
+                    lay.time_unit.name(),
+                    units::IMU_RATE_HZ.0,
+                    units::IMU_RATE_HZ.1 / 1e3,
+                    u.name(),
+                    u.name(),
+                    over(!lay.time_from_flag && lay.time_stated)
+                ),
+            ));
+        }
+    }
+    if lay.gyro.is_some() && !lay.gyro_stated && opts.gyro_scale.is_none() {
+        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
+        let rate = crate::timing::nominal_rate(&t);
+        for (k, axis) in rows.gyro.iter().enumerate() {
+            let sigma = crate::record_check::outliers::noise_scale(axis);
+            let Some(n) = rate.map(|r| units::gyro_density(sigma, r)) else {
+                break;
+            };
+            if n > units::MAX_GYRO_DENSITY {
+                return Err(layout::bad(
+                    path,
+                    format!(
+                        "the gyroscope columns state no unit, and read as rad/s their white noise is {n:.3e} rad/s/sqrt(Hz) (gyro {}), more than any IMU gyroscope has (at most {:.0e}); in deg/s it is {:.3e}: give --gyro-unit deg/s (or --gyro-unit rad/s if that is right)",
+                        ['x', 'y', 'z'][k],
+                        units::MAX_GYRO_DENSITY,
+                        n * std::f64::consts::PI / 180.0
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Values stated in no unit must be plausible in SI: else the error says which unit to add.
@@ -346,17 +669,25 @@ fn check_plausible(path: &Path, lay: &Layout, rows: &Rows) -> Result<(), Error> 
 /// as that folder's by [`super::open`]).
 pub(crate) fn open(path: &Path, opts: &InputOptions) -> Result<DecodedSource, Error> {
     let p = parse(path, "imu", opts)?;
-    Ok(DecodedSource::new(
-        InputKind::Text,
-        p.streams,
-        p.notes,
-        Vec::new(),
-    ))
+    let mut src = DecodedSource::new(InputKind::Text, p.streams, p.notes, Vec::new());
+    src.add_losses(p.lost.into_iter().map(|l| lost_rows(0, l)).collect());
+    Ok(src)
+}
+
+/// What the malformed lines of stream `channel` held, as its loss.
+pub(crate) fn lost_rows(channel: u32, (n, what): (u64, String)) -> crate::source::Loss {
+    crate::source::Loss {
+        what,
+        messages: Some(n),
+        channel: Some(channel),
+        ..Default::default()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use layout::Delim;
 
     /// Bytes per range that make a test body of a few hundred kB many ranges.
     const SMALL_RANGE: usize = 4096;

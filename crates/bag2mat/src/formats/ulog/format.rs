@@ -15,7 +15,7 @@ pub struct Field {
 }
 
 /// The bytes of a scalar type, or `None` for a nested format.
-fn scalar_size(ty: &str) -> Option<usize> {
+pub(super) fn scalar_size(ty: &str) -> Option<usize> {
     Some(match ty {
         "int8_t" | "uint8_t" | "bool" | "char" => 1,
         "int16_t" | "uint16_t" => 2,
@@ -25,9 +25,24 @@ fn scalar_size(ty: &str) -> Option<usize> {
     })
 }
 
-/// Parses a format message's text `name:type field;…`.
+/// The largest array length a format may declare (pyulog refuses larger ones; a message
+/// holds at most 65,535 bytes anyway).
+pub(super) const MAX_ARRAY: usize = 0xFFFF;
+
+/// A name as the format writes them: printable, without spaces or separators.
+fn name_like(s: &str) -> bool {
+    !s.is_empty()
+        && s.bytes()
+            .all(|b| b.is_ascii_graphic() && !matches!(b, b':' | b';' | b'[' | b']'))
+}
+
+/// Parses a format message's text `name:type field;…` (`None`: not a definition — a damaged
+/// text, an array longer than [`MAX_ARRAY`]).
 pub(super) fn parse_format(text: &str) -> Option<(String, Vec<Field>)> {
     let (name, rest) = text.split_once(':')?;
+    if !name_like(name) {
+        return None;
+    }
     let mut fields = Vec::new();
     for f in rest.split(';').filter(|f| !f.trim().is_empty()) {
         let (ty, fname) = f.trim().rsplit_once(' ')?;
@@ -35,6 +50,9 @@ pub(super) fn parse_format(text: &str) -> Option<(String, Vec<Field>)> {
             Some((t, n)) => (t, n.strip_suffix(']')?.parse().ok()?),
             None => (ty, 1),
         };
+        if !(name_like(ty) && name_like(fname)) || len == 0 || len > MAX_ARRAY {
+            return None;
+        }
         fields.push(Field {
             ty: ty.to_string(),
             len,
@@ -121,12 +139,54 @@ pub(super) struct Formats {
     pub(super) defs: HashMap<String, Vec<Field>>,
 }
 
+/// The most bytes a message's data can hold (its size is a u16, the message id takes 2).
+const MAX_DATA: usize = u16::MAX as usize - 2;
+
 impl Formats {
-    /// Every scalar of a format with its flattened name.
+    /// Every scalar of a format with its flattened name; `None` when a nested format is
+    /// missing or the format is larger than a message can be (a damaged array length never
+    /// sizes memory: the size is checked before any slot is made).
     pub(super) fn slots(&self, name: &str) -> Option<HashMap<String, Slot>> {
+        if self.size(name, 0)? > MAX_DATA {
+            return None;
+        }
         let mut out = HashMap::new();
         self.flatten(name, "", 0, &mut out, 0)?;
         Some(out)
+    }
+
+    /// The bytes a format takes (saturating: an absurd size is absurd, not a wrap).
+    fn size(&self, name: &str, depth: usize) -> Option<usize> {
+        if depth > 16 {
+            return None;
+        }
+        let mut n = 0usize;
+        for f in self.defs.get(name)? {
+            let one = match scalar_size(&f.ty) {
+                Some(s) => s,
+                None => self.size(&f.ty, depth + 1)?,
+            };
+            n = n.saturating_add(one.saturating_mul(f.len));
+        }
+        Some(n)
+    }
+
+    /// The sizes a data message of format `name` may have (without its message id), as
+    /// pyulog takes them: the whole format, or without its trailing `_padding` fields (PX4's
+    /// logger leaves them out). `None`: not a format a message can hold.
+    pub(super) fn data_sizes(&self, name: &str) -> Option<(usize, usize)> {
+        let max = self.size(name, 0)?;
+        if max > MAX_DATA {
+            return None;
+        }
+        let mut min = max;
+        for f in self.defs.get(name)?.iter().rev() {
+            match scalar_size(&f.ty) {
+                Some(s) if f.name.starts_with("_padding") => min -= s * f.len,
+                _ => break,
+            }
+        }
+        Some((min, max))
     }
 
     fn flatten(

@@ -71,6 +71,28 @@ impl McapReader {
                             && !r.schemas.get(&c.schema_id).is_some_and(schema_plausible))
                 })
         };
+        // a summary without a CRC may be damaged unseen: the copies in the first chunk (its
+        // CRC checked) win where they differ
+        if self.summary_unchecked
+            && let Some(k) = self
+                .locs
+                .iter()
+                .position(|l| matches!(l, Loc::Chunk { .. }))
+        {
+            let (schemas, channels) = self.inner_channels(k);
+            for s in schemas {
+                if self.schemas.get(&s.id).is_some_and(|old| *old != s) {
+                    self.contents.notes.push(format!(
+                        "the summary's Schema record {} differs from the one in the first chunk (whose CRC holds): the chunk's is used",
+                        s.id
+                    ));
+                }
+                self.schemas.insert(s.id, s);
+            }
+            for c in channels {
+                self.mcap_channels.insert(c.id, c);
+            }
+        }
         for k in 0..self.locs.len() {
             if self.summary_used && !needed(self) {
                 break;
@@ -79,6 +101,21 @@ impl McapReader {
                 self.collect_inner_channels(k);
             }
         }
+    }
+
+    /// The schemas and channels inside part `loc` that decode.
+    fn inner_channels(&self, loc: usize) -> (Vec<Schema>, Vec<record::Channel>) {
+        let (mut schemas, mut channels) = (Vec::new(), Vec::new());
+        let _ = self.with_records(
+            loc,
+            |_, op, content| match Op::from_byte(op) {
+                Some(Op::Schema) => schemas.extend(Schema::decode(content).ok()),
+                Some(Op::Channel) => channels.extend(record::Channel::decode(content).ok()),
+                _ => {}
+            },
+            &|| Vec::new(),
+        );
+        (schemas, channels)
     }
 
     /// Collects the schemas and channels inside part `loc`.

@@ -87,6 +87,8 @@ struct IndexRef {
 #[derive(Debug, Clone)]
 struct Lost {
     what: String,
+    /// The file offsets of the stretch.
+    range: (u64, u64),
     span: Option<(u64, u64)>,
     /// Bytes of records (decompressed, when known) the stretch held.
     bytes: u64,
@@ -121,6 +123,10 @@ pub struct McapReader {
     indexes: Vec<Vec<IndexRef>>,
     /// Stretches the walk could not read.
     lost: Vec<Lost>,
+    /// The summary used stores no CRC: nothing checks it.
+    summary_unchecked: bool,
+    /// The schemas and channels of a summary whose CRC does not match.
+    untrusted_meta: Option<(BTreeMap<u16, Schema>, BTreeMap<u16, record::Channel>)>,
     contents: source::Contents,
 }
 
@@ -257,6 +263,8 @@ impl McapReader {
             locs: Vec::new(),
             indexes: Vec::new(),
             lost: Vec::new(),
+            untrusted_meta: None,
+            summary_unchecked: false,
             contents: source::Contents::default(),
         };
         let (data_end, mut summary) = r.summary_and_data_end();
@@ -271,6 +279,16 @@ impl McapReader {
             r.chunks_from_summary(&s.chunk_indexes);
         }
         r.complete_channels();
+        // a summary whose CRC does not match: its schemas and channels stand in only for
+        // those the data section (and its chunks) lack
+        if let Some((schemas, channels)) = r.untrusted_meta.take() {
+            for (id, s) in schemas {
+                r.schemas.entry(id).or_insert(s);
+            }
+            for (id, c) in channels {
+                r.mcap_channels.entry(id).or_insert(c);
+            }
+        }
         r.account_lost();
         r.build_channels();
         Ok(r)
@@ -288,12 +306,18 @@ impl McapReader {
                 match self.read_summary(footer_pos, &f) {
                     Ok(s) => {
                         self.summary_used = true;
+                        self.summary_unchecked = f.summary_crc == 0;
                         if s.trusted {
                             data_end = f.summary_start;
                         } else {
                             // A damaged footer may misplace the summary: the walk goes on
-                            // to the footer and ends at the Data End record.
+                            // to the footer and ends at the Data End record. Its schemas and
+                            // channels only stand in for those the data section lacks.
                             self.statistics = None;
+                            self.untrusted_meta = Some((
+                                std::mem::take(&mut self.schemas),
+                                std::mem::take(&mut self.mcap_channels),
+                            ));
                         }
                         summary = Some(s);
                     }

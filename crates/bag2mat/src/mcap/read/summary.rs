@@ -129,11 +129,17 @@ impl McapReader {
     /// damaged): read from the summary's fields when their bytes are in the file, counted
     /// from their Message Index records otherwise.
     pub(super) fn chunks_from_summary(&mut self, chunk_indexes: &[ChunkIndex]) {
-        let found: std::collections::BTreeSet<u64> = self
+        // the chunks the walk found, by where their records lie
+        let found: Vec<(u64, u64)> = self
             .locs
             .iter()
             .filter_map(|l| match l {
-                Loc::Chunk { pos, .. } => Some(*pos),
+                Loc::Chunk {
+                    pos,
+                    records_pos,
+                    compressed_size,
+                    ..
+                } => Some((*pos, records_pos.saturating_add(*compressed_size))),
                 Loc::Loose { .. } => None,
             })
             .collect();
@@ -146,16 +152,63 @@ impl McapReader {
             buf: Vec::new(),
             at: 0,
         };
+        // the message index records the walk found after its chunks
+        let attached: std::collections::BTreeSet<u64> = self
+            .indexes
+            .iter()
+            .flatten()
+            .map(|ix| ix.entries_pos - 6 - RECORD_PREFIX)
+            .collect();
         for ci in chunk_indexes {
-            let k = if found.contains(&ci.chunk_start_offset) {
-                self.locs.iter().position(
-                    |l| matches!(l, Loc::Chunk { pos, .. } if *pos == ci.chunk_start_offset),
-                )
+            let cs = ci.chunk_start_offset;
+            let describes_found = ci
+                .message_index_offsets
+                .iter()
+                .any(|(_, o)| attached.contains(o));
+            if !found.iter().any(|&(a, _)| a == cs) && describes_found {
+                // a chunk index whose offset is damaged: its message indexes follow a chunk
+                // the walk read
+                self.contents.notes.push(format!(
+                    "the summary lists a chunk at byte {cs} whose message indexes follow another chunk (a damaged chunk index); ignored"
+                ));
+                continue;
+            }
+            if found.iter().any(|&(a, e)| a < cs && cs < e) {
+                // a damaged chunk index pointing inside a chunk the walk read whole
+                self.contents.notes.push(format!(
+                    "the summary lists a chunk at byte {cs}, inside a chunk the data section holds whole (a damaged chunk index); ignored"
+                ));
+                continue;
+            }
+            let k = if found.iter().any(|&(a, _)| a == cs) {
+                self.locs
+                    .iter()
+                    .position(|l| matches!(l, Loc::Chunk { pos, .. } if *pos == cs))
             } else {
                 self.summary_chunk(&mut w, ci)
             };
             // The summary's message indexes count the chunk when the walk found none.
             let indexes = summary_indexes(&mut w, ci);
+            if k.is_some() && !found.iter().any(|&(a, _)| a == cs) {
+                // the stretch the walk could not read because of this chunk's damaged record
+                // header (with the message indexes after it, which count it) is this chunk,
+                // read now: not lost
+                let record = |ix: &IndexRef| ix.entries_pos - 6 - RECORD_PREFIX;
+                let mine: Vec<u64> = ci.message_index_offsets.iter().map(|x| x.1).collect();
+                let next = chunk_indexes
+                    .iter()
+                    .map(|c| c.chunk_start_offset)
+                    .filter(|&o| o > cs)
+                    .min()
+                    .unwrap_or(self.len);
+                self.lost.retain_mut(|l| {
+                    let had = l.indexes.len();
+                    l.indexes.retain(|ix| !mine.contains(&record(ix)));
+                    let explained = (had > 0 && l.indexes.is_empty())
+                        || (had == 0 && (cs..next).contains(&l.range.0));
+                    !explained
+                });
+            }
             match k {
                 Some(k) if self.indexes[k].is_empty() && !indexes.is_empty() => {
                     self.contents.parts[k].counts = Some(
@@ -168,9 +221,9 @@ impl McapReader {
                 }
                 Some(_) => {}
                 None => self.lost.push(Lost {
+                    range: (cs, cs.saturating_add(ci.chunk_length)),
                     what: format!(
-                        "the summary lists a chunk at byte {} that the data section does not hold",
-                        ci.chunk_start_offset
+                        "the summary lists a chunk at byte {cs} that the data section does not hold"
                     ),
                     span: Some((ci.message_start_time, ci.message_end_time)),
                     bytes: ci

@@ -227,6 +227,15 @@ impl McapReader {
             && w.get(content_pos, (end - content_pos).min(4096) as usize)
                 .ok()
                 .is_some_and(|b| ChunkHeader::decode(b).is_ok());
+        if is_chunk && let Some(e) = self.chunk_by_size(w, pos, st) {
+            // a chunk whose record length is damaged: its header's size frames it
+            let k = self.add_chunk(w, pos, e - content_pos, None)?;
+            self.contents.notes.push(format!(
+                "the chunk at byte {pos} has a damaged record length; it was read as its header's size frames it"
+            ));
+            st.after = After::Chunk(k);
+            return Ok(Flow::Read(e));
+        }
         let landing = if is_chunk {
             Landing::Chunked
         } else {
@@ -259,6 +268,34 @@ impl McapReader {
             clen,
             content_pos,
         } = rec;
+        // a chunk whose opcode is damaged into another one's (a message index, a message):
+        // its stored length and compression frame it as a chunk, which its CRC checks
+        if op != Op::Chunk as u8 && chunk_header(w, content_pos, clen).is_some() {
+            self.contents.notes.push(format!(
+                "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
+            ));
+            let k = self.add_chunk(w, pos, clen, None)?;
+            st.after = After::Chunk(k);
+            return Ok(Flow::Read(rec_end));
+        }
+        // a record (but a chunk, its message indexes and the section's end) whose length is
+        // damaged but still inside the file: what follows it is no record, and the records
+        // it swallowed (chunks) are found by walking on from its start
+        let lands = |r: &Self, w: &mut Window| {
+            rec_end == st.end || r.frames(w, rec_end, st.end, st.landing).is_some()
+        };
+        if matches!(
+            Op::from_byte(op),
+            Some(
+                Op::Header | Op::Schema | Op::Channel | Op::Message | Op::Attachment | Op::Metadata
+            )
+        ) && !lands(self, w)
+            && let Some(next) = self.resync(w, pos + 1, st.end, st.hints, st.landing)
+            && next < rec_end
+        {
+            st.after = self.damaged(w, pos, next, op, "its length runs past the next record");
+            return Ok(Flow::Skip(next));
+        }
         match Op::from_byte(op) {
             Some(Op::Header) if pos == MAGIC.len() as u64 => {
                 match self.small(w, rec)?.map(|b| Header::decode(&b)) {
@@ -294,6 +331,23 @@ impl McapReader {
                 if chunk_header(w, content_pos, clen).is_some() {
                     let k = self.add_chunk(w, pos, clen, None)?;
                     st.after = After::Chunk(k);
+                } else if lands(self, w)
+                    && let Some(k) = self.chunk_by_record(w, pos, clen)?
+                {
+                    // its header's size field is damaged: the record, which the next one
+                    // follows, frames its stored records (its CRC checks them)
+                    self.contents.notes.push(format!(
+                        "the chunk at byte {pos} has a damaged size field; its records were read as its record frames them"
+                    ));
+                    st.after = After::Chunk(k);
+                } else if let Some(e) = self.chunk_by_size(w, pos, st) {
+                    // its record length is damaged: its header's size frames it
+                    let k = self.add_chunk(w, pos, e - content_pos, None)?;
+                    self.contents.notes.push(format!(
+                        "the chunk at byte {pos} has a damaged record length; it was read as its header's size frames it"
+                    ));
+                    st.after = After::Chunk(k);
+                    return Ok(Flow::Read(e));
                 } else {
                     let next = self.resync(w, pos + 1, st.end, st.hints, st.landing);
                     let to = next.unwrap_or(st.end);
@@ -301,7 +355,18 @@ impl McapReader {
                     return Ok(Flow::Skip(to));
                 }
             }
-            Some(Op::MessageIndex) => self.message_index(w, rec, st.after)?,
+            Some(Op::MessageIndex) => {
+                if !self.message_index(w, rec, st.after)? {
+                    st.after = self.damaged(
+                        w,
+                        pos,
+                        rec_end,
+                        op,
+                        "its entries do not index the chunk before it",
+                    );
+                    return Ok(Flow::Skip(rec_end));
+                }
+            }
             Some(Op::Message) => {
                 let b = w
                     .get(content_pos, MESSAGE_FIXED_LEN.min(clen as usize))
@@ -340,7 +405,10 @@ impl McapReader {
     }
 
     /// A Message Index record: its entries belong to the chunk (or lost stretch) before it.
-    fn message_index(&mut self, w: &mut Window, rec: Rec, after: After) -> Result<(), Error> {
+    /// False when its entries cannot index the chunk before it (offsets past its records,
+    /// times outside its span): the record is damage (a chunk whose opcode and header are
+    /// damaged), not that chunk's index.
+    fn message_index(&mut self, w: &mut Window, rec: Rec, after: After) -> Result<bool, Error> {
         let Rec {
             clen, content_pos, ..
         } = rec;
@@ -360,6 +428,9 @@ impl McapReader {
             };
             match after {
                 After::Chunk(k) => {
+                    if !self.indexes_chunk(k, &ix) {
+                        return Ok(false);
+                    }
                     self.indexes[k].push(ix);
                     self.contents.parts[k]
                         .counts
@@ -370,7 +441,30 @@ impl McapReader {
                 After::Other => {}
             }
         }
-        Ok(())
+        Ok(true)
+    }
+
+    /// True when the entries of `ix` may index chunk part `k`: each offset inside its
+    /// records and each time inside its span.
+    fn indexes_chunk(&self, k: usize, ix: &IndexRef) -> bool {
+        let Some(Loc::Chunk {
+            uncompressed_size,
+            compressed_size,
+            compression,
+            ..
+        }) = self.locs.get(k)
+        else {
+            return true;
+        };
+        let size = if compression.is_empty() {
+            *uncompressed_size.max(compressed_size)
+        } else {
+            *uncompressed_size
+        };
+        let span = self.contents.parts[k].span;
+        self.entries(ix)
+            .iter()
+            .all(|&(t, off)| off < size && span.is_none_or(|(a, b)| a > b || (a..=b).contains(&t)))
     }
 
     /// A Data End or Footer record of its length: the end of the data section, unless
@@ -495,6 +589,7 @@ impl McapReader {
             None => stored.saturating_mul(source::MAX_EXPANSION),
         };
         self.lost.push(Lost {
+            range: (pos, to),
             what: format!(
                 "bytes {pos}..{to} could not be read as records (a {} record at byte {pos}: {why}); skipped",
                 op_name(op)
@@ -504,6 +599,50 @@ impl McapReader {
             indexes: Vec::new(),
         });
         After::Lost(self.lost.len() - 1)
+    }
+
+    /// The end of the chunk record at `pos` as its header's compressed size frames it, when
+    /// a whole record (or the end) follows there and its compression is one read here.
+    fn chunk_by_size(&self, w: &mut Window, pos: u64, st: &Walk) -> Option<u64> {
+        let content_pos = pos + RECORD_PREFIX;
+        let avail = st.end.saturating_sub(content_pos).min(4096) as usize;
+        let b = w.get(content_pos, avail).ok()?;
+        let (h, off) = ChunkHeader::decode(b).ok()?;
+        if !["", "lz4", "zstd"].contains(&h.compression.as_str()) {
+            return None;
+        }
+        let e = (content_pos + off as u64).checked_add(h.compressed_size)?;
+        (e <= st.end && (e == st.end || self.frames(w, e, st.end, Landing::Chunked).is_some()))
+            .then_some(e)
+    }
+
+    /// Adds the chunk record at `pos` (content length `clen`) whose header's compressed
+    /// size disagrees with the record's length, reading the records the record holds
+    /// (when its compression is one read here).
+    fn chunk_by_record(
+        &mut self,
+        w: &mut Window,
+        pos: u64,
+        clen: u64,
+    ) -> Result<Option<usize>, Error> {
+        let content_pos = pos + RECORD_PREFIX;
+        let b = w
+            .get(content_pos, clen.min(4096) as usize)
+            .map_err(|e| Error::io(&self.path, e))?;
+        let Ok((h, off)) = ChunkHeader::decode(b) else {
+            return Ok(None);
+        };
+        if !["", "lz4", "zstd"].contains(&h.compression.as_str()) || (off as u64) > clen {
+            return Ok(None);
+        }
+        let k = self.add_chunk(w, pos, clen, None)?;
+        if let Some(Loc::Chunk {
+            compressed_size, ..
+        }) = self.locs.get_mut(k)
+        {
+            *compressed_size = clen - off as u64;
+        }
+        Ok(Some(k))
     }
 
     /// Adds the chunk record at `pos` (content length `clen`) as a part; `from_index` gives

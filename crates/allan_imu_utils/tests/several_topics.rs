@@ -1,0 +1,62 @@
+//! Several topics in one run (`--all-imu-topics`, `--topic` repeated): a topic that cannot be
+//! analysed is an error for that topic alone, said once; the other topics are analysed and
+//! written; the exit status is 1 — the rule allan_kalibr follows too.
+
+use std::process::Command;
+
+/// A ROS 1 bag (Debian's python rosbag) with two 30 s topics at 100 Hz and one of `short`
+/// messages.
+pub fn rig_bag(dir: &std::path::Path, short: usize) -> std::path::PathBuf {
+    let bag = dir.join("rig.bag");
+    let topic = |t: &str, n: usize| {
+        format!(r#"{{"topic": "{t}", "n": {n}, "rate": 100, "gyro_n": 1e-4, "acc_n": 1e-3}}"#)
+    };
+    let spec = format!(
+        r#"{{"seed": 41, "topics": [{}, {}, {}]}}"#,
+        topic("/imu0", 3000),
+        topic("/imu1", 3000),
+        topic("/short", short)
+    );
+    bag2mat::test_tools::independent_log("ros1", &bag, &spec);
+    bag
+}
+
+#[test]
+fn a_topic_too_short_fails_alone_and_the_other_topics_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // 5 messages: imu_utils' fit needs more Allan points than they give
+    let bag = rig_bag(dir.path(), 5);
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_allan_imu_utils"))
+        .arg(&bag)
+        .args(["--all-imu-topics", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    let errors: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("allan_imu_utils: error:"))
+        .collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    assert!(
+        errors[0].starts_with("allan_imu_utils: error: too few samples on topic '/short'"),
+        "{stderr}"
+    );
+    for t in ["imu0", "imu1"] {
+        assert!(
+            out.join(t).join("imu_imu_param.yaml").is_file(),
+            "{t} not written:\n{stderr}"
+        );
+        assert!(
+            stdout.contains(&format!("===== topic /{t} =====")),
+            "{stdout}"
+        );
+    }
+    assert!(!out.join("short").exists());
+    assert!(!stdout.contains("===== topic /short"), "{stdout}");
+}
