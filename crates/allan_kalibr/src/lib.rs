@@ -103,7 +103,6 @@ pub use ieee952::files::{
     CURVES_FILE, TERMS_FILE, file_names as ieee952_file_names,
     write_outputs as write_ieee952_files,
 };
-pub use ieee952::fit::GM;
 pub use ieee952::imu::{
     AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
     summary_text as ieee952_summary_text,
@@ -118,6 +117,9 @@ pub use ieee952::psd::{Line as PsdLine, Psd};
 pub use ieee952::region::Readings;
 pub use ieee952::region::{B_FLOOR_FACTOR, Reading, ReadingKind};
 pub use ieee952::stated::section_text as ieee952_section_text;
+pub use ieee952::term::{
+    AvarBasis, FLICKER_AVAR, LINE_SLOTS, NoiseTerm, PsdForm, TERM_COUNT, TERMS, TermFacts,
+};
 pub use ieee952::{
     AlphaSource, Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CovBasis,
     CurveData, CurvePoint, FitConfig, FitSummary, GridSpec, IdMethod, Ieee952Error, LineShape,

@@ -101,6 +101,7 @@
 //! method. The fit here reaches the bound within sampling error in the accuracy study.
 
 pub(crate) mod advisor;
+mod analysed_curve;
 mod avar_cov;
 mod band;
 pub(crate) mod ci;
@@ -108,6 +109,7 @@ pub(crate) mod curves_in;
 pub(crate) mod edf;
 pub(crate) mod files;
 pub(crate) mod fit;
+mod golden;
 pub(crate) mod imu;
 mod input_error;
 pub(crate) mod line_check;
@@ -121,6 +123,7 @@ pub(crate) mod psd_plot;
 pub(crate) mod region;
 pub(crate) mod stated;
 mod tau_grid;
+pub(crate) mod term;
 
 pub(crate) mod chart_panels;
 pub(crate) mod config_values;
