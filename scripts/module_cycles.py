@@ -78,7 +78,9 @@ PATH = re.compile(r'\b((?:crate|super|self)(?:::\w+)+)')
 
 
 def paths_of(text):
-    """(path, is_pub_use) for every path the code names; use trees expanded."""
+    """(path, is_pub_use) for every path the code names; use trees expanded. An import for
+    the docs only (`#[cfg(doc)] use …;`, the targets of intra-doc links) is no dependency."""
+    text = re.sub(r'#\[cfg\(doc\)\]\s*(?:pub(?:\([^)]*\))?\s+)?use\s[^;]*;', ' ', text)
     out = []
     for m in USE.finditer(text):
         for p in expand_use(m.group(2)):
@@ -89,12 +91,16 @@ def paths_of(text):
     return out
 
 
-def base_of(m, parts):
-    """The module a path starts from, and the rest of it; None for another crate's path."""
+def base_of(m, parts, known):
+    """The module a path starts from, and the rest of it; None for another crate's path.
+    A path may start with a child module of the module it is written in (2018 paths:
+    `pub use ieee952::Name;` in lib.rs is `crate::ieee952::Name`)."""
     if not parts:
         return None
     if parts[0] == 'crate':
         return (), list(parts[1:])
+    if m + (parts[0],) in known:
+        return m, list(parts)
     if parts[0] in ('super', 'self'):
         base = m
         parts = list(parts)
@@ -166,13 +172,13 @@ def crate_cycles(src):
     for m, ps in parsed.items():
         for p, is_pub in ps:
             if is_pub and len(p) >= 2:
-                b = base_of(m, p)
+                b = base_of(m, p, known)
                 if b is not None and b[1]:
                     reexports[(m, b[1][-1])] = (b[0], b[1][:-1])
     edges = set()
     for m, ps in parsed.items():
         for p, _ in ps:
-            b = base_of(m, p)
+            b = base_of(m, p, known)
             if b is None:
                 continue
             tgt = resolve(known, reexports, b[0], b[1])

@@ -47,7 +47,7 @@ fi
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
-# (module cycles: scripts/module_cycles.py joins this list once ieee952 has none)
+/usr/bin/python3 scripts/module_cycles.py
 
 cargo test --workspace "$@"
 

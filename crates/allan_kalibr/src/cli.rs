@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 
 use crate::front::CommonArgs;
 use crate::kalibr::estimator::Estimator;
-use crate::run::Config;
+use crate::run::{Config, TOOL};
 
 /// kalibr_allan's Allan-deviation results (rpng/kalibr_allan 9d38ea9), in seconds, without
 /// MATLAB or ROS; `allan_kalibr check` and `allan_kalibr plan` (below).
@@ -52,11 +52,11 @@ pub enum Command {
     /// Say what each IMU noise value of your config files is (Kalibr imu.yaml or imu_chain,
     /// OpenVINS, VINS, ORB-SLAM3, Basalt JSON, PX4 .params, ArduPilot .param, GTSAM,
     /// imu_utils' yaml) and what is wrong with it: one line per key on stdout, exit 0.
-    Check(crate::consumers::check::CheckArgs),
+    Check(crate::check::CheckArgs),
     /// Plan a static record from an IMU's figures (Kalibr units or datasheet units): the
     /// record for +-25 % / +-10 % on each term, whether B can be resolved, an honest bound
     /// on K where the datasheet has none, and every consumer's parameters (-o DIR: files).
-    Plan(crate::consumers::plan::PlanArgs),
+    Plan(crate::plan::PlanArgs),
 }
 
 /// What a command line runs.
@@ -65,9 +65,9 @@ pub enum Run {
     /// An analysis.
     Analyse(Box<Config>),
     /// `check`.
-    Check(crate::consumers::check::CheckArgs),
+    Check(crate::check::CheckArgs),
     /// `plan`.
-    Plan(crate::consumers::plan::PlanArgs),
+    Plan(crate::plan::PlanArgs),
 }
 
 impl TryFrom<Cli> for Run {
@@ -86,8 +86,8 @@ impl TryFrom<Cli> for Run {
 pub fn command_main() -> ExitCode {
     match crate::front::command_line::<Cli, Run>(TOOL) {
         Ok(Run::Analyse(config)) => crate::front::run_job(TOOL, config.as_ref()),
-        Ok(Run::Check(a)) => crate::consumers::check::main(&a),
-        Ok(Run::Plan(a)) => crate::consumers::plan::main(&a),
+        Ok(Run::Check(a)) => crate::check::main(&a),
+        Ok(Run::Plan(a)) => crate::plan::main(&a),
         Err(code) => code,
     }
 }
@@ -118,9 +118,6 @@ pub struct Args {
     #[command(flatten)]
     pub operating: crate::operating::OperatingArgs,
 }
-
-/// The tool's name: its default output folder is `<input stem>_allan_kalibr/`.
-pub const TOOL: &str = "allan_kalibr";
 
 impl TryFrom<Args> for Config {
     type Error = bag2mat::shared::cli::UsageError;

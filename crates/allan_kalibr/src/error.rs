@@ -30,7 +30,7 @@ pub enum Error {
     /// The input is neither a `.mat` nor a bag bag2mat reads.
     #[error(
         "{path}: unknown input type (expected a .mat file or a bag: {})",
-        bag2mat::ACCEPTED
+        bag2mat::accepted()
     )]
     UnknownInput {
         /// The file.
@@ -50,5 +50,29 @@ pub enum Error {
     Curves(#[from] crate::ieee952::curves_in::CurvesError),
     /// The operating-noise analysis cannot run (`--reference`, `--operating`).
     #[error(transparent)]
-    Operating(#[from] crate::operating::OperatingError),
+    Operating(#[from] OperatingError),
+}
+
+/// What the analysis cannot do on this record.
+#[derive(Debug, thiserror::Error)]
+pub enum OperatingError {
+    /// The reference cannot be used.
+    #[error("reference {}: {what}", .path.display())]
+    Reference {
+        /// The reference.
+        path: PathBuf,
+        /// Why.
+        what: String,
+    },
+    /// The static record cannot be used.
+    #[error("--static {}: {what}", .path.display())]
+    Static {
+        /// The static record.
+        path: PathBuf,
+        /// Why.
+        what: String,
+    },
+    /// The record cannot be analysed.
+    #[error("{0}")]
+    Record(String),
 }

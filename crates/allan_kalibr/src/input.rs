@@ -9,6 +9,8 @@
 
 use std::path::Path;
 
+use bag2mat::shared::note::Note;
+
 use crate::error::Error;
 
 /// An estimated rate within this relative distance of an integer is rounded to it
@@ -434,6 +436,52 @@ pub(crate) fn choose_rate(
                 finding: None,
             })
         }
+    }
+}
+
+/// The finiteness and value checks of each column present (`absent`: the sensor the record
+/// lacks): a column that cannot be analysed is an error, a doubtful one a warning in `notes`.
+pub(crate) fn check_scans(
+    scans: &[ColumnScan; 6],
+    absent: Option<bag2mat::Sensor>,
+    notes: &mut Vec<Note>,
+) -> Result<(), Error> {
+    for (a, (name, scan)) in AXIS_NAMES.iter().zip(scans).enumerate() {
+        if Some(data_imu_sensor(a)) == absent {
+            continue;
+        }
+        match scan.problem(name) {
+            Some((true, what)) => return Err(Error::BadData { what }),
+            Some((false, what)) => notes.push(Note::warning(what)),
+            None => {}
+        }
+    }
+    Ok(())
+}
+
+/// `--skip-start`: drops the samples of the first `seconds` of the record, said in `notes`
+/// (a warning when that is most of it).
+pub(crate) fn skip_start(
+    data: &mut ImuData,
+    seconds: f64,
+    notes: &mut Vec<Note>,
+) -> Result<(), Error> {
+    let (k, warning) = bag2mat::checked_skip(&data.t, seconds)?;
+    data.drop_first(k);
+    notes.extend(warning.map(Note::warning));
+    notes.push(Note::info(format!(
+        "--skip-start {seconds}: dropped the first {k} samples ({} left)",
+        data.len()
+    )));
+    Ok(())
+}
+
+/// The sensor of column `a` of the six `data_imu` sample columns (ax ay az wx wy wz).
+fn data_imu_sensor(a: usize) -> bag2mat::Sensor {
+    if a < 3 {
+        bag2mat::Sensor::Acc
+    } else {
+        bag2mat::Sensor::Gyro
     }
 }
 

@@ -24,9 +24,9 @@
 //! * `yaml`: Kalibr imu.yaml and the YAML spelling both halves write.
 //! * [`consumers`]: every estimator users feed the figures into (Kalibr, OpenVINS, VINS,
 //!   ORB-SLAM3, Basalt, PX4 EKF2, ArduPilot EKF3, GTSAM), each described once — keys, units,
-//!   convention, the source it was read from — and the config files written for them,
-//!   `allan_kalibr check` ([`consumers::check`]) and `allan_kalibr plan`
-//!   ([`consumers::plan`]).
+//!   convention, the source it was read from — and the config files written for them.
+//! * [`check`] and [`plan`]: the commands `allan_kalibr check` and `allan_kalibr plan`, above
+//!   the analysis they run or advise with and the consumers' conventions they apply.
 //! * `input`: `.mat`/`.bag` loading and the update-rate check ([`load_input`],
 //!   [`snap_rate`]); `run`: the whole job ([`run()`], [`Config`]).
 //! * `ieee952`: the IEEE Std 952 analysis both analysers (this one and `allan_imu_utils`)
@@ -67,6 +67,7 @@
 //! * The update rate drives the grid; timestamps are only counted (they are checked here
 //!   and a warning printed, which upstream never does).
 
+pub mod check;
 mod cli;
 pub mod consumers;
 mod error;
@@ -75,11 +76,13 @@ mod ieee952;
 mod input;
 mod kalibr;
 pub mod operating;
+pub mod plan;
 mod run;
 pub mod spline;
 mod yaml;
 
-pub use cli::{Args, Cli, Command, Run, TOOL, command_main};
+pub use cli::{Args, Cli, Command, Run, command_main};
+pub use consumers::SensorValue;
 pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
@@ -100,8 +103,6 @@ pub use ieee952::files::{
     CURVES_FILE, TERMS_FILE, file_names as ieee952_file_names,
     write_outputs as write_ieee952_files,
 };
-pub use ieee952::fit::GM;
-pub use ieee952::imu::SensorValue;
 pub use ieee952::imu::{
     AxisResult, ImuAnalysis, ImuCurves, analyse_curves as analyse_imu_curves,
     summary_text as ieee952_summary_text,
@@ -116,6 +117,9 @@ pub use ieee952::psd::{Line as PsdLine, Psd};
 pub use ieee952::region::Readings;
 pub use ieee952::region::{B_FLOOR_FACTOR, Reading, ReadingKind};
 pub use ieee952::stated::section_text as ieee952_section_text;
+pub use ieee952::term::{
+    AvarBasis, FLICKER_AVAR, LINE_SLOTS, NoiseTerm, PsdForm, TERM_COUNT, TERMS, TermFacts,
+};
 pub use ieee952::{
     AlphaSource, Analysis as Ieee952Analysis, AxisVerdict, Config as Ieee952Config, CovBasis,
     CurveData, CurvePoint, FitConfig, FitSummary, GridSpec, IdMethod, Ieee952Error, LineShape,
@@ -129,6 +133,6 @@ pub use kalibr::estimator::{Estimator, prefix_in_place, sig2_prefix_fused, sig2_
 pub use kalibr::grid::TauGrid;
 pub use kalibr::report::{chart_lines, final_lines};
 pub use run::{
-    Analysis, Config, RunOutput, TopicRun, analyse, curves_rate, curves_text, run, run_topics,
-    sections,
+    Analysis, Config, RunOutput, TOOL, TopicRun, analyse, curves_rate, curves_text, run,
+    run_topics, sections,
 };

@@ -15,10 +15,16 @@ use crate::kalibr::chart_fit::{ChartFit, gen_chart};
 use crate::kalibr::curves;
 use crate::kalibr::estimator::{Estimator, sig2_curves};
 use crate::kalibr::grid::TauGrid;
+use crate::kalibr::imu_yaml::{ImuYaml, SectionFile};
 use crate::kalibr::report;
-use crate::yaml::{ImuYaml, SectionFile};
 use bag2mat::shared::note::Note;
 use bag2mat::shared::output::Outputs;
+
+/// The tool's name: its default output folder is `<input stem>_allan_kalibr/`, its files'
+/// provenance and its messages name it. Here, with the job, so that the commands above the
+/// job (`cli`, `check`, `plan`) and the job itself read one name; the analyses below it
+/// (`operating`) are given it.
+pub const TOOL: &str = "allan_kalibr";
 
 /// What the program runs with (resolved from the command line in `cli`).
 #[derive(Debug, Clone, PartialEq)]
@@ -135,7 +141,7 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
         return Ok(vec![run_curves(config, curves, outputs)?]);
     }
     if let Some(s) = &config.operating {
-        return crate::operating::sections(config, s, outputs);
+        return crate::operating::sections(TOOL, &config.common, &config.title, s, outputs);
     }
     let topics = run_topics(config, outputs)?;
     let several = topics.len() > 1;
@@ -256,7 +262,7 @@ pub(crate) fn section_only(
     let mut data = datas.swap_remove(0);
     let mut notes = Vec::new();
     if let Some(skip) = config.common.skip_start {
-        skip_start(&mut data, skip, &mut notes)?;
+        input::skip_start(&mut data, skip, &mut notes)?;
     }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
@@ -298,9 +304,10 @@ fn run_on(
         data_topic.as_deref().unwrap_or(""),
         data.integration,
         &data.clock.t_ns,
-    )?;
+    )
+    .map_err(bag2mat::Error::from)?;
     if let Some(skip) = config.common.skip_start {
-        skip_start(&mut data, skip, &mut notes)?;
+        input::skip_start(&mut data, skip, &mut notes)?;
     }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
@@ -328,7 +335,7 @@ fn run_on(
         ),
     };
     let prov = Provenance::new(
-        crate::cli::TOOL,
+        TOOL,
         input_text(config.common.samples_path(), data_topic.as_deref()),
         record_rate(config, &c.rate),
     );
@@ -473,7 +480,7 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
     } else {
         std::array::from_fn(|a| input::ColumnScan::of(&data.axes[a]))
     };
-    check_scans(&scans, absent, notes)?;
+    input::check_scans(&scans, absent, notes)?;
     let rate = input::choose_rate(config.common.rate, check.rate, data.len())?;
     notes.extend(rate.message.clone().map(Note::info));
     findings.extend(rate.finding.clone());
@@ -486,26 +493,6 @@ fn check_record(config: &Config, data: ImuData, notes: &mut Vec<Note>) -> Result
         early,
         checks_s,
     })
-}
-
-/// The finiteness and value checks of each column present (`absent`: the sensor the record
-/// lacks): a column that cannot be analysed is an error, a doubtful one a warning in `notes`.
-pub(crate) fn check_scans(
-    scans: &[input::ColumnScan; 6],
-    absent: Option<bag2mat::Sensor>,
-    notes: &mut Vec<Note>,
-) -> Result<(), Error> {
-    for (a, (name, scan)) in input::AXIS_NAMES.iter().zip(scans).enumerate() {
-        if Some(data_imu_sensor(a)) == absent {
-            continue;
-        }
-        match scan.problem(name) {
-            Some((true, what)) => return Err(Error::BadData { what }),
-            Some((false, what)) => notes.push(Note::warning(what)),
-            None => {}
-        }
-    }
-    Ok(())
 }
 
 /// The IEEE 952 section's curves and the seconds they took: none when the section is off
@@ -651,23 +638,6 @@ fn write_outputs(
     Ok(written)
 }
 
-/// `--skip-start`: drops the samples of the first `seconds` of the record, said in `notes`
-/// (a warning when that is most of it).
-pub(crate) fn skip_start(
-    data: &mut ImuData,
-    seconds: f64,
-    notes: &mut Vec<Note>,
-) -> Result<(), Error> {
-    let (k, warning) = bag2mat::checked_skip(&data.t, seconds)?;
-    data.drop_first(k);
-    notes.extend(warning.map(Note::warning));
-    notes.push(Note::info(format!(
-        "--skip-start {seconds}: dropped the first {k} samples ({} left)",
-        data.len()
-    )));
-    Ok(())
-}
-
 /// `--curves`: the IEEE 952 analysis of curves another tool wrote (no samples: no compat
 /// outputs), with the same files and chart as from a bag.
 pub fn run_curves(
@@ -694,7 +664,7 @@ pub fn run_curves(
     let title = chart_title(config);
     let rostopic = config.common.named_topic();
     let prov = Provenance::new(
-        crate::cli::TOOL,
+        TOOL,
         curves_text(&curves.paths),
         curves_rate(config.common.rate, &c),
     );
@@ -797,13 +767,4 @@ pub(crate) fn write_plots(
         out.extend(chart::write_chart(outputs, &gyro, dir, "allan_gyro")?);
     }
     Ok(out)
-}
-
-/// The sensor of column `a` of the six `data_imu` sample columns (ax ay az wx wy wz).
-fn data_imu_sensor(a: usize) -> bag2mat::Sensor {
-    if a < 3 {
-        bag2mat::Sensor::Acc
-    } else {
-        bag2mat::Sensor::Gyro
-    }
 }

@@ -5,7 +5,7 @@
 
 use std::process::{Command, Output};
 
-use allan_kalibr::consumers::plan::{Walk, plan_sensor};
+use allan_kalibr::plan::{Walk, plan_sensor};
 use bag2mat::Sensor;
 
 use crate::studies::plan::{SENSORS, advice_of, ratios, within};

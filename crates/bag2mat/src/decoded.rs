@@ -147,7 +147,12 @@ impl DecodedSource {
                     encoding: if s.imu {
                         Encoding::Row
                     } else {
-                        Encoding::Other(kind_encoding(kind).to_string())
+                        Encoding::Other(
+                            kind.facts()
+                                .other_topics
+                                .unwrap_or(kind.describe())
+                                .to_string(),
+                        )
                     },
                     md5sum: None,
                     count: Some(s.len() as u64),
@@ -207,15 +212,6 @@ impl DecodedSource {
             }
         }
         self.contents.losses.extend(losses);
-    }
-}
-
-/// How a format's non-Imu topics' encoding is named.
-fn kind_encoding(kind: InputKind) -> &'static str {
-    match kind {
-        InputKind::Ulog => "ulog",
-        InputKind::DataFlash => "df",
-        _ => "text",
     }
 }
 

@@ -1,29 +1,67 @@
 //! What an input is, from its content (never its extension): the first bytes of a file (the
 //! bag formats' magic numbers, then the log formats' sniffers), `metadata.yaml` or an EuRoC
 //! `imuN` folder for a directory. An input that is none of them is an error naming the
-//! formats accepted ([`crate::source::ACCEPTED`]).
+//! formats accepted ([`crate::source::accepted`]).
 
 use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
 use crate::error::Error;
-use crate::source::{ACCEPTED, InputKind, ROS1_MAGIC, SQLITE_MAGIC, ZSTD_MAGIC};
+use crate::formats::{DATAFLASH_MAGIC, NPY_MAGIC, ULOG_MAGIC};
+use crate::source::{InputKind, ROS1_MAGIC, SQLITE_MAGIC, ZSTD_MAGIC, accepted};
 
-/// Recognises `path` from its content.
+/// How a kind of input is recognised: the detection half of the format registry (the other
+/// half, how each kind is opened, is `crate::input::open_with`'s match; what it is called,
+/// [`InputKind::facts`]).
+#[derive(Clone, Copy)]
+enum Recognise {
+    /// A directory, by what it holds.
+    Dir(fn(&Path) -> bool),
+    /// A file, by its first bytes (at least 16 where the file has them).
+    Magic(fn(&[u8]) -> bool),
+    /// A file no magic number claims, by a look at its content (tried after every magic).
+    Sniff(fn(&Path) -> bool),
+}
+
+/// How `kind` is recognised (one arm per kind: a new kind is a compile error here until it
+/// says how).
+fn recognise(kind: InputKind) -> Recognise {
+    match kind {
+        InputKind::Ros1Bag => Recognise::Magic(|h| h.starts_with(ROS1_MAGIC)),
+        InputKind::Rosbag2Dir => Recognise::Dir(|p| p.join("metadata.yaml").is_file()),
+        InputKind::Mcap => Recognise::Magic(|h| h.starts_with(crate::mcap::MAGIC)),
+        InputKind::Sqlite3 => Recognise::Magic(|h| h.starts_with(SQLITE_MAGIC)),
+        InputKind::Zstd => Recognise::Magic(|h| h.starts_with(ZSTD_MAGIC)),
+        InputKind::EurocDir => Recognise::Dir(|p| !crate::formats::euroc::imu_files(p).is_empty()),
+        InputKind::Text => Recognise::Sniff(crate::formats::text::looks_like_text),
+        InputKind::Ulog => Recognise::Magic(|h| h.starts_with(ULOG_MAGIC)),
+        // the first message defines FMT itself (type 128, 89 bytes, "FMT"): recognised by
+        // those too, so that a damaged first byte does not hide a log DFReader reads
+        InputKind::DataFlash => Recognise::Magic(|h| {
+            h.starts_with(DATAFLASH_MAGIC) || h.get(3..8) == Some(b"\x80\x59FMT")
+        }),
+        InputKind::Npy => Recognise::Magic(|h| h.starts_with(NPY_MAGIC)),
+    }
+}
+
+/// Recognises `path` from its content: directories by what they hold, files by their magic
+/// numbers in [`InputKind::ALL`]'s order, then by the sniffers.
 pub fn input_kind(path: &Path) -> Result<InputKind, Error> {
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    let kinds = InputKind::ALL.map(|k| (k, recognise(k)));
     if meta.is_dir() {
-        if path.join("metadata.yaml").is_file() {
-            return Ok(InputKind::Rosbag2Dir);
-        }
-        if let Some(kind) = crate::formats::detect_dir(path) {
-            return Ok(kind);
+        if let Some((k, _)) = kinds
+            .iter()
+            .find(|(_, r)| matches!(r, Recognise::Dir(f) if f(path)))
+        {
+            return Ok(*k);
         }
         return Err(Error::NotABag {
             path: path.to_path_buf(),
             what: format!(
-                "a directory without metadata.yaml or an EuRoC/ASL imuN/data.csv. Accepted: {ACCEPTED}"
+                "a directory without metadata.yaml or an EuRoC/ASL imuN/data.csv. Accepted: {}",
+                accepted()
             ),
         });
     }
@@ -38,20 +76,17 @@ pub fn input_kind(path: &Path) -> Result<InputKind, Error> {
         }
     }
     let head = &head[..got];
-    if head.starts_with(ROS1_MAGIC) {
-        return Ok(InputKind::Ros1Bag);
+    if let Some((k, _)) = kinds
+        .iter()
+        .find(|(_, r)| matches!(r, Recognise::Magic(f) if f(head)))
+    {
+        return Ok(*k);
     }
-    if head.starts_with(crate::mcap::MAGIC) {
-        return Ok(InputKind::Mcap);
-    }
-    if head.starts_with(SQLITE_MAGIC) {
-        return Ok(InputKind::Sqlite3);
-    }
-    if head.starts_with(ZSTD_MAGIC) {
-        return Ok(InputKind::Zstd);
-    }
-    if let Some(kind) = crate::formats::detect_file(path, head) {
-        return Ok(kind);
+    if let Some((k, _)) = kinds
+        .iter()
+        .find(|(_, r)| matches!(r, Recognise::Sniff(f) if f(path)))
+    {
+        return Ok(*k);
     }
     let what = if head.is_empty() {
         "the file is empty".to_string()
@@ -76,6 +111,6 @@ pub fn input_kind(path: &Path) -> Result<InputKind, Error> {
     };
     Err(Error::NotABag {
         path: path.to_path_buf(),
-        what: format!("{what}. Accepted: {ACCEPTED}"),
+        what: format!("{what}. Accepted: {}", accepted()),
     })
 }

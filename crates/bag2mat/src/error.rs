@@ -35,7 +35,7 @@ pub enum Error {
         /// Why.
         what: String,
     },
-    /// The input is none of the accepted kinds (see [`crate::source::ACCEPTED`]).
+    /// The input is none of the accepted kinds (see [`crate::source::accepted`]).
     #[error("{path}: not a bag this tool reads: {what}")]
     NotABag {
         /// The file.

@@ -9,6 +9,8 @@ use crate::series::{ImuRead, ImuSeries, ReadOptions, TopicSelector};
 use crate::source::{InputKind, Source};
 
 /// Opens any accepted input. A path to a bag directory's `metadata.yaml` opens the directory.
+/// The opening half of the format registry: one arm per [`InputKind`] (the detection half
+/// is `crate::detect`, the names [`InputKind::facts`]).
 pub fn open(path: &Path) -> Result<Box<dyn Source>, Error> {
     open_with(path, &crate::formats::InputOptions::default())
 }
@@ -35,7 +37,11 @@ pub(crate) fn open_with(
         InputKind::Sqlite3 => Box::new(crate::rosbag2::Sqlite3Reader::open(path)?),
         InputKind::Rosbag2Dir => Box::new(crate::rosbag2::BagDir::open(path)?),
         InputKind::Zstd => Box::new(crate::rosbag2::BagDir::open_compressed_file(path)?),
-        kind => crate::formats::open(kind, path, opts)?,
+        InputKind::Text => crate::formats::open_text(path, opts)?,
+        InputKind::EurocDir => Box::new(crate::formats::euroc::open(path, opts)?),
+        InputKind::Npy => Box::new(crate::formats::npy::open(path)?),
+        InputKind::Ulog => Box::new(crate::formats::ulog::open(path)?),
+        InputKind::DataFlash => Box::new(crate::formats::dataflash::open(path)?),
     })
 }
 

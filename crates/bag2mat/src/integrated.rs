@@ -19,8 +19,9 @@
 //! The honest figures come from the samples these deltas integrate, which the same log
 //! usually holds (`sensor_combined`, `sensor_gyro`/`sensor_accel`, the FIFO topics), or from
 //! `vehicle_imu` logged at its full rate.
-
-use crate::error::Error;
+//!
+//! The refusal is this module's own error ([`DeadTime`]); the crate's `Error` wraps it, so
+//! that this module needs nothing from the error module.
 
 /// Rows whose integration interval is within this fraction of their spacing tile the time
 /// (PX4's integrator restarts at each message; the intervals vary by a sample period of a
@@ -82,7 +83,11 @@ pub struct DeadTime {
 /// Whether the rows of `topic` (their integration `integration`, their stamps `stamps` in
 /// ns) may be analysed as samples: yes when the topic integrates nothing or its intervals
 /// tile the time ([`CONTIGUOUS_TOL`]); else the [`DeadTime`] that says why not.
-pub fn check(topic: &str, integration: Option<Integration>, stamps: &[i64]) -> Result<(), Error> {
+pub fn check(
+    topic: &str,
+    integration: Option<Integration>,
+    stamps: &[i64],
+) -> Result<(), DeadTime> {
     let Some(i) = integration else {
         return Ok(());
     };
@@ -104,11 +109,11 @@ pub fn check(topic: &str, integration: Option<Integration>, stamps: &[i64]) -> R
     if (worst / spacing - 1.0).abs() <= CONTIGUOUS_TOL {
         return Ok(());
     }
-    Err(Error::DeadTime(DeadTime {
+    Err(DeadTime {
         topic: topic.to_string(),
         integration: worst,
         spacing,
-    }))
+    })
 }
 
 #[cfg(test)]
@@ -131,12 +136,10 @@ mod tests {
         assert!(check("vehicle_imu", int(4000.0), &stamps(4000)).is_ok());
         assert!(check("vehicle_imu", int(3800.0), &stamps(4000)).is_ok());
         assert!(check("sensor_combined", None, &stamps(500_000)).is_ok());
-        let e = check("vehicle_imu", int(4900.0), &stamps(500_000)).unwrap_err();
-        let Error::DeadTime(d) = &e else {
-            panic!("{e}")
-        };
+        let d = check("vehicle_imu", int(4900.0), &stamps(500_000)).unwrap_err();
         assert!((d.spacing - 0.5).abs() < 1e-12 && (d.integration - 4.9e-3).abs() < 1e-12);
-        let text = e.to_string();
+        // the crate's error says it as it is
+        let text = crate::error::Error::from(d).to_string();
         assert!(text.contains("√(500.0/4.9) = 10.1× too high"), "{text}");
     }
 }

@@ -74,6 +74,7 @@ mod source;
 pub mod test_tools;
 mod time;
 mod timing;
+mod units;
 mod zstd;
 
 pub use bag::read::BagIndex;
@@ -91,8 +92,7 @@ pub use error::{Error, TopicSummary};
 pub use formats::euroc::{
     Stated as SensorYaml, output_base as euroc_output_base, stated_for as sensor_yaml_for,
 };
-pub use formats::text::STANDARD_GRAVITY;
-pub use formats::{AccUnit, GyroUnit, InputArgs, InputOptions, TimeUnit};
+pub use formats::{InputArgs, InputOptions};
 pub use imu_msg::BadMessage;
 pub use imu_msg::{Imu, MD5 as IMU_MD5, definition as imu_definition};
 pub use info::{InfoReport, TopicInfo, info, info_with};
@@ -120,11 +120,12 @@ pub use series::{
     ImuRead, ImuSeries, ReadOptions, StandIn, TimeColumn, TopicReport, TopicSelector,
     absent_warning, topic_folder_names,
 };
-pub use source::{ACCEPTED, InputKind, Source};
 pub use source::{
     Channel as SourceChannel, Contents as SourceContents, Encoding as MessageEncoding,
     Loss as SourceLoss, Part as SourcePart, PartRead,
 };
+pub use source::{InputKind, KindFacts, Source, accepted};
 pub use time::RosTime;
 pub use timing::{Gap as TimingGap, Segment as TimingSegment};
 pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};
+pub use units::{AccUnit, GyroUnit, STANDARD_GRAVITY, TimeUnit};

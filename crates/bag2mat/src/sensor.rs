@@ -24,19 +24,6 @@ impl Sensor {
         }
     }
 
-    /// Unit of a noise term's parameter by the field name sim's spec and truth files use
-    /// (`white_noise`, `random_walk`, `rate_ramp`, `quantization`; anything else: the
-    /// signal's unit).
-    pub fn term_unit(self, field: &str) -> &'static str {
-        match field {
-            "white_noise" => self.n_unit(),
-            "random_walk" => self.k_unit(),
-            "rate_ramp" => self.r_unit(),
-            "quantization" => self.q_unit(),
-            _ => self.unit(),
-        }
-    }
-
     /// Unit of N.
     pub fn n_unit(self) -> &'static str {
         match self {

@@ -34,26 +34,100 @@ pub enum InputKind {
     DataFlash,
 }
 
+/// What the workspace says about one kind of input: its name in messages, its phrase in
+/// the list of accepted inputs, and how the non-Imu topics of a log its reader decodes
+/// are labelled. One row per kind ([`InputKind::facts`]); how a kind is recognised and
+/// opened is the format registry's (`crate::registry`), which sits above the readers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KindFacts {
+    /// How the kind is named in messages ("ROS 1 bag").
+    pub name: &'static str,
+    /// Its phrase in [`accepted`]'s list.
+    pub accepted: &'static str,
+    /// The encoding named for a decoded log's non-Imu topics (`None`: a container whose
+    /// channels carry their own encoding).
+    pub other_topics: Option<&'static str>,
+}
+
 impl InputKind {
+    /// Every kind, in the order [`accepted`] lists them (and the format registry tries
+    /// them: magic numbers in this order, then the text sniffer).
+    pub const ALL: [InputKind; 10] = [
+        InputKind::Ros1Bag,
+        InputKind::Rosbag2Dir,
+        InputKind::Mcap,
+        InputKind::Sqlite3,
+        InputKind::Zstd,
+        InputKind::EurocDir,
+        InputKind::Text,
+        InputKind::Ulog,
+        InputKind::DataFlash,
+        InputKind::Npy,
+    ];
+
+    /// The kind's facts (one row per kind: a new kind is a compile error here until it
+    /// has its row).
+    pub const fn facts(self) -> KindFacts {
+        const fn f(
+            name: &'static str,
+            accepted: &'static str,
+            other_topics: Option<&'static str>,
+        ) -> KindFacts {
+            KindFacts {
+                name,
+                accepted,
+                other_topics,
+            }
+        }
+        match self {
+            InputKind::Ros1Bag => f("ROS 1 bag", "a ROS 1 bag (format 2.0)", None),
+            InputKind::Rosbag2Dir => f(
+                "ROS 2 bag directory",
+                "a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files)",
+                None,
+            ),
+            InputKind::Mcap => f("MCAP file", "an .mcap file", None),
+            InputKind::Sqlite3 => f(
+                "rosbag2 sqlite3 file",
+                "a rosbag2 .db3 (sqlite3) file",
+                None,
+            ),
+            InputKind::Zstd => f("zstd-compressed file", "a zstd-compressed .mcap/.db3", None),
+            InputKind::EurocDir => f(
+                "EuRoC/ASL dataset",
+                "a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root)",
+                Some("text"),
+            ),
+            InputKind::Text => f("text log", "a CSV/TSV/whitespace text log", Some("text")),
+            InputKind::Ulog => f("PX4 ULog", "a PX4 ULog (.ulg)", Some("ulog")),
+            InputKind::DataFlash => f(
+                "ArduPilot DataFlash log",
+                "an ArduPilot DataFlash log (.bin)",
+                Some("df"),
+            ),
+            InputKind::Npy => f(
+                "NumPy .npy",
+                "a NumPy .npy (N x 7, bag2mat's layout)",
+                Some("text"),
+            ),
+        }
+    }
+
     /// How the kind is named in messages.
     pub fn describe(self) -> &'static str {
-        match self {
-            InputKind::Ros1Bag => "ROS 1 bag",
-            InputKind::Mcap => "MCAP file",
-            InputKind::Sqlite3 => "rosbag2 sqlite3 file",
-            InputKind::Rosbag2Dir => "ROS 2 bag directory",
-            InputKind::Zstd => "zstd-compressed file",
-            InputKind::Text => "text log",
-            InputKind::EurocDir => "EuRoC/ASL dataset",
-            InputKind::Npy => "NumPy .npy",
-            InputKind::Ulog => "PX4 ULog",
-            InputKind::DataFlash => "ArduPilot DataFlash log",
-        }
+        self.facts().name
     }
 }
 
-/// Every kind of input accepted, for error messages.
-pub const ACCEPTED: &str = "a ROS 1 bag (format 2.0), a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files), an .mcap file, a rosbag2 .db3 (sqlite3) file, a zstd-compressed .mcap/.db3, a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root), a CSV/TSV/whitespace text log, a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin), or a NumPy .npy (N x 7, bag2mat's layout)";
+/// Every kind of input accepted, for error messages: [`InputKind::ALL`]'s phrases.
+pub fn accepted() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(|| {
+        let p: Vec<&str> = InputKind::ALL.iter().map(|k| k.facts().accepted).collect();
+        let (last, rest) = p.split_last().expect("ALL is not empty");
+        format!("{}, or {last}", rest.join(", "))
+    })
+}
 
 /// The magic line of a ROS 1 bag.
 pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
@@ -279,4 +353,42 @@ pub struct Contents {
     /// Channels of integrated deltas (PX4 `vehicle_imu`), with their rows' median
     /// integration intervals ([`crate::Integration`]).
     pub integration: Vec<(u32, crate::Integration)>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The list of accepted inputs every "not a bag" message ends with, as the messages
+    /// said it before the list came from the kinds' facts (its bytes are part of the CLI's
+    /// output).
+    const ACCEPTED_BEFORE: &str = "a ROS 1 bag (format 2.0), a ROS 2 bag directory (metadata.yaml with .db3 or .mcap files), an .mcap file, a rosbag2 .db3 (sqlite3) file, a zstd-compressed .mcap/.db3, a EuRoC/ASL dataset (data.csv, its imuN folder or the dataset root), a CSV/TSV/whitespace text log, a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin), or a NumPy .npy (N x 7, bag2mat's layout)";
+
+    #[test]
+    fn the_accepted_list_is_every_kinds_phrase_unchanged() {
+        assert_eq!(accepted(), ACCEPTED_BEFORE);
+    }
+
+    #[test]
+    fn every_kind_is_in_all_once() {
+        for k in InputKind::ALL {
+            // exhaustive: a new kind fails to compile here until it is placed in ALL
+            let listed = match k {
+                InputKind::Ros1Bag
+                | InputKind::Mcap
+                | InputKind::Sqlite3
+                | InputKind::Rosbag2Dir
+                | InputKind::Zstd
+                | InputKind::Text
+                | InputKind::EurocDir
+                | InputKind::Npy
+                | InputKind::Ulog
+                | InputKind::DataFlash => InputKind::ALL.iter().filter(|&&x| x == k).count(),
+            };
+            assert_eq!(listed, 1, "{k:?}");
+        }
+        let names: std::collections::HashSet<&str> =
+            InputKind::ALL.iter().map(|k| k.describe()).collect();
+        assert_eq!(names.len(), InputKind::ALL.len(), "two kinds share a name");
+    }
 }

@@ -463,7 +463,7 @@ pub fn euroc_from_bag2mat_csv(csv: &Path, root: &Path) -> PathBuf {
     );
     for l in lines {
         let f: Vec<&str> = l.split(',').collect();
-        let ns = crate::formats::text::parse_time_ns(f[0].as_bytes(), crate::formats::TimeUnit::S)
+        let ns = crate::formats::text::parse_time_ns(f[0].as_bytes(), crate::units::TimeUnit::S)
             .expect("a time in seconds");
         out.push_str(&format!(
             "{ns},{},{},{},{},{},{}\n",

@@ -4,7 +4,9 @@
 //! the two figures the analysis measures — the continuous-time white-noise density N
 //! (rad/s/√Hz, m/s²/√Hz) and bias random walk K (rad/s²/√Hz, m/s³/√Hz), Kalibr's definitions
 //! (`crate::ieee952` module docs). The config writers ([`render`]), `allan_kalibr check`
-//! ([`check`]) and `allan_kalibr plan` ([`plan`]) all take the conventions from here.
+//! ([`crate::check`]) and `allan_kalibr plan` ([`crate::plan`]) all take the conventions from
+//! here: this module is a leaf below the analysis, which writes the files, and the commands,
+//! which read them.
 //!
 //! | consumer | keys | the number is | from N, K |
 //! |---|---|---|---|
@@ -22,17 +24,15 @@
 //! MATLAB's `insfilter`/`factorIMUParameters` and GINS-style files are not written: their
 //! conventions were not read from source.
 
-pub mod check;
-mod datasheet;
+pub(crate) mod datasheet;
 mod header;
-pub mod plan;
-mod read;
+pub(crate) mod read;
 pub(crate) mod render;
 pub(crate) mod values;
 
 pub use header::{Provenance, RecordRate, input_text, utc_now};
 pub use render::render;
-pub use values::{AxisValue, ConfigValues, Origin};
+pub use values::{AxisValue, ConfigValues, Origin, SensorValue};
 
 use bag2mat::Sensor;
 

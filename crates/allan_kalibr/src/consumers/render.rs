@@ -20,9 +20,9 @@
 
 use std::fmt::Write as _;
 
+use super::SensorValue;
 use super::values::{AxisValue, inline_note, key_note};
 use super::{ConfigValues, Consumer, ConsumerId, Origin, Provenance, Quantity, consumer};
-use crate::SensorValue;
 use crate::yaml::{yaml_float, yaml_sci, yaml_str};
 
 /// Comment lines are wrapped at this width (the text after `# `).

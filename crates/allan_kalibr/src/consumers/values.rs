@@ -6,7 +6,17 @@
 //! [`super::plan`]; rendered per consumer by [`super::render`].
 
 use super::Quantity;
-use crate::SensorValue;
+
+/// One number per sensor for the configuration files.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorValue {
+    /// The value.
+    pub value: f64,
+    /// True when the value is a 95 % upper bound (no axis resolved the term).
+    pub upper_bound: bool,
+    /// True when the value comes from an IEEE 952 region reading (no reliable fit).
+    pub region: bool,
+}
 
 /// Where the figures come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -127,6 +127,8 @@ pub(crate) fn expected(
     rate: f64,
     record: f64,
 ) -> (Analysis, Option<Advice>) {
+    use super::model::basis;
+    use super::term::NoiseTerm;
     use super::{CurveData, CurvePoint, IdMethod, Overlap};
     let cfg = super::Config::default();
     let tau0 = 1.0 / rate;
@@ -140,9 +142,9 @@ pub(crate) fn expected(
             CurvePoint {
                 m,
                 tau,
-                avar: n * n * super::model::basis(1, tau)
-                    + b * b * super::model::basis(2, tau)
-                    + k * k * super::model::basis(3, tau),
+                avar: n * n * basis(NoiseTerm::WhiteNoise, tau)
+                    + b * b * basis(NoiseTerm::BiasInstability, tau)
+                    + k * k * basis(NoiseTerm::RandomWalk, tau),
                 id: None,
                 id_method: IdMethod::None,
             }

@@ -482,7 +482,10 @@ mod tests {
     const RNG_SEED: u64 = 0xC0_7A12;
 
     fn model_avar(m: usize, tau0: f64, c: &[f64; 6]) -> f64 {
-        (0..5).map(|j| c[j] * basis(j, m as f64 * tau0)).sum()
+        super::super::term::NoiseTerm::POWER_LAWS
+            .iter()
+            .map(|&t| c[t.index()] * basis(t, m as f64 * tau0))
+            .sum()
     }
 
     fn one(ms: &[usize], n: usize, tau0: f64, c: &[f64; 6]) -> Vec<Vec<f64>> {

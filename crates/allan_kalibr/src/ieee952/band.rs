@@ -24,8 +24,9 @@
 //! that τ), a point gets Greenhall's EDF of the FM power law of the curve's local slope
 //! there (AVAR ∝ τ^μ: α = −μ − 1 rounded and clamped to white, flicker or random-walk FM).
 
-use super::fit::{self, LINE0, Shapes, TERM_COUNT};
+use super::fit::{self, Shapes, TERM_COUNT};
 use super::model::effective_coef;
+use super::term::NoiseTerm;
 use super::{CovBasis, CurvePoint, Overlap, edf};
 
 /// EDF of the estimate at cluster size `m` (τ = `tau`) under the model `coef`, `shapes`
@@ -46,10 +47,11 @@ pub(super) fn model_edf(
     // correction, not a quantization; fixed lines at the PSD's coefficient
     let fixed = shapes.fixed_coef();
     let mut cp = *coef;
-    cp[0] = cp[0].max(0.0);
-    for j in LINE0..TERM_COUNT {
-        if fixed[j] != 0.0 {
-            cp[j] = fixed[j];
+    let q = NoiseTerm::Quantization;
+    cp[q] = cp[q].max(0.0);
+    for l in NoiseTerm::LINES {
+        if fixed[l] != 0.0 {
+            cp[l] = fixed[l];
         }
     }
     let mut var = basis.point_var(m, &effective_coef(&cp, shapes, tau))?;
@@ -57,7 +59,7 @@ pub(super) fn model_edf(
         if let Some(l) = l
             && l.bandwidth > 0.0
         {
-            let la = cp[LINE0 + s].max(0.0) * l.avar(tau);
+            let la = cp[NoiseTerm::Line(s)].max(0.0) * l.avar(tau);
             var += 2.0 * la * la / l.edf();
         }
     }
@@ -122,9 +124,14 @@ mod tests {
         for &m in &ms {
             let tau = m as f64 * tau0;
             let mut nus = Vec::new();
-            for (j, alpha) in [(1usize, 0i32), (2, -1), (3, -2)] {
+            for t in [
+                NoiseTerm::WhiteNoise,
+                NoiseTerm::BiasInstability,
+                NoiseTerm::RandomWalk,
+            ] {
+                let alpha = t.facts().alpha;
                 let mut c = [0.0; TERM_COUNT];
-                c[j] = 1e-4;
+                c[t] = 1e-4;
                 let nu = model_edf(&basis, &c, &flat, m, tau).expect("edf");
                 let want = edf::greenhall_edf(alpha, m, n + 1, Overlap::Overlapping).unwrap();
                 assert!(
@@ -135,8 +142,9 @@ mod tests {
             }
             // white FM and random walk with equal Allan variance at this τ
             let mut c = [0.0; TERM_COUNT];
-            c[1] = 1e-4;
-            c[3] = 1e-4 * fit::basis(1, tau) / fit::basis(3, tau);
+            let (white, walk) = (NoiseTerm::WhiteNoise, NoiseTerm::RandomWalk);
+            c[white] = 1e-4;
+            c[walk] = 1e-4 * fit::basis(white, tau) / fit::basis(walk, tau);
             let mix = model_edf(&basis, &c, &flat, m, tau).expect("edf");
             assert!(mix > nus[2] && mix < nus[0], "m {m}: {mix} vs {nus:?}");
             // and never more than about 1.5 n/m

@@ -9,7 +9,7 @@ use super::avar_cov;
 use super::{
     APPROX_CHI2, APPROX_DELTA, AxisVerdict, Config, CurveData, CurvePoint, FIT_TOL, MAX_MISS_SHARE,
     MIN_RANGE_DECADES, MISS_RUN_SPAN, N_READING_TAU, Overlap, SHORT_FEATURE_GAIN,
-    SHORT_FEATURE_SPAN, Term, Verdict, band, ci, fit, pipeline, short, terms,
+    SHORT_FEATURE_SPAN, Term, Verdict, analysed_curve, band, ci, fit, short, terms,
 };
 
 /// Chooses the fitted range and fits it: from `start` ([`fit::choose_start`]), then the
@@ -413,8 +413,14 @@ fn extension_is_honest(
     let terms = |x: &fit::FitResult| {
         let first = fd.points[x.used[0]].tau;
         let last = fd.points[x.used[x.used.len() - 1]].tau;
-        let curve =
-            pipeline::curve_points(data, cfg, Some(x), Some(x), fd.basis, Some((first, last)));
+        let curve = analysed_curve::curve_points(
+            data,
+            cfg,
+            Some(x),
+            Some(x),
+            fd.basis,
+            Some((first, last)),
+        );
         let record = terms::record_points(&curve, fd, first);
         let t = terms::make_terms(x, fd, &curve, &record, cfg);
         t.as_array().into_iter().chain([t.g])

@@ -7,6 +7,7 @@
 //! (the conservative choice, as allan_variance_ros writes), and never a number the data do
 //! not support — see [`ImuAnalysis::sensor_value`].
 
+use crate::consumers::SensorValue;
 use std::fmt::Write as _;
 
 use rayon::prelude::*;
@@ -48,17 +49,6 @@ pub struct ImuAnalysis {
     pub checks: Vec<Finding>,
     /// Where the curves came from and what was inferred (for the printed section).
     pub notes: Vec<String>,
-}
-
-/// One number per sensor for the configuration files.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SensorValue {
-    /// The value.
-    pub value: f64,
-    /// True when the value is a 95 % upper bound (no axis resolved the term).
-    pub upper_bound: bool,
-    /// True when the value comes from an IEEE 952 region reading (no reliable fit).
-    pub region: bool,
 }
 
 /// Groups curves by what their statistical covariance depends on, so each basis is built

@@ -101,6 +101,7 @@
 //! method. The fit here reaches the bound within sampling error in the accuracy study.
 
 pub(crate) mod advisor;
+mod analysed_curve;
 mod avar_cov;
 mod band;
 pub(crate) mod ci;
@@ -108,6 +109,7 @@ pub(crate) mod curves_in;
 pub(crate) mod edf;
 pub(crate) mod files;
 pub(crate) mod fit;
+mod golden;
 pub(crate) mod imu;
 mod input_error;
 pub(crate) mod line_check;
@@ -121,12 +123,14 @@ pub(crate) mod psd_plot;
 pub(crate) mod region;
 pub(crate) mod stated;
 mod tau_grid;
+pub(crate) mod term;
 
 pub(crate) mod chart_panels;
 pub(crate) mod config_values;
 mod curve_data;
 mod declare;
 mod pipeline;
+mod point;
 mod result;
 mod terms;
 
@@ -144,10 +148,9 @@ pub use tau_grid::GridSpec;
 pub use curve_data::{CurveData, CurvePoint};
 pub use pipeline::analyse;
 pub use pipeline::analyse_curve;
+pub use point::{AlphaSource, Point};
 pub use result::short;
-pub use result::{
-    AlphaSource, Analysis, AxisVerdict, FitSummary, LineTerm, Point, Term, Terms, Verdict,
-};
+pub use result::{Analysis, AxisVerdict, FitSummary, LineTerm, Term, Terms, Verdict};
 
 /// The model may miss a curve point by this fraction (ADEV) where the point's own 95 % band
 /// is narrower: the bar for "the model describes the curve".

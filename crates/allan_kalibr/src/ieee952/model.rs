@@ -1,40 +1,15 @@
 //! The model the fit is linear in: each term's basis function of τ (the five IEEE 952 power
-//! laws, the Gauss–Markov bump, the flicker floor's lower corner and the vibration lines'
-//! exact sampled shapes), the shapes that parameterise them, and the model's AVAR at τ.
+//! laws of the term table, [`super::term`], the Gauss–Markov bump, the flicker floor's lower
+//! corner and the vibration lines' exact sampled shapes), the shapes that parameterise them,
+//! and the model's AVAR at τ.
 
-/// The model's coefficients: the five IEEE 952 terms, the exponentially correlated
-/// (Gauss–Markov) bias of IEEE 952 Annex C, then up to [`LINE_SLOTS`] vibration lines (IEEE
-/// 952's sinusoidal noise, see [`LineShape`]).
-pub const TERM_COUNT: usize = 6 + LINE_SLOTS;
-/// Lines the model can hold (the strongest the PSD finds).
-pub const LINE_SLOTS: usize = 3;
-/// Index of the first line coefficient A².
-pub const LINE0: usize = 6;
-/// The five IEEE 952 power-law terms (the first five coefficients).
-pub const IEEE_TERMS: usize = 5;
-/// Index of the Gauss–Markov coefficient σ².
-pub const GM: usize = 5;
-/// Term names in coefficient order.
-pub const TERM_NAMES: [&str; TERM_COUNT] = ["Q", "N", "B", "K", "R", "G", "L1", "L2", "L3"];
-/// Power-law α of the AVAR of each term (R, a deterministic ramp, is given RW FM's; the
-/// Gauss–Markov bias, flat around its peak, flicker FM's; a line, white FM's: its bump and
-/// ripples come with the white noise's EDF, the wider interval for a nearly deterministic
-/// estimate).
-pub const TERM_ALPHA: [i32; TERM_COUNT] = [2, 0, -1, -2, -2, -1, 0, 0, 0];
-/// 2 ln2/π: the AVAR of bias instability B is this times B².
-pub const FLICKER_AVAR: f64 = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI;
+use super::term::NoiseTerm::{self, BiasInstability, GaussMarkov, Ramp, RandomWalk, WhiteNoise};
+pub use super::term::{FLICKER_AVAR, LINE_SLOTS, TERM_COUNT};
 
-/// Basis function g_j(τ) of coefficient j of the IEEE 952 terms: AVAR = Σ c_j g_j(τ)
-/// (0 for the Gauss–Markov coefficient, whose shape needs its correlation time: [`basis_at`]).
-pub fn basis(j: usize, tau: f64) -> f64 {
-    match j {
-        0 => 3.0 / (tau * tau),
-        1 => 1.0 / tau,
-        2 => FLICKER_AVAR,
-        3 => tau / 3.0,
-        4 => tau * tau / 2.0,
-        _ => 0.0,
-    }
+/// Basis function g(τ) of an IEEE 952 power law: AVAR = Σ c_j g_j(τ) (0 for the shaped
+/// terms, whose shape needs its parameters: [`basis_at`]).
+pub fn basis(t: NoiseTerm, tau: f64) -> f64 {
+    t.power_law_avar(tau)
 }
 
 /// Allan variance of a first-order Gauss–Markov bias of unit variance and correlation time
@@ -172,7 +147,7 @@ pub struct Shapes {
     pub gm_t: f64,
     /// Shortest correlation time of the flicker floor, s (0: a flat floor, IEEE 952's B).
     pub b_lo: f64,
-    /// The lines of coefficients `LINE0`… (None: that slot is empty).
+    /// The lines of the [`NoiseTerm::Line`] coefficients, by slot (None: that slot is empty).
     pub lines: LineSlots,
 }
 
@@ -200,7 +175,10 @@ impl Shapes {
     /// Whether coefficient j is a fitted term here (a line slot only when it holds a line
     /// whose A² is fitted, [`LineShape::fixed`]).
     pub(crate) fn has(&self, j: usize) -> bool {
-        j < LINE0 || self.lines[j - LINE0].is_some_and(|l| !l.fixed())
+        match NoiseTerm::at(j) {
+            NoiseTerm::Line(k) => self.lines[k].is_some_and(|l| !l.fixed()),
+            _ => true,
+        }
     }
 
     /// The coefficients of the fixed lines (0 elsewhere).
@@ -210,20 +188,25 @@ impl Shapes {
             if let Some(l) = l
                 && l.fixed()
             {
-                c[LINE0 + k] = l.psd_amp2;
+                c[NoiseTerm::Line(k)] = l.psd_amp2;
             }
         }
         c
     }
 }
 
-/// Basis function j at τ with the shapes `s`.
+/// Basis function of coefficient j at τ with the shapes `s`.
 pub fn basis_at(j: usize, tau: f64, s: &Shapes) -> f64 {
-    match j {
-        GM => gm_basis(tau, s.gm_t),
-        2 if s.b_lo > 0.0 => FLICKER_AVAR * flicker_band(tau / s.b_lo),
-        j if j >= LINE0 => s.lines[j - LINE0].map_or(0.0, |l| l.avar(tau)),
-        _ => basis(j, tau),
+    term_basis_at(NoiseTerm::at(j), tau, s)
+}
+
+/// Basis function of term `t` at τ with the shapes `s`.
+pub fn term_basis_at(t: NoiseTerm, tau: f64, s: &Shapes) -> f64 {
+    match t {
+        GaussMarkov => gm_basis(tau, s.gm_t),
+        BiasInstability if s.b_lo > 0.0 => FLICKER_AVAR * flicker_band(tau / s.b_lo),
+        NoiseTerm::Line(k) => s.lines[k].map_or(0.0, |l| l.avar(tau)),
+        _ => basis(t, tau),
     }
 }
 
@@ -238,42 +221,42 @@ pub(in crate::ieee952) fn effective_coef(
     tau: f64,
 ) -> [f64; TERM_COUNT] {
     let mut e = *c;
-    e[GM] = 0.0;
+    e[GaussMarkov] = 0.0;
     let spread = |e: &mut [f64; TERM_COUNT], a: f64, shape: &dyn Fn(f64) -> f64| {
         let slope = ((shape(tau * SLOPE_STEP) / shape(tau / SLOPE_STEP)).ln()
             / (2.0 * SLOPE_STEP.ln()))
         .clamp(-1.0, 1.0);
-        let j = if slope >= 0.5 {
-            3
+        let t = if slope >= 0.5 {
+            RandomWalk
         } else if slope <= -0.5 {
-            1
+            WhiteNoise
         } else {
-            2
+            BiasInstability
         };
-        e[j] += a / basis(j, tau);
+        e[t] += a / basis(t, tau);
     };
-    if s.b_lo > 0.0 && c[2] != 0.0 {
-        e[2] = 0.0;
-        let a = c[2] * basis_at(2, tau, s);
-        spread(&mut e, a, &|t| basis_at(2, t, s));
+    if s.b_lo > 0.0 && c[BiasInstability] != 0.0 {
+        e[BiasInstability] = 0.0;
+        let a = c[BiasInstability] * term_basis_at(BiasInstability, tau, s);
+        spread(&mut e, a, &|t| term_basis_at(BiasInstability, t, s));
     }
-    if c[GM] != 0.0 && s.gm_t > 0.0 {
-        let a = c[GM] * gm_basis(tau, s.gm_t);
+    if c[GaussMarkov] != 0.0 && s.gm_t > 0.0 {
+        let a = c[GaussMarkov] * gm_basis(tau, s.gm_t);
         spread(&mut e, a, &|t| gm_basis(t, s.gm_t));
     }
     // a line's share of a point's variance: as white noise of the same Allan variance (its
     // sinusoid's estimate varies less; the covariance errs on the wide side there)
-    for j in LINE0..TERM_COUNT {
-        if c[j] != 0.0 {
-            e[1] += c[j].max(0.0) * basis_at(j, tau, s) / basis(1, tau);
-            e[j] = 0.0;
+    for l in NoiseTerm::LINES {
+        if c[l] != 0.0 {
+            e[WhiteNoise] += c[l].max(0.0) * term_basis_at(l, tau, s) / basis(WhiteNoise, tau);
+            e[l] = 0.0;
         }
     }
     // a ramp is deterministic, but its estimate at a τ carries the noise's cross term with
     // it: as the random walk of the same Allan variance there, so that an R read off the
     // longest points is as uncertain as those points are (issue 18.5)
-    if c[4] > 0.0 {
-        e[3] += c[4] * basis(4, tau) / basis(3, tau);
+    if c[Ramp] > 0.0 {
+        e[RandomWalk] += c[Ramp] * basis(Ramp, tau) / basis(RandomWalk, tau);
     }
     e
 }

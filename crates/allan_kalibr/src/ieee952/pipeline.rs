@@ -2,11 +2,13 @@
 //! ([`super::declare`]), the curve with its bounds, what the left-out short τ are, the region
 //! readings, the terms ([`super::terms`]) and the fit's diagnostics.
 
+use super::analysed_curve::curve_points;
 use super::declare::declare_fit;
+use super::term::NoiseTerm;
 use super::terms::{make_terms, record_points, region_terms};
 use super::{
-    AlphaSource, Analysis, AxisVerdict, Config, CovBasis, CurveData, CurvePoint, FIT_TOL,
-    FitSummary, Ieee952Error, Point, band, ci, fit, region,
+    Analysis, AxisVerdict, Config, CovBasis, CurveData, CurvePoint, FIT_TOL, FitSummary,
+    Ieee952Error, Point, fit, region,
 };
 
 /// Analyses one rate series y (unit U, sample period `tau0` s).
@@ -73,8 +75,12 @@ pub fn analyse_curve(data: &CurveData, cfg: &Config, basis: Option<&CovBasis>) -
         max_misfit,
     });
     let bounds = (
-        region::upper_bound(record.iter().copied(), |t| fit::basis(1, t).sqrt()),
-        region::upper_bound(record.iter().copied(), |t| fit::basis(3, t).sqrt()),
+        region::upper_bound(record.iter().copied(), |t| {
+            fit::basis(NoiseTerm::WhiteNoise, t).sqrt()
+        }),
+        region::upper_bound(record.iter().copied(), |t| {
+            fit::basis(NoiseTerm::RandomWalk, t).sqrt()
+        }),
     );
     drop(record);
     Analysis {
@@ -127,65 +133,6 @@ fn fit_data<'a>(
     }
 }
 
-/// The analysed curve: each valid point with its EDF and α ([`band`]: from `band_model`,
-/// the fit declared, whose exact variance `basis` gives; without one, from the curve's
-/// local slope), its bounds at `cfg.curve_confidence` and at 95 %, whether it is in the
-/// declared `range`, and the model `fitted` there.
-pub(super) fn curve_points(
-    data: &CurveData,
-    cfg: &Config,
-    fitted: Option<&fit::FitResult>,
-    band_model: Option<&fit::FitResult>,
-    basis: Option<&CovBasis>,
-    range: Option<(f64, f64)>,
-) -> Vec<Point> {
-    let valid: Vec<&CurvePoint> = data
-        .points
-        .iter()
-        .filter(|p| p.avar > 0.0 && p.avar.is_finite())
-        .collect();
-    let slope = band::slope_alphas(&valid);
-    valid
-        .iter()
-        .zip(slope)
-        .map(|(p, slope_alpha)| {
-            let from_model = band_model.zip(basis).and_then(|(f, b)| {
-                let nu = band::model_edf(b, &f.coef, &f.shapes, p.m, p.tau)?;
-                let dominant = fit::dominant_term(&f.coef, &f.shapes, p.tau);
-                Some((nu, fit::TERM_ALPHA[dominant], AlphaSource::Model))
-            });
-            let (nu, alpha, alpha_source) = from_model.unwrap_or_else(|| {
-                let nu = data
-                    .n
-                    .and_then(|n| band::slope_edf(slope_alpha, p.m, n, data.kind))
-                    .unwrap_or(f64::NAN);
-                (nu, slope_alpha, AlphaSource::CurveSlope)
-            });
-            let adev = p.avar.sqrt();
-            let (lo, hi) =
-                ci::chi2_interval(adev, nu, cfg.curve_confidence).unwrap_or((f64::NAN, f64::NAN));
-            let (lo95, hi95) = ci::chi2_interval(adev, nu, 0.95).unwrap_or((f64::NAN, f64::NAN));
-            let in_range = range
-                .is_some_and(|(a, b)| p.tau >= a * (1.0 - 1e-12) && p.tau <= b * (1.0 + 1e-12));
-            Point {
-                m: p.m,
-                tau: p.tau,
-                avar: p.avar,
-                adev,
-                lo,
-                hi,
-                lo95,
-                hi95,
-                edf: nu,
-                alpha,
-                alpha_source,
-                in_range,
-                model: fitted.map_or(f64::NAN, |f| f.predict(p.tau).max(0.0).sqrt()),
-            }
-        })
-        .collect()
-}
-
 /// What the left-out short τ of a declared fit `f` are, named from where those points lie
 /// against the fitted white-noise line N/√τ (the model's N alone: a negative 1/τ²
 /// low-pass correction bends the model under that line, and a point between the two is
@@ -206,7 +153,8 @@ fn name_short_cut(verdict: &mut AxisVerdict, f: &fit::FitResult, curve: &[Point]
     };
     let (mut above, mut below) = (false, false);
     for p in curve.iter().filter(|p| p.tau < range.0 * (1.0 - 1e-12)) {
-        let white = (f.coef[1] * fit::basis(1, p.tau)).max(0.0).sqrt();
+        let n = NoiseTerm::WhiteNoise;
+        let white = (f.coef[n] * fit::basis(n, p.tau)).max(0.0).sqrt();
         if !fit::is_positive(white) {
             continue;
         }

@@ -10,6 +10,7 @@ use plotters::prelude::*;
 
 use super::chart_panels::{LogLog, draw_legend, log_log_panel, titled_panels};
 use super::imu::{AxisResult, ImuAnalysis};
+use super::term::NoiseTerm;
 use super::{Analysis, Point};
 
 /// Panel size in SVG user units (the PNG is drawn at [`PNG_SCALE`]).
@@ -323,28 +324,30 @@ where
     };
     let coef = f.coef;
     // each fitted term's line, over the whole τ axis
-    let terms = an.terms.as_array();
-    for j in 0..super::fit::IEEE_TERMS {
-        let v = terms[j].value;
-        if !super::fit::is_positive(v) || coef[j] <= 0.0 {
+    for (j, term) in NoiseTerm::POWER_LAWS.into_iter().enumerate() {
+        let Some(fitted) = an.terms.get(term) else {
+            continue;
+        };
+        let v = fitted.value;
+        if !super::fit::is_positive(v) || coef[term] <= 0.0 {
             continue;
         }
         let c = TERM_COLORS[j];
-        let name = super::fit::TERM_NAMES[j];
+        let name = term.symbol();
         ctx.draw_series(DashedLineSeries::new(
             line_over(x0, x1, (y0, y1), &|t| {
-                v * super::fit::basis_at(j, t, &f.shapes).sqrt()
+                v * super::fit::term_basis_at(term, t, &f.shapes).sqrt()
             }),
             px(5.0),
             px(4.0),
             c.stroke_width(px(1.0).max(1)),
         ))?
-        .label(term_label(name, &terms[j]))
+        .label(term_label(name, &fitted))
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
     }
-    if coef[super::fit::GM] > 0.0 {
+    if coef[NoiseTerm::GaussMarkov] > 0.0 {
         let (sigma, tg) = (an.terms.g.value, f.shapes.gm_t);
-        let c = TERM_COLORS[2];
+        let c = TERM_COLORS[NoiseTerm::BiasInstability.index()];
         ctx.draw_series(DashedLineSeries::new(
             line_over(x0, x1, (y0, y1), &|t| {
                 sigma * super::fit::gm_basis(t, tg).sqrt()

@@ -29,6 +29,8 @@ use std::f64::consts::PI;
 use rustfft::num_complex::Complex;
 
 use super::fit::is_positive;
+use super::golden::golden_min;
+use super::term::NoiseTerm;
 
 /// Samples per Welch segment (2¹⁴: at 200 Hz a resolution of 0.012 Hz, so that a line at
 /// 0.002 of the rate lies 33 bins from zero and its frequency is read to a fraction of a
@@ -131,7 +133,7 @@ pub(crate) fn white_density(
     tau0: f64,
     range_start: f64,
 ) -> Option<f64> {
-    let white = 2.0 * coef[1].max(0.0);
+    let white = 2.0 * coef[NoiseTerm::WhiteNoise].max(0.0);
     if !is_positive(white) {
         return None;
     }
@@ -172,21 +174,24 @@ pub(crate) fn model_psd(
     shapes: &super::fit::Shapes,
     tau0: f64,
 ) -> f64 {
-    let c = |j: usize| coef[j].max(0.0);
-    let mut s = 8.0 * c(0) * (PI * f * tau0).sin().powi(2) / tau0
-        + 2.0 * c(1)
-        + c(2) / (PI * f)
-        + c(3) / (2.0 * PI * PI * f * f);
+    let c = |t: NoiseTerm| coef[t].max(0.0);
+    // the power laws' densities from the term table, in coefficient order
+    let mut s = 0.0;
+    for t in NoiseTerm::POWER_LAWS {
+        if let Some(d) = t.density(c(t), f, tau0) {
+            s += d;
+        }
+    }
     if shapes.gm_t > 0.0 {
         let t = shapes.gm_t;
-        s += 4.0 * c(super::fit::GM) * t / (1.0 + (2.0 * PI * f * t).powi(2));
+        s += 4.0 * c(NoiseTerm::GaussMarkov) * t / (1.0 + (2.0 * PI * f * t).powi(2));
     }
     for (k, l) in shapes.lines.iter().enumerate() {
         if let Some(l) = l
             && l.bandwidth > 0.0
         {
             s += 0.5
-                * c(super::fit::LINE0 + k)
+                * c(NoiseTerm::Line(k))
                 * super::lines::resonance_psd(f, l.frequency, l.bandwidth);
         }
     }
@@ -619,28 +624,6 @@ const RESONANCE_SE_STEP: f64 = 0.02;
 /// 4/9 and second neighbours' at 1/36, 1 + 2·(4/9 + 1/36) ≈ 1.94.
 const HANN_BIN_VARIANCE: f64 = 1.944;
 
-/// The minimum of a unimodal `f` on [a, b], golden-section search to `rel_tol` of the
-/// interval.
-pub(crate) fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, rel_tol: f64) -> f64 {
-    const G: f64 = 0.618_033_988_749_894_8;
-    let tol = rel_tol * (b - a).abs();
-    let (mut x1, mut x2) = (b - G * (b - a), a + G * (b - a));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    while (b - a).abs() > tol {
-        if f1 <= f2 {
-            b = x2;
-            (x2, f2) = (x1, f1);
-            x1 = b - G * (b - a);
-            f1 = f(x1);
-        } else {
-            a = x1;
-            (x1, f1) = (x2, f2);
-            x2 = a + G * (b - a);
-            f2 = f(x2);
-        }
-    }
-    0.5 * (a + b)
-}
 /// The resonance fit's searches stop at this share of their interval.
 const GOLDEN_REL_TOL: f64 = 1e-6;
 /// Hann window's equivalent noise bandwidth, bins.

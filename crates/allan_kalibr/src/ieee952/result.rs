@@ -1,53 +1,11 @@
-//! What the analysis finds for one axis: the analysed curve ([`Point`]), the IEEE 952
+//! What the analysis finds for one axis: the analysed curve ([`Point`], its own module), the IEEE 952
 //! terms with their intervals and verdicts ([`Terms`], [`Verdict`]), the verdict on the
 //! axis ([`AxisVerdict`]), the fit's diagnostics ([`FitSummary`]), all in [`Analysis`].
 
+use super::term::NoiseTerm;
 #[cfg(doc)]
 use super::{APPROX_DELTA, B_FLOOR_TOL, FIT_TOL, analyse};
-use super::{Overlap, fit, psd, region};
-
-/// Where a point's EDF (and the α printed beside it) came from (the `band` module: the
-/// fitted model's mixture, else the curve's slope).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AlphaSource {
-    /// The declared fit's model: the exact variance of the estimate under its mixture of
-    /// terms; α is its dominant term's.
-    Model,
-    /// No model describes the curve: Greenhall's EDF of the FM power law of the curve's
-    /// local slope there, α.
-    CurveSlope,
-}
-
-/// One point of the analysed Allan deviation curve.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Point {
-    /// Cluster size in samples.
-    pub m: usize,
-    /// τ = m·τ0 in seconds.
-    pub tau: f64,
-    /// Allan variance, U².
-    pub avar: f64,
-    /// Allan deviation, U.
-    pub adev: f64,
-    /// Lower bound of the deviation at `Config::curve_confidence`, U (NaN: no sample count).
-    pub lo: f64,
-    /// Upper bound of the deviation at `Config::curve_confidence`, U.
-    pub hi: f64,
-    /// Lower bound at 95 %, U.
-    pub lo95: f64,
-    /// Upper bound at 95 %, U.
-    pub hi95: f64,
-    /// Equivalent degrees of freedom of the estimate behind the bounds (see `alpha_source`).
-    pub edf: f64,
-    /// Power-law α of the point's dominant noise (see `alpha_source`).
-    pub alpha: i32,
-    /// Where α came from.
-    pub alpha_source: AlphaSource,
-    /// Inside the fitted range.
-    pub in_range: bool,
-    /// Fitted model deviation at this τ (NaN without a fit).
-    pub model: f64,
-}
+use super::{Overlap, Point, fit, psd, region};
 
 /// Whether a term can be reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -171,9 +129,43 @@ pub struct LineTerm {
 }
 
 impl Terms {
-    /// Terms in the order Q, N, B, K, R.
+    /// Terms in the order Q, N, B, K, R ([`NoiseTerm::POWER_LAWS`]).
     pub fn as_array(&self) -> [Term; 5] {
-        [self.q, self.n, self.b, self.k, self.r]
+        NoiseTerm::POWER_LAWS.map(|t| self.get(t).unwrap_or_else(Term::not_fitted))
+    }
+
+    /// The estimate of term `t` (None for a line: [`Terms::lines`]).
+    pub fn get(&self, t: NoiseTerm) -> Option<Term> {
+        match t {
+            NoiseTerm::Quantization => Some(self.q),
+            NoiseTerm::WhiteNoise => Some(self.n),
+            NoiseTerm::BiasInstability => Some(self.b),
+            NoiseTerm::RandomWalk => Some(self.k),
+            NoiseTerm::Ramp => Some(self.r),
+            NoiseTerm::GaussMarkov => Some(self.g),
+            NoiseTerm::Line(_) => None,
+        }
+    }
+
+    /// The terms `term` gives for Q, N, B, K, R and the Gauss–Markov σ, with its time
+    /// `g_time`, the flicker floor's corner `b_corner` and the `lines`.
+    pub(super) fn from_fn(
+        mut term: impl FnMut(NoiseTerm) -> Term,
+        g_time: f64,
+        b_corner: f64,
+        lines: [Option<LineTerm>; fit::LINE_SLOTS],
+    ) -> Terms {
+        Terms {
+            q: term(NoiseTerm::Quantization),
+            n: term(NoiseTerm::WhiteNoise),
+            b: term(NoiseTerm::BiasInstability),
+            k: term(NoiseTerm::RandomWalk),
+            r: term(NoiseTerm::Ramp),
+            g: term(NoiseTerm::GaussMarkov),
+            g_time,
+            b_corner,
+            lines,
+        }
     }
 }
 
@@ -296,7 +288,8 @@ pub fn short(x: f64) -> String {
 /// Fit diagnostics.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FitSummary {
-    /// Coefficients Q², N², B², K², R², σ_GM² (Q² < 0: the low-pass correction).
+    /// Coefficients Q², N², B², K², R², σ_GM², the lines' A², indexed by [`NoiseTerm`] (Q² < 0:
+    /// the low-pass correction).
     pub coef: [f64; fit::TERM_COUNT],
     /// Their covariance.
     pub cov: [[f64; fit::TERM_COUNT]; fit::TERM_COUNT],

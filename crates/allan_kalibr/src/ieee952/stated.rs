@@ -5,7 +5,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::imu::{ImuAnalysis, SensorValue};
+use super::imu::ImuAnalysis;
+use crate::consumers::SensorValue;
 use bag2mat::Sensor;
 
 /// The IEEE 952 section as both analysers print it: the summary, then the figures the

@@ -1,6 +1,9 @@
 //! The IEEE 952 terms of a declared fit, each with its interval and verdict, and of an axis
 //! without one (the region readings, each bounded by the whole curve).
 
+use super::term::NoiseTerm::{
+    self, BiasInstability, GaussMarkov, Quantization, Ramp, RandomWalk, WhiteNoise,
+};
 use super::{
     B_FLOOR_TOL, Config, LineTerm, Point, RESOLVED_SHARE, Term, Terms, Verdict, fit, region,
 };
@@ -93,29 +96,24 @@ pub(super) fn make_terms(
             None
         },
         levels: levels(cfg.term_confidence),
-        k_beyond: (have_stats && f.coef[fit::GM] > 0.0)
+        k_beyond: (have_stats && f.coef[GaussMarkov] > 0.0)
             .then(|| fit::Profile::beyond(fd, f, &cfg.fit, BEYOND_BUMP * f.shapes.gm_t))
             .flatten(),
     };
-    let term = |j: usize| t.bounded(j, t.fitted(j));
-    Terms {
-        q: t.fitted(0),
-        n: term(1),
-        b: term(2),
-        k: term(3),
-        r: term(4),
-        g: term(fit::GM),
-        g_time: f.shapes.gm_t,
-        b_corner: f.shapes.b_lo,
-        lines: std::array::from_fn(|k| {
+    // (Q is never held against the record: [`TermsOfFit::bounded`])
+    Terms::from_fn(
+        |j| t.bounded(j, t.fitted(j)),
+        f.shapes.gm_t,
+        f.shapes.b_lo,
+        std::array::from_fn(|k| {
             f.shapes.lines[k].map(|l| LineTerm {
                 frequency: l.frequency,
                 bandwidth: l.bandwidth,
-                amplitude: f.coef[fit::LINE0 + k].max(0.0).sqrt(),
+                amplitude: f.coef[NoiseTerm::Line(k)].max(0.0).sqrt(),
                 psd_amplitude: l.psd_amp2.sqrt(),
             })
         }),
-    }
+    )
 }
 
 /// The fit grid's curve points from `from_tau` on (the points a whole-record bound is
@@ -164,29 +162,29 @@ pub const BEYOND_BUMP: f64 = 8.0;
 impl TermsOfFit<'_> {
     /// The whole record's 95 % upper bound of term `j` ([`region::upper_bound`] over
     /// `record`).
-    fn record_bound(&self, j: usize) -> f64 {
+    fn record_bound(&self, j: NoiseTerm) -> f64 {
         let shapes = &self.f.shapes;
         region::upper_bound(self.record.iter().copied(), |tau| {
-            fit::basis_at(j, tau, shapes).sqrt()
+            fit::term_basis_at(j, tau, shapes).sqrt()
         })
     }
 
     /// The profile term `j`'s interval comes from: K beyond a bump where the model has one
     /// ([`BEYOND_BUMP`]), else the fit's range.
-    fn chosen(&self, j: usize) -> Option<&fit::Profile<'_, '_>> {
-        if j == 3 && self.f.coef[fit::GM] > 0.0 {
+    fn chosen(&self, j: NoiseTerm) -> Option<&fit::Profile<'_, '_>> {
+        if j == RandomWalk && self.f.coef[GaussMarkov] > 0.0 {
             self.k_beyond.as_ref()
         } else {
             self.profile.as_ref()
         }
-        .filter(|p| p.has(j))
+        .filter(|p| p.has(j.index()))
     }
 
     /// The interval of term `j`'s coefficient at the χ²(1) `level` (two-sided 95 %, or the
     /// one-sided bound; the lower end only with `lower`, else 0): the profile, widened to
     /// span the flicker floor's plausible shapes ([`fit::FitResult::alternatives`]) and, in
     /// quadrature, the resonances' bandwidths, and always holding the fitted value.
-    fn interval(&self, j: usize, level: f64, lower: bool) -> (f64, f64) {
+    fn interval(&self, j: NoiseTerm, level: f64, lower: bool) -> (f64, f64) {
         let TermsOfFit { f, fd, cfg, .. } = *self;
         let z = level.sqrt();
         let c = f.coef[j].max(0.0);
@@ -196,17 +194,17 @@ impl TermsOfFit<'_> {
         } else {
             self.record_bound(j).powi(2)
         };
-        let bump_k = j == 3 && f.coef[fit::GM] > 0.0;
+        let bump_k = j == RandomWalk && f.coef[GaussMarkov] > 0.0;
         let (mut lo_c, mut hi_c) = match self.chosen(j) {
-            Some(p) if p.has(j) => p.interval(j, level, lower, guess),
+            Some(p) if p.has(j.index()) => p.interval(j.index(), level, lower, guess),
             // too few points beyond the bump: K is not told from it; its bound is the
             // whole range's
             _ if bump_k => match &self.profile {
-                Some(p) if p.has(j) => (0.0, p.interval(j, level, false, guess).1),
+                Some(p) if p.has(j.index()) => (0.0, p.interval(j.index(), level, false, guess).1),
                 _ => (0.0, self.record_bound(j).powi(2)),
             },
             _ => {
-                let (l, h) = fit::inverted_interval(fd, f, &cfg.fit, j, z);
+                let (l, h) = fit::inverted_interval(fd, f, &cfg.fit, j.index(), z);
                 (if lower { l } else { 0.0 }, h)
             }
         };
@@ -229,7 +227,7 @@ impl TermsOfFit<'_> {
     }
 
     /// Term `j` from the fit alone: its value, interval and verdict.
-    fn fitted(&self, j: usize) -> Term {
+    fn fitted(&self, j: NoiseTerm) -> Term {
         let TermsOfFit {
             f,
             cfg,
@@ -245,7 +243,7 @@ impl TermsOfFit<'_> {
         let c = f.coef[j];
         let se_c = f.cov[j][j].max(0.0).sqrt();
         let nan_if = |v: f64| if have_stats { v } else { f64::NAN };
-        if j == fit::GM && (f.left_out[j] || c <= 0.0) {
+        if j == GaussMarkov && (f.left_out[j] || c <= 0.0) {
             // a bump the data do not ask for: not part of the model (no bound: no time)
             return Term::not_fitted();
         }
@@ -254,7 +252,8 @@ impl TermsOfFit<'_> {
         }
         let value = c.sqrt();
         let std_err = nan_if((se_c * se_c + shape_var[j]).sqrt() / (2.0 * value));
-        let dominant_somewhere = f.max_share[j] >= RESOLVED_SHARE && (j != 2 || floor_shown(value));
+        let dominant_somewhere =
+            f.max_share[j] >= RESOLVED_SHARE && (j != BiasInstability || floor_shown(value));
         if !have_stats {
             // no sample count: no interval, so nothing is "resolved" statistically; a term the
             // model needs and that dominates somewhere is still the model's
@@ -275,7 +274,7 @@ impl TermsOfFit<'_> {
         let zero_allowed = f.ambiguous[j]
             || self
                 .chosen(j)
-                .is_some_and(|p| p.allows(j, 0.0, self.levels.0));
+                .is_some_and(|p| p.allows(j.index(), 0.0, self.levels.0));
         let (lo_c, hi_c) = if zero_allowed {
             (0.0, f64::NAN)
         } else {
@@ -306,7 +305,7 @@ impl TermsOfFit<'_> {
 
     /// Term `j` the selection left out or the fit put at its bound: 0 with its one-sided
     /// 95 % upper bound (the profile's; the whole record's where that says nothing).
-    fn absent(&self, j: usize) -> Term {
+    fn absent(&self, j: NoiseTerm) -> Term {
         if !self.have_stats {
             return Term {
                 value: 0.0,
@@ -337,15 +336,15 @@ impl TermsOfFit<'_> {
     /// line, or to a bend the range cut, whose +½ line the long-τ curve does not follow):
     /// not resolved, the record's bound instead. A bound the fit's profile leaves open is
     /// the record's.
-    fn bounded(&self, j: usize, mut t: Term) -> Term {
-        if !self.have_stats || matches!(t.verdict, Verdict::NotFitted) || j == 0 {
+    fn bounded(&self, j: NoiseTerm, mut t: Term) -> Term {
+        if !self.have_stats || matches!(t.verdict, Verdict::NotFitted) || j == Quantization {
             return t;
         }
         let bound = self.record_bound(j);
         // only a term that lifts the long end can be contradicted by it: near the start of
         // a band-limited range the curve lies a little under the white-noise line (the
         // model's negative 1/τ² correction), so N's bound there is no bound
-        let pushes_long = matches!(j, 2 | 3 | 4 | fit::GM);
+        let pushes_long = matches!(j, BiasInstability | RandomWalk | Ramp | GaussMarkov);
         // (a term the fit puts above the record's bound, resolved or with its whole interval)
         if pushes_long && (t.value > bound && t.verdict == Verdict::Resolved || t.lo >= bound) {
             return Term {
@@ -374,9 +373,9 @@ impl TermsOfFit<'_> {
 /// like white noise on, [`region::upper_bound`]) — a reading above that bound is the bound
 /// instead; the rest not fitted.
 pub(super) fn region_terms(region: &region::Readings, record: &[&Point]) -> Terms {
-    let clamp = |j: usize, t: Term| -> Term {
+    let clamp = |j: NoiseTerm, t: Term| -> Term {
         let bound = region::upper_bound(record.iter().copied(), |tau| {
-            fit::basis_at(j, tau, &fit::Shapes::FLAT).sqrt()
+            fit::term_basis_at(j, tau, &fit::Shapes::FLAT).sqrt()
         });
         match t.verdict {
             Verdict::RegionReading if t.value > bound => Term {
@@ -394,15 +393,15 @@ pub(super) fn region_terms(region: &region::Readings, record: &[&Point]) -> Term
             _ => t,
         }
     };
-    Terms {
-        q: Term::not_fitted(),
-        n: clamp(1, Term::from_reading(region.n)),
-        b: clamp(2, Term::from_reading(region.b)),
-        k: clamp(3, Term::from_reading(region.k)),
-        r: Term::not_fitted(),
-        g: Term::not_fitted(),
-        g_time: f64::NAN,
-        b_corner: 0.0,
-        lines: [None; fit::LINE_SLOTS],
-    }
+    Terms::from_fn(
+        |j| match j {
+            WhiteNoise => clamp(j, Term::from_reading(region.n)),
+            BiasInstability => clamp(j, Term::from_reading(region.b)),
+            RandomWalk => clamp(j, Term::from_reading(region.k)),
+            _ => Term::not_fitted(),
+        },
+        f64::NAN,
+        0.0,
+        [None; fit::LINE_SLOTS],
+    )
 }

@@ -8,12 +8,13 @@
 //! * [`report`]: the exact text `SCRIPT_process_results.m` prints; [`curves`]: the curves as
 //!   CSV; [`chart`]: `gen_chart.m`'s two charts.
 //!
-//! Kalibr's `imu.yaml` ([`crate::yaml`]) is written from these numbers too, but its YAML
-//! spelling is shared with the IEEE 952 files and lives at the crate root.
+//! * [`imu_yaml`]: Kalibr's `imu.yaml` written from these numbers; its YAML spelling is
+//!   shared with the IEEE 952 files and the consumers' configs ([`crate::yaml`]).
 
 pub(crate) mod chart;
 pub(crate) mod chart_fit;
 pub(crate) mod curves;
 pub(crate) mod estimator;
 pub(crate) mod grid;
+pub(crate) mod imu_yaml;
 pub(crate) mod report;

@@ -50,10 +50,11 @@ use bag2mat::shared::output::Outputs;
 
 use crate::consumers::{Provenance, RecordRate, input_text};
 use crate::error::Error;
+pub use crate::error::OperatingError;
+use crate::front::Common;
 use crate::front::Section;
 use crate::ieee952::imu::{ImuAnalysis, ImuCurves};
 use crate::input::{self, ImuData};
-use crate::run::Config;
 
 /// The flags of the analysis, flattened into `allan_kalibr`'s arguments.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -190,30 +191,6 @@ impl OperatingArgs {
     }
 }
 
-/// What the analysis cannot do on this record.
-#[derive(Debug, thiserror::Error)]
-pub enum OperatingError {
-    /// The reference cannot be used.
-    #[error("reference {}: {what}", .path.display())]
-    Reference {
-        /// The reference.
-        path: PathBuf,
-        /// Why.
-        what: String,
-    },
-    /// The static record cannot be used.
-    #[error("--static {}: {what}", .path.display())]
-    Static {
-        /// The static record.
-        path: PathBuf,
-        /// Why.
-        what: String,
-    },
-    /// The record cannot be analysed.
-    #[error("{0}")]
-    Record(String),
-}
-
 /// A static value of one axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StaticValue {
@@ -330,6 +307,16 @@ pub struct Operating {
     pub cannot_separate: Vec<String>,
 }
 
+/// The six analysed series: index in the section order (gyro x y z, acc x y z), sensor, axis.
+pub const AXES: [(usize, Sensor, usize); 6] = [
+    (0, Sensor::Gyro, 0),
+    (1, Sensor::Gyro, 1),
+    (2, Sensor::Gyro, 2),
+    (3, Sensor::Acc, 0),
+    (4, Sensor::Acc, 1),
+    (5, Sensor::Acc, 2),
+];
+
 /// The section's six series (gyro x y z, then acc x y z) of the `data_imu`-ordered columns.
 fn series_of(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
     [&a[3], &a[4], &a[5], &a[0], &a[1], &a[2]]
@@ -339,22 +326,22 @@ fn series_of(a: &[Vec<f64>; 6]) -> [&[f64]; 6] {
 /// spikes): the samples kept, the findings (motion dropped: it is what is analysed), the
 /// rate.
 fn prepare(
-    config: &Config,
+    common: &Common,
     mut data: ImuData,
     notes: &mut Vec<Note>,
 ) -> Result<(ImuData, Vec<bag2mat::Finding>, f64), Error> {
-    if let Some(skip) = config.common.skip_start {
-        crate::run::skip_start(&mut data, skip, notes)?;
+    if let Some(skip) = common.skip_start {
+        input::skip_start(&mut data, skip, notes)?;
     }
     if data.len() < 3 {
         return Err(Error::TooShort { n: data.len() });
     }
     let scans = data.scan_checked()?;
-    crate::run::check_scans(&scans, data.absent, notes)?;
+    input::check_scans(&scans, data.absent, notes)?;
     let check = bag2mat::check_record(
         &data.record(),
         &bag2mat::CheckOptions {
-            drop_outliers: config.common.drop_outliers,
+            drop_outliers: common.drop_outliers,
         },
     );
     let mut findings: Vec<bag2mat::Finding> = check
@@ -366,31 +353,31 @@ fn prepare(
     bag2mat::drop_absent(&mut findings, data.absent);
     notes.extend(data.absent.map(bag2mat::absent_warning));
     let data = data.select(&check.keep);
-    let rate = input::choose_rate(config.common.rate, check.rate, data.len())?;
+    let rate = input::choose_rate(common.rate, check.rate, data.len())?;
     findings.extend(rate.finding.clone());
     Ok((data, findings, rate.section))
 }
 
 /// The static IEEE 952 analysis of `path` (its first topic as the config's selection reads
 /// it), refused when it moves.
-fn static_analysis(config: &Config, path: &Path) -> Result<ImuAnalysis, Error> {
+fn static_analysis(common: &Common, path: &Path) -> Result<ImuAnalysis, Error> {
     let err = |what: String| OperatingError::Static {
         path: path.to_path_buf(),
         what,
     };
     let mut datas = input::load_all(
         path,
-        &config.common.topics,
-        config.common.time,
+        &common.topics,
+        common.time,
         true,
-        &config.common.input_options,
+        &common.input_options,
     )?;
     if datas.is_empty() {
         return Err(err("no IMU topic".into()).into());
     }
     let data = datas.remove(0);
     let scans = data.scan_checked()?;
-    crate::run::check_scans(&scans, data.absent, &mut Vec::new())?;
+    input::check_scans(&scans, data.absent, &mut Vec::new())?;
     let check = bag2mat::check_record(&data.record(), &bag2mat::CheckOptions::default());
     if let Some(r) = check.refusal() {
         return Err(err(format!("not a static record: {}", r.short())).into());
@@ -432,19 +419,40 @@ fn static_of(an: &ImuAnalysis, sensor: Sensor, axis: usize) -> Option<StaticValu
     }
 }
 
+/// What every topic of one run shares: the run's settings, the reference and static
+/// analysis read once, and where the files go.
+struct RunContext<'a> {
+    /// The tool writing the files (their provenance).
+    tool: &'a str,
+    /// The settings both analysers share.
+    common: &'a Common,
+    /// The chart title (empty: the input's file stem).
+    title: &'a str,
+    /// The analysis' own settings.
+    settings: &'a Settings,
+    /// The reference trajectory (`--reference`).
+    reference: Option<&'a bag2mat::PoseSeries>,
+    /// The static record's IEEE 952 analysis (`--static LOG`).
+    static_an: Option<&'a ImuAnalysis>,
+    /// The run's output stage.
+    outputs: &'a Outputs,
+}
+
 /// Runs the analysis on every selected topic; each gets its own folder when there are
-/// several. Every file among `outputs`.
+/// several. Every file among `outputs`, said as written by `tool`.
 pub(crate) fn sections(
-    config: &Config,
+    tool: &str,
+    common: &Common,
+    title: &str,
     s: &Settings,
     outputs: &Outputs,
 ) -> Result<Vec<Section>, Error> {
     let datas = input::load_all(
-        config.common.samples_path(),
-        &config.common.topics,
-        config.common.time,
-        config.common.quiet,
-        &config.common.input_options,
+        common.samples_path(),
+        &common.topics,
+        common.time,
+        common.quiet,
+        &common.input_options,
     )?;
     let reference = match &s.reference {
         Some((path, topic)) => Some(
@@ -452,7 +460,7 @@ pub(crate) fn sections(
                 path,
                 &bag2mat::PoseOptions {
                     topic: topic.clone(),
-                    time: config.common.time,
+                    time: common.time,
                 },
             )
             .map_err(|e| OperatingError::Reference {
@@ -463,34 +471,35 @@ pub(crate) fn sections(
         None => None,
     };
     let static_an = match &s.static_source {
-        StaticSource::Log(p) => Some(static_analysis(config, p)?),
+        StaticSource::Log(p) => Some(static_analysis(common, p)?),
         _ => None,
     };
-    let several = datas.len() > 1 || config.common.topics.all_imu;
+    let several = datas.len() > 1 || common.topics.all_imu;
     let names: Vec<String> = datas
         .iter()
         .map(|d| d.topic.clone().unwrap_or_default())
         .collect();
     let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
     let folders = bag2mat::topic_folder_names(&names);
+    let ctx = RunContext {
+        tool,
+        common,
+        title,
+        settings: s,
+        reference: reference.as_ref(),
+        static_an: static_an.as_ref(),
+        outputs,
+    };
     let mut out = Vec::new();
     for (data, folder) in datas.into_iter().zip(folders) {
         let dir = if several {
-            config.common.out_dir.join(folder)
+            common.out_dir.join(folder)
         } else {
-            config.common.out_dir.clone()
+            common.out_dir.clone()
         };
         let topic = data.topic.clone().unwrap_or_default();
         let notes = bag2mat::shared::note::warnings(&data.notes);
-        match run_topic(
-            config,
-            s,
-            data,
-            reference.as_ref(),
-            static_an.as_ref(),
-            &dir,
-            outputs,
-        ) {
+        match run_topic(&ctx, data, &dir) {
             Ok(section) => out.push(section),
             // one topic of several: said as its error, the others still written (the rule
             // of both analysers' own runs, `crate::run::sections`)
@@ -502,22 +511,23 @@ pub(crate) fn sections(
 }
 
 /// One topic: checks, the analysis, its files and its text.
-fn run_topic(
-    config: &Config,
-    s: &Settings,
-    data: ImuData,
-    reference: Option<&bag2mat::PoseSeries>,
-    static_an: Option<&ImuAnalysis>,
-    dir: &Path,
-    outputs: &Outputs,
-) -> Result<Section, Error> {
+fn run_topic(ctx: &RunContext, data: ImuData, dir: &Path) -> Result<Section, Error> {
+    let RunContext {
+        tool,
+        common,
+        title,
+        settings: s,
+        reference,
+        static_an,
+        outputs,
+    } = *ctx;
     let mut notes = bag2mat::shared::note::warnings(&data.notes);
     let topic_name = data.topic.clone();
     let topic = data
         .topic
         .clone()
-        .unwrap_or_else(|| config.common.named_topic().to_string());
-    let (data, findings, rate) = prepare(config, data, &mut notes)?;
+        .unwrap_or_else(|| common.named_topic().to_string());
+    let (data, findings, rate) = prepare(common, data, &mut notes)?;
     if let Some(r) = reference {
         notes.extend(
             r.notes
@@ -567,22 +577,21 @@ fn run_topic(
         };
     }
     op.operating_an = files::operating_analysis(&op, &findings);
-    let title = if config.title.is_empty() {
-        config
-            .common
+    let title = if title.is_empty() {
+        common
             .input
             .first()
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default()
     } else {
-        config.title.clone()
+        title.to_string()
     };
     outputs.ensure_dir(dir)?;
     let prov = Provenance::new(
-        crate::cli::TOOL,
-        input_text(config.common.samples_path(), topic_name.as_deref()),
-        match config.common.rate {
+        tool,
+        input_text(common.samples_path(), topic_name.as_deref()),
+        match common.rate {
             Some(r) => RecordRate::Given(r),
             None => RecordRate::Measured(rate),
         },
@@ -664,7 +673,7 @@ fn analyse_with_reference(
     let jitter = stamp_jitter(&t_ns[k0..k1]);
     let mut axes = Vec::new();
     let band_lo_min = signal::BAND_LO_MIN.max(signal::BIAS_BAND_FACTOR / cal.bias_knot);
-    for (a, sensor, axis) in signal::AXES {
+    for (a, sensor, axis) in AXES {
         if !present(sensor) {
             continue;
         }

@@ -308,7 +308,7 @@ pub fn phases(
                 (b * hop + hop).min(n)
             };
             let mut axes = Vec::new();
-            for (i, sensor, axis) in super::signal::AXES {
+            for (i, sensor, axis) in super::AXES {
                 if absent == Some(sensor) || analysed[i].len() < end {
                     continue;
                 }

@@ -18,18 +18,9 @@
 use bag2mat::Sensor;
 use rustfft::num_complex::Complex;
 
-use super::{AxisOperating, Operating, Settings, band, phases};
+use super::{AXES, AxisOperating, Operating, Settings, band, phases};
 use crate::input::ImuData;
 
-/// The six analysed series: index in the section order (gyro x y z, acc x y z), sensor, axis.
-pub const AXES: [(usize, Sensor, usize); 6] = [
-    (0, Sensor::Gyro, 0),
-    (1, Sensor::Gyro, 1),
-    (2, Sensor::Gyro, 2),
-    (3, Sensor::Acc, 0),
-    (4, Sensor::Acc, 1),
-    (5, Sensor::Acc, 2),
-];
 /// The lowest lower band edge, Hz: below ~1 Hz an estimator's bias states take the error
 /// (IEEE 952 reads N at τ = 1 s).
 pub const BAND_LO_MIN: f64 = 1.0;

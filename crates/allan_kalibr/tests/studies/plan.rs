@@ -4,7 +4,7 @@
 //! that sensor (the bar), and a record of the planned length reaches the planned
 //! precision — its own 95 % interval on K about ±25 %, holding the truth.
 
-use allan_kalibr::consumers::plan::{Records, plan_sensor};
+use allan_kalibr::plan::{Records, plan_sensor};
 use allan_kalibr::{Advice, Ieee952Config, Verdict, advise, analyse_ieee952};
 use bag2mat::Sensor;
 

@@ -9,7 +9,9 @@
 //! show: N is the long-τ white level of the whole chain (aliasing and the LSB rounding
 //! included, √(S₀·Δt + LSB²/12·Δt)); B, K, Q, R are the model's own figures.
 
-use allan_kalibr::{CurveData, GM, Ieee952Analysis, Ieee952Config, Term, Verdict, analyse_curve};
+use allan_kalibr::{
+    CurveData, Ieee952Analysis, Ieee952Config, NoiseTerm, Term, Verdict, analyse_curve,
+};
 use bag2mat::Sensor;
 use rayon::prelude::*;
 use sim::AxisTruth;
@@ -101,7 +103,7 @@ pub(super) fn run_profile(profile: Profile, seed: u64, rate: f64, duration: f64)
     let n = (duration * rate).round() as usize;
     let mut cfg = Ieee952Config::default();
     if std::env::var("NO_GM").is_ok() {
-        cfg.fit.terms[GM] = false;
+        cfg.fit.terms[NoiseTerm::GaussMarkov] = false;
     }
     let jobs: Vec<(Sensor, usize)> = [Sensor::Gyro, Sensor::Acc]
         .into_iter()

@@ -2,9 +2,9 @@
 //! imu_utils from 2–3.3 h static recordings).
 
 use allan_kalibr::{
-    AxisVerdict, B_FLOOR_FACTOR, CurvesOptions, GM, Ieee952Analysis, Ieee952Config, MAX_MISS_SHARE,
-    MISS_RUN_SPAN, Reading, ReadingKind, Term, Verdict, analyse_curve, chi2_interval, read_curves,
-    short,
+    AxisVerdict, B_FLOOR_FACTOR, CurvesOptions, Ieee952Analysis, Ieee952Config, MAX_MISS_SHARE,
+    MISS_RUN_SPAN, NoiseTerm, Reading, ReadingKind, Term, Verdict, analyse_curve, chi2_interval,
+    read_curves, short,
 };
 use bag2mat::Sensor;
 
@@ -80,7 +80,7 @@ pub(super) fn print_row(imu: &str, sensor: Sensor, axis: usize, a: &Ieee952Analy
 fn real_curves_table() {
     let mut cfg = Ieee952Config::default();
     if std::env::var("NO_GM").is_ok() {
-        cfg.fit.terms[GM] = false;
+        cfg.fit.terms[NoiseTerm::GaussMarkov] = false;
     }
     if std::env::var("NO_CORNER").is_ok() {
         cfg.fit.flicker_corner = false;

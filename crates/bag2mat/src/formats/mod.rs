@@ -22,9 +22,9 @@ pub(crate) mod ulog;
 use std::path::Path;
 
 use crate::error::Error;
-use crate::source::{InputKind, Source};
+use crate::source::Source;
 
-pub use text::{AccUnit, GyroUnit, TimeUnit};
+use crate::units::{AccUnit, GyroUnit, TimeUnit};
 
 /// What the user said about an input whose content does not say it all (text logs).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -137,52 +137,14 @@ pub const DATAFLASH_MAGIC: &[u8] = &[0xA3, 0x95, 0x80];
 /// The first bytes of a NumPy file.
 pub const NPY_MAGIC: &[u8] = b"\x93NUMPY";
 
-/// Recognises a file of this module from its first bytes (at least 16 where the file has
-/// them) and, for text, its first [`text::SNIFF_BYTES`].
-pub(crate) fn detect_file(path: &Path, head: &[u8]) -> Option<InputKind> {
-    if head.starts_with(ULOG_MAGIC) {
-        return Some(InputKind::Ulog);
-    }
-    // the first message defines FMT itself (type 128, 89 bytes, "FMT"): recognised by
-    // those too, so that a damaged first byte does not hide a log DFReader reads
-    if head.starts_with(DATAFLASH_MAGIC) || head.get(3..8) == Some(b"\x80\x59FMT") {
-        return Some(InputKind::DataFlash);
-    }
-    if head.starts_with(NPY_MAGIC) {
-        return Some(InputKind::Npy);
-    }
-    text::looks_like_text(path).then_some(InputKind::Text)
-}
-
-/// Recognises a directory of this module (an EuRoC/ASL layout).
-pub(crate) fn detect_dir(path: &Path) -> Option<InputKind> {
-    (!euroc::imu_files(path).is_empty()).then_some(InputKind::EurocDir)
-}
-
-/// Opens an input of this module's kinds.
-pub(crate) fn open(
-    kind: InputKind,
-    path: &Path,
-    opts: &InputOptions,
-) -> Result<Box<dyn Source>, Error> {
-    Ok(match kind {
-        // a data.csv in an EuRoC imuN folder is that folder's topic, with its sensor.yaml
-        InputKind::Text => match euroc::data_csv_folder(path) {
-            Some(dir) => Box::new(euroc::open_files(
-                vec![(euroc::folder_topic(dir), path.to_path_buf())],
-                opts,
-            )?),
-            None => Box::new(text::open(path, opts)?),
-        },
-        InputKind::EurocDir => Box::new(euroc::open(path, opts)?),
-        InputKind::Npy => Box::new(npy::open(path)?),
-        InputKind::Ulog => Box::new(ulog::open(path)?),
-        InputKind::DataFlash => Box::new(dataflash::open(path)?),
-        other => {
-            return Err(Error::NotABag {
-                path: path.to_path_buf(),
-                what: format!("{} is not one of the log formats", other.describe()),
-            });
-        }
+/// Opens a text log: a `data.csv` in an EuRoC `imuN` folder is that folder's topic, with its
+/// `sensor.yaml`; any other, a plain text log.
+pub(crate) fn open_text(path: &Path, opts: &InputOptions) -> Result<Box<dyn Source>, Error> {
+    Ok(match euroc::data_csv_folder(path) {
+        Some(dir) => Box::new(euroc::open_files(
+            vec![(euroc::folder_topic(dir), path.to_path_buf())],
+            opts,
+        )?),
+        None => Box::new(text::open(path, opts)?),
     })
 }

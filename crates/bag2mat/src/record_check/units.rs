@@ -17,7 +17,7 @@
 
 use super::{Axis, Finding, Kind, Level};
 use crate::Sensor;
-use crate::formats::{AccUnit, TimeUnit};
+use crate::units::{AccUnit, TimeUnit};
 
 /// The median specific-force magnitude a record may have, m/s²: gravity is 9.78–9.83 on
 /// Earth's surface, a MEMS accelerometer's scale and bias errors add a few percent, and a

@@ -171,7 +171,7 @@ impl Sqlite3Reader {
                     path: path.to_path_buf(),
                     what: format!(
                         "an SQLite database without the rosbag2 '{t}' table. Accepted: {}",
-                        source::ACCEPTED
+                        source::accepted()
                     ),
                 });
             }

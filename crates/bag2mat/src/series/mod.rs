@@ -188,11 +188,11 @@ impl ImuSeries {
     /// samples: the [`crate::DeadTime`] error that says why (the rule:
     /// [`crate::check_integration`]). Every other topic passes.
     pub fn check_integration(&self) -> Result<(), Error> {
-        crate::integrated::check(
+        Ok(crate::integrated::check(
             &self.topic,
             self.integration,
             &crate::timing::ns_of_times(&self.stamp),
-        )
+        )?)
     }
 
     /// The chosen time column.

@@ -30,6 +30,7 @@ use std::fmt::Write as _;
 use crate::error::{Result, SimError};
 
 /// The two sensors of an IMU (the workspace's one sensor type, with the units of each term).
+use allan_kalibr::NoiseTerm;
 use bag2mat::Sensor;
 
 /// Axis names.
@@ -374,9 +375,9 @@ impl AxisModel {
     /// `output_rate` Hz); `at` names sensor, axis and field in the error.
     fn validate(&self, output_rate: f64, at: FieldError<'_>) -> Result<()> {
         for (field, v) in [
-            ("white_noise", self.white_noise),
-            ("random_walk", self.random_walk),
-            ("quantization", self.quantization),
+            (NoiseTerm::WhiteNoise.name(), self.white_noise),
+            (NoiseTerm::RandomWalk.name(), self.random_walk),
+            (NoiseTerm::Quantization.name(), self.quantization),
             ("resolution", self.resolution),
         ] {
             if !(v.is_finite() && v >= 0.0) {
@@ -385,7 +386,7 @@ impl AxisModel {
         }
         if !self.rate_ramp.is_finite() {
             return Err(at(
-                "rate_ramp",
+                NoiseTerm::Ramp.name(),
                 format!("must be finite, got {}", self.rate_ramp),
             ));
         }
@@ -395,7 +396,7 @@ impl AxisModel {
         for gm in &self.gauss_markov {
             if !(gm.sigma.is_finite() && gm.sigma >= 0.0 && gm.tau.is_finite() && gm.tau > 0.0) {
                 return Err(at(
-                    "gauss_markov",
+                    NoiseTerm::GaussMarkov.name(),
                     format!(
                         "sigma must be >= 0 and tau > 0 s, got sigma {} tau {}",
                         gm.sigma, gm.tau
@@ -428,9 +429,9 @@ impl AxisModel {
             o,
             "    {axis}: N {:.4e} {}, K {:.4e} {}",
             self.white_noise,
-            s.term_unit("white_noise"),
+            NoiseTerm::WhiteNoise.unit(s),
             self.random_walk,
-            s.term_unit("random_walk")
+            NoiseTerm::RandomWalk.unit(s)
         );
         if let Some(bi) = self.bias_instability {
             let _ = write!(
@@ -446,14 +447,14 @@ impl AxisModel {
             let _ = write!(o, ", GM {:.4e} {} / {} s", gm.sigma, s.unit(), gm.tau);
         }
         if self.rate_ramp != 0.0 {
-            let _ = write!(o, ", R {:.4e} {}", self.rate_ramp, s.term_unit("rate_ramp"));
+            let _ = write!(o, ", R {:.4e} {}", self.rate_ramp, NoiseTerm::Ramp.unit(s));
         }
         if self.quantization != 0.0 {
             let _ = write!(
                 o,
                 ", Q {:.4e} {} (step {:.4e})",
                 self.quantization,
-                s.term_unit("quantization"),
+                NoiseTerm::Quantization.unit(s),
                 super::quantization_step(self.quantization)
             );
         }
@@ -497,7 +498,7 @@ impl BiasInstability {
         let min_tau = MIN_TAU_SAMPLES / output_rate;
         if !(self.b.is_finite() && self.b >= 0.0) {
             return Err(at(
-                "bias_instability",
+                NoiseTerm::BiasInstability.name(),
                 format!("B must be a non-negative number, got {}", self.b),
             ));
         }
@@ -507,7 +508,7 @@ impl BiasInstability {
             && self.tau_hi > self.tau_lo)
         {
             return Err(at(
-                "bias_instability",
+                NoiseTerm::BiasInstability.name(),
                 format!(
                     "corner times must satisfy {min_tau} s ({} output samples) <= tau_lo < tau_hi, got {} .. {}",
                     MIN_TAU_SAMPLES, self.tau_lo, self.tau_hi
@@ -531,7 +532,7 @@ impl Line {
             && self.bandwidth < self.frequency)
         {
             return Err(at(
-                "lines",
+                NoiseTerm::Line(0).name(),
                 format!(
                     "a line needs 0 < frequency < {} Hz (half the output rate), amplitude >= 0 and 0 <= bandwidth < frequency (lightly damped), got frequency {} Hz, amplitude {}, bandwidth {} Hz",
                     0.5 * output_rate,

@@ -37,6 +37,7 @@
 
 use super::filter::{autocorrelation, impulse_response};
 use super::model::{AxisModel, Filter, ResolvedChain};
+use allan_kalibr::NoiseTerm;
 
 /// x = m·Δt/T below which the AR(1) variance uses its series.
 pub const AR1_SERIES_BELOW: f64 = 0.2;
@@ -413,17 +414,19 @@ pub struct TermAvar {
     pub deterministic_cross: f64,
 }
 
-/// Term names in [`TermAvar`] order (file columns).
+/// Term names in [`TermAvar`] order (file columns): the estimator's terms by their names in
+/// the term table ([`NoiseTerm::name`]; the lines summed in one column), and the two the
+/// simulator adds to them (the output's LSB rounding and the warm-up), which no fit has.
 pub const TERM_NAMES: [&str; 9] = [
-    "white_noise",
-    "quantization",
+    NoiseTerm::WhiteNoise.name(),
+    NoiseTerm::Quantization.name(),
     "resolution",
-    "bias_instability",
-    "gauss_markov",
-    "random_walk",
-    "rate_ramp",
+    NoiseTerm::BiasInstability.name(),
+    NoiseTerm::GaussMarkov.name(),
+    NoiseTerm::RandomWalk.name(),
+    NoiseTerm::Ramp.name(),
     "warmup",
-    "lines",
+    NoiseTerm::Line(0).name(),
 ];
 
 impl TermAvar {

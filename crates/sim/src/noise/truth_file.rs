@@ -20,6 +20,7 @@ use super::filter::{Biquad, autocorrelation, enbw, impulse_response};
 use super::model::{AXES, AxisModel, BiasInstability, Filter, ImuModel, ResolvedChain, Warmup};
 use super::truth::{AxisTruth, TERM_NAMES, TermAvar, WIDROW_MIN, tau_grid};
 use crate::error::{Result, SimError};
+use allan_kalibr::NoiseTerm;
 
 /// What the truth describes.
 #[derive(Debug, Clone)]
@@ -90,18 +91,18 @@ pub fn g(v: f64) -> String {
 }
 
 fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
-    let u = |f: &str| s.term_unit(f);
+    let u = |t: NoiseTerm| t.unit(s);
     let _ = writeln!(
         o,
         "{indent}white_noise: {}   # N [{}]",
         g(a.white_noise),
-        u("white_noise")
+        u(NoiseTerm::WhiteNoise)
     );
     let _ = writeln!(
         o,
         "{indent}random_walk: {}   # K [{}]",
         g(a.random_walk),
-        u("random_walk")
+        u(NoiseTerm::RandomWalk)
     );
     bias_instability_yaml(o, s, a.bias_instability, indent);
     let gm: Vec<String> = a
@@ -119,13 +120,13 @@ fn axis_model_yaml(o: &mut String, s: Sensor, a: &AxisModel, indent: &str) {
         o,
         "{indent}rate_ramp: {}   # R [{}]",
         g(a.rate_ramp),
-        u("rate_ramp")
+        u(NoiseTerm::Ramp)
     );
     let _ = writeln!(
         o,
         "{indent}quantization: {}   # Q [{}], IEEE 952 (integrated value quantised with step sqrt(12)*Q)",
         g(a.quantization),
-        u("quantization")
+        u(NoiseTerm::Quantization)
     );
     let _ = writeln!(
         o,
@@ -219,10 +220,10 @@ pub fn yaml_text(info: &TruthInfo<'_>) -> Result<String> {
             o,
             "  {}: {{white_noise: {}, random_walk: {}, bias_instability: {u}, gauss_markov_sigma: {u}, rate_ramp: {}, quantization: {}, resolution: {u}, warmup_amplitude: {u}, line_amplitude: {u}, allan_deviation: {u}}}",
             s.name(),
-            s.term_unit("white_noise"),
-            s.term_unit("random_walk"),
-            s.term_unit("rate_ramp"),
-            s.term_unit("quantization"),
+            NoiseTerm::WhiteNoise.unit(s),
+            NoiseTerm::RandomWalk.unit(s),
+            NoiseTerm::Ramp.unit(s),
+            NoiseTerm::Quantization.unit(s),
             u = s.unit()
         );
     }
@@ -368,7 +369,7 @@ fn discrete_axis_yaml(
         o,
         "        white_noise_density_effective: {}   # [{}] sqrt(sum_k R(k) * dt): the -1/2 line at long tau, aliasing included",
         g((w.s0() * dt).sqrt()),
-        s.term_unit("white_noise")
+        NoiseTerm::WhiteNoise.unit(s)
     );
     let _ = writeln!(
         o,
@@ -397,7 +398,7 @@ fn discrete_axis_yaml(
         o,
         "        quantization_step: {}   # [{}] sqrt(12)*Q on the integrated value",
         g(super::quantization_step(a.quantization)),
-        s.term_unit("quantization")
+        NoiseTerm::Quantization.unit(s)
     );
     deterministic_axis_yaml(o, info, s, a, t);
 }

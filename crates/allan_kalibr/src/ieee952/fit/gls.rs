@@ -8,8 +8,9 @@
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
+use super::NoiseTerm::{self, BiasInstability, GaussMarkov, Quantization, Ramp};
 use super::linalg::{covariance, nnls_subsets, whiten};
-use super::{FitData, GM, LINE0, Shapes, TERM_COUNT, basis_at, effective_coef, is_positive};
+use super::{FitData, Shapes, TERM_COUNT, basis_at, effective_coef, is_positive};
 
 /// Iterations of the discrepancy root-finding (bisection in log δ over 18 e-folds: 2⁻³⁰ of
 /// that is a relative precision of 2e-8 in δ).
@@ -131,9 +132,9 @@ impl<'d, 'a> Problem<'d, 'a> {
                     && l.bandwidth > 0.0
                 {
                     let coef = if l.fixed() {
-                        fixed[LINE0 + s]
+                        fixed[NoiseTerm::Line(s)]
                     } else {
-                        c[LINE0 + s]
+                        c[NoiseTerm::Line(s)]
                     };
                     let a = coef.max(0.0) * l.avar(tau);
                     v[k][k] += 2.0 * a * a / l.edf();
@@ -147,18 +148,18 @@ impl<'d, 'a> Problem<'d, 'a> {
     fn sigma_terms(&self, c: &[f64; TERM_COUNT]) -> Option<Vec<Vec<f64>>> {
         let b = self.data.basis?;
         let mut cp = *c;
-        cp[0] = cp[0].max(0.0);
+        cp[Quantization] = cp[Quantization].max(0.0);
         let fixed = self.shapes.fixed_coef();
-        for j in LINE0..TERM_COUNT {
-            if fixed[j] != 0.0 {
-                cp[j] = fixed[j];
+        for l in NoiseTerm::LINES {
+            if fixed[l] != 0.0 {
+                cp[l] = fixed[l];
             }
         }
         let idx: Vec<usize> = self.sel.iter().map(|&i| self.data.basis_index[i]).collect();
-        let shaped = (cp[2] != 0.0 && self.shapes.b_lo > 0.0)
-            || cp[GM] != 0.0
-            || cp[4] != 0.0
-            || (LINE0..TERM_COUNT).any(|j| cp[j] != 0.0);
+        let shaped = (cp[BiasInstability] != 0.0 && self.shapes.b_lo > 0.0)
+            || cp[GaussMarkov] != 0.0
+            || cp[Ramp] != 0.0
+            || NoiseTerm::LINES.iter().any(|&l| cp[l] != 0.0);
         if !shaped {
             return Some(b.cov(&idx, &cp));
         }

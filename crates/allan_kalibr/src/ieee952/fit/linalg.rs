@@ -7,7 +7,7 @@
 // Small dense matrix code (Cholesky, normal equations) reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use super::{LINE0, TERM_COUNT, is_positive};
+use super::{NoiseTerm, TERM_COUNT, is_positive};
 
 /// L⁻¹G and L⁻¹A with V = LLᵀ (V scaled to unit diagonal first, tiny ridge for safety).
 /// `g` may be empty (then only `a` is whitened).
@@ -64,7 +64,7 @@ pub(super) fn whiten(
 
 /// Weighted least squares over the enabled terms with sign constraints (terms not in
 /// `signed` ≥ 0), by enumerating the sets of free terms; `feasible` rejects solutions (e.g.
-/// a model that is not positive at every point). The line terms (from [`LINE0`] on) are in
+/// a model that is not positive at every point). The line terms ([`NoiseTerm::Line`]) are in
 /// every set and take any sign: their shapes come from the PSD, so the enumeration is over
 /// the power laws only (2⁶ sets whatever the lines).
 pub(super) fn nnls_subsets(
@@ -75,8 +75,9 @@ pub(super) fn nnls_subsets(
     signed: &[bool; TERM_COUNT],
     feasible: &dyn Fn(&[f64; TERM_COUNT]) -> bool,
 ) -> Option<[f64; TERM_COUNT]> {
-    let always: Vec<usize> = enabled.iter().copied().filter(|&j| j >= LINE0).collect();
-    let choose: Vec<usize> = enabled.iter().copied().filter(|&j| j < LINE0).collect();
+    let is_line = |j: usize| NoiseTerm::at(j).is_line();
+    let always: Vec<usize> = enabled.iter().copied().filter(|&j| is_line(j)).collect();
+    let choose: Vec<usize> = enabled.iter().copied().filter(|&j| !is_line(j)).collect();
     let k = choose.len();
     let mut best: Option<(f64, [f64; TERM_COUNT])> = None;
     let first = if always.is_empty() { 1u32 } else { 0 };
@@ -92,7 +93,7 @@ pub(super) fn nnls_subsets(
         if set
             .iter()
             .zip(&sol)
-            .any(|(&j, v)| *v < 0.0 && !signed[j] && j < LINE0)
+            .any(|(&j, v)| *v < 0.0 && !signed[j] && !is_line(j))
         {
             continue;
         }

@@ -99,8 +99,11 @@ pub(in crate::ieee952) use super::model::is_positive;
 #[cfg(test)]
 pub(in crate::ieee952) use super::model::{FLICKER_AVAR, flicker_band};
 pub use super::model::{
-    GM, IEEE_TERMS, LINE_SLOTS, LINE0, LineShape, LineSlots, Shapes, TERM_ALPHA, TERM_COUNT,
-    TERM_NAMES, basis, basis_at, gm_basis,
+    LINE_SLOTS, LineShape, LineSlots, Shapes, TERM_COUNT, basis, basis_at, gm_basis, term_basis_at,
+};
+pub use super::term::NoiseTerm;
+use super::term::NoiseTerm::{
+    BiasInstability, GaussMarkov, Quantization, Ramp, RandomWalk, WhiteNoise,
 };
 use gls::{Delta, FixedLs, Problem, Solve, fixed_ls, gls};
 pub(in crate::ieee952) use linalg::solve_spd;
@@ -289,7 +292,7 @@ pub(crate) fn predict(coef: &[f64; TERM_COUNT], shapes: &Shapes, tau: f64) -> f6
 pub const TRIM_CHI2: f64 = 15.136_705_226_623_606;
 /// Nuisance terms [`FitConfig::select`] adds only when the data ask for them: Q, B, R (and
 /// the Gauss–Markov bias, with its own threshold [`SELECT_CHI2_GM`]).
-const NUISANCE: [usize; 3] = [0, 2, 4];
+const NUISANCE: [NoiseTerm; 3] = [Quantization, BiasInstability, Ramp];
 /// χ²(1) quantile at 0.99: a nuisance term enters when it lowers the fit's χ² by more than
 /// this (a 1 % chance of adding a term the data do not have).
 pub const SELECT_CHI2: f64 = 6.634_896_601_021_214;
@@ -315,10 +318,10 @@ fn robust_scale(resid_w: &[f64]) -> f64 {
 
 fn signed_terms(cfg: &FitConfig) -> [bool; TERM_COUNT] {
     let mut s = [false; TERM_COUNT];
-    s[0] = cfg.band_limit;
+    s[Quantization] = cfg.band_limit;
     // the lines' shapes come from the PSD; their coefficients take any sign
-    for v in s.iter_mut().skip(LINE0) {
-        *v = true;
+    for l in NoiseTerm::LINES {
+        s[l] = true;
     }
     s
 }
@@ -326,7 +329,7 @@ fn signed_terms(cfg: &FitConfig) -> [bool; TERM_COUNT] {
 /// The IEEE 952 terms of `cfg` (the Gauss–Markov one off).
 fn ieee_only(terms: [bool; TERM_COUNT]) -> [bool; TERM_COUNT] {
     let mut t = terms;
-    t[GM] = false;
+    t[GaussMarkov] = false;
     t
 }
 
@@ -434,21 +437,22 @@ pub(crate) fn fit(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<Fit
     // kept it takes its share of the short-τ variance from N. Refit without it and report
     // it as left out, with the bound of the fit that had it (part of the term selection:
     // a fit of every term, `select` off, keeps it).
-    if cfg.select && cfg.terms[0] && f.coef[0] > 0.0 && f.max_share[0] < super::RESOLVED_SHARE {
+    let q = Quantization;
+    if cfg.select && cfg.terms[q] && f.coef[q] > 0.0 && f.max_share[q] < super::RESOLVED_SHARE {
         let without = FitConfig {
             terms: {
                 let mut t = cfg.terms;
-                t[0] = false;
+                t[q] = false;
                 t
             },
             ..*cfg
         };
         if let Some(mut g) = fit_terms(data, used, &without) {
-            g.left_out[0] = true;
-            g.left_out_coef[0] = f.coef[0];
-            g.coef[0] = 0.0;
-            g.cov[0][0] = f.cov[0][0];
-            g.free[0] = false;
+            g.left_out[q] = true;
+            g.left_out_coef[q] = f.coef[q];
+            g.coef[q] = 0.0;
+            g.cov[q][q] = f.cov[q][q];
+            g.free[q] = false;
             return Some(g);
         }
     }
@@ -484,10 +488,10 @@ fn fit_terms(data: &FitData, used: &[usize], cfg: &FitConfig) -> Option<FitResul
             coef[j] = *v;
         }
     }
-    if coef[GM] == 0.0 {
+    if coef[GaussMarkov] == 0.0 {
         shapes.gm_t = f64::NAN;
     }
-    if coef[2] == 0.0 {
+    if coef[BiasInstability] == 0.0 {
         shapes.b_lo = 0.0;
     }
     let model = FinalModel {
@@ -576,10 +580,10 @@ fn select_terms(
     let base = data.base_shapes();
     if cfg.select {
         let mut t = [false; TERM_COUNT];
-        t[1] = cfg.terms[1];
-        t[3] = cfg.terms[3];
-        for j in LINE0..TERM_COUNT {
-            t[j] = cfg.terms[j] && base.has(j);
+        t[WhiteNoise] = cfg.terms[WhiteNoise];
+        t[RandomWalk] = cfg.terms[RandomWalk];
+        for l in NoiseTerm::LINES {
+            t[l] = cfg.terms[l] && base.has(l.index());
         }
         if t.iter().any(|x| *x) {
             return select_forward(data, used, cfg, full, est, t);
@@ -636,7 +640,7 @@ fn select_forward(
 
 /// A candidate step of the selection: the term added (none for a corner of the flicker
 /// floor), its χ² drop beyond its threshold, and the shapes with it.
-type Candidate = (Option<usize>, f64, Shapes);
+type Candidate = (Option<NoiseTerm>, f64, Shapes);
 
 /// The best candidate step from the terms `t` and `shapes` (χ² `cur`, `chi` the χ² of a
 /// candidate under the current model's covariance): each nuisance term not in yet, the
@@ -652,7 +656,7 @@ fn best_candidate(
 ) -> Option<Candidate> {
     // (term added or none, χ² drop beyond its threshold, shapes)
     let mut best: Option<Candidate> = None;
-    let mut consider = |j: Option<usize>, excess: f64, sh: Shapes| {
+    let mut consider = |j: Option<NoiseTerm>, excess: f64, sh: Shapes| {
         if best.is_none_or(|b| excess > b.1) {
             best = Some((j, excess, sh));
         }
@@ -666,9 +670,9 @@ fn best_candidate(
             }
         }
     }
-    if cfg.terms[GM] && !t[GM] {
+    if cfg.terms[GaussMarkov] && !t[GaussMarkov] {
         let mut tt = t;
-        tt[GM] = true;
+        tt[GaussMarkov] = true;
         // the best correlation time; a bump only where the data locate it (a
         // best time at either end of the search is a trend the power laws
         // miss, not a bump)
@@ -696,18 +700,20 @@ fn best_candidate(
             };
             let l0 = sh.gm_t.ln();
             let half = 0.5 * std::f64::consts::LN_2 / GM_GRID.per_octave;
-            let lt = super::psd::golden_min(at, l0 - 2.0 * half, l0 + 2.0 * half, GM_T_REL_TOL);
+            let lt = super::golden::golden_min(at, l0 - 2.0 * half, l0 + 2.0 * half, GM_T_REL_TOL);
             let refined = Shapes {
                 gm_t: lt.exp(),
                 ..shapes
             };
             match chi(tt, refined) {
-                Some(cr) if cr < c => consider(Some(GM), cur - cr - SELECT_CHI2_GM, refined),
-                _ => consider(Some(GM), cur - c - SELECT_CHI2_GM, sh),
+                Some(cr) if cr < c => {
+                    consider(Some(GaussMarkov), cur - cr - SELECT_CHI2_GM, refined)
+                }
+                _ => consider(Some(GaussMarkov), cur - c - SELECT_CHI2_GM, sh),
             }
         }
     }
-    if t[2] && shapes.b_lo == 0.0 {
+    if t[BiasInstability] && shapes.b_lo == 0.0 {
         for &lo in corners {
             let sh = Shapes { b_lo: lo, ..shapes };
             if let Some(c) = chi(t, sh) {
@@ -750,21 +756,21 @@ impl FinalModel<'_> {
         let signed = signed_terms(cfg);
         let mut ambiguous = [false; TERM_COUNT];
         let mut bump_for_floor = f64::NAN;
-        if cfg.select && cfg.terms[GM] {
+        if cfg.select && cfg.terms[GaussMarkov] {
             let d = if data.basis.is_none() { 1.0 } else { s.delta };
             let grid = shape_grid(data, used, GM_GRID);
             let chi = |tt: [bool; TERM_COUNT], sh: Shapes| {
                 fixed_ls(data, used, tt, signed, &s.coef, d, sh).map(|x| x.1)
             };
             if let Some(cur) = chi(terms, shapes) {
-                for j in [2, 3] {
+                for j in [BiasInstability, RandomWalk] {
                     if !terms[j] || coef[j] == 0.0 {
                         continue;
                     }
                     let mut tt = terms;
                     tt[j] = false;
-                    tt[GM] = true;
-                    let times: Vec<f64> = if terms[GM] {
+                    tt[GaussMarkov] = true;
+                    let times: Vec<f64> = if terms[GaussMarkov] {
                         vec![shapes.gm_t]
                     } else {
                         grid.clone()
@@ -777,7 +783,7 @@ impl FinalModel<'_> {
                             |a, b| if b.0 < a.0 { b } else { a },
                         );
                     ambiguous[j] = alt + SWAP_PENALTY <= cur;
-                    if j == 2 && !terms[GM] {
+                    if j == BiasInstability && !terms[GaussMarkov] {
                         bump_for_floor = at;
                     }
                 }
@@ -801,7 +807,8 @@ impl FinalModel<'_> {
         } = *self;
         let signed = signed_terms(cfg);
         let mut alternatives = Vec::new();
-        if terms[2] && coef[2] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
+        let b = BiasInstability;
+        if terms[b] && coef[b] > 0.0 && cfg.flicker_corner && data.basis.is_some() {
             let cands: Vec<f64> = std::iter::once(0.0)
                 .chain(shape_grid(data, used, CORNER_GRID))
                 .collect();
@@ -838,14 +845,15 @@ fn max_shares(
     shapes: &Shapes,
 ) -> [f64; TERM_COUNT] {
     let mut noise_coef = *coef;
-    for v in noise_coef.iter_mut().skip(LINE0) {
-        *v = 0.0;
+    for l in NoiseTerm::LINES {
+        noise_coef[l] = 0.0;
     }
     std::array::from_fn(|j| {
         used.iter()
             .map(|&i| {
                 let tau = data.points[i].tau;
-                let total = predict(if j < LINE0 { &noise_coef } else { coef }, shapes, tau);
+                let noise = !NoiseTerm::at(j).is_line();
+                let total = predict(if noise { &noise_coef } else { coef }, shapes, tau);
                 if total > 0.0 {
                     (coef[j] * basis_at(j, tau, shapes) / total).max(0.0)
                 } else {
@@ -1036,7 +1044,10 @@ mod tests {
                 FitPoint {
                     m,
                     tau,
-                    avar: (0..5).map(|j| truth[j] * basis(j, tau)).sum(),
+                    avar: NoiseTerm::POWER_LAWS
+                        .iter()
+                        .map(|&t| truth[t.index()] * basis(t, tau))
+                        .sum(),
                 }
             })
             .collect();
@@ -1067,13 +1078,14 @@ mod tests {
             },
         )
         .unwrap();
-        for j in 0..5 {
+        for t in NoiseTerm::POWER_LAWS {
+            let j = t.index();
             assert!(
-                ((r.coef[j] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
+                ((r.coef[t] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
                 "term {}: expected {:e}, got {:e}",
-                TERM_NAMES[j],
+                t.symbol(),
                 truth[j],
-                r.coef[j]
+                r.coef[t]
             );
         }
         assert!(r.converged);
@@ -1127,17 +1139,18 @@ mod tests {
         assert_eq!(choose_start(&d, &FitConfig::default()), 0);
         let used: Vec<usize> = (0..ms.len()).collect();
         let r = fit(&d, &used, &FitConfig::default()).unwrap();
-        for j in [1, 3] {
+        for t in [WhiteNoise, RandomWalk] {
+            let j = t.index();
             assert!(
-                ((r.coef[j] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
+                ((r.coef[t] - truth[j]) / truth[j]).abs() < EXACT_REL_TOL,
                 "term {}: expected {:e}, got {:e}",
-                TERM_NAMES[j],
+                t.symbol(),
                 truth[j],
-                r.coef[j]
+                r.coef[t]
             );
         }
         assert!(
-            r.left_out[0] && r.left_out[2] && r.left_out[4],
+            r.left_out[Quantization] && r.left_out[BiasInstability] && r.left_out[Ramp],
             "nuisance terms must stay out: {:?}",
             r.left_out
         );
@@ -1173,14 +1186,14 @@ mod tests {
         const N_FILTER_REL_TOL: f64 = 0.02;
         const K_FILTER_REL_TOL: f64 = 0.10;
         assert!(
-            (r.coef[1].sqrt() / n2.sqrt() - 1.0).abs() < N_FILTER_REL_TOL,
+            (r.coef[WhiteNoise].sqrt() / n2.sqrt() - 1.0).abs() < N_FILTER_REL_TOL,
             "N² {:e} vs {n2:e}",
-            r.coef[1]
+            r.coef[WhiteNoise]
         );
         assert!(
-            (r.coef[3].sqrt() / k2.sqrt() - 1.0).abs() < K_FILTER_REL_TOL,
+            (r.coef[RandomWalk].sqrt() / k2.sqrt() - 1.0).abs() < K_FILTER_REL_TOL,
             "K² {:e} vs {k2:e}",
-            r.coef[3]
+            r.coef[RandomWalk]
         );
     }
 
@@ -1222,7 +1235,9 @@ mod tests {
             ..Shapes::FLAT
         };
         for p in d.points.iter_mut() {
-            p.avar = predict(&[0.0, n2, b2, k2, 0.0, 0.0, 0.0, 0.0, 0.0], &shapes, p.tau);
+            let mut c = [0.0; TERM_COUNT];
+            (c[WhiteNoise], c[BiasInstability], c[RandomWalk]) = (n2, b2, k2);
+            p.avar = predict(&c, &shapes, p.tau);
         }
         let used: Vec<usize> = (0..ms.len()).collect();
         let r = fit(&d, &used, &FitConfig::default()).unwrap();
@@ -1235,14 +1250,14 @@ mod tests {
         const N_GRID_REL_TOL: f64 = 0.01;
         const B_GRID_REL_TOL: f64 = 0.05;
         assert!(
-            (r.coef[1] / n2).sqrt() - 1.0 < N_GRID_REL_TOL,
+            (r.coef[WhiteNoise] / n2).sqrt() - 1.0 < N_GRID_REL_TOL,
             "{:e}",
-            r.coef[1]
+            r.coef[WhiteNoise]
         );
         assert!(
-            ((r.coef[2] / b2).sqrt() - 1.0).abs() < B_GRID_REL_TOL,
+            ((r.coef[BiasInstability] / b2).sqrt() - 1.0).abs() < B_GRID_REL_TOL,
             "{:e}",
-            r.coef[2]
+            r.coef[BiasInstability]
         );
         // the flat-floor model misses it: N low
         let flat = fit(
@@ -1255,10 +1270,10 @@ mod tests {
         )
         .unwrap();
         assert!(
-            flat.coef[1] < r.coef[1],
+            flat.coef[WhiteNoise] < r.coef[WhiteNoise],
             "{:e} vs {:e}",
-            flat.coef[1],
-            r.coef[1]
+            flat.coef[WhiteNoise],
+            r.coef[WhiteNoise]
         );
     }
 
@@ -1266,17 +1281,26 @@ mod tests {
     fn nnls_subsets_matches_brute_force_grid() {
         // a 2-term case where the unconstrained solution is negative: y = 1/τ data with a dip
         let g: Vec<[f64; TERM_COUNT]> = (1..20)
-            .map(|k| std::array::from_fn(|j| basis(j, k as f64)))
+            .map(|k| std::array::from_fn(|j| basis(NoiseTerm::at(j), k as f64)))
             .collect();
         let a: Vec<f64> = (1..20)
             .map(|k| 1.0 / k as f64 - 0.01 * k as f64 / 3.0)
             .collect();
         let w = vec![1.0; g.len()];
-        let c = nnls_subsets(&g, &a, &w, &[1, 3], &[false; TERM_COUNT], &|_| true).unwrap();
-        assert_eq!(c[3], 0.0, "K must be clamped at 0");
+        let (n, k) = (WhiteNoise, RandomWalk);
+        let c = nnls_subsets(
+            &g,
+            &a,
+            &w,
+            &[n.index(), k.index()],
+            &[false; TERM_COUNT],
+            &|_| true,
+        )
+        .unwrap();
+        assert_eq!(c[k], 0.0, "K must be clamped at 0");
         // with K = 0, N² is the 1-D LS solution
-        let num: f64 = g.iter().zip(&a).map(|(gi, ai)| gi[1] * ai).sum();
-        let den: f64 = g.iter().map(|gi| gi[1] * gi[1]).sum();
-        assert!((c[1] - num / den).abs() < 1e-12);
+        let num: f64 = g.iter().zip(&a).map(|(gi, ai)| gi[n] * ai).sum();
+        let den: f64 = g.iter().map(|gi| gi[n] * gi[n]).sum();
+        assert!((c[n] - num / den).abs() < 1e-12);
     }
 }

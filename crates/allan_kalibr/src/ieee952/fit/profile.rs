@@ -45,10 +45,11 @@
 // Small dense matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
+use super::NoiseTerm::{self, BiasInstability, GaussMarkov, RandomWalk, WhiteNoise};
 use super::gls::Problem;
 use super::linalg::nnls_subsets;
 use super::{
-    FitConfig, FitData, FitResult, GM, GM_GRID, Shapes, TERM_COUNT, is_positive, signed_terms,
+    FitConfig, FitData, FitResult, GM_GRID, Shapes, TERM_COUNT, is_positive, signed_terms,
 };
 
 /// χ²(1) at 0.95: the two ends of a 95 % interval.
@@ -158,7 +159,7 @@ impl<'d, 'a> Profile<'d, 'a> {
     ) -> Option<Profile<'d, 'a>> {
         data.basis?;
         let mut shapes = vec![res.shapes];
-        if res.coef[GM] != 0.0 && res.shapes.gm_t.is_finite() {
+        if res.coef[GaussMarkov] != 0.0 && res.shapes.gm_t.is_finite() {
             // the correlation time is a parameter too: the fit's ± an octave in eighths
             // of an octave, within the times the fit searches
             let (first, last) = (
@@ -187,13 +188,14 @@ impl<'d, 'a> Profile<'d, 'a> {
         // for the flicker floor's interval: the model with a bump beside it, at the time
         // that explains the floor best (B's only: a bump beside the floor is no statement
         // on the other terms)
-        if res.bump_for_floor.is_finite() && res.coef[GM] == 0.0 && cfg.terms[GM] {
+        if res.bump_for_floor.is_finite() && res.coef[GaussMarkov] == 0.0 && cfg.terms[GaussMarkov]
+        {
             let sh = Shapes {
                 gm_t: res.bump_for_floor,
                 ..res.shapes
             };
             if let Some(mut v) = Variant::new(data, res, cfg, sh, used) {
-                v.only = Some(2);
+                v.only = Some(BiasInstability.index());
                 variants.push(v);
             }
         }
@@ -267,7 +269,10 @@ impl<'d, 'a> Variant<'d, 'a> {
         let free: Vec<usize> = (0..TERM_COUNT)
             .filter(|&j| cfg.terms[j] && shapes.has(j))
             .filter(|&j| {
-                res.coef[j] != 0.0 || matches!(j, 1..=3) || (j == GM && shapes.gm_t.is_finite())
+                let t = NoiseTerm::at(j);
+                res.coef[j] != 0.0
+                    || matches!(t, WhiteNoise | BiasInstability | RandomWalk)
+                    || (t == GaussMarkov && shapes.gm_t.is_finite())
             })
             .collect();
         let delta = if res.delta.is_finite() {
@@ -277,7 +282,7 @@ impl<'d, 'a> Variant<'d, 'a> {
         };
         let start = res.coef;
         let can = std::array::from_fn(|j| {
-            cfg.terms[j] && shapes.has(j) && (j != GM || shapes.gm_t.is_finite())
+            cfg.terms[j] && shapes.has(j) && (j != GaussMarkov.index() || shapes.gm_t.is_finite())
         });
         let mut pr = Variant {
             only: None,

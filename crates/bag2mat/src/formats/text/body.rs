@@ -2,8 +2,8 @@
 //! other line by the `csv` crate; each range straight into its slot of the columns.
 
 use super::layout::{Delim, Layout};
-use super::units::TimeUnit;
 use crate::rows::{Row, RowsMut};
+use crate::units::TimeUnit;
 
 /// Parses a decimal time in `unit` to nanoseconds, every digit kept (exponents through f64).
 pub(crate) fn parse_time_ns(s: &[u8], unit: TimeUnit) -> Option<u64> {

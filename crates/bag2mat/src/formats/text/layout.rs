@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use super::InputOptions;
-use super::units::{AccUnit, GyroUnit, TimeUnit};
 use crate::error::Error;
+use crate::units::{AccUnit, GyroUnit, TimeUnit};
 
 /// What a column holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -418,7 +418,7 @@ fn not_table(path: &Path, why: &str) -> Error {
         path: path.to_path_buf(),
         what: format!(
             "it is text, but {why}. Accepted: {}",
-            crate::source::ACCEPTED
+            crate::source::accepted()
         ),
     }
 }
@@ -832,7 +832,7 @@ fn resolve_unit<U: Copy + PartialEq>(
     what: &str,
     flag: Option<U>,
     header: &[String],
-    parse: fn(&str) -> Result<U, super::units::UnknownUnit>,
+    parse: fn(&str) -> Result<U, crate::units::UnknownUnit>,
     known: Option<U>,
     name: fn(U) -> &'static str,
     warnings: &mut Vec<String>,

@@ -21,7 +21,6 @@ use rayon::prelude::*;
 
 mod body;
 mod layout;
-mod units;
 mod window;
 
 use super::InputOptions;
@@ -30,12 +29,12 @@ use crate::decoded::{DecodedSource, Stream};
 use crate::error::Error;
 use crate::rows::{Row, Rows};
 use crate::source::InputKind;
+use crate::units::AccUnit;
 /// The test tools read times as the body does.
 #[cfg(any(test, feature = "test-support"))]
 pub(crate) use body::parse_time_ns;
 use body::{Chunk, Summary, line_range, parse_lines, room};
 use layout::{Delim, Layout, bad, layout};
-pub use units::{AccUnit, GyroUnit, TimeUnit};
 
 /// Bytes looked at to decide whether a file is text, and to find its header.
 pub const SNIFF_BYTES: usize = 64 * 1024;
@@ -44,8 +43,6 @@ pub const SNIFF_BYTES: usize = 64 * 1024;
 pub const MAX_BAD_FRACTION: f64 = 0.01;
 /// Malformed lines always tolerated (with warnings), whatever the file's length.
 pub const MIN_BAD_LIMIT: u64 = 10;
-/// Standard gravity, m/s² (the `g` unit; CGPM 1901).
-pub const STANDARD_GRAVITY: f64 = 9.80665;
 /// Bytes per parallel parse range.
 const RANGE_BYTES: usize = 4 << 20;
 /// Rows sampled for the unit plausibility checks.
@@ -534,6 +531,27 @@ fn id_list(found: &[(String, u64)]) -> String {
         .join(", ")
 }
 
+/// The rows' sample rate for the unit checks: one over the median step between sorted time
+/// stamps (the unit question is one of orders of magnitude, and a damaged row's stamp —
+/// a line split inside its number — must not move it: the record check's nominal rate,
+/// which counts missing samples across every gap, would read one stray stamp as a gap of
+/// years).
+fn median_rate(rows: &Rows) -> Option<f64> {
+    let mut t: Vec<u64> = rows.stamp.iter().map(|s| s.as_nanos()).collect();
+    t.sort_unstable();
+    let mut d: Vec<u64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|&x| x > 0)
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    let (_, m, _) = d.select_nth_unstable(mid);
+    Some(1e9 / *m as f64)
+}
+
 /// The physics of what the layout read, whatever units it was told (the rules:
 /// `crate::record_check::units`): a median specific force another accelerometer unit puts at
 /// gravity, a rate another time unit puts among IMUs', or an unstated gyroscope unit whose
@@ -568,28 +586,25 @@ fn check_physics(path: &Path, lay: &Layout, rows: &Rows, opts: &InputOptions) ->
             ));
         }
     }
-    if lay.time.is_some() {
-        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
-        if let Some(rate) = crate::timing::nominal_rate(&t)
-            && let Some((u, r)) = units::rate_unit_fix(rate, lay.time_unit)
-        {
-            return Err(layout::bad(
-                path,
-                format!(
-                    "the time column read in {} gives a sample rate of {rate:.4} Hz, outside what IMUs have ({} Hz – {} kHz); in {} it gives {r:.1} Hz: give --time-unit {}{}",
-                    lay.time_unit.name(),
-                    units::IMU_RATE_HZ.0,
-                    units::IMU_RATE_HZ.1 / 1e3,
-                    u.name(),
-                    u.name(),
-                    over(!lay.time_from_flag && lay.time_stated)
-                ),
-            ));
-        }
+    if lay.time.is_some()
+        && let Some(rate) = median_rate(rows)
+        && let Some((u, r)) = units::rate_unit_fix(rate, lay.time_unit)
+    {
+        return Err(layout::bad(
+            path,
+            format!(
+                "the time column read in {} gives a sample rate of {rate:.4} Hz, outside what IMUs have ({} Hz – {} kHz); in {} it gives {r:.1} Hz: give --time-unit {}{}",
+                lay.time_unit.name(),
+                units::IMU_RATE_HZ.0,
+                units::IMU_RATE_HZ.1 / 1e3,
+                u.name(),
+                u.name(),
+                over(!lay.time_from_flag && lay.time_stated)
+            ),
+        ));
     }
     if lay.gyro.is_some() && !lay.gyro_stated && opts.gyro_scale.is_none() {
-        let t: Vec<i64> = rows.stamp.iter().map(|s| s.as_nanos() as i64).collect();
-        let rate = crate::timing::nominal_rate(&t);
+        let rate = median_rate(rows);
         for (k, axis) in rows.gyro.iter().enumerate() {
             let sigma = crate::record_check::outliers::noise_scale(axis);
             let Some(n) = rate.map(|r| units::gyro_density(sigma, r)) else {

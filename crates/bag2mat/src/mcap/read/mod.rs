@@ -248,7 +248,7 @@ impl McapReader {
         if got < 8 || &magic != MAGIC {
             return Err(Error::NotABag {
                 path: path.to_path_buf(),
-                what: format!("missing the MCAP magic. Accepted: {}", source::ACCEPTED),
+                what: format!("missing the MCAP magic. Accepted: {}", source::accepted()),
             });
         }
         let mut r = McapReader {

@@ -1,7 +1,7 @@
 //! `allan_kalibr plan`: from an IMU's figures — N and K in Kalibr's units, or a datasheet's
 //! ARW, VRW, noise density and bias instability — and its rate, how long a static record
 //! must be for ±25 % and ±10 % at 95 % on each term, whether the bias instability B can be
-//! resolved at all, and the parameters of every consumer ([`super::CONSUMERS`]) from these
+//! resolved at all, and the parameters of every consumer ([`crate::consumers::CONSUMERS`]) from these
 //! figures, marked "from a datasheet, not measured" (`-o DIR` writes the files).
 //!
 //! The record lengths are the analysis' own advice (`crate::ieee952::advisor`): the
@@ -20,8 +20,10 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::{CONSUMERS, ConfigValues, Origin, Provenance, Quantity, RecordRate, datasheet, render};
 use crate::SensorValue;
+use crate::consumers::{
+    CONSUMERS, ConfigValues, Origin, Provenance, Quantity, RecordRate, datasheet, render,
+};
 use crate::ieee952::advisor::{self, TARGETS, duration_text};
 use bag2mat::Sensor;
 
@@ -529,7 +531,7 @@ pub fn plan(args: &PlanArgs) -> Result<(String, Vec<SensorPlan>, ConfigValues), 
 
 /// `allan_kalibr plan`: the plan on stdout; with `-o DIR` every consumer's file.
 pub fn main(args: &PlanArgs) -> std::process::ExitCode {
-    let tool = crate::cli::TOOL;
+    let tool = crate::run::TOOL;
     let (text, _, values) = match plan(args) {
         Ok(p) => p,
         Err(e) => return bag2mat::shared::cli::fail(tool, &e),

@@ -1,7 +1,12 @@
-//! The units a text log's columns may be in (header, flag or a known layout), and their
-//! factors to SI.
+//! The units an IMU log's columns may be stated in (a text log's header, a flag, a known
+//! layout), their names and their factors to SI.
+//!
+//! A leaf of their own: the text reader parses them (`crate::formats::text`) and the record
+//! check names the unit that explains an implausible figure (`crate::record_check::units`),
+//! so neither reaches into the other for them.
 
-use super::STANDARD_GRAVITY;
+/// Standard gravity, m/s² (the `g` unit; CGPM 1901).
+pub const STANDARD_GRAVITY: f64 = 9.80665;
 
 /// Unit of a time column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -133,7 +138,7 @@ impl AccUnit {
 }
 
 /// A unit's text without spaces, lower case (`rad s^-1` → `rads^-1`).
-pub(super) fn unit_key(s: &str) -> String {
+fn unit_key(s: &str) -> String {
     s.chars()
         .filter(|c| !c.is_whitespace())
         .flat_map(char::to_lowercase)

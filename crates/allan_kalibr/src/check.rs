@@ -1,7 +1,7 @@
 //! `allan_kalibr check CONFIG…`: reads the config files users already have (Kalibr
 //! `imu.yaml` and `imu_chain`, OpenVINS, VINS, ORB-SLAM3, Basalt JSON, PX4 `.params`,
 //! ArduPilot `.param`, GTSAM, imu_utils' yaml) and says, one line per key on stdout, what the
-//! number is under that consumer's convention ([`super::CONSUMERS`]) and what is wrong with
+//! number is under that consumer's convention ([`crate::consumers::CONSUMERS`]) and what is wrong with
 //! it: a value the consumer will not read as a number, a discrete (per-sample) value where it
 //! wants a continuous density (or the other way), a variance where it wants a standard
 //! deviation, imu_utils' bias instability where a random walk belongs, a rate that disagrees
@@ -15,8 +15,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::read::{self, Entry, Kind};
-use super::{Consumer, ConsumerId, Form, Key, Quantity, consumer, datasheet};
+use crate::consumers::read::{self, Entry, Kind};
+use crate::consumers::{Consumer, ConsumerId, Form, Key, Quantity, consumer, datasheet};
 use crate::ieee952::files as terms;
 
 /// A value within this factor of the measured one agrees with it (the 95 % precision of K
@@ -999,7 +999,7 @@ fn imu_utils(
                     format!(
                         "imu_utils' {s}_w is the bias-instability floor of the Allan curve (in {}), not a random walk: no consumer's random-walk key takes it ({} measures K: its kalibr_imu_ieee952.yaml)",
                         sensor.unit(),
-                        crate::cli::TOOL
+                        crate::run::TOOL
                     ),
                 ),
             };
@@ -1036,7 +1036,7 @@ pub fn main(args: &CheckArgs) -> std::process::ExitCode {
                 .filter(|l| matches!(l.verdict, Verdict::Finding(..)))
                 .count();
             if let Err(e) = bag2mat::shared::cli::print(&text) {
-                return bag2mat::shared::cli::fail(crate::cli::TOOL, &e);
+                return bag2mat::shared::cli::fail(crate::run::TOOL, &e);
             }
             eprintln!(
                 "check: {findings} finding(s) in {} value(s) of {} file(s)",
@@ -1045,7 +1045,7 @@ pub fn main(args: &CheckArgs) -> std::process::ExitCode {
             );
             std::process::ExitCode::SUCCESS
         }
-        Err(e) => bag2mat::shared::cli::fail(crate::cli::TOOL, &e),
+        Err(e) => bag2mat::shared::cli::fail(crate::run::TOOL, &e),
     }
 }
 
