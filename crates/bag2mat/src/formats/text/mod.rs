@@ -586,8 +586,11 @@ fn check_physics(path: &Path, lay: &Layout, rows: &Rows, opts: &InputOptions) ->
             ));
         }
     }
+    // one sort of the stamps for both checks below, and none when neither runs
+    let rate_cell = std::cell::OnceCell::new();
+    let rate = || *rate_cell.get_or_init(|| median_rate(rows));
     if lay.time.is_some()
-        && let Some(rate) = median_rate(rows)
+        && let Some(rate) = rate()
         && let Some((u, r)) = units::rate_unit_fix(rate, lay.time_unit)
     {
         return Err(layout::bad(
@@ -604,7 +607,7 @@ fn check_physics(path: &Path, lay: &Layout, rows: &Rows, opts: &InputOptions) ->
         ));
     }
     if lay.gyro.is_some() && !lay.gyro_stated && opts.gyro_scale.is_none() {
-        let rate = median_rate(rows);
+        let rate = rate();
         for (k, axis) in rows.gyro.iter().enumerate() {
             let sigma = crate::record_check::outliers::noise_scale(axis);
             let Some(n) = rate.map(|r| units::gyro_density(sigma, r)) else {
