@@ -469,3 +469,19 @@ fn degenerate_values_are_explained() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("overflow"), "{err}");
 }
+
+/// `--help` names every kind of input the registry holds and the bagconvert .mat (the
+/// analysers' shared argument, from [`bag2mat::InputKind::ALL`]).
+#[test]
+fn help_lists_every_input_kind() {
+    let out = bin().arg("--help").output().unwrap();
+    assert!(out.status.success());
+    let help = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let kinds = bag2mat::InputKind::ALL.iter().map(|k| k.facts().accepted);
+    for phrase in std::iter::once(allan_kalibr::MAT_INPUT).chain(kinds) {
+        assert!(help.contains(phrase), "{phrase:?} missing from {help}");
+    }
+}

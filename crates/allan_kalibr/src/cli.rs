@@ -13,8 +13,8 @@ use crate::run::{Config, TOOL};
 /// kalibr_allan's Allan-deviation results (rpng/kalibr_allan 9d38ea9), in seconds, without
 /// MATLAB or ROS; `allan_kalibr check` and `allan_kalibr plan` (below).
 ///
-/// Reads IMU samples from any input bag2mat reads (ROS 1 and ROS 2 bags, a bagconvert .mat,
-/// EuRoC/ASL, CSV/TSV, PX4 ULog, ArduPilot DataFlash, NumPy), computes the non-overlapping
+/// Reads IMU samples from a bagconvert .mat or any input bag2mat reads (INPUT lists them),
+/// computes the non-overlapping
 /// Allan deviation on upstream's 2000-point tau grid, fits the -1/2 and +1/2 lines as
 /// gen_chart.m does, prints upstream's lines and writes imu.yaml (upstream's file, as
 /// kalibr_allan writes it), allan_curves.csv and allan_{accel,gyro}.{png,svg}.

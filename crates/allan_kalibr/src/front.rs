@@ -26,6 +26,9 @@ pub const MIN_RATE_HZ: f64 = 1e-3;
 /// The fastest sample rate accepted, Hz (IMUs sample at 1 Hz to a few tens of kHz).
 pub const MAX_RATE_HZ: f64 = 1e7;
 
+/// The input the analysers read besides bag2mat's, as their help names it.
+pub const MAT_INPUT: &str = "a bagconvert .mat (data_imu, N x 7: t ax ay az wx wy wz)";
+
 /// The topic read when none is named and the input has it: both upstream tools' default.
 pub const DEFAULT_TOPIC: &str = "imu";
 
@@ -35,10 +38,8 @@ pub const DEFAULT_TOPIC: &str = "imu";
 #[allow(rustdoc::invalid_html_tags)]
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct CommonArgs {
-    /// The input: a ROS 1 bag (uncompressed, bz2 or lz4 chunks), a ROS 2 bag directory, an
-    /// .mcap or .db3, a bagconvert .mat (data_imu, N x 7: t ax ay az wx wy wz), or an IMU log
-    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
-    #[arg(required_unless_present = "curves", value_name = "INPUT")]
+    /// The input (its help lists every kind read: bag2mat's and [`MAT_INPUT`]).
+    #[arg(required_unless_present = "curves", value_name = "INPUT", help = bag2mat::input_help(&[MAT_INPUT]))]
     pub input: Option<PathBuf>,
     /// Analyse existing Allan curves instead (IEEE 952 section only): an imu_utils data
     /// directory, allan_variance_ros' allan_variance.csv, an allan_curves.csv, an

@@ -86,8 +86,8 @@ pub use consumers::SensorValue;
 pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
-    Common, CommonArgs, Input, Job, Section, command_line, main as analyser_main, rate_for_text,
-    refusal_text, run_job, topic_failed,
+    Common, CommonArgs, Input, Job, MAT_INPUT, Section, command_line, main as analyser_main,
+    rate_for_text, refusal_text, run_job, topic_failed,
 };
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};

@@ -619,3 +619,19 @@ fn degenerate_values_are_explained() {
         "{err}"
     );
 }
+
+/// `-h` names every kind of input the registry holds and the bagconvert .mat: the list comes
+/// from [`bag2mat::InputKind::ALL`] and [`allan_kalibr::MAT_INPUT`], not a hand-written copy.
+#[test]
+fn help_lists_every_input_kind() {
+    let out = run(&["-h"]);
+    assert!(out.status.success());
+    let help = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let kinds = bag2mat::InputKind::ALL.iter().map(|k| k.facts().accepted);
+    for phrase in std::iter::once(allan_kalibr::MAT_INPUT).chain(kinds) {
+        assert!(help.contains(phrase), "{phrase:?} missing from {help}");
+    }
+}

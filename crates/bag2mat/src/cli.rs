@@ -17,18 +17,16 @@ use crate::{TimeColumn, TopicSelector};
 /// Convert sensor_msgs/Imu topics of a bag to a MATLAB .mat (kalibr_allan's bagconvert layout:
 /// variable data_imu, N×7, columns t ax ay az wx wy wz, t = record time in seconds).
 ///
-/// Reads ROS 1 bags, ROS 2 bag directories (sqlite3 or MCAP, split, zstd-compressed), bare
-/// .mcap and .db3 files, and IMU logs from outside ROS (EuRoC/ASL datasets, CSV/TSV text,
-/// PX4 ULog, ArduPilot DataFlash .bin, NumPy .npy), recognised from their content.
-/// `bag2mat info BAG` lists what an input holds.
+/// Reads ROS bags and IMU logs from outside ROS, recognised from their content (BAG lists
+/// them). `bag2mat info BAG` lists what an input holds.
 #[derive(Parser, Debug)]
 #[command(name = "bag2mat", version, args_conflicts_with_subcommands = true)]
 pub struct Args {
     #[allow(missing_docs)] // a subcommand's help is its own
     #[command(subcommand)]
     pub command: Option<Command>,
-    /// The input: a ROS 1 bag, a ROS 2 bag directory, an .mcap or a .db3, or an IMU log
-    /// (EuRoC/ASL dataset, CSV/TSV text, PX4 .ulg, ArduPilot .bin, NumPy .npy).
+    /// The input (its help lists every kind read: [`crate::input_help`]).
+    #[arg(help = crate::input_help(&[]))]
     pub bag: Option<PathBuf>,
     /// The Imu topic (`imu` and `/imu` are tried in that order if the exact name is missing)
     /// [default: the input's only sensor_msgs/Imu topic].
@@ -66,7 +64,8 @@ pub enum Command {
     /// Every topic of a bag (any format) with its type, message count, mean rate, rate
     /// jitter, time span and gaps; the Imu topics are flagged.
     Info {
-        /// The input.
+        /// The input (its help lists every kind read: [`crate::input_help`]).
+        #[arg(help = crate::input_help(&[]))]
         bag: PathBuf,
         /// No progress bar.
         #[arg(short, long)]

@@ -124,7 +124,7 @@ pub use source::{
     Channel as SourceChannel, Contents as SourceContents, Encoding as MessageEncoding,
     Loss as SourceLoss, Part as SourcePart, PartRead,
 };
-pub use source::{InputKind, KindFacts, Source, accepted};
+pub use source::{InputKind, KindFacts, Source, accepted, input_help};
 pub use time::RosTime;
 pub use timing::{Gap as TimingGap, Segment as TimingSegment};
 pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};

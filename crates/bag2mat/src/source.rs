@@ -122,11 +122,25 @@ impl InputKind {
 /// Every kind of input accepted, for error messages: [`InputKind::ALL`]'s phrases.
 pub fn accepted() -> &'static str {
     static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    TEXT.get_or_init(|| {
-        let p: Vec<&str> = InputKind::ALL.iter().map(|k| k.facts().accepted).collect();
-        let (last, rest) = p.split_last().expect("ALL is not empty");
-        format!("{}, or {last}", rest.join(", "))
-    })
+    TEXT.get_or_init(|| or_list(InputKind::ALL.iter().map(|k| k.facts().accepted)))
+}
+
+/// `a, b, or c`.
+fn or_list<'a>(items: impl IntoIterator<Item = &'a str>) -> String {
+    let p: Vec<&str> = items.into_iter().collect();
+    let (last, rest) = p.split_last().expect("a list of inputs is not empty");
+    format!("{}, or {last}", rest.join(", "))
+}
+
+/// The help text of an input argument, from [`InputKind::ALL`]'s phrases: `extra` names
+/// the inputs a tool reads besides bag2mat's (the analysers' bagconvert `.mat`), first. A
+/// new kind shows in every tool's `--help` with its row of [`InputKind::facts`].
+pub fn input_help(extra: &[&str]) -> String {
+    let kinds = InputKind::ALL.iter().map(|k| k.facts().accepted);
+    format!(
+        "The input, recognised from its content: {}.",
+        or_list(extra.iter().copied().chain(kinds))
+    )
 }
 
 /// The magic line of a ROS 1 bag.

@@ -179,3 +179,25 @@ fn the_only_imu_topic_is_the_default_and_several_must_be_named() {
     );
     assert!(!out.exists());
 }
+
+/// `--help` (for the conversion and for `info`) names every kind of input the registry
+/// holds: the list comes from [`bag2mat::InputKind::ALL`], not a hand-written copy.
+#[test]
+fn help_lists_every_input_kind() {
+    for args in [&["--help"][..], &["info", "--help"][..]] {
+        let out = bag2mat().args(args).output().unwrap();
+        assert!(out.status.success());
+        // clap wraps long help at the terminal width: compare with whitespace collapsed
+        let help = String::from_utf8_lossy(&out.stdout)
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        for k in bag2mat::InputKind::ALL {
+            assert!(
+                help.contains(k.facts().accepted),
+                "{args:?}: {:?} missing from {help}",
+                k.facts().accepted
+            );
+        }
+    }
+}
