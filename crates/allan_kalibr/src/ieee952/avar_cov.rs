@@ -47,14 +47,28 @@
 
 use super::model::TERM_COUNT;
 use super::oadev::Overlap;
+use super::term::NoiseTerm;
 use rayon::prelude::*;
 
 /// Lags summed term by term before switching to the integral.
 pub const EXACT_LAGS: usize = 512;
 
-/// Stochastic components with a covariance: Q, N, B, K (R is deterministic).
-pub const COMPONENTS: usize = 4;
-/// The ten (t, u), t ≤ u, component pairs of the quadratic form.
+/// The terms with a covariance, in the basis' order: the four stochastic power laws (the
+/// ramp R is deterministic; a Gauss–Markov bias or a line enters through the effective
+/// power-law coefficients the fit gives the points it shapes). Component `t` of the basis is
+/// `COMPONENTS[t]`, and its coefficient is read from a coefficient array at that term's index.
+pub const COMPONENTS: [NoiseTerm; 4] = [
+    NoiseTerm::Quantization,
+    NoiseTerm::WhiteNoise,
+    NoiseTerm::BiasInstability,
+    NoiseTerm::RandomWalk,
+];
+/// The smooth components, whose γ is a function ([`gamma_unit`]): [`COMPONENTS`] after white
+/// PM (Q), whose part is a set of spikes ([`phi_q`]). `phi_smooth`'s entry `s` is component
+/// `s + 1`.
+const SMOOTH: [NoiseTerm; 3] = [COMPONENTS[1], COMPONENTS[2], COMPONENTS[3]];
+/// The ten (t, u), t ≤ u, component pairs of the quadratic form (indices into
+/// [`COMPONENTS`]).
 const PAIRS: [(usize, usize); 10] = [
     (0, 0),
     (0, 1),
@@ -70,13 +84,13 @@ const PAIRS: [(usize, usize); 10] = [
 
 const W: [f64; 3] = [1.0, -2.0, 1.0];
 
-/// γ of one unit-coefficient smooth component (1 = N, 2 = B, 3 = K) at t seconds.
-fn gamma_unit(comp: usize, t: f64) -> f64 {
+/// γ of one unit-coefficient smooth component ([`SMOOTH`]: N, B, K) at t seconds.
+fn gamma_unit(term: NoiseTerm, t: f64) -> f64 {
     let a = t.abs();
-    match comp {
-        1 => -a / 2.0,
-        2 if a > 0.0 => t * t * a.ln() / (2.0 * std::f64::consts::PI),
-        3 => a * a * a / 12.0,
+    match term {
+        NoiseTerm::WhiteNoise => -a / 2.0,
+        NoiseTerm::BiasInstability if a > 0.0 => t * t * a.ln() / (2.0 * std::f64::consts::PI),
+        NoiseTerm::RandomWalk => a * a * a / 12.0,
         _ => 0.0,
     }
 }
@@ -88,8 +102,8 @@ fn phi_smooth(h: f64, mi: f64, mj: f64, tau0: f64) -> [f64; 3] {
         for (b, wb) in W.iter().enumerate() {
             let t = (h + b as f64 * mj - a as f64 * mi) * tau0;
             let w = wa * wb;
-            for (c, v) in s.iter_mut().enumerate() {
-                *v += w * gamma_unit(c + 1, t);
+            for (&term, v) in SMOOTH.iter().zip(s.iter_mut()) {
+                *v += w * gamma_unit(term, t);
             }
         }
     }
@@ -183,7 +197,7 @@ fn pair_sums(mi: usize, mj: usize, big_mi: usize, big_mj: usize, tau0: f64) -> [
         let q = phi_q(h, mi as i64, mj as i64);
         let p = phi_smooth(h as f64, mif, mjf, tau0);
         acc[0] += n * q * q;
-        for u in 1..COMPONENTS {
+        for u in 1..COMPONENTS.len() {
             acc[u] += n * q * p[u - 1];
         }
     }
@@ -274,7 +288,7 @@ fn normal_var_sums(m: usize, big_m: usize, tau0: f64) -> [f64; 10] {
         add_smooth(&mut acc, n, &p, 1.0);
         let q = phi_q(h, m as i64, m as i64);
         acc[0] += n * q * q;
-        for u in 1..COMPONENTS {
+        for u in 1..COMPONENTS.len() {
             acc[u] += n * q * p[u - 1];
         }
     }
@@ -284,12 +298,17 @@ fn normal_var_sums(m: usize, big_m: usize, tau0: f64) -> [f64; 10] {
     acc.map(|v| v / d)
 }
 
-/// Evaluates a ten-entry basis at coefficients (Q², N², B², K²).
+/// Component `t`'s coefficient in a coefficient array indexed by term.
+fn coef(c: &[f64], t: usize) -> f64 {
+    c[COMPONENTS[t].index()]
+}
+
+/// Evaluates a ten-entry basis at the coefficients `c` (indexed by term: Q², N², B², K², …).
 fn quad(s: &[f64; 10], c: &[f64]) -> f64 {
     let mut v = 0.0;
     for (k, &(t, u)) in PAIRS.iter().enumerate() {
         let f = if t == u { 1.0 } else { 2.0 };
-        v += f * c[t] * c[u] * s[k];
+        v += f * coef(c, t) * coef(c, u) * s[k];
     }
     v
 }
@@ -300,9 +319,9 @@ fn bilinear(s: &[f64; 10], ci: &[f64], cj: &[f64]) -> f64 {
     let mut v = 0.0;
     for (k, &(t, u)) in PAIRS.iter().enumerate() {
         v += if t == u {
-            ci[t] * cj[u] * s[k]
+            coef(ci, t) * coef(cj, u) * s[k]
         } else {
-            (ci[t] * cj[u] + ci[u] * cj[t]) * s[k]
+            (coef(ci, t) * coef(cj, u) + coef(ci, u) * coef(cj, t)) * s[k]
         };
     }
     v
@@ -458,7 +477,10 @@ pub fn avar_cov_pair_exact(
     let mut s = 0.0;
     for h in h_lo..=h_hi {
         let p = phi_smooth(h as f64, mi as f64, mj as f64, tau0);
-        let cc = c[0] * phi_q(h, mi as i64, mj as i64) + c[1] * p[0] + c[2] * p[1] + c[3] * p[2];
+        let cc = coef(c, 0) * phi_q(h, mi as i64, mj as i64)
+            + coef(c, 1) * p[0]
+            + coef(c, 2) * p[1]
+            + coef(c, 3) * p[2];
         s += pair_count(h as f64, big_mi as f64, big_mj as f64) * cc * cc;
     }
     let (ti, tj) = (mi as f64 * tau0, mj as f64 * tau0);

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use super::oadev::Overlap;
 use super::{CurveData, CurvePoint, IdMethod};
 use crate::ieee952::files;
-use bag2mat::Sensor;
+use bag2mat::{STANDARD_GRAVITY, Sensor};
 
 mod imu_utils;
 use imu_utils::{imu_utils_name, read_imu_utils};
@@ -32,8 +32,6 @@ use imu_utils::{imu_utils_name, read_imu_utils};
 pub const IMU_UTILS_PSEUDO_DEG_H: f64 = 57.3 * 3600.0;
 /// allan_variance_ros' period step: period = 0.1·p s.
 pub const AVR_PERIOD_STEP: f64 = 0.1;
-/// Standard gravity for curves given in g.
-pub const STANDARD_GRAVITY: f64 = 9.806_65;
 /// A plain CSV's τ must be an integer multiple of τ0 to this relative precision.
 const GRID_REL_TOL: f64 = 1e-3;
 
