@@ -180,7 +180,7 @@ where
 }
 
 /// Whether a density is plottable on a log axis.
-fn positive(v: f64) -> bool {
+pub(crate) fn positive(v: f64) -> bool {
     v.is_finite() && v > 0.0
 }
 
@@ -239,22 +239,51 @@ where
     DB::ErrorType: 'static,
 {
     let px = |v: f64| (v * scale).round() as u32;
+    draw_binned(ctx, bins, floor, Some("PSD, largest bin"), "PSD", scale)?;
+    if !model.is_empty() {
+        ctx.draw_series(LineSeries::new(
+            model.iter().copied(),
+            BLACK.stroke_width(px(2.0)),
+        ))?
+        .label("fitted model")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
+    }
+    Ok(())
+}
+
+/// A binned PSD as both PSD charts draw it (this one and the operating analysis'): its
+/// envelope (largest bin, faint; in the legend as `envelope` when given), its mean
+/// (`mean`) and its local floor (dashed grey).
+pub(crate) fn draw_binned<'a, DB: DrawingBackend + 'a>(
+    ctx: &mut LogLog<'a, DB>,
+    bins: &[Bin],
+    floor: &[Bin],
+    envelope: Option<&str>,
+    mean: &str,
+    scale: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let px = |v: f64| (v * scale).round() as u32;
     let data = RGBColor(0, 90, 170);
-    ctx.draw_series(LineSeries::new(
+    let env = ctx.draw_series(LineSeries::new(
         bins.iter()
             .filter(|b| positive(b.max))
             .map(|b| (b.freq, b.max)),
         data.mix(0.3).stroke_width(px(1.0).max(1)),
-    ))?
-    .label("PSD, largest bin")
-    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data.mix(0.3)));
+    ))?;
+    if let Some(label) = envelope {
+        env.label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data.mix(0.3)));
+    }
     ctx.draw_series(LineSeries::new(
         bins.iter()
             .filter(|b| positive(b.mean))
             .map(|b| (b.freq, b.mean)),
         data.stroke_width(px(1.5).max(1)),
     ))?
-    .label("PSD")
+    .label(mean)
     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data.stroke_width(2)));
     let grey = RGBColor(120, 120, 120);
     ctx.draw_series(DashedLineSeries::new(
@@ -268,14 +297,6 @@ where
     ))?
     .label("local floor")
     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2)));
-    if !model.is_empty() {
-        ctx.draw_series(LineSeries::new(
-            model.iter().copied(),
-            BLACK.stroke_width(px(2.0)),
-        ))?
-        .label("fitted model")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK.stroke_width(2)));
-    }
     Ok(())
 }
 

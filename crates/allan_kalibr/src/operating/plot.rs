@@ -14,7 +14,7 @@ use plotters::prelude::*;
 
 use super::{AxisOperating, Operating};
 use crate::ieee952::chart_panels;
-use crate::ieee952::psd_plot::log_bins;
+use crate::ieee952::psd_plot::{draw_binned, log_bins, positive};
 
 /// Panel size of the PSD chart in SVG units.
 const PANEL: (u32, u32) = (560, 420);
@@ -103,10 +103,6 @@ impl bag2mat::shared::plot::Figure for PsdChart<'_> {
     }
 }
 
-fn positive(v: f64) -> bool {
-    v.is_finite() && v > 0.0
-}
-
 fn psd_panel<DB: DrawingBackend>(
     ax: &AxisOperating,
     area: &DrawingArea<DB, Shift>,
@@ -149,33 +145,8 @@ where
         ("f [Hz]", &format!("PSD [({})²/Hz]", ax.sensor.unit())),
         scale,
     )?;
-    let data = RGBColor(0, 90, 170);
-    ctx.draw_series(LineSeries::new(
-        bins.iter()
-            .filter(|b| positive(b.max))
-            .map(|b| (b.freq, b.max)),
-        data.mix(0.3).stroke_width(px(1.0).max(1)),
-    ))?;
-    ctx.draw_series(LineSeries::new(
-        bins.iter()
-            .filter(|b| positive(b.mean))
-            .map(|b| (b.freq, b.mean)),
-        data.stroke_width(px(1.5).max(1)),
-    ))?
-    .label("residual PSD")
-    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], data.stroke_width(2)));
+    draw_binned(&mut ctx, &bins, &floor, None, "residual PSD", scale)?;
     let grey = RGBColor(120, 120, 120);
-    ctx.draw_series(DashedLineSeries::new(
-        floor
-            .iter()
-            .filter(|b| positive(b.mean))
-            .map(|b| (b.freq, b.mean)),
-        px(4.0),
-        px(3.0),
-        grey.stroke_width(px(1.0).max(1)),
-    ))?
-    .label("local floor")
-    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey.stroke_width(2)));
     let purple = RGBColor(140, 60, 170);
     if spl.iter().any(|b| positive(b.mean) && b.mean > y0) {
         ctx.draw_series(LineSeries::new(
