@@ -57,6 +57,10 @@ pub const DT_TOL: f64 = 1e-9;
 pub const LINEAR_TOL: f64 = 1e-10;
 /// Half-step of the numerical time derivatives of the prediction, ns.
 pub const DERIVATIVE_STEP_NS: i64 = 250_000;
+/// Pieces the normal equations are summed in, each on one thread, then added in order: a
+/// count that does not depend on the machine, so every run gives the same bytes (a few
+/// dozen partial matrices at most: small beside the samples).
+const NORMAL_CHUNKS: usize = 32;
 /// Grid step of the coarse time-offset search, s.
 pub const COARSE_STEP: f64 = 0.005;
 /// The reference must turn by this much (standard deviation of |ω|, rad/s) for the time
@@ -433,118 +437,114 @@ pub fn calibrate(
         let w = [1.0 / sigma2[0], 1.0 / sigma2[1]];
         let dshift = st.theta[DT] - kin_dt;
         let st_ref = &st;
-        let (h, g, ss) = (0..n)
-            .into_par_iter()
-            .fold(
-                || {
-                    (
-                        DMatrix::<f64>::zeros(p_count, p_count),
-                        DVector::<f64>::zeros(p_count),
-                        [0.0f64; 2],
-                    )
-                },
-                |(mut h, mut gv, mut ss), k| {
-                    let kk = &kins[k];
-                    let (l, u) = hat(k);
-                    let fr = kk.ab - kk.r.transpose() * gw
-                        + (kk.abd + kk.w.cross(&(kk.r.transpose() * gw))) * dshift;
-                    let frd = kk.abd + kk.w.cross(&(kk.r.transpose() * gw));
-                    let w_b = kk.w + kk.wd * dshift;
-                    let km = so3::hat(&kk.wd) + so3::hat(&w_b) * so3::hat(&w_b);
-                    let lv = km * lev;
-                    let mut add = |idx: &[usize], val: &[f64], r: f64, wt: f64| {
-                        for a in 0..idx.len() {
-                            gv[idx[a]] += wt * val[a] * r;
-                            for b in 0..idx.len() {
-                                h[(idx[a], idx[b])] += wt * val[a] * val[b];
-                            }
-                        }
-                    };
-                    if gyro.is_some() {
-                        let fm = if acc.is_some() {
-                            Vector3::new(meas(1, 0, k), meas(1, 1, k), meas(1, 2, k))
-                        } else {
-                            Vector3::zeros()
-                        };
-                        let pred = ag * w_b
-                            + gs * fm
-                            + st_ref.bias(0, l) * (1.0 - u)
-                            + st_ref.bias(0, l + 1) * u;
-                        let d = ag * kk.wd;
-                        for i in 0..3 {
-                            let r = meas(0, i, k) - pred[i];
-                            ss[0] += r * r;
-                            let bi = BIAS + i * nb + l;
-                            let idx = [
-                                DT,
-                                AG + 3 * i,
-                                AG + 3 * i + 1,
-                                AG + 3 * i + 2,
-                                GS + 3 * i,
-                                GS + 3 * i + 1,
-                                GS + 3 * i + 2,
-                                bi,
-                                bi + 1,
-                            ];
-                            let val = [d[i], w_b.x, w_b.y, w_b.z, fm.x, fm.y, fm.z, 1.0 - u, u];
-                            add(&idx, &val, r, w[0]);
-                        }
-                    }
-                    if acc.is_some() {
-                        let x = fr + lv;
-                        let pred =
-                            aa * x + st_ref.bias(1, l) * (1.0 - u) + st_ref.bias(1, l + 1) * u;
-                        let d = aa * frd;
-                        let dl = aa * km;
-                        let rt = kk.r.transpose();
-                        let dt1 = aa * (rt * -(e1.cross(&gw)));
-                        let dt2 = aa * (rt * -(e2.cross(&gw)));
-                        for i in 0..3 {
-                            let r = meas(1, i, k) - pred[i];
-                            ss[1] += r * r;
-                            let bi = BIAS + 3 * nb + i * nb + l;
-                            let idx = [
-                                DT,
-                                AA + 3 * i,
-                                AA + 3 * i + 1,
-                                AA + 3 * i + 2,
-                                LEV,
-                                LEV + 1,
-                                LEV + 2,
-                                TILT,
-                                TILT + 1,
-                                bi,
-                                bi + 1,
-                            ];
-                            let val = [
-                                d[i],
-                                x.x,
-                                x.y,
-                                x.z,
-                                dl[(i, 0)],
-                                dl[(i, 1)],
-                                dl[(i, 2)],
-                                dt1[i],
-                                dt2[i],
-                                1.0 - u,
-                                u,
-                            ];
-                            add(&idx, &val, r, w[1]);
-                        }
-                    }
-                    (h, gv, ss)
-                },
+        type Normal = (DMatrix<f64>, DVector<f64>, [f64; 2]);
+        let zero = || -> Normal {
+            (
+                DMatrix::<f64>::zeros(p_count, p_count),
+                DVector::<f64>::zeros(p_count),
+                [0.0f64; 2],
             )
-            .reduce(
-                || {
-                    (
-                        DMatrix::<f64>::zeros(p_count, p_count),
-                        DVector::<f64>::zeros(p_count),
-                        [0.0f64; 2],
-                    )
-                },
-                |a, b| (a.0 + b.0, a.1 + b.1, [a.2[0] + b.2[0], a.2[1] + b.2[1]]),
-            );
+        };
+        let normal = |(mut h, mut gv, mut ss): Normal, k: usize| {
+            let kk = &kins[k];
+            let (l, u) = hat(k);
+            let fr = kk.ab - kk.r.transpose() * gw
+                + (kk.abd + kk.w.cross(&(kk.r.transpose() * gw))) * dshift;
+            let frd = kk.abd + kk.w.cross(&(kk.r.transpose() * gw));
+            let w_b = kk.w + kk.wd * dshift;
+            let km = so3::hat(&kk.wd) + so3::hat(&w_b) * so3::hat(&w_b);
+            let lv = km * lev;
+            let mut add = |idx: &[usize], val: &[f64], r: f64, wt: f64| {
+                for a in 0..idx.len() {
+                    gv[idx[a]] += wt * val[a] * r;
+                    for b in 0..idx.len() {
+                        h[(idx[a], idx[b])] += wt * val[a] * val[b];
+                    }
+                }
+            };
+            if gyro.is_some() {
+                let fm = if acc.is_some() {
+                    Vector3::new(meas(1, 0, k), meas(1, 1, k), meas(1, 2, k))
+                } else {
+                    Vector3::zeros()
+                };
+                let pred =
+                    ag * w_b + gs * fm + st_ref.bias(0, l) * (1.0 - u) + st_ref.bias(0, l + 1) * u;
+                let d = ag * kk.wd;
+                for i in 0..3 {
+                    let r = meas(0, i, k) - pred[i];
+                    ss[0] += r * r;
+                    let bi = BIAS + i * nb + l;
+                    let idx = [
+                        DT,
+                        AG + 3 * i,
+                        AG + 3 * i + 1,
+                        AG + 3 * i + 2,
+                        GS + 3 * i,
+                        GS + 3 * i + 1,
+                        GS + 3 * i + 2,
+                        bi,
+                        bi + 1,
+                    ];
+                    let val = [d[i], w_b.x, w_b.y, w_b.z, fm.x, fm.y, fm.z, 1.0 - u, u];
+                    add(&idx, &val, r, w[0]);
+                }
+            }
+            if acc.is_some() {
+                let x = fr + lv;
+                let pred = aa * x + st_ref.bias(1, l) * (1.0 - u) + st_ref.bias(1, l + 1) * u;
+                let d = aa * frd;
+                let dl = aa * km;
+                let rt = kk.r.transpose();
+                let dt1 = aa * (rt * -(e1.cross(&gw)));
+                let dt2 = aa * (rt * -(e2.cross(&gw)));
+                for i in 0..3 {
+                    let r = meas(1, i, k) - pred[i];
+                    ss[1] += r * r;
+                    let bi = BIAS + 3 * nb + i * nb + l;
+                    let idx = [
+                        DT,
+                        AA + 3 * i,
+                        AA + 3 * i + 1,
+                        AA + 3 * i + 2,
+                        LEV,
+                        LEV + 1,
+                        LEV + 2,
+                        TILT,
+                        TILT + 1,
+                        bi,
+                        bi + 1,
+                    ];
+                    let val = [
+                        d[i],
+                        x.x,
+                        x.y,
+                        x.z,
+                        dl[(i, 0)],
+                        dl[(i, 1)],
+                        dl[(i, 2)],
+                        dt1[i],
+                        dt2[i],
+                        1.0 - u,
+                        u,
+                    ];
+                    add(&idx, &val, r, w[1]);
+                }
+            }
+            (h, gv, ss)
+        };
+        // a fixed number of chunks, summed in order: the same sums on every run (rayon's
+        // fold/reduce splits by work stealing, and f64 addition is not associative: the last
+        // digits of the operating densities changed from run to run)
+        let chunk = n.div_ceil(NORMAL_CHUNKS).max(1);
+        let (h, g, ss) = (0..n.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| (c * chunk..n.min((c + 1) * chunk)).fold(zero(), normal))
+            .collect::<Vec<Normal>>()
+            .into_iter()
+            .fold(zero(), |a, b| {
+                (a.0 + b.0, a.1 + b.1, [a.2[0] + b.2[0], a.2[1] + b.2[1]])
+            });
         let mut h = h;
         let mut g = g;
         // priors (module docs): A − R, G, lever arm, the tilt step, the biases

@@ -184,6 +184,45 @@ fn operating_density_offset_and_lines_against_a_motion_capture_reference() {
     );
 }
 
+/// Two runs of the analysis on one record write the same bytes: the calibration's sums do
+/// not depend on how the threads split the work (they did, in the last digits).
+#[test]
+fn the_operating_analysis_writes_the_same_bytes_on_every_run() {
+    let d = tempfile::tempdir().unwrap();
+    let w = record::write(d.path(), &record::Spec::handheld(100.0, 100.0, 120.0, 5));
+    let outs: Vec<std::path::PathBuf> = (0..RUNS_COMPARED)
+        .map(|k| {
+            let out = d.path().join(format!("out{k}"));
+            run(&[
+                w.imu.to_str().unwrap(),
+                "--reference",
+                w.reference.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "-q",
+            ]);
+            out
+        })
+        .collect();
+    for f in [
+        "operating_noise.csv",
+        "operating_lines.csv",
+        "operating_psd.csv",
+    ] {
+        let first = std::fs::read(outs[0].join(f)).unwrap();
+        for o in &outs[1..] {
+            assert!(
+                std::fs::read(o.join(f)).unwrap() == first,
+                "{f} differs between runs"
+            );
+        }
+    }
+}
+
+/// Runs compared by the reproducibility test (each pair is a chance for a split of the work
+/// that differs).
+const RUNS_COMPARED: usize = 3;
+
 /// The static record of the agreement test: 20 minutes at 200 Hz, white noise and random
 /// walk only (what the static analysis models exactly), a tilted IMU at rest.
 fn static_spec(seed: u64) -> record::Spec {
