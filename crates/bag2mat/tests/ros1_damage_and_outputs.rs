@@ -102,7 +102,7 @@ fn check_complete_or_reported(path: &Path, what: &str) {
     assert!(
         s.notes
             .iter()
-            .any(|n| n.contains(&format!("{missing} ")) && n.contains("lost")),
+            .any(|n| n.text.contains(&format!("{missing} ")) && n.text.contains("lost")),
         "{what}: {missing} rows missing, notes {:?}",
         s.notes
     );
@@ -220,9 +220,9 @@ fn damaged_message_header_is_reported() {
         assert_eq!(s.len(), N as usize - 1, "{what}");
         let (t, _) = synthetic(3000);
         assert!(
-            s.notes.iter().any(|n| n.contains("1 message")
-                && n.contains("lost")
-                && n.contains(&t.to_string())),
+            s.notes.iter().any(|n| n.text.contains("1 message")
+                && n.text.contains("lost")
+                && n.text.contains(&t.to_string())),
             "{what}: the lost message is not named (count, time): {:?}",
             s.notes
         );

@@ -125,7 +125,7 @@ fn slash_form_fallback_is_noted() {
     let s = read_imu_series(&path, "/imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!((s.len(), s.topic.as_str()), (10, "imu"));
     assert!(
-        s.notes.iter().any(|n| n.contains("using 'imu'")),
+        s.notes.iter().any(|n| n.text.contains("using 'imu'")),
         "{:?}",
         s.notes
     );
@@ -170,7 +170,7 @@ fn out_of_order_record_times_come_out_sorted() {
     w.finish().unwrap();
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.seq, vec![0, 1, 2, 3, 4, 5]);
-    assert!(s.notes.iter().any(|n| n.contains("sorted")));
+    assert!(s.notes.iter().any(|n| n.text.contains("sorted")));
 }
 
 #[test]
@@ -190,7 +190,7 @@ fn truncated_bag_keeps_complete_chunks() {
             s.len()
         );
         assert!(
-            s.notes.iter().any(|n| n.contains("truncated")),
+            s.notes.iter().any(|n| n.text.contains("truncated")),
             "{c:?}: {:?}",
             s.notes
         );
@@ -217,7 +217,7 @@ fn unfinished_bag_is_scanned() {
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.len(), 3000);
     assert!(
-        s.notes.iter().any(|n| n.contains("index_pos = 0")),
+        s.notes.iter().any(|n| n.text.contains("index_pos = 0")),
         "{:?}",
         s.notes
     );
@@ -302,7 +302,7 @@ fn matrix_routes_agree_and_sort() {
     let want: Vec<f64> = (0..6).map(|i| synthetic(i).0.to_sec()).collect();
     assert_eq!(conv.data.t(), &want[..]);
     assert!(
-        conv.notes.iter().any(|n| n.contains("sorted")),
+        conv.notes.iter().any(|n| n.text.contains("sorted")),
         "{:?}",
         conv.notes
     );
