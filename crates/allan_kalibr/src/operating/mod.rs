@@ -529,11 +529,10 @@ fn run_topic(ctx: &RunContext, data: ImuData, dir: &Path) -> Result<Section, Err
         .unwrap_or_else(|| common.named_topic().to_string());
     let (data, findings, rate) = prepare(common, data, &mut notes)?;
     if let Some(r) = reference {
-        notes.extend(
-            r.notes
-                .iter()
-                .map(|n| Note::warning(format!("reference: {n}"))),
-        );
+        notes.extend(r.notes.iter().map(|n| Note {
+            text: format!("reference: {}", n.text),
+            ..n.clone()
+        }));
     }
     let mut op = match reference {
         Some(r) => analyse_with_reference(&data, rate, r, s)?,
