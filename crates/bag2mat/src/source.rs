@@ -264,12 +264,12 @@ impl std::fmt::Display for Loss {
 pub struct PartRead {
     /// Messages of the wanted channels handed to the callback.
     pub delivered: u64,
-    /// Why the part stopped before its end (the messages before it were delivered).
+    /// Why the part stopped before its end, by kind (the messages before it were delivered).
     pub error: Option<PartError>,
     /// Messages of wanted channels found but not handed out (e.g. a payload that does not
     /// decompress), and why the first of them was skipped.
     pub skipped: u64,
-    /// Why the first skipped message was skipped.
+    /// Why the first skipped message was skipped, by kind.
     pub skip_reason: Option<SkipReason>,
     /// Messages the part's own index promises that could not be delivered (damaged record
     /// headers, a resynchronised stretch), with their channel, count and time span.
