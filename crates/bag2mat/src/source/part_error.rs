@@ -136,3 +136,104 @@ pub enum SkipReason {
         why: &'static str,
     },
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each kind says what the readers said as text before there were kinds (the words are
+    /// part of the output: `warning:` lines, `bag2mat info`'s losses).
+    #[test]
+    fn every_kind_says_the_text_the_readers_said() {
+        let io = || Arc::new(std::io::Error::other("boom"));
+        let cases: Vec<(String, &str)> = vec![
+            (
+                PartError::NoSuchPart {
+                    index: 4,
+                    wording: NoSuchPart::Chunk,
+                }
+                .to_string(),
+                "no such chunk",
+            ),
+            (
+                PartError::NoSuchPart {
+                    index: 4,
+                    wording: NoSuchPart::Part,
+                }
+                .to_string(),
+                "no such part",
+            ),
+            (
+                PartError::NoSuchPart {
+                    index: 4,
+                    wording: NoSuchPart::Numbered,
+                }
+                .to_string(),
+                "no part 4",
+            ),
+            (
+                PartError::RowsTaken.to_string(),
+                "the rows were handed over to a read already",
+            ),
+            (
+                PartError::from(Ros1ChunkError::PastEnd).to_string(),
+                "chunk record runs past the end of the file",
+            ),
+            (
+                PartError::from(Ros1ChunkError::NotChunk).to_string(),
+                "not a chunk record",
+            ),
+            (
+                PartError::from(Ros1ChunkError::Decompress {
+                    codec: "bz2",
+                    source: io(),
+                })
+                .to_string(),
+                "bz2: boom",
+            ),
+            (
+                PartError::from(Ros1ChunkError::Size { got: 3, size: 4 }).to_string(),
+                "chunk body is 3 bytes, its header says 4",
+            ),
+            (
+                PartError::from(Ros1ChunkError::Io(io())).to_string(),
+                "boom",
+            ),
+            (
+                PartError::from(McapChunkError::PastEnd).to_string(),
+                "the chunk's records run past the end of the file",
+            ),
+            (
+                PartError::from(McapChunkError::Lz4(io())).to_string(),
+                "lz4: boom",
+            ),
+            (
+                PartError::from(McapChunkError::Compression("brotli".into())).to_string(),
+                "unsupported chunk compression 'brotli'",
+            ),
+            (
+                PartError::from(McapChunkError::Size { got: 3, stated: 4 }).to_string(),
+                "chunk records are 3 bytes, its header says 4",
+            ),
+            (
+                PartError::from(McapChunkError::Crc {
+                    got: 0xab,
+                    stored: 0x1234_5678,
+                })
+                .to_string(),
+                "chunk CRC 000000ab differs from the stored 12345678",
+            ),
+            (
+                SkipReason::Undecodable {
+                    topic: "sensor_gyro_fifo".into(),
+                    why: "a FIFO message with a zero dt",
+                }
+                .to_string(),
+                "'sensor_gyro_fifo': a FIFO message with a zero dt",
+            ),
+        ];
+        for (said, before) in cases {
+            assert_eq!(said, before);
+        }
+    }
+}
