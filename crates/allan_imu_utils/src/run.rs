@@ -217,7 +217,7 @@ pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, E
             c.common.out_dir = config.common.out_dir.join(folder);
         }
         let topic = series.topic.clone();
-        let notes = bag2mat::shared::note::warnings(&series.notes);
+        let notes = series.notes.clone();
         outs.push(TopicRun {
             topic,
             notes,
@@ -236,7 +236,7 @@ fn run_series(
 ) -> Result<Outcome, Error> {
     let mut timings: Vec<(&str, Duration)> = vec![("read_bag", read_time)];
     let topic = series.topic.clone();
-    let mut notes = bag2mat::shared::note::warnings(&series.notes);
+    let mut notes = series.notes.clone();
     // integrated deltas far apart are no samples to analyse
     series.check_integration()?;
     let absent = stand_in_and_skip(config, &mut series, &mut notes)?;

@@ -27,7 +27,7 @@ pub struct ImuData {
     /// The topic the samples came from (the bag's own spelling), if known.
     pub topic: Option<String>,
     /// Messages for the user (bag2mat's notes).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// The stamps in nanoseconds and what the record check needs besides the samples.
     pub clock: Clock,
     /// A sensor the topic does not carry (PX4 `sensor_gyro`, a gyro-only DataFlash

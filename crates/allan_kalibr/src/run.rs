@@ -234,7 +234,7 @@ pub fn run_topics(config: &Config, outputs: &Outputs) -> Result<Vec<TopicRun>, E
             .topic
             .clone()
             .unwrap_or_else(|| config.common.named_topic().to_string());
-        let notes = bag2mat::shared::note::warnings(&data.notes);
+        let notes = data.notes.clone();
         outs.push(TopicRun {
             topic,
             notes,
@@ -297,7 +297,7 @@ fn run_on(
     outputs: &Outputs,
 ) -> Result<RunOutput, Error> {
     // What the reader found (losses, fallbacks) is always said, also with --quiet.
-    let mut notes = bag2mat::shared::note::warnings(&data.notes);
+    let mut notes = data.notes.clone();
     let data_topic = data.topic.clone();
     // integrated deltas far apart are no samples to analyse
     bag2mat::check_integration(

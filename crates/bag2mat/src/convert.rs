@@ -104,7 +104,7 @@ pub struct Converted {
     /// The topic as named in the bag.
     pub topic: String,
     /// Notes for stderr.
-    pub notes: Vec<String>,
+    pub notes: Vec<crate::shared::note::Note>,
 }
 
 /// Reads one topic straight into bagconvert's N×7 matrix (record time).
@@ -321,7 +321,7 @@ pub fn run(cfg: &Config, mut outputs: Outputs) -> Result<Vec<(PathBuf, usize)>, 
     let mut written = Vec::new();
     for (s, out) in read.series.into_iter().zip(outs) {
         for n in &s.notes {
-            eprintln!("warning: {n}");
+            eprintln!("{}", n.line());
         }
         for w in conversion_warnings(&s, cfg.time) {
             eprintln!("warning: {w}");

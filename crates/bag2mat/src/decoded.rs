@@ -123,7 +123,7 @@ impl DecodedSource {
     pub(crate) fn new(
         kind: InputKind,
         mut streams: Vec<Stream>,
-        notes: Vec<String>,
+        notes: Vec<crate::shared::note::Note>,
         losses: Vec<Loss>,
     ) -> DecodedSource {
         let mut contents = Contents {
@@ -215,9 +215,6 @@ impl DecodedSource {
     }
 }
 
-/// What a part of rows handed over by [`source::Source::take_rows`] says when read.
-const TAKEN: &str = "the rows were handed over to a read already";
-
 impl source::Source for DecodedSource {
     fn kind(&self) -> InputKind {
         self.kind
@@ -233,7 +230,10 @@ impl source::Source for DecodedSource {
     ) -> source::PartRead {
         let mut r = source::PartRead::default();
         let Some(&(k, id, a, b)) = self.map.get(part) else {
-            r.error = Some(format!("no part {part}"));
+            r.error = Some(source::PartError::NoSuchPart {
+                index: part,
+                wording: source::NoSuchPart::Numbered,
+            });
             return r;
         };
         if !want(id) {
@@ -249,7 +249,7 @@ impl source::Source for DecodedSource {
         }
         let rows = self.rows[k].read().unwrap_or_else(|e| e.into_inner());
         if rows.len() < b {
-            r.error = Some(TAKEN.into());
+            r.error = Some(source::PartError::RowsTaken);
             return r;
         }
         for i in a..b {
@@ -271,7 +271,7 @@ impl source::Source for DecodedSource {
         }
         let rows = self.rows[k].read().unwrap_or_else(|e| e.into_inner());
         if rows.len() < b {
-            r.error = Some(TAKEN.into());
+            r.error = Some(source::PartError::RowsTaken);
             return Some(r);
         }
         for i in a..b {
@@ -388,10 +388,17 @@ mod tests {
         let by_parts = read_from(&whole(), &sel, &opts).unwrap();
         let src = whole();
         assert!(src.take_rows(0).is_some_and(|r| r.len() == n as usize));
-        // taken: its parts say so instead of delivering nothing in silence
+        // taken: its parts say so (by kind) instead of delivering nothing in silence
+        let part = src.read_part(0, &|_| true, &mut |_, _, _| {});
+        assert!(
+            matches!(part.error, Some(source::PartError::RowsTaken)),
+            "{:?}",
+            part.error
+        );
+        let taken = source::PartError::RowsTaken.to_string();
         let after = read_from(&src, &sel, &opts);
         assert!(
-            matches!(&after, Err(Error::NothingRead { why, .. }) if why.iter().any(|w| w.contains(TAKEN))),
+            matches!(&after, Err(Error::NothingRead { why, .. }) if why.iter().any(|w| w.contains(&taken))),
             "{:?}",
             after.map(|r| r.series.len())
         );

@@ -65,7 +65,7 @@ pub struct InfoReport {
     /// Every topic, sorted by name.
     pub topics: Vec<TopicInfo>,
     /// Notes from opening.
-    pub notes: Vec<String>,
+    pub notes: Vec<crate::shared::note::Note>,
     /// Data the container reports lost, and parts that could not be read.
     pub losses: Vec<Loss>,
     /// When the log itself says it started, ns (a PX4 ULog's header), if it says.
@@ -140,7 +140,9 @@ fn read_times(src: &dyn source::Source, quiet: bool) -> (BTreeMap<u32, Vec<u64>>
     let mut times: BTreeMap<u32, Vec<u64>> = BTreeMap::new();
     for (i, (m, r)) in per_part.into_iter().enumerate() {
         losses.extend(r.lost);
-        if let Some(e) = r.error.or(r.skip_reason) {
+        let why = (r.error.as_ref().map(|e| e.to_string()))
+            .or_else(|| r.skip_reason.as_ref().map(|s| s.to_string()));
+        if let Some(e) = why {
             losses.push(Loss {
                 what: format!("{}: {e}", parts[i].label),
                 messages: None,
@@ -331,7 +333,7 @@ impl InfoReport {
             }
         }
         for n in &self.notes {
-            s.push_str(&format!("note: {n}\n"));
+            s.push_str(&format!("note: {}\n", n.text));
         }
         if let Some(start) = self.log_start {
             for t in self.topics.iter().filter(|t| t.before_start > 0) {

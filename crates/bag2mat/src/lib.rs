@@ -122,10 +122,12 @@ pub use series::{
 };
 pub use source::{
     Channel as SourceChannel, Contents as SourceContents, Encoding as MessageEncoding,
-    Loss as SourceLoss, Part as SourcePart, PartRead,
+    Loss as SourceLoss, McapChunkError, NoSuchPart, Part as SourcePart, PartError, PartRead,
+    Ros1ChunkError, SkipReason,
 };
 pub use source::{InputKind, KindFacts, Source, accepted, input_help};
 pub use time::RosTime;
 pub use timing::{Gap as TimingGap, Segment as TimingSegment};
 pub use timing::{Timing, analyse as analyse_timing, ns_of_seconds, ns_of_times};
 pub use units::{AccUnit, GyroUnit, STANDARD_GRAVITY, TimeUnit};
+pub use zstd::ZstdError;

@@ -9,6 +9,12 @@
 //! says how many it delivered and why it stopped early. Decoding, the topic rules, progress
 //! and sorting are written once on top of this, in [`crate::series`].
 
+mod part_error;
+
+pub use part_error::{McapChunkError, NoSuchPart, PartError, Ros1ChunkError, SkipReason};
+
+use crate::shared::note::Note;
+
 /// What an input is, recognised from its first bytes (or `metadata.yaml` for a directory).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputKind {
@@ -268,23 +274,23 @@ impl std::fmt::Display for Loss {
 }
 
 /// What reading one part delivered.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default)]
 pub struct PartRead {
     /// Messages of the wanted channels handed to the callback.
     pub delivered: u64,
-    /// Why the part stopped before its end (the messages before it were delivered).
-    pub error: Option<String>,
+    /// Why the part stopped before its end, by kind (the messages before it were delivered).
+    pub error: Option<PartError>,
     /// Messages of wanted channels found but not handed out (e.g. a payload that does not
     /// decompress), and why the first of them was skipped.
     pub skipped: u64,
-    /// Why the first skipped message was skipped.
-    pub skip_reason: Option<String>,
+    /// Why the first skipped message was skipped, by kind.
+    pub skip_reason: Option<SkipReason>,
     /// Messages the part's own index promises that could not be delivered (damaged record
     /// headers, a resynchronised stretch), with their channel, count and time span.
     pub lost: Vec<Loss>,
     /// What the read found and worked around without losing data (a row read in place of
     /// one whose id is damaged, rows a damaged page holds twice read once, …).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
 }
 
 /// The callback of [`Source::read_part`]: `(channel id, record time in ns, payload)`.
@@ -308,7 +314,7 @@ pub trait Source: Sync {
         &self.contents().parts
     }
     /// What opening found (unindexed, truncated, scanned, …).
-    fn notes(&self) -> &[String] {
+    fn notes(&self) -> &[Note] {
         &self.contents().notes
     }
     /// What opening found lost (incomplete records, unreadable index entries, …).
@@ -357,7 +363,7 @@ pub struct Contents {
     /// Its parts, in storage order.
     pub parts: Vec<Part>,
     /// What opening found (unindexed, truncated, scanned, …).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// What opening found lost.
     pub losses: Vec<Loss>,
     /// When the log itself says it started, ns (a PX4 ULog's header): a message stamped

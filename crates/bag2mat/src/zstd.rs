@@ -33,7 +33,7 @@ pub(crate) fn decompress_into(data: &[u8], out: &mut Vec<u8>, limit: u64) -> Res
 /// Data that does not decompress as zstd (or past its limit).
 #[derive(Debug, thiserror::Error)]
 #[error("zstd: {0}")]
-pub(crate) struct ZstdError(#[from] std::io::Error);
+pub struct ZstdError(#[from] std::io::Error);
 
 struct LimitedWriter<'a> {
     out: &'a mut Vec<u8>,

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use bag2mat::test_tools::{Reported, reported_losses, venv_python, workspace};
+use bag2mat::{NoSuchPart, PartError, SkipReason};
 
 fn bag2mat() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bag2mat"))
@@ -286,6 +287,78 @@ fn ulog_a_data_message_that_does_not_fit_its_subscription_is_read_as_what_it_is(
     b[u.combined(1000) + 2] = b'A';
     let (d, lost) = check_ulog(dir.path(), (&p, &c), &b, "add.ulg");
     assert!(lost <= 1, "{}", d.stderr);
+}
+
+/// PX4's gyro FIFO topic as the firmware defines it: `samples` rows of `x`/`y`/`z` (scaled by
+/// `scale`), `dt` µs apart.
+const GYRO_FIFO: &str = "sensor_gyro_fifo:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float dt;float scale;int16_t[32] x;int16_t[32] y;int16_t[32] z;uint8_t samples;uint8_t rotation;uint8_t[2] _padding0;";
+
+/// A FIFO message of several samples whose `dt` is zero cannot place its samples in time:
+/// it is skipped with the kind that says it does not decode, naming its topic, and every
+/// other message of its part is delivered. Told by the skip reason's kind, not its words.
+#[test]
+fn ulog_a_fifo_message_with_a_zero_dt_is_skipped_as_undecodable() {
+    const MESSAGES: u64 = 200;
+    const SAMPLES: u8 = 4;
+    const BAD: u64 = 120;
+    let dir = tempfile::tempdir().unwrap();
+    let mut u = Ulog {
+        b: b"ULog\x01\x12\x35\x01".to_vec(),
+        msgs: Vec::new(),
+    };
+    u.b.extend_from_slice(&0u64.to_le_bytes());
+    u.msg(b'B', &[0u8; 40]);
+    u.msg(b'F', GYRO_FIFO.as_bytes());
+    u.msg(b'A', b"\x00\x00\x00sensor_gyro_fifo");
+    for i in 0..MESSAGES {
+        let t = 1_000_000 + 1_000 * i;
+        let mut d = 0u16.to_le_bytes().to_vec();
+        d.extend_from_slice(&t.to_le_bytes()); // timestamp
+        d.extend_from_slice(&t.to_le_bytes()); // timestamp_sample
+        d.extend_from_slice(&7u32.to_le_bytes()); // device_id
+        let dt: f32 = if i == BAD { 0.0 } else { 250.0 };
+        d.extend_from_slice(&dt.to_le_bytes());
+        d.extend_from_slice(&1e-3f32.to_le_bytes()); // scale
+        for axis in 0..3i16 {
+            for k in 0..32i16 {
+                d.extend_from_slice(&(axis * 100 + k).to_le_bytes());
+            }
+        }
+        d.extend_from_slice(&[SAMPLES, 0, 0, 0]); // samples, rotation, padding
+        u.msg(b'D', &d);
+    }
+    let p = dir.path().join("fifo.ulg");
+    std::fs::write(&p, &u.b).unwrap();
+    let src = bag2mat::open_input(&p).unwrap();
+    let (mut rows, mut skipped, mut reasons) = (0u64, 0u64, Vec::new());
+    for k in 0..src.parts().len() {
+        let r = src.read_part(k, &|_| true, &mut |_, _, _| {});
+        assert!(r.error.is_none(), "{:?}", r.error);
+        rows += r.delivered;
+        skipped += r.skipped;
+        reasons.extend(r.skip_reason);
+    }
+    let per = u64::from(SAMPLES);
+    assert_eq!((rows, skipped), ((MESSAGES - 1) * per, per), "{reasons:?}");
+    assert!(
+        matches!(
+            reasons.as_slice(),
+            [SkipReason::Undecodable { topic, .. }] if topic == "sensor_gyro_fifo"
+        ),
+        "{reasons:?}"
+    );
+    let past = src.read_part(src.parts().len(), &|_| true, &mut |_, _, _| {});
+    assert!(
+        matches!(
+            past.error,
+            Some(PartError::NoSuchPart {
+                wording: NoSuchPart::Numbered,
+                ..
+            })
+        ),
+        "{:?}",
+        past.error
+    );
 }
 
 /// An unknown message type is skipped by its size (as pyulog skips it), not to the next

@@ -84,7 +84,7 @@ fn pose_topics_written_by_rosbags_read_back_exactly_in_ros1_and_ros2() {
         )
         .unwrap();
         assert!(
-            s.notes.iter().any(|n| n.contains("using '/odom'")),
+            s.notes.iter().any(|n| n.text.contains("using '/odom'")),
             "{:?}",
             s.notes
         );

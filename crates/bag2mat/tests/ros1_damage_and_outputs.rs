@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::Command;
 
 use bag2mat::test_tools::{BagOp, BagRecordHeader, raw_bag_record, read_u32};
-use bag2mat::{Compression, ReadOptions, read_imu_series};
+use bag2mat::{Compression, NoSuchPart, PartError, ReadOptions, Ros1ChunkError, read_imu_series};
 
 use crate::common::{run, synthetic, write_synthetic};
 
@@ -102,7 +102,7 @@ fn check_complete_or_reported(path: &Path, what: &str) {
     assert!(
         s.notes
             .iter()
-            .any(|n| n.contains(&format!("{missing} ")) && n.contains("lost")),
+            .any(|n| n.text.contains(&format!("{missing} ")) && n.text.contains("lost")),
         "{what}: {missing} rows missing, notes {:?}",
         s.notes
     );
@@ -220,9 +220,9 @@ fn damaged_message_header_is_reported() {
         assert_eq!(s.len(), N as usize - 1, "{what}");
         let (t, _) = synthetic(3000);
         assert!(
-            s.notes.iter().any(|n| n.contains("1 message")
-                && n.contains("lost")
-                && n.contains(&t.to_string())),
+            s.notes.iter().any(|n| n.text.contains("1 message")
+                && n.text.contains("lost")
+                && n.text.contains(&t.to_string())),
             "{what}: the lost message is not named (count, time): {:?}",
             s.notes
         );
@@ -709,4 +709,92 @@ fn messages_a_person_can_act_on() {
             && !err.contains(".x.mat."),
         "{err}"
     );
+}
+
+/// The kind each part of the bag at `p` stops with (`None`: read to its end), keyed by the
+/// part's label; and the kind a part index past the last says.
+fn part_errors(p: &Path) -> (Vec<(String, Option<PartError>)>, Option<PartError>) {
+    let src = bag2mat::open_input(p).unwrap();
+    let each = (0..src.parts().len())
+        .map(|k| {
+            let r = src.read_part(k, &|_| true, &mut |_, _, _| {});
+            (src.parts()[k].label.clone(), r.error)
+        })
+        .collect();
+    let past = src.read_part(src.parts().len(), &|_| true, &mut |_, _, _| {});
+    (each, past.error)
+}
+
+/// A chunk whose bz2 block does not decompress stops its part as a decompression error of
+/// that codec, and one whose stated size is not its body's as a size error carrying both
+/// sizes: told by the error's kind (no reading of its words); every other chunk reads whole.
+#[test]
+fn a_damaged_chunk_stops_its_part_with_the_kind_of_its_damage() {
+    let dir = tempfile::tempdir().unwrap();
+    for (compression, name) in [(Compression::Bz2, "bz2"), (Compression::None, "plain")] {
+        let p = dir.path().join(format!("{name}.bag"));
+        write_synthetic(&p, "/imu", N, compression, false);
+        let mut bytes = std::fs::read(&p).unwrap();
+        let chunks: Vec<Rec> = records(&bytes)
+            .into_iter()
+            .filter(|r| r.op == BagOp::Chunk)
+            .collect();
+        assert!(chunks.len() >= 3, "{name}: {} chunks", chunks.len());
+        let hit = chunks[1].clone();
+        let stated = hit.data.len();
+        match compression {
+            // bz2's stream header is 4 bytes ("BZh9"); the block magic after it is zeroed
+            Compression::Bz2 => bytes[hit.data.start + 4..hit.data.start + 64].fill(0),
+            // the chunk header's uncompressed size, one more than the body holds
+            _ => {
+                let at = field(&bytes, &hit.header, "size");
+                let size = read_u32(&bytes, at).unwrap();
+                assert_eq!(
+                    size as usize, stated,
+                    "{name}: an uncompressed chunk's size"
+                );
+                bytes[at..at + 4].copy_from_slice(&(size + 1).to_le_bytes());
+            }
+        }
+        std::fs::write(&p, &bytes).unwrap();
+        let (each, past) = part_errors(&p);
+        let label = format!("chunk at byte {}", hit.pos);
+        assert!(each.iter().any(|(l, _)| *l == label), "{name}: {each:?}");
+        for (l, e) in &each {
+            if *l != label {
+                assert!(e.is_none(), "{name}, {l}: {e:?}");
+                continue;
+            }
+            match compression {
+                Compression::Bz2 => assert!(
+                    matches!(
+                        e,
+                        Some(PartError::Ros1Chunk(Ros1ChunkError::Decompress {
+                            codec: "bz2",
+                            ..
+                        }))
+                    ),
+                    "{name}, {l}: {e:?}"
+                ),
+                _ => assert!(
+                    matches!(
+                        e,
+                        Some(PartError::Ros1Chunk(Ros1ChunkError::Size { got, size }))
+                            if *got == stated && *size == stated + 1
+                    ),
+                    "{name}, {l}: {e:?}"
+                ),
+            }
+        }
+        assert!(
+            matches!(
+                past,
+                Some(PartError::NoSuchPart {
+                    wording: NoSuchPart::Chunk,
+                    ..
+                })
+            ),
+            "{name}: {past:?}"
+        );
+    }
 }

@@ -382,12 +382,12 @@ fn damaged_mcap_and_db3_never_panic() {
     let s = read(&path).unwrap().series.remove(0);
     assert!(!s.is_empty() && s.len() < 6000, "{}", s.len());
     assert!(
-        s.notes.iter().any(|n| n.contains("no footer")),
+        s.notes.iter().any(|n| n.text.contains("no footer")),
         "{:?}",
         s.notes
     );
     assert!(
-        s.notes.iter().any(|n| n.contains("truncated")),
+        s.notes.iter().any(|n| n.text.contains("truncated")),
         "{:?}",
         s.notes
     );
@@ -434,7 +434,7 @@ fn damaged_mcap_and_db3_never_panic() {
         r.series[0]
             .notes
             .iter()
-            .any(|n| n.contains("CRC") || n.contains("chunk")),
+            .any(|n| n.text.contains("CRC") || n.text.contains("chunk")),
         "{:?}",
         r.series[0].notes
     );

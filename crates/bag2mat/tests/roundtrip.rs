@@ -125,7 +125,7 @@ fn slash_form_fallback_is_noted() {
     let s = read_imu_series(&path, "/imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!((s.len(), s.topic.as_str()), (10, "imu"));
     assert!(
-        s.notes.iter().any(|n| n.contains("using 'imu'")),
+        s.notes.iter().any(|n| n.text.contains("using 'imu'")),
         "{:?}",
         s.notes
     );
@@ -170,7 +170,7 @@ fn out_of_order_record_times_come_out_sorted() {
     w.finish().unwrap();
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.seq, vec![0, 1, 2, 3, 4, 5]);
-    assert!(s.notes.iter().any(|n| n.contains("sorted")));
+    assert!(s.notes.iter().any(|n| n.text.contains("sorted")));
 }
 
 #[test]
@@ -190,7 +190,7 @@ fn truncated_bag_keeps_complete_chunks() {
             s.len()
         );
         assert!(
-            s.notes.iter().any(|n| n.contains("truncated")),
+            s.notes.iter().any(|n| n.text.contains("truncated")),
             "{c:?}: {:?}",
             s.notes
         );
@@ -201,6 +201,40 @@ fn truncated_bag_keeps_complete_chunks() {
             );
         }
     }
+}
+
+/// A reader's note is said by whoever prints it, in its own way: the converter as a
+/// `warning:` line on stderr, `bag2mat info` as a `note:` line of its report (never both
+/// prefixes, never the note's level as part of its text).
+#[test]
+fn a_readers_note_is_a_warning_to_the_converter_and_a_note_to_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("u.bag");
+    write_synthetic(&path, "imu", 3000, Compression::Bz2, false);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let h = &mut bytes[13..13 + 4104];
+    let at = h.windows(10).position(|w| w == b"index_pos=").unwrap() + 10;
+    h[at..at + 8].fill(0);
+    std::fs::write(&path, &bytes).unwrap();
+    let said = "the bag has no index (index_pos = 0: the writer did not finish)";
+    let bin = || std::process::Command::new(env!("CARGO_BIN_EXE_bag2mat"));
+    let (ok, out, err) = crate::common::run(bin().arg("info").arg(&path));
+    assert!(ok, "{err}");
+    let lines = |t: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| l.contains(said))
+            .map(str::to_string)
+            .collect()
+    };
+    let info = lines(&format!("{out}{err}"));
+    assert_eq!(info.len(), 1, "{out}{err}");
+    assert!(info[0].starts_with(&format!("note: {said}")), "{info:?}");
+    let csv = dir.path().join("u.csv");
+    let (ok, _, err) = crate::common::run(bin().arg(&path).args(["imu", "-q", "-o"]).arg(&csv));
+    assert!(ok, "{err}");
+    let conv = lines(&err);
+    assert_eq!(conv.len(), 1, "{err}");
+    assert!(conv[0].starts_with(&format!("warning: {said}")), "{conv:?}");
 }
 
 #[test]
@@ -217,7 +251,7 @@ fn unfinished_bag_is_scanned() {
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.len(), 3000);
     assert!(
-        s.notes.iter().any(|n| n.contains("index_pos = 0")),
+        s.notes.iter().any(|n| n.text.contains("index_pos = 0")),
         "{:?}",
         s.notes
     );
@@ -302,7 +336,7 @@ fn matrix_routes_agree_and_sort() {
     let want: Vec<f64> = (0..6).map(|i| synthetic(i).0.to_sec()).collect();
     assert_eq!(conv.data.t(), &want[..]);
     assert!(
-        conv.notes.iter().any(|n| n.contains("sorted")),
+        conv.notes.iter().any(|n| n.text.contains("sorted")),
         "{:?}",
         conv.notes
     );

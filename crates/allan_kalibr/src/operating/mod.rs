@@ -498,7 +498,7 @@ pub(crate) fn sections(
             common.out_dir.clone()
         };
         let topic = data.topic.clone().unwrap_or_default();
-        let notes = bag2mat::shared::note::warnings(&data.notes);
+        let notes = data.notes.clone();
         match run_topic(&ctx, data, &dir) {
             Ok(section) => out.push(section),
             // one topic of several: said as its error, the others still written (the rule
@@ -521,7 +521,7 @@ fn run_topic(ctx: &RunContext, data: ImuData, dir: &Path) -> Result<Section, Err
         static_an,
         outputs,
     } = *ctx;
-    let mut notes = bag2mat::shared::note::warnings(&data.notes);
+    let mut notes = data.notes.clone();
     let topic_name = data.topic.clone();
     let topic = data
         .topic
@@ -529,11 +529,10 @@ fn run_topic(ctx: &RunContext, data: ImuData, dir: &Path) -> Result<Section, Err
         .unwrap_or_else(|| common.named_topic().to_string());
     let (data, findings, rate) = prepare(common, data, &mut notes)?;
     if let Some(r) = reference {
-        notes.extend(
-            r.notes
-                .iter()
-                .map(|n| Note::warning(format!("reference: {n}"))),
-        );
+        notes.extend(r.notes.iter().map(|n| Note {
+            text: format!("reference: {}", n.text),
+            ..n.clone()
+        }));
     }
     let mut op = match reference {
         Some(r) => analyse_with_reference(&data, rate, r, s)?,

@@ -5,6 +5,7 @@
 //! the dataset's own noise figures: they are read and said next to ours, for the user to
 //! judge whether they hold.
 
+use crate::shared::note::Note;
 use std::path::{Path, PathBuf};
 
 use super::InputOptions;
@@ -202,18 +203,21 @@ pub(crate) fn open_files(
     let mut losses = Vec::new();
     for (topic, f) in files {
         let p = super::text::parse(&f, &topic, opts)?;
-        notes.extend(p.notes.into_iter().map(|n| format!("{topic}: {n}")));
+        notes.extend(p.notes.into_iter().map(|n| Note {
+            text: format!("{topic}: {}", n.text),
+            ..n
+        }));
         if let Some((n, what)) = p.lost {
             // one stream per topic: its channel is its place
             let ch = streams.len() as u32;
             losses.push(super::text::lost_rows(ch, (n, format!("{topic}: {what}"))));
         }
         match sensor_yaml(&f) {
-            Some(Ok(s)) if s != Stated::default() => notes.push(format!(
+            Some(Ok(s)) if s != Stated::default() => notes.push(Note::warning(format!(
                 "{topic}: the dataset's sensor.yaml states {} (compare with the figures measured here)",
                 s.describe()
-            )),
-            Some(Err(e)) => notes.push(format!("{topic}: sensor.yaml does not parse: {e}")),
+            ))),
+            Some(Err(e)) => notes.push(Note::warning(format!("{topic}: sensor.yaml does not parse: {e}"))),
             _ => {}
         }
         streams.extend(p.streams);

@@ -3,6 +3,7 @@
 //! a conversion reads back into the analysers. Format versions 1–3, either byte order, C or
 //! Fortran order.
 
+use crate::shared::note::Note;
 use std::path::Path;
 
 use crate::cursor::Cursor;
@@ -119,17 +120,17 @@ pub(crate) fn open(path: &Path) -> Result<DecodedSource, Error> {
             ),
         });
     } else if data.len().is_multiple_of(row_bytes) {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "the header says {} rows, the data hold {whole} whole rows: all of them were read",
             h.rows
-        ));
+        )));
         whole
     } else if whole >= h.rows {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{} bytes after the {} rows the header says were not read",
             data.len() - h.rows * row_bytes,
             h.rows
-        ));
+        )));
         h.rows
     } else {
         // cut short: the row it ends inside is lost; the header promised the rest

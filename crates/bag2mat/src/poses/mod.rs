@@ -16,6 +16,8 @@
 //! and anything the user should know (a topic under its other slash form, undecodable
 //! messages, repeated stamps dropped) in [`PoseSeries::notes`].
 
+use crate::shared::note::Note;
+
 pub mod msg;
 
 use std::path::{Path, PathBuf};
@@ -40,8 +42,8 @@ pub struct PoseSeries {
     pub position: Vec<[f64; 3]>,
     /// Orientation body → world, `[x, y, z, w]` as recorded.
     pub orientation: Vec<[f64; 4]>,
-    /// What the user should know about the read.
-    pub notes: Vec<String>,
+    /// What the user should know about the read (warnings).
+    pub notes: Vec<Note>,
 }
 
 impl PoseSeries {
@@ -80,9 +82,9 @@ impl PoseSeries {
             out.push(self.t_ns[i], self.position[i], self.orientation[i]);
         }
         if repeated > 0 {
-            out.notes.push(format!(
+            out.notes.push(Note::warning(format!(
                 "{repeated} pose(s) repeat an earlier pose's time and were dropped"
-            ));
+            )));
         }
         out
     }
@@ -342,11 +344,11 @@ fn read_topic(path: &Path, src: &dyn Source, opts: &PoseOptions) -> Result<PoseS
                     ),
                 });
             }
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "reference topic '{}' is not in the bag; using '{}'",
                 crate::printable::escape(t),
                 crate::printable::escape(&other)
-            ));
+            )));
             other
         }
         None => match pose_topics().as_slice() {
@@ -434,23 +436,24 @@ fn read_topic(path: &Path, src: &dyn Source, opts: &PoseOptions) -> Result<PoseS
             }
         });
         if let Some(e) = read.error {
-            out.notes.push(format!("{}: {e}", src.parts()[part].label));
+            out.notes
+                .push(Note::warning(format!("{}: {e}", src.parts()[part].label)));
         }
         for l in read.lost {
-            out.notes.push(l.to_string());
+            out.notes.push(Note::warning(l.to_string()));
         }
     }
     if bad > 0 {
-        out.notes.push(format!(
+        out.notes.push(Note::warning(format!(
             "{bad} message(s) on '{}' did not decode and were skipped (the first: {})",
             crate::printable::escape(&topic),
             first_bad.unwrap_or_default()
-        ));
+        )));
     }
     if out.is_empty() {
         return Err(Error::NothingRead {
             topic,
-            why: out.notes,
+            why: out.notes.into_iter().map(|n| n.text).collect(),
         });
     }
     Ok(out.sorted())

@@ -8,6 +8,8 @@
 //!   [`crate::source::Source`], with channels merged across files by topic and type.
 //! * [`Ros2BagWriter`]: a bag directory with one storage file, Imu as CDR.
 
+use crate::shared::note::Note;
+
 pub(crate) mod metadata;
 pub(crate) mod sqlite;
 mod table_walk;
@@ -94,10 +96,10 @@ impl BagDir {
         let mut damaged = false;
         let info = BagInfo::parse(&text).unwrap_or_else(|e| {
             damaged = true;
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "{} is damaged ({e}); the storage files in the directory were read without it (it promises no counts)",
                 meta_path.display()
-            ));
+            )));
             BagInfo::default()
         });
         let paths = storage_paths(dir, &info, damaged, &mut notes, &mut losses)?;
@@ -151,10 +153,10 @@ impl BagDir {
             if let Some(n) = c.count
                 && n > most
             {
-                self.contents.notes.push(format!(
+                self.contents.notes.push(Note::warning(format!(
                     "metadata.yaml promises {n} messages on '{}', more than its storage files can hold (at most {most}): the count is damaged and not used",
                     crate::printable::escape(&c.topic)
-                ));
+                )));
                 c.count = self.file_counts.get(&c.id).copied().flatten();
             }
         }
@@ -176,7 +178,7 @@ impl BagDir {
         files: Vec<(Box<dyn Source>, Option<Decompressed>)>,
         info: Option<BagInfo>,
         message_zstd: bool,
-        mut notes: Vec<String>,
+        mut notes: Vec<Note>,
         mut losses: Vec<Loss>,
     ) -> BagDir {
         let mut channels: Vec<Channel> = Vec::new();
@@ -252,7 +254,10 @@ impl Source for BagDir {
     ) -> PartRead {
         let Some(&(fi, pi)) = self.part_map.get(part) else {
             return PartRead {
-                error: Some("no such part".into()),
+                error: Some(source::PartError::NoSuchPart {
+                    index: part,
+                    wording: source::NoSuchPart::Part,
+                }),
                 ..PartRead::default()
             };
         };
@@ -272,7 +277,7 @@ impl Source for BagDir {
                     Ok(()) => sink(g, t, &buf),
                     Err(e) => {
                         skipped += 1;
-                        skip_reason.get_or_insert(e.to_string());
+                        skip_reason.get_or_insert(source::SkipReason::Decompress(e.into()));
                     }
                 }
             });
@@ -514,7 +519,7 @@ fn storage_paths(
     dir: &Path,
     info: &BagInfo,
     damaged: bool,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<Note>,
     losses: &mut Vec<Loss>,
 ) -> Result<Vec<PathBuf>, Error> {
     let mut paths: Vec<PathBuf> = info
@@ -538,15 +543,15 @@ fn storage_paths(
             .collect();
         found.sort();
         if listed == 0 && !damaged {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "metadata.yaml lists no storage files; reading the {} found in the directory",
                 found.len()
-            ));
+            )));
         } else if listed > 0 && !found.is_empty() {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "none of the {listed} storage file(s) metadata.yaml lists is in the directory; reading the {} found there",
                 found.len()
-            ));
+            )));
         }
         for p in &paths {
             losses.push(Loss::new(format!(

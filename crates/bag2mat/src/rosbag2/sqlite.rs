@@ -17,6 +17,7 @@
 //! lists past the last row the table holds (a tail the table lost), and a file without one
 //! gets `PRAGMA quick_check`.
 
+use crate::shared::note::Note;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -252,17 +253,17 @@ impl Sqlite3Reader {
             });
         }
         if plan.moved.0 > 0 {
-            out.notes.push(format!(
+            out.notes.push(Note::warning(format!(
                 "message rows {start}..: {} row(s) stored out of place (a damaged row id such as {}) were read where their ids belong",
                 plan.moved.0,
                 plan.moved.1.unwrap_or_default()
-            ));
+            )));
         }
         if plan.doubles > 0 {
-            out.notes.push(format!(
+            out.notes.push(Note::warning(format!(
                 "message rows {start}..: {} row(s) that damaged pages of the table show twice were read once",
                 plan.doubles
-            ));
+            )));
         }
     }
 
@@ -437,7 +438,7 @@ struct Connected {
     read_path: std::path::PathBuf,
     copy: Option<tempfile::TempDir>,
     tables: Vec<String>,
-    notes: Vec<String>,
+    notes: Vec<Note>,
     losses: Vec<Loss>,
 }
 
@@ -461,9 +462,9 @@ impl Connected {
         {
             // SQLite refuses a file shorter than its header says; its whole pages are read
             // from a private copy that says what it holds.
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "the file is truncated: it holds {kept} of the {pages} pages its header announces; they were read from a private copy"
-            ));
+            )));
             losses.push(Loss {
                 what: format!(
                     "the last {} page(s) of the file are missing (truncated)",
@@ -546,16 +547,16 @@ struct Walked2 {
 fn plan_parts(
     conn: &Connection,
     capacity: u64,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<Note>,
     losses: &mut Vec<Loss>,
 ) -> Vec<i64> {
     let first = match seek(conn, i64::MIN) {
         Ok(Some(id)) => Some(id),
         Ok(None) => None,
         Err(e) => {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "the messages table's first page is unreadable (sqlite3: {e}); reading from the first id that can be sought"
-            ));
+            )));
             seek_past(conn, 0, None, capacity)
         }
     };
@@ -610,14 +611,17 @@ impl Source for Sqlite3Reader {
     ) -> PartRead {
         let mut out = PartRead::default();
         let Some(&start) = self.starts.get(part) else {
-            out.error = Some("no such part".into());
+            out.error = Some(source::PartError::NoSuchPart {
+                index: part,
+                wording: source::NoSuchPart::Part,
+            });
             return out;
         };
         let stop = self.starts.get(part + 1).copied();
         let conn = match self.take() {
             Ok(c) => c,
             Err(e) => {
-                out.error = Some(e.to_string());
+                out.error = Some(source::PartError::Storage(e.into()));
                 return out;
             }
         };

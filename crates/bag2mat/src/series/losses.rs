@@ -2,6 +2,7 @@
 //! undecodable and skipped messages and the notes that say so.
 
 use super::*;
+use crate::shared::note::Note;
 
 /// Messages lost on one topic, as the losses found count them.
 #[derive(Default)]
@@ -69,8 +70,8 @@ pub(super) fn part_losses(
             }
         }
         let reason = match (&o.read.error, o.read.skipped) {
-            (Some(e), _) => Some(e.clone()),
-            (None, n) if n > 0 => o.read.skip_reason.clone(),
+            (Some(e), _) => Some(e.to_string()),
+            (None, n) if n > 0 => o.read.skip_reason.as_ref().map(|s| s.to_string()),
             _ => None,
         };
         let rest = mine.map(|m| m.saturating_sub(got.saturating_add(known)));
@@ -108,7 +109,7 @@ pub(super) fn part_losses(
 /// The notes that say how many messages of `topic` were lost, or may have been, and how
 /// many did not decode. `no_container_loss`: the container itself reported none.
 pub(super) fn loss_notes(
-    notes: &mut Vec<String>,
+    notes: &mut Vec<Note>,
     r: &TopicReport,
     topic: &str,
     tally: &LossTally,
@@ -152,7 +153,7 @@ pub(super) fn loss_notes(
         see
     };
     if missing > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{missing} of {} messages on '{}' were lost{}{tail}",
             // a loss a reader counted beyond its promise (a batch short of its header)
             // belongs to the total too
@@ -164,25 +165,25 @@ pub(super) fn loss_notes(
             } else {
                 String::new()
             }
-        ));
+        )));
     } else if more > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "up to {more} messages on '{}' were lost{why}{tail}",
             topic
-        ));
+        )));
     } else if uncounted {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "messages on '{}' may have been lost: the damaged data does not count them (see above)",
             topic
-        ));
+        )));
     }
     if r.undecodable > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{} messages on '{}' do not decode as sensor_msgs/Imu and were skipped (first: {})",
             r.undecodable,
             topic,
             r.first_error.as_deref().unwrap_or("?")
-        ));
+        )));
     }
 }
 

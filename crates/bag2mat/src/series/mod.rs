@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, TopicSummary};
 use crate::imu_msg::{self, ImuSample};
+use crate::shared::note::Note;
 use crate::source::{self, Channel, Encoding, InputKind, Loss, Source};
 use crate::time::RosTime;
 
@@ -107,7 +108,7 @@ pub struct ImuSeries {
     /// Angular velocity, one column per axis x, y, z, rad/s.
     pub gyro: [Vec<f64>; 3],
     /// Things the binary should tell the user on stderr (topic fallback, lost chunks, …).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// Promised against delivered.
     pub report: TopicReport,
     /// Where each row was stored, when the rows were sorted by record time (`None`: row
@@ -624,7 +625,7 @@ fn read_source(
 
     let n_sel = selected.len();
     let mut series = Vec::with_capacity(n_sel);
-    let mut dropped: Vec<String> = Vec::new();
+    let mut dropped: Vec<Note> = Vec::new();
     for ((k, s), rows) in selected.into_iter().enumerate().zip(columns) {
         let out = topic_series(src, &s, k, rows, promised[k], &outs, &after);
         if out.is_empty() {
@@ -633,13 +634,13 @@ fn read_source(
             if s.named || series.is_empty() && k + 1 == n_sel && dropped.len() + 1 == n_sel {
                 return Err(Error::NothingRead {
                     topic: s.topic.clone(),
-                    why: out.notes.clone(),
+                    why: out.notes.iter().map(|n| n.text.clone()).collect(),
                 });
             }
-            dropped.push(format!(
+            dropped.push(Note::warning(format!(
                 "Imu topic '{}' holds no readable message and was left out",
                 s.topic
-            ));
+            )));
             continue;
         }
         series.push(out);
@@ -797,17 +798,17 @@ fn topic_series(
     for l in &container {
         tally.count(l, l.channel.is_some());
     }
-    let mut notes: Vec<String> = src.notes().to_vec();
+    let mut notes: Vec<Note> = src.notes().to_vec();
     for o in outs {
         notes.extend(o.read.notes.iter().cloned());
     }
     // the container's losses, but another topic's own (a loss that names its channel)
-    notes.extend(container.iter().map(|l| l.to_string()));
-    notes.extend(s.note.iter().cloned());
-    notes.extend(r.losses.iter().map(|l| l.to_string()));
+    notes.extend(container.iter().map(|l| Note::warning(l.to_string())));
+    notes.extend(s.note.iter().cloned().map(Note::warning));
+    notes.extend(r.losses.iter().map(|l| Note::warning(l.to_string())));
     loss_notes(&mut notes, r, &s.topic, &tally, container.is_empty());
     if sorted {
-        notes.push(SORTED_NOTE.to_string());
+        notes.push(Note::warning(SORTED_NOTE));
     }
     out.notes = notes;
     out

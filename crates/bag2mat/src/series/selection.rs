@@ -37,7 +37,7 @@ pub(super) fn select(src: &dyn Source, sel: &TopicSelector) -> Result<Vec<Select
     let chans = src.channels();
     if chans.is_empty() {
         // Say why there is nothing (truncated, damaged) rather than "no topics".
-        let mut why: Vec<String> = src.notes().to_vec();
+        let mut why: Vec<String> = src.notes().iter().map(|n| n.text.clone()).collect();
         why.extend(src.losses().iter().map(|l| l.to_string()));
         return Err(Error::NoTopics { why });
     }

@@ -88,12 +88,3 @@ impl fmt::Display for Note {
         }
     }
 }
-
-/// Warnings, each from its text (the readers' notes: every one says the data are not what
-/// was asked for).
-pub fn warnings<'a>(texts: impl IntoIterator<Item = &'a String>) -> Vec<Note> {
-    texts
-        .into_iter()
-        .map(|t| Note::warning(t.clone()))
-        .collect()
-}

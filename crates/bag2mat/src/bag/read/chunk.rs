@@ -3,24 +3,11 @@
 
 use super::*;
 
-/// Why a chunk's body cannot be read (the part's error, as its text).
-#[derive(Debug, thiserror::Error)]
-pub(super) enum ChunkError {
-    #[error("chunk record runs past the end of the file")]
-    PastEnd,
-    #[error("not a chunk record")]
-    NotChunk,
-    #[error(transparent)]
-    Record(#[from] RecordError),
-    #[error("{0}")]
-    Io(std::io::Error),
-    #[error("{codec}: {source}")]
-    Decompress {
-        codec: &'static str,
-        source: std::io::Error,
-    },
-    #[error("chunk body is {got} bytes, its header says {size}")]
-    Size { got: usize, size: usize },
+/// A chunk record whose header does not parse: the part's error says so by its kind.
+impl From<RecordError> for Ros1ChunkError {
+    fn from(e: RecordError) -> Ros1ChunkError {
+        Ros1ChunkError::RecordHeader(std::sync::Arc::new(e))
+    }
 }
 
 impl BagReader {
@@ -31,8 +18,10 @@ impl BagReader {
         &self,
         pos: u64,
         f: impl FnOnce(&[u8]) -> R,
-    ) -> Result<R, ChunkError> {
-        let (h, data_pos, dlen) = self.record_at(pos, self.len).ok_or(ChunkError::PastEnd)?;
+    ) -> Result<R, Ros1ChunkError> {
+        let (h, data_pos, dlen) = self
+            .record_at(pos, self.len)
+            .ok_or(Ros1ChunkError::PastEnd)?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
@@ -53,37 +42,37 @@ impl BagReader {
         dlen: u32,
         raw: &mut Vec<u8>,
         body: &mut Vec<u8>,
-    ) -> Result<Compression, ChunkError> {
+    ) -> Result<Compression, Ros1ChunkError> {
         let h = Header::parse(h_bytes)?;
         if h.op()? != Op::Chunk {
-            return Err(ChunkError::NotChunk);
+            return Err(Ros1ChunkError::NotChunk);
         }
         let ChunkHeader { compression, size } = ChunkHeader::decode(&h)?;
         let size = size as usize;
         raw.resize(dlen as usize, 0);
         self.file
             .read_exact_at(raw, data_pos)
-            .map_err(ChunkError::Io)?;
+            .map_err(|e| Ros1ChunkError::Io(e.into()))?;
         body.clear();
         let got = match compression {
             Compression::None => raw.len(),
             Compression::Bz2 => bzip2::read::BzDecoder::new(&raw[..])
                 .take(size as u64 + 1)
                 .read_to_end(body)
-                .map_err(|source| ChunkError::Decompress {
+                .map_err(|source| Ros1ChunkError::Decompress {
                     codec: "bz2",
-                    source,
+                    source: source.into(),
                 })?,
             Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&raw[..])
                 .take(size as u64 + 1)
                 .read_to_end(body)
-                .map_err(|source| ChunkError::Decompress {
+                .map_err(|source| Ros1ChunkError::Decompress {
                     codec: "lz4",
-                    source,
+                    source: source.into(),
                 })?,
         };
         if got != size {
-            return Err(ChunkError::Size { got, size });
+            return Err(Ros1ChunkError::Size { got, size });
         }
         Ok(compression)
     }
@@ -123,7 +112,7 @@ impl BagReader {
             });
         });
         if let Err(e) = r {
-            out.error = Some(e.to_string());
+            out.error = Some(e.into());
             return out;
         }
         let short = c.index_data.iter().any(|(conn, d)| {

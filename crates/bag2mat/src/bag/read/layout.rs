@@ -2,6 +2,7 @@
 //! passed and counted), and the two joined, with a note wherever they disagree.
 
 use super::*;
+use crate::shared::note::Note;
 
 impl BagReader {
     /// Reads the index section record by record: connections and chunk infos. A damaged
@@ -14,9 +15,9 @@ impl BagReader {
         let mut damaged = 0;
         while pos < self.len {
             let Some((hb, data_pos, dlen)) = self.record_at(pos, self.len) else {
-                self.contents.notes.push(format!(
+                self.contents.notes.push(Note::warning(format!(
                     "the index section is damaged at byte {pos} (a record runs past the end of the file); the chunks were walked instead"
-                ));
+                )));
                 break;
             };
             let data = self.bytes_at(data_pos, dlen).unwrap_or_default();
@@ -28,17 +29,17 @@ impl BagReader {
             if let Err(e) = decoded {
                 damaged += 1;
                 if damaged == 1 {
-                    self.contents.notes.push(format!(
+                    self.contents.notes.push(Note::warning(format!(
                         "the index section has a damaged record at byte {pos} ({e}); skipped, the chunks themselves were walked"
-                    ));
+                    )));
                 }
             }
             pos = data_pos + dlen as u64;
         }
         if damaged > 1 {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "{damaged} damaged index records were skipped in all"
-            ));
+            )));
         }
         (connections, infos)
     }
@@ -229,20 +230,20 @@ impl BagReader {
             walk.chunks.into_iter().map(|c| (c.pos, c)).collect();
         let unlisted = self.join_chunk_infos(&mut chunks, infos);
         if had_index && !unlisted.is_empty() {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "{} chunk(s) are not listed in the bag's index (first at byte {}); they were read",
                 unlisted.len(),
                 unlisted.iter().next().copied().unwrap_or(0)
-            ));
+            )));
         }
         if let Some(n) = chunk_count
             && had_index
             && n as usize != chunks.len()
         {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the bag header announces {n} chunks; {} were found",
                 chunks.len()
-            ));
+            )));
         }
         self.chunks = chunks.into_values().collect();
         let mut connections: BTreeMap<u32, Connection> = BTreeMap::new();
@@ -275,20 +276,20 @@ impl BagReader {
                     // rosbag lists a chunk's connections in any order.
                     mine.sort_unstable();
                     if own.is_some() && own.as_ref() != Some(&mine) {
-                        self.contents.notes.push(format!(
+                        self.contents.notes.push(Note::warning(format!(
                             "the chunk info of the chunk at byte {} lists {:?} messages per connection, the chunk's own index {:?}; the chunk is read whole and its own index is used",
                             info.chunk_pos,
                             mine,
                             own.unwrap_or_default()
-                        ));
+                        )));
                     }
                     c.info_counts = Some(info.counts);
                     c.span = Some((info.start_time, info.end_time));
                 }
-                Some(_) => self.contents.notes.push(format!(
+                Some(_) => self.contents.notes.push(Note::warning(format!(
                     "two chunk infos name the chunk at byte {}; the chunk is read once",
                     info.chunk_pos
-                )),
+                ))),
                 None => self.unwalked_chunk(chunks, info),
             }
         }

@@ -15,6 +15,8 @@
 //! every message the chunk's index lists that was not delivered is reported with its count
 //! and time span.
 
+use crate::shared::note::Note;
+
 mod chunk;
 mod layout;
 
@@ -30,7 +32,9 @@ use super::record::{
     Op, RecordError,
 };
 use crate::error::{Error, TopicSummary};
-use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
+use crate::source::{
+    self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Ros1ChunkError, Source,
+};
 use crate::time::RosTime;
 use chunk::{BodyRecord, find, walk_body};
 
@@ -163,9 +167,9 @@ impl BagReader {
             contents: source::Contents::default(),
         };
         if let Some(e) = &header_damage {
-            reader.contents.notes.push(format!(
+            reader.contents.notes.push(Note::warning(format!(
                 "the bag header is damaged ({e}); the chunks after it were walked without the index"
-            ));
+            )));
         }
         let index_ok = index_pos >= first && index_pos < len;
         let (index_conns, infos) = if index_ok {
@@ -197,16 +201,16 @@ impl BagReader {
     fn no_index(&mut self, index_pos: u64) {
         let len = self.len;
         if index_pos == 0 {
-            self.contents.notes.push("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string());
+            self.contents.notes.push(Note::warning("the bag has no index (index_pos = 0: the writer did not finish); its chunks were walked (`rosbag reindex` repairs it)".to_string()));
         } else if index_pos >= len {
             self.contents.losses.push(Loss::new(format!(
                 "the file ends at byte {len}, before its index at byte {index_pos}: it was cut short, and what its last {} or more bytes held is lost; the chunks that are there were walked",
                 index_pos - len
             )));
         } else {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the bag's index_pos {index_pos} points into its header; its chunks were walked"
-            ));
+            )));
         }
     }
 
@@ -371,7 +375,10 @@ impl Source for BagReader {
         match self.chunks.get(part) {
             Some(c) => self.for_each_in_chunk(c, want, sink),
             None => PartRead {
-                error: Some("no such chunk".into()),
+                error: Some(source::PartError::NoSuchPart {
+                    index: part,
+                    wording: source::NoSuchPart::Chunk,
+                }),
                 ..PartRead::default()
             },
         }

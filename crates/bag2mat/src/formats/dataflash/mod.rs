@@ -13,6 +13,8 @@
 //! message are skipped to the next header and reported; batch data without its header, and
 //! batches with fewer samples than their header promises, are losses.
 
+use crate::shared::note::Note;
+
 mod batch;
 mod imu;
 // The synthetic-log writers of the tests and benchmarks (re-exported by `test_tools`).
@@ -577,24 +579,24 @@ impl Reader {
         let mut notes = Vec::new();
         let (runs, bytes, first) = self.skipped;
         if runs > 0 {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "{bytes} bytes in {runs} stretch{} are no DataFlash message and were skipped to the next header (first at byte {first})",
                 if runs == 1 { "" } else { "es" },
-            ));
+            )));
         }
         for (what, n, at) in self.repaired.iter().chain(&self.batches.repaired) {
-            notes.push(format!("{what}: {n} (first at byte {at})"));
+            notes.push(Note::warning(format!("{what}: {n} (first at byte {at})")));
         }
         if fixed.moved.0 > 0 {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "IMU messages with a damaged instance byte given back to the instance their loop lacks: {} (first at byte {})",
                 fixed.moved.0, fixed.moved.1
-            ));
+            )));
         }
         if let Some(at) = self.truncated {
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "the log ends inside a message at byte {at} (cut short): read to there"
-            ));
+            )));
         }
         let mut imu_lost: Vec<(u32, (u64, usize))> = self.imu_lost.into_iter().collect();
         imu_lost.sort_unstable();

@@ -2,6 +2,7 @@
 //! the delimiter, which column holds what (header names or `--columns`) and in which unit.
 //! Nothing is guessed: an ambiguity is an error that says what to add.
 
+use crate::shared::note::Note;
 use std::path::Path;
 
 use super::InputOptions;
@@ -147,7 +148,7 @@ pub(super) struct Layout {
     /// A column that says which sensor each row is from (`sensor_id`, …): index and name.
     pub(super) sensor_column: Option<(usize, String)>,
     /// What deciding the layout found worth a warning (a flag over the header's unit).
-    pub(super) warnings: Vec<String>,
+    pub(super) warnings: Vec<Note>,
     /// The accelerometer's unit (stated, given or known; `None`: none, SI assumed).
     pub(super) acc_unit: Option<AccUnit>,
     /// The time unit came from the flag.
@@ -766,7 +767,7 @@ impl Named {
         opts: &InputOptions,
         own_layout: bool,
         phone: Option<PhoneApp>,
-        warnings: &mut Vec<String>,
+        warnings: &mut Vec<Note>,
     ) -> Result<TimeUnit, Error> {
         let Some(i) = time else {
             return Ok(TimeUnit::Ns);
@@ -783,12 +784,12 @@ impl Named {
             .or(phone.and_then(|p| p.time));
         match (opts.time_unit, header_unit.or(known)) {
             (Some(f), Some(h)) if f != h => {
-                warnings.push(format!(
+                warnings.push(Note::warning(format!(
                     "the header says the time is in {}, --time-unit says {}: read in {}",
                     h.name(),
                     f.name(),
                     f.name()
-                ));
+                )));
                 Ok(f)
             }
             (Some(f), _) => Ok(f),
@@ -835,7 +836,7 @@ fn resolve_unit<U: Copy + PartialEq>(
     parse: fn(&str) -> Result<U, crate::units::UnknownUnit>,
     known: Option<U>,
     name: fn(U) -> &'static str,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Note>,
 ) -> Result<Option<U>, Error> {
     if header.len() > 1 {
         return Err(bad(
@@ -852,12 +853,12 @@ fn resolve_unit<U: Copy + PartialEq>(
     };
     match (flag, h) {
         (Some(f), Some(h)) if f != h => {
-            warnings.push(format!(
+            warnings.push(Note::warning(format!(
                 "the header says the {what} is in {}, the flag says {}: read in {}",
                 name(h),
                 name(f),
                 name(f)
-            ));
+            )));
             Ok(Some(f))
         }
         (Some(f), _) => Ok(Some(f)),

@@ -15,6 +15,7 @@
 //! one pass with `fast-float2`, any other line by the `csv` crate; times are parsed as
 //! decimals straight to nanoseconds, so `1403636579.758555` s keeps every digit.
 
+use crate::shared::note::Note;
 use std::path::Path;
 
 use rayon::prelude::*;
@@ -105,7 +106,7 @@ pub struct Parsed {
     /// The samples: the topic's stream.
     pub streams: Vec<Stream>,
     /// Notes (units assumed, stamps out of order, malformed lines).
-    pub notes: Vec<String>,
+    pub notes: Vec<Note>,
     /// The rows the malformed lines held, and why they were lost (the stream's loss).
     pub lost: Option<(u64, String)>,
 }
@@ -144,7 +145,7 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     }
     // malformed lines that held no row (junk): a note
     if let Some((0, what)) = &lost {
-        notes.push(what.clone());
+        notes.push(Note::warning(what.clone()));
         lost = None;
     }
     if lay.time.is_none() {
@@ -161,17 +162,17 @@ pub(crate) fn parse(path: &Path, topic: &str, opts: &InputOptions) -> Result<Par
     check_physics(path, &lay, &rows, opts)?;
     let scaled = opts.gyro_scale.is_some() || opts.acc_scale.is_some();
     if !(lay.gyro_stated && lay.acc_stated) || lay.gyro.is_none() || lay.acc.is_none() || scaled {
-        notes.push(format!("{}: {}", path.display(), lay.what));
+        notes.push(Note::warning(format!("{}: {}", path.display(), lay.what)));
     }
     if lay.gyro.is_none() {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "'{topic}' has no gyroscope columns: its gyro values are NaN"
-        ));
+        )));
     }
     if lay.acc.is_none() {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "'{topic}' has no accelerometer columns: its acc values are NaN"
-        ));
+        )));
     }
     Ok(Parsed {
         streams: vec![Stream::of_rows(topic, msg_type, rows)],
@@ -353,7 +354,7 @@ fn malformed_lines(
 
 /// The notes on stamps that go backwards or repeat, with the line of the first of each,
 /// within the ranges and across their borders.
-fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<String> {
+fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<Note> {
     let (mut back, mut dup) = (0u64, 0u64);
     let (mut first_back, mut first_dup) = (None, None);
     let mut prev: Option<u64> = None;
@@ -381,18 +382,18 @@ fn stamp_order(chunks: &[Summary], line_starts: &[u64]) -> Vec<String> {
     }
     let mut notes = Vec::new();
     if back > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{back} time stamp{} backwards (first at line {})",
             if back == 1 { " goes" } else { "s go" },
             first_back.unwrap_or(0)
-        ));
+        )));
     }
     if dup > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{dup} time stamp{} the one before (first at line {}); the rows are kept",
             if dup == 1 { " repeats" } else { "s repeat" },
             first_dup.unwrap_or(0)
-        ));
+        )));
     }
     notes
 }
@@ -408,7 +409,7 @@ fn body_copy(
     bytes: &[u8],
     lay: &Layout,
     opts: &InputOptions,
-    notes: &mut Vec<String>,
+    notes: &mut Vec<Note>,
 ) -> Result<Option<Vec<u8>>, Error> {
     let ids = lay
         .sensor_column
@@ -433,10 +434,10 @@ fn body_copy(
         (Some((col, name, found)), Some(id)) => {
             let n: u64 = found.iter().map(|(_, c)| c).sum();
             let mine = found.iter().find(|(v, _)| v == id).map_or(0, |x| x.1);
-            notes.push(format!(
+            notes.push(Note::warning(format!(
                 "--sensor-id {id}: {mine} of the {n} rows (column '{name}'; the file holds {})",
                 id_list(found)
-            ));
+            )));
             Some((*col, id.as_str()))
         }
         (Some((_, name, found)), None) if found.len() > 1 => {

@@ -29,6 +29,8 @@
 //! parallel), and `px4-ulog`'s unpack helpers panic on short slices by design; the read path
 //! wants every message's record time, typed errors and the losses spelt out.
 
+use crate::shared::note::Note;
+
 mod decoder;
 mod format;
 mod frame;
@@ -344,29 +346,29 @@ fn losses(found: &Found, channels: &[crate::source::Channel]) -> Vec<Loss> {
 }
 
 /// What the hop found and read through, or skipped, as notes.
-fn notes(found: &Found) -> Vec<String> {
+fn notes(found: &Found) -> Vec<Note> {
     let mut notes = Vec::new();
     let (stretches, bytes, first) = found.skipped;
     if stretches > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{bytes} bytes in {stretches} stretch{} do not parse as ULog messages and were skipped to the next whole messages (first at byte {first})",
             if stretches == 1 { "" } else { "es" },
-        ));
+        )));
     }
     let (orphans, at, id) = found.orphans;
     if orphans > 0 {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "{orphans} data message{} of an id no subscription names were skipped (first at byte {at}, id {id})",
             if orphans == 1 { "" } else { "s" },
-        ));
+        )));
     }
     for (what, (n, at)) in &found.repaired {
-        notes.push(format!("{what}: {n} (first at byte {at})"));
+        notes.push(Note::warning(format!("{what}: {n} (first at byte {at})")));
     }
     if let Some(at) = found.truncated {
-        notes.push(format!(
+        notes.push(Note::warning(format!(
             "the log ends inside a message at byte {at} (cut short): read to there"
-        ));
+        )));
     }
     notes
 }
@@ -419,7 +421,10 @@ impl UlogReader {
         let mut r = crate::source::PartRead::default();
         let wanted: Vec<bool> = (0..self.chans.len() as u32).map(want).collect();
         let Some(p) = self.parts.get(part) else {
-            r.error = Some(format!("no part {part}"));
+            r.error = Some(crate::source::PartError::NoSuchPart {
+                index: part,
+                wording: crate::source::NoSuchPart::Numbered,
+            });
             return r;
         };
         let bytes = self.map.bytes();
@@ -445,9 +450,11 @@ impl UlogReader {
             });
             if let Err(why) = rows {
                 r.skipped += d.rows_in(data).max(1) as u64;
-                r.skip_reason.get_or_insert_with(|| {
-                    format!("'{}': {why}", self.contents.channels[ch as usize].topic)
-                });
+                r.skip_reason
+                    .get_or_insert_with(|| crate::source::SkipReason::Undecodable {
+                        topic: self.contents.channels[ch as usize].topic.clone(),
+                        why,
+                    });
             }
         };
         let mut at = p.start;

@@ -2,6 +2,7 @@
 //! chunks, the per-channel counts of the Message Index records, and the losses accounted.
 
 use super::*;
+use crate::shared::note::Note;
 
 impl McapReader {
     /// Turns each unreadable stretch into losses: per channel from the Message Index
@@ -82,10 +83,10 @@ impl McapReader {
             let (schemas, channels) = self.inner_channels(k);
             for s in schemas {
                 if self.schemas.get(&s.id).is_some_and(|old| *old != s) {
-                    self.contents.notes.push(format!(
+                    self.contents.notes.push(Note::warning(format!(
                         "the summary's Schema record {} differs from the one in the first chunk (whose CRC holds): the chunk's is used",
                         s.id
-                    ));
+                    )));
                 }
                 self.schemas.insert(s.id, s);
             }
@@ -194,11 +195,11 @@ impl McapReader {
                     && (self.header.profile == "ros2"
                         || schema.is_some_and(|s| s.encoding == "ros2msg"))
                 {
-                    notes.push(format!(
+                    notes.push(Note::warning(format!(
                         "the Channel record of '{}' names the encoding {:?} (damaged); read as cdr, the encoding of ROS 2 files",
                         crate::printable::escape(&c.topic),
                         c.message_encoding
-                    ));
+                    )));
                     Encoding::Cdr
                 } else {
                     Encoding::from_name(&c.message_encoding)

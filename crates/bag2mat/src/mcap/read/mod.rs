@@ -18,6 +18,8 @@
 //! complete record, and the Data End and summary records it may still hold after its chunks
 //! are used.
 
+use crate::shared::note::Note;
+
 mod channels;
 mod summary;
 mod walk;
@@ -34,7 +36,9 @@ use super::record::{
 };
 use crate::cursor::{Cursor, CursorError};
 use crate::error::Error;
-use crate::source::{self, Encoding, InputKind, Loss, MessageSink, Part, PartRead, Source};
+use crate::source::{
+    self, Encoding, InputKind, Loss, McapChunkError, MessageSink, Part, PartError, PartRead, Source,
+};
 
 /// Bytes read at once while walking the top-level records.
 const SCAN_WINDOW: usize = 64 * 1024;
@@ -325,16 +329,16 @@ impl McapReader {
                         self.schemas.clear();
                         self.mcap_channels.clear();
                         self.statistics = None;
-                        self.contents.notes.push(format!(
+                        self.contents.notes.push(Note::warning(format!(
                             "the summary section is damaged ({e}); the data section was scanned instead"
-                        ));
+                        )));
                     }
                 }
             }
         } else {
-            self.contents.notes.push(
+            self.contents.notes.push(Note::warning(
                 "the file has no footer (the recording was cut short, or the file is truncated); its records were scanned".to_string(),
-            );
+            ));
         }
         (data_end, summary)
     }
@@ -368,7 +372,7 @@ impl McapReader {
             });
         } else {
             // Every message the index lists was delivered: the damage cost none.
-            out.notes.push(what);
+            out.notes.push(Note::warning(what));
         }
     }
 
@@ -418,8 +422,11 @@ impl McapReader {
         loc: usize,
         f: impl FnMut(u64, u8, &[u8]),
         listed: &dyn Fn() -> Vec<u64>,
-    ) -> Result<Vec<(String, u64)>, ChunkError> {
-        let loc = self.locs.get(loc).ok_or(ChunkError::NoPart)?;
+    ) -> Result<Vec<(String, u64)>, PartError> {
+        let loc = self.locs.get(loc).ok_or(PartError::NoSuchPart {
+            index: loc,
+            wording: source::NoSuchPart::Part,
+        })?;
         BUFFERS.with(|cell| {
             let mut bufs = cell.borrow_mut();
             let (raw, body) = &mut *bufs;
@@ -435,13 +442,13 @@ impl McapReader {
         loc: &Loc,
         raw: &'b mut Vec<u8>,
         body: &'b mut Vec<u8>,
-    ) -> Result<&'b [u8], ChunkError> {
+    ) -> Result<&'b [u8], McapChunkError> {
         match loc {
             Loc::Loose { start, end } => {
                 raw.resize((end - start) as usize, 0);
                 self.file
                     .read_exact_at(raw, *start)
-                    .map_err(ChunkError::Io)?;
+                    .map_err(|e| McapChunkError::Io(e.into()))?;
                 Ok(raw)
             }
             Loc::Chunk {
@@ -453,12 +460,12 @@ impl McapReader {
                 ..
             } => {
                 if records_pos.saturating_add(*compressed_size) > self.len {
-                    return Err(ChunkError::PastEnd);
+                    return Err(McapChunkError::PastEnd);
                 }
                 raw.resize(*compressed_size as usize, 0);
                 self.file
                     .read_exact_at(raw, *records_pos)
-                    .map_err(ChunkError::Io)?;
+                    .map_err(|e| McapChunkError::Io(e.into()))?;
                 // A damaged size field must not fail records the CRC vouches for: the
                 // output is bounded by what the stored bytes decompress to (or the size
                 // stated, if larger), never preallocated.
@@ -472,27 +479,28 @@ impl McapReader {
                         lz4_flex::frame::FrameDecoder::new(raw)
                             .take(limit.saturating_add(1))
                             .read_to_end(body)
-                            .map_err(ChunkError::Lz4)?;
+                            .map_err(|e| McapChunkError::Lz4(e.into()))?;
                         body
                     }
                     "zstd" => {
-                        crate::zstd::decompress_into(raw, body, limit)?;
+                        crate::zstd::decompress_into(raw, body, limit)
+                            .map_err(|e| McapChunkError::Zstd(e.into()))?;
                         body
                     }
-                    other => return Err(ChunkError::Compression(other.to_string())),
+                    other => return Err(McapChunkError::Compression(other.to_string())),
                 };
                 let crc_ok = *crc != 0 && crc32fast::hash(records) == *crc;
                 // Without a CRC, the stored records of an uncompressed chunk are what
                 // its record length frames, whatever its size field says.
                 let framed = *crc == 0 && compression.is_empty();
                 if records.len() as u64 != *uncompressed_size && !crc_ok && !framed {
-                    return Err(ChunkError::Size {
+                    return Err(McapChunkError::Size {
                         got: records.len(),
                         stated: *uncompressed_size,
                     });
                 }
                 if *crc != 0 && !crc_ok {
-                    return Err(ChunkError::Crc {
+                    return Err(McapChunkError::Crc {
                         got: crc32fast::hash(records),
                         stored: *crc,
                     });
@@ -552,7 +560,7 @@ impl Source for McapReader {
         let damage = match r {
             Ok(d) => d,
             Err(e) => {
-                out.error = Some(e.to_string());
+                out.error = Some(e);
                 return out;
             }
         };
@@ -614,27 +622,6 @@ fn resync_hints(summary: Option<&Summary>) -> Vec<u64> {
     hints.sort_unstable();
     hints.dedup();
     hints
-}
-
-/// Why a part's stored records cannot be read (the part's error, as its text).
-#[derive(Debug, thiserror::Error)]
-enum ChunkError {
-    #[error("no such part")]
-    NoPart,
-    #[error("{0}")]
-    Io(std::io::Error),
-    #[error("the chunk's records run past the end of the file")]
-    PastEnd,
-    #[error("lz4: {0}")]
-    Lz4(std::io::Error),
-    #[error(transparent)]
-    Zstd(#[from] crate::zstd::ZstdError),
-    #[error("unsupported chunk compression '{0}'")]
-    Compression(String),
-    #[error("chunk records are {got} bytes, its header says {stated}")]
-    Size { got: usize, stated: u64 },
-    #[error("chunk CRC {got:08x} differs from the stored {stored:08x}")]
-    Crc { got: u32, stored: u32 },
 }
 
 /// Calls `f(offset, opcode, content)` for each record of `records`, in order; a record

@@ -2,6 +2,7 @@
 //! statistics, chunk indexes; their CRC checked when stored) and the chunks they locate.
 
 use super::*;
+use crate::shared::note::Note;
 
 /// Why the summary section cannot be used (the note says so, and the data section is
 /// scanned instead).
@@ -62,10 +63,10 @@ impl McapReader {
             let crc = crc32fast::hash(&b);
             if crc != f.summary_crc {
                 trusted = false;
-                self.contents.notes.push(format!(
+                self.contents.notes.push(Note::warning(format!(
                     "the summary section is damaged (CRC {crc:08x} differs from the footer's {:08x}): its counts are not used, its chunk indexes only locate chunks",
                     f.summary_crc
-                ));
+                )));
             }
         }
         let mut b = vec![0u8; (end - f.summary_start) as usize];
@@ -168,16 +169,16 @@ impl McapReader {
             if !found.iter().any(|&(a, _)| a == cs) && describes_found {
                 // a chunk index whose offset is damaged: its message indexes follow a chunk
                 // the walk read
-                self.contents.notes.push(format!(
+                self.contents.notes.push(Note::warning(format!(
                     "the summary lists a chunk at byte {cs} whose message indexes follow another chunk (a damaged chunk index); ignored"
-                ));
+                )));
                 continue;
             }
             if found.iter().any(|&(a, e)| a < cs && cs < e) {
                 // a damaged chunk index pointing inside a chunk the walk read whole
-                self.contents.notes.push(format!(
+                self.contents.notes.push(Note::warning(format!(
                     "the summary lists a chunk at byte {cs}, inside a chunk the data section holds whole (a damaged chunk index); ignored"
-                ));
+                )));
                 continue;
             }
             let k = if found.iter().any(|&(a, _)| a == cs) {
@@ -255,10 +256,10 @@ impl McapReader {
             })
             .flatten();
         if added.is_some() {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the chunk at byte {} has a damaged record header; it was read where the summary locates it",
                 ci.chunk_start_offset
-            ));
+            )));
         }
         added
     }

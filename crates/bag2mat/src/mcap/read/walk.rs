@@ -3,6 +3,7 @@
 //! last complete record.
 
 use super::*;
+use crate::shared::note::Note;
 
 /// A top-level record the walk met: where, its opcode, and the content length it states.
 #[derive(Clone, Copy)]
@@ -176,9 +177,9 @@ impl McapReader {
                     if first && op != Op::Header as u8 {
                         // The Header only names the profile and library: its damage costs
                         // nothing.
-                        self.contents.notes.push(format!(
+                        self.contents.notes.push(Note::warning(format!(
                             "the first record (byte {pos}) is not an MCAP Header; the records after the magic were read anyway"
-                        ));
+                        )));
                     }
                     first = false;
                     self.record(&mut w, rec, rec_end, &mut st)?
@@ -206,9 +207,9 @@ impl McapReader {
             });
         }
         if !st.seen_data_end && pos >= end && self.summary_used {
-            self.contents
-                .notes
-                .push("the data section has no Data End record".to_string());
+            self.contents.notes.push(Note::warning(
+                "the data section has no Data End record".to_string(),
+            ));
         }
         Ok(st.found_summary)
     }
@@ -230,9 +231,9 @@ impl McapReader {
         if is_chunk && let Some(e) = self.chunk_by_size(w, pos, st) {
             // a chunk whose record length is damaged: its header's size frames it
             let k = self.add_chunk(w, pos, e - content_pos, None)?;
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the chunk at byte {pos} has a damaged record length; it was read as its header's size frames it"
-            ));
+            )));
             st.after = After::Chunk(k);
             return Ok(Flow::Read(e));
         }
@@ -271,9 +272,9 @@ impl McapReader {
         // a chunk whose opcode is damaged into another one's (a message index, a message):
         // its stored length and compression frame it as a chunk, which its CRC checks
         if op != Op::Chunk as u8 && chunk_header(w, content_pos, clen).is_some() {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
-            ));
+            )));
             let k = self.add_chunk(w, pos, clen, None)?;
             st.after = After::Chunk(k);
             return Ok(Flow::Read(rec_end));
@@ -300,9 +301,9 @@ impl McapReader {
             Some(Op::Header) if pos == MAGIC.len() as u64 => {
                 match self.small(w, rec)?.map(|b| Header::decode(&b)) {
                     Some(Ok(h)) => self.header = h,
-                    _ => self.contents.notes.push(format!(
+                    _ => self.contents.notes.push(Note::warning(format!(
                         "the MCAP Header record at byte {pos} is damaged; the records after it were read anyway"
-                    )),
+                    ))),
                 }
                 st.after = After::Other;
             }
@@ -310,9 +311,9 @@ impl McapReader {
                 if let Some(Ok(s)) = self.small(w, rec)?.map(|b| Schema::decode(&b)) {
                     offer(&mut self.schemas, s.id, s, schema_plausible);
                 } else {
-                    self.contents
-                        .notes
-                        .push(format!("unreadable Schema record at byte {pos} skipped"));
+                    self.contents.notes.push(Note::warning(format!(
+                        "unreadable Schema record at byte {pos} skipped"
+                    )));
                 }
                 st.after = After::Other;
             }
@@ -320,9 +321,9 @@ impl McapReader {
                 if let Some(Ok(c)) = self.small(w, rec)?.map(|b| record::Channel::decode(&b)) {
                     offer(&mut self.mcap_channels, c.id, c, channel_plausible);
                 } else {
-                    self.contents
-                        .notes
-                        .push(format!("unreadable Channel record at byte {pos} skipped"));
+                    self.contents.notes.push(Note::warning(format!(
+                        "unreadable Channel record at byte {pos} skipped"
+                    )));
                 }
                 st.after = After::Other;
             }
@@ -336,16 +337,16 @@ impl McapReader {
                 {
                     // its header's size field is damaged: the record, which the next one
                     // follows, frames its stored records (its CRC checks them)
-                    self.contents.notes.push(format!(
+                    self.contents.notes.push(Note::warning(format!(
                         "the chunk at byte {pos} has a damaged size field; its records were read as its record frames them"
-                    ));
+                    )));
                     st.after = After::Chunk(k);
                 } else if let Some(e) = self.chunk_by_size(w, pos, st) {
                     // its record length is damaged: its header's size frames it
                     let k = self.add_chunk(w, pos, e - content_pos, None)?;
-                    self.contents.notes.push(format!(
+                    self.contents.notes.push(Note::warning(format!(
                         "the chunk at byte {pos} has a damaged record length; it was read as its header's size frames it"
-                    ));
+                    )));
                     st.after = After::Chunk(k);
                     return Ok(Flow::Read(e));
                 } else {
@@ -482,10 +483,10 @@ impl McapReader {
                 })
             });
         if data_follows {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "a {} record at byte {pos} stands in the middle of the data section (a damaged opcode?); the records after it were read",
                 op_name(op)
-            ));
+            )));
             st.after = After::Other;
             return Flow::Read(rec_end);
         }
@@ -531,9 +532,9 @@ impl McapReader {
             matches!(ChunkHeader::decode(b), Ok((h, off)) if h.compressed_size == clen - off as u64)
         };
         if as_chunk {
-            self.contents.notes.push(format!(
+            self.contents.notes.push(Note::warning(format!(
                 "the record at byte {pos} has opcode 0x{op:02x} but holds a chunk (a damaged opcode); it was read as the chunk"
-            ));
+            )));
             let k = self.add_chunk(w, pos, clen, None)?;
             st.after = After::Chunk(k);
             return Ok(Flow::Read(rec_end));
