@@ -537,10 +537,14 @@ fn id_list(found: &[(String, u64)]) -> String {
 /// which counts missing samples across every gap, would read one stray stamp as a gap of
 /// years).
 fn median_rate(rows: &Rows) -> Option<f64> {
+    let sorted = rows.stamp.is_sorted();
+    if sorted && let Some(step) = median_step_by_count(&rows.stamp) {
+        return Some(1e9 / step as f64);
+    }
     // the steps of the sorted stamps, but zero: straight from the rows when they are in
     // order (the usual log), else in place over a sorted copy (one buffer either way)
     let mut d: Vec<u64> = Vec::with_capacity(rows.stamp.len());
-    if rows.stamp.is_sorted() {
+    if sorted {
         d.extend(
             rows.stamp
                 .windows(2)
@@ -567,6 +571,41 @@ fn median_rate(rows: &Rows) -> Option<f64> {
     let mid = d.len() / 2;
     let (_, m, _) = d.select_nth_unstable(mid);
     Some(1e9 / *m as f64)
+}
+
+/// Steps sampled for the candidate median step of stamps in order.
+const MEDIAN_STEP_SAMPLE: usize = 4096;
+
+/// The median positive step of stamps in order (`t` sorted), found without a buffer of
+/// every step when a sample's median is it: the median of the steps at
+/// [`MEDIAN_STEP_SAMPLE`] evenly spaced places is the median of all of them exactly when
+/// fewer than half of all positive steps (rounded down) are below it and more are at or
+/// below it — one counting pass. A logger's steps take a few values (EuRoC's are whole
+/// multiples of 256 ns), so the sample's median usually is the median; else `None`.
+fn median_step_by_count(t: &[RosTime]) -> Option<u64> {
+    let step = |i: usize| t[i + 1].as_nanos() - t[i].as_nanos();
+    let n = t.len().saturating_sub(1);
+    let stride = (n / MEDIAN_STEP_SAMPLE).max(1);
+    let mut sample: Vec<u64> = (0..n)
+        .step_by(stride)
+        .map(step)
+        .filter(|&d| d > 0)
+        .collect();
+    if sample.is_empty() {
+        return None;
+    }
+    let mid = sample.len() / 2;
+    let c = *sample.select_nth_unstable(mid).1;
+    let (mut positive, mut below, mut at_most) = (0usize, 0usize, 0usize);
+    for w in t.windows(2) {
+        let d = w[1].as_nanos() - w[0].as_nanos();
+        positive += usize::from(d > 0);
+        below += usize::from(d > 0 && d < c);
+        at_most += usize::from(d > 0 && d <= c);
+    }
+    // the sorted positive steps' element positive / 2 is c
+    let mid = positive / 2;
+    (below <= mid && mid < at_most).then_some(c)
 }
 
 /// The physics of what the layout read, whatever units it was told (the rules:
@@ -747,14 +786,16 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             st >> 33
         };
-        for case in 0..200 {
-            let n = (next() % 300) as usize;
+        for case in 0..400 {
+            let n = (next() % 20_000) as usize;
             let mut t: Vec<u64> = Vec::with_capacity(n);
             let mut now = 1_403_636_579_758_555_392u64;
             for _ in 0..n {
-                now += match next() % 10 {
-                    0 => 0,
-                    1 => 5_000_000 + next() % 1_000,
+                // regular steps with a few repeats and a few jittered ones, or every
+                // step jittered (the sample's median then seldom is the median)
+                now += match (case % 4, next() % 10) {
+                    (_, 0) => 0,
+                    (2, _) | (_, 1) => 5_000_000 + next() % 1_000,
                     _ => 5_000_000,
                 };
                 t.push(now);
