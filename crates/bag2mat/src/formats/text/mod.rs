@@ -580,8 +580,9 @@ const MEDIAN_STEP_SAMPLE: usize = 4096;
 /// every step when a sample's median is it: the median of the steps at
 /// [`MEDIAN_STEP_SAMPLE`] evenly spaced places is the median of all of them exactly when
 /// fewer than half of all positive steps (rounded down) are below it and more are at or
-/// below it — one counting pass. A logger's steps take a few values (EuRoC's are whole
-/// multiples of 256 ns), so the sample's median usually is the median; else `None`.
+/// below it — one counting pass. A logger's steps mostly take a few values (the nominal
+/// step, give or take its clock's resolution), so the sample's median usually is the
+/// median; else `None` (the caller then selects over a buffer of every step).
 fn median_step_by_count(t: &[RosTime]) -> Option<u64> {
     let step = |i: usize| t[i + 1].as_nanos() - t[i].as_nanos();
     let n = t.len().saturating_sub(1);
