@@ -5,7 +5,16 @@
 #     analysis of the same file (target: the read takes at most 15 % of the analysis), with
 #     pandas.read_csv (C engine, timed inside Python around read_csv, warm: the first read
 #     of a process took 0.98 s where the next took 0.56-0.70 s) and `wc -l` beside it for
-#     scale. pandas 3.1 uses both cores here, as bag2mat does;
+#     scale. pandas 3.1 uses both cores here, as bag2mat does. Measured on the 2-core machine
+#     (Dec 2026, load 1.8-2.0, best of 9 reads / 5 analyses, old and new binaries taking
+#     turns): read 0.325 s (CPU 0.57 s) -> 0.248 s (CPU 0.48 s) with stamps read eight
+#     digits at a time and the median-step rate counted instead of sorted; the analysis
+#     1.15 s -> 1.06 s (CPU 2.1 -> 2.0 s): the read is 23 % of it (was 28 %), not yet the
+#     15 % target. What bounds it: fast-float2 alone takes 15 ns per field (timed on a 40 MB
+#     slice of this file), 0.26 CPU s for its 17.28 M fields, i.e. 0.13 s on two cores, 15 %
+#     of a 0.87 s analysis by itself; an exact parser of the `-d.ddddddddddddddddd` shape
+#     of our own (u128 reciprocals of 5^k, safe code) took 18 ns (not kept); the first touch
+#     of the 184 MB of columns costs 0.02 s or 0.5 s (the machine's two modes), `wc -l` 0.11 s;
 #   * a 4 h ULog (sensor_combined, 2 x sensor_gyro/sensor_accel at 200 Hz, vehicle_imu,
 #     vehicle_status; ~800 MB) vs pyulog's ULog() (target: >= 20x faster).
 # Best of RUNS (default 7) of each, the runs of bag2mat and pandas taking turns (pyulog: 1

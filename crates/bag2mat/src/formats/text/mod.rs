@@ -538,19 +538,76 @@ fn id_list(found: &[(String, u64)]) -> String {
 /// which counts missing samples across every gap, would read one stray stamp as a gap of
 /// years).
 fn median_rate(rows: &Rows) -> Option<f64> {
-    let mut t: Vec<u64> = rows.stamp.iter().map(|s| s.as_nanos()).collect();
-    t.sort_unstable();
-    let mut d: Vec<u64> = t
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|&x| x > 0)
-        .collect();
+    let sorted = rows.stamp.is_sorted();
+    if sorted && let Some(step) = median_step_by_count(&rows.stamp) {
+        return Some(1e9 / step as f64);
+    }
+    // the steps of the sorted stamps, but zero: straight from the rows when they are in
+    // order (the usual log), else in place over a sorted copy (one buffer either way)
+    let mut d: Vec<u64> = Vec::with_capacity(rows.stamp.len());
+    if sorted {
+        d.extend(
+            rows.stamp
+                .windows(2)
+                .map(|w| w[1].as_nanos() - w[0].as_nanos())
+                .filter(|&x| x > 0),
+        );
+    } else {
+        d.extend(rows.stamp.iter().map(|s| s.as_nanos()));
+        d.sort_unstable();
+        let mut kept = 0;
+        for i in 1..d.len() {
+            let step = d[i] - d[i - 1];
+            if step > 0 {
+                // kept < i: it overwrites a stamp no later step reads
+                d[kept] = step;
+                kept += 1;
+            }
+        }
+        d.truncate(kept);
+    }
     if d.is_empty() {
         return None;
     }
     let mid = d.len() / 2;
     let (_, m, _) = d.select_nth_unstable(mid);
     Some(1e9 / *m as f64)
+}
+
+/// Steps sampled for the candidate median step of stamps in order.
+const MEDIAN_STEP_SAMPLE: usize = 4096;
+
+/// The median positive step of stamps in order (`t` sorted), found without a buffer of
+/// every step when a sample's median is it: the median of the steps at
+/// [`MEDIAN_STEP_SAMPLE`] evenly spaced places is the median of all of them exactly when
+/// fewer than half of all positive steps (rounded down) are below it and more are at or
+/// below it — one counting pass. A logger's steps mostly take a few values (the nominal
+/// step, give or take its clock's resolution), so the sample's median usually is the
+/// median; else `None` (the caller then selects over a buffer of every step).
+fn median_step_by_count(t: &[RosTime]) -> Option<u64> {
+    let step = |i: usize| t[i + 1].as_nanos() - t[i].as_nanos();
+    let n = t.len().saturating_sub(1);
+    let stride = (n / MEDIAN_STEP_SAMPLE).max(1);
+    let mut sample: Vec<u64> = (0..n)
+        .step_by(stride)
+        .map(step)
+        .filter(|&d| d > 0)
+        .collect();
+    if sample.is_empty() {
+        return None;
+    }
+    let mid = sample.len() / 2;
+    let c = *sample.select_nth_unstable(mid).1;
+    let (mut positive, mut below, mut at_most) = (0usize, 0usize, 0usize);
+    for w in t.windows(2) {
+        let d = w[1].as_nanos() - w[0].as_nanos();
+        positive += usize::from(d > 0);
+        below += usize::from(d > 0 && d < c);
+        at_most += usize::from(d > 0 && d <= c);
+    }
+    // the sorted positive steps' element positive / 2 is c
+    let mid = positive / 2;
+    (below <= mid && mid < at_most).then_some(c)
 }
 
 /// The physics of what the layout read, whatever units it was told (the rules:
@@ -707,6 +764,63 @@ pub(crate) fn lost_rows(channel: u32, (n, what): (u64, String)) -> crate::source
 mod tests {
     use super::*;
     use layout::Delim;
+
+    /// The median-step rate is one over the median of the positive steps of the sorted
+    /// stamps, as the plain sort-and-collect computes it, for stamps in order, out of
+    /// order, repeated, and too few.
+    #[test]
+    fn the_median_rate_is_that_of_the_sorted_stamps() {
+        let slow = |t: &[u64]| -> Option<f64> {
+            let mut t = t.to_vec();
+            t.sort_unstable();
+            let mut d: Vec<u64> = t
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .filter(|&x| x > 0)
+                .collect();
+            d.sort_unstable();
+            d.get(d.len() / 2).map(|m| 1e9 / *m as f64)
+        };
+        let mut st = 0x2026_1208_3ED1_A4E5_u64;
+        let mut next = || {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            st >> 33
+        };
+        for case in 0..400 {
+            let n = (next() % 20_000) as usize;
+            let mut t: Vec<u64> = Vec::with_capacity(n);
+            let mut now = 1_403_636_579_758_555_392u64;
+            for _ in 0..n {
+                // regular steps with a few repeats and a few jittered ones, or every
+                // step jittered (the sample's median then seldom is the median)
+                now += match (case % 4, next() % 10) {
+                    (_, 0) => 0,
+                    (2, _) | (_, 1) => 5_000_000 + next() % 1_000,
+                    _ => 5_000_000,
+                };
+                t.push(now);
+            }
+            if case % 2 == 1 && n > 1 {
+                // a few swapped or thrown far back
+                for _ in 0..3 {
+                    let (a, b) = ((next() as usize) % n, (next() as usize) % n);
+                    t.swap(a, b);
+                }
+                t[0] = t[0].saturating_sub(next() << 20);
+            }
+            let mut rows = Rows::zeroed(n);
+            for (s, &x) in rows.stamp.iter_mut().zip(&t) {
+                *s = RosTime::from_nanos(x);
+            }
+            assert_eq!(
+                median_rate(&rows).map(f64::to_bits),
+                slow(&t).map(f64::to_bits),
+                "case {case}"
+            );
+        }
+    }
 
     /// Bytes per range that make a test body of a few hundred kB many ranges.
     const SMALL_RANGE: usize = 4096;
