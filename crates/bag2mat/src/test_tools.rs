@@ -784,3 +784,17 @@ pub fn yaml_number(text: &str, path: &str) -> f64 {
         .map(|(_, x)| x)
         .unwrap_or_else(|| panic!("no number at {path} in:\n{text}"))
 }
+
+/// Asserts that a binary's help output (`stdout` of `--help`) names every kind of input the
+/// registry holds ([`crate::InputKind::ALL`]'s phrases) and each of `extra`, in clap's
+/// wrapping (whitespace compared collapsed).
+pub fn assert_help_lists_every_input(stdout: &[u8], extra: &[&str]) {
+    let help = String::from_utf8_lossy(stdout)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let kinds = crate::InputKind::ALL.iter().map(|k| k.facts().accepted);
+    for phrase in extra.iter().copied().chain(kinds) {
+        assert!(help.contains(phrase), "{phrase:?} missing from {help}");
+    }
+}

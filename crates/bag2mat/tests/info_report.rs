@@ -94,12 +94,7 @@ fn batch_sample_losses_are_the_batch_topics_own() {
     };
     let read = bag2mat::read_imu_topics(&log, &sel, &bag2mat::ReadOptions { quiet: true }).unwrap();
     for s in &read.series {
-        let notes = s
-            .notes
-            .iter()
-            .map(|n| n.text.as_str())
-            .collect::<Vec<_>>()
-            .join("\n");
+        let notes = bag2mat::shared::note::texts(&s.notes);
         if s.topic.starts_with("ISB_") {
             // each batch topic's last batch is short by 32 samples: its own, said on it (as
             // a bound: the log may have stopped before the batch was written whole)

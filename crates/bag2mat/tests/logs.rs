@@ -118,12 +118,7 @@ fn ulog_topics_match_pyulog_bit_for_bit_also_on_pyulogs_own_rewrite() {
         let series = assert_same_rows(f, &theirs);
         // the dropout the log records is a loss, and pyulog counts the same one
         assert!(other.contains(&"dropouts 1 60".to_string()), "{other:?}");
-        let note = series[0]
-            .notes
-            .iter()
-            .map(|n| n.text.as_str())
-            .collect::<Vec<_>>()
-            .join("\n");
+        let note = bag2mat::shared::note::texts(&series[0].notes);
         assert!(
             note.contains("1 dropout totalling 60 ms"),
             "{}: {note}",
@@ -228,12 +223,7 @@ fn dataflash_imu_and_batches_match_pymavlink_bit_for_bit() {
     // the last batch of each sensor stops short of the others' count: said on each, with
     // the samples it lacks as a bound (the log may have stopped before writing them)
     for s in &series[2..4] {
-        let notes = s
-            .notes
-            .iter()
-            .map(|n| n.text.as_str())
-            .collect::<Vec<_>>()
-            .join("\n");
+        let notes = bag2mat::shared::note::texts(&s.notes);
         assert!(
             notes.contains(&format!("up to 32 messages on '{}' were lost", s.topic)),
             "{notes}"
@@ -319,12 +309,7 @@ fn euroc_file_folder_and_root_read_the_same_decimals_as_pandas() {
                 );
             }
         }
-        let notes = s
-            .notes
-            .iter()
-            .map(|n| n.text.as_str())
-            .collect::<Vec<_>>()
-            .join("\n");
+        let notes = bag2mat::shared::note::texts(&s.notes);
         assert!(
             notes.contains("sensor.yaml states gyroscope_noise_density 0.00016968"),
             "{notes}"
@@ -543,22 +528,12 @@ fn a_damaged_ulog_says_what_it_lost_and_keeps_the_rest() {
         (combined.topic.as_str(), combined.len()),
         ("sensor_combined", 150)
     );
-    let notes = combined
-        .notes
-        .iter()
-        .map(|n| n.text.as_str())
-        .collect::<Vec<_>>()
-        .join("\n");
+    let notes = bag2mat::shared::note::texts(&combined.notes);
     assert!(notes.contains("37 bytes in 1 stretch"), "{notes}");
     assert!(notes.contains("ends inside a message"), "{notes}");
     let deltas = &r.series[1];
     assert_eq!(deltas.len(), 99);
-    let notes = deltas
-        .notes
-        .iter()
-        .map(|n| n.text.as_str())
-        .collect::<Vec<_>>()
-        .join("\n");
+    let notes = bag2mat::shared::note::texts(&deltas.notes);
     assert!(
         notes.contains("'vehicle_imu': a delta with a zero dt; 1 message lost"),
         "{notes}"

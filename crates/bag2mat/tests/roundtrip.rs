@@ -203,19 +203,26 @@ fn truncated_bag_keeps_complete_chunks() {
     }
 }
 
-/// A reader's note is said by whoever prints it, in its own way: the converter as a
-/// `warning:` line on stderr, `bag2mat info` as a `note:` line of its report (never both
-/// prefixes, never the note's level as part of its text).
-#[test]
-fn a_readers_note_is_a_warning_to_the_converter_and_a_note_to_info() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("u.bag");
+/// `dir/u.bag`: 3000 Imu messages in bz2 chunks, as a writer that crashed leaves them (it
+/// never rewrote the header: index_pos = 0).
+fn unfinished_bag(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("u.bag");
     write_synthetic(&path, "imu", 3000, Compression::Bz2, false);
     let mut bytes = std::fs::read(&path).unwrap();
     let h = &mut bytes[13..13 + 4104];
     let at = h.windows(10).position(|w| w == b"index_pos=").unwrap() + 10;
     h[at..at + 8].fill(0);
     std::fs::write(&path, &bytes).unwrap();
+    path
+}
+
+/// A reader's note is said by whoever prints it, in its own way: the converter as a
+/// `warning:` line on stderr, `bag2mat info` as a `note:` line of its report (never both
+/// prefixes, never the note's level as part of its text).
+#[test]
+fn a_readers_note_is_a_warning_to_the_converter_and_a_note_to_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = unfinished_bag(dir.path());
     let said = "the bag has no index (index_pos = 0: the writer did not finish)";
     let bin = || std::process::Command::new(env!("CARGO_BIN_EXE_bag2mat"));
     let (ok, out, err) = crate::common::run(bin().arg("info").arg(&path));
@@ -240,14 +247,7 @@ fn a_readers_note_is_a_warning_to_the_converter_and_a_note_to_info() {
 #[test]
 fn unfinished_bag_is_scanned() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("u.bag");
-    write_synthetic(&path, "imu", 3000, Compression::Bz2, false);
-    let mut bytes = std::fs::read(&path).unwrap();
-    // A writer that crashed never rewrote the header: index_pos = 0.
-    let h = &mut bytes[13..13 + 4104];
-    let at = h.windows(10).position(|w| w == b"index_pos=").unwrap() + 10;
-    h[at..at + 8].fill(0);
-    std::fs::write(&path, &bytes).unwrap();
+    let path = unfinished_bag(dir.path());
     let s = read_imu_series(&path, "imu", &ReadOptions { quiet: true }).unwrap();
     assert_eq!(s.len(), 3000);
     assert!(

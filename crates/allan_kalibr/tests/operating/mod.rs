@@ -41,6 +41,18 @@ pub fn run(args: &[&str]) -> (String, String) {
     (o, e)
 }
 
+/// `allan_kalibr IMU --reference REF -o out -q` on a written record: (stdout, stderr).
+pub fn analyse_against_reference(w: &record::Written, out: &Path) -> (String, String) {
+    run(&[
+        w.imu.to_str().unwrap(),
+        "--reference",
+        w.reference.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ])
+}
+
 /// The rows of a CSV with `#` comment lines, as (header → value) lookups.
 pub fn csv_rows(path: &Path) -> Vec<Vec<(String, String)>> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -101,14 +113,7 @@ fn check_against_injected(spec: &record::Spec, tag: &str) {
         std::fs::copy(&w.reference, k.join("reference.tum")).unwrap();
     }
     let out = d.path().join("out");
-    let (text, _) = run(&[
-        w.imu.to_str().unwrap(),
-        "--reference",
-        w.reference.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "-q",
-    ]);
+    let (text, _) = analyse_against_reference(&w, &out);
     eprintln!("{tag}:\n{text}");
     let want = spec.expected();
     for row in csv_rows(&out.join("operating_noise.csv")) {
@@ -193,14 +198,7 @@ fn the_operating_analysis_writes_the_same_bytes_on_every_run() {
     let outs: Vec<std::path::PathBuf> = (0..RUNS_COMPARED)
         .map(|k| {
             let out = d.path().join(format!("out{k}"));
-            run(&[
-                w.imu.to_str().unwrap(),
-                "--reference",
-                w.reference.to_str().unwrap(),
-                "-o",
-                out.to_str().unwrap(),
-                "-q",
-            ]);
+            analyse_against_reference(&w, &out);
             out
         })
         .collect();

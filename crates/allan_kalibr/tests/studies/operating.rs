@@ -9,7 +9,8 @@
 use allan_kalibr::operating::band;
 
 use crate::operating::{
-    LINE_FREQ_REL_TOL, N_REL_TOL, OFFSET_TOL, axis_index, csv_rows, num, record, run, yaml,
+    LINE_FREQ_REL_TOL, N_REL_TOL, OFFSET_TOL, analyse_against_reference, axis_index, csv_rows, num,
+    record, yaml,
 };
 
 /// Seeds per set-up.
@@ -51,14 +52,7 @@ fn operating_interval_coverage_study() {
             spec.ref_noise = noise;
             let w = record::write(d.path(), &spec);
             let out = d.path().join("out");
-            run(&[
-                w.imu.to_str().unwrap(),
-                "--reference",
-                w.reference.to_str().unwrap(),
-                "-o",
-                out.to_str().unwrap(),
-                "-q",
-            ]);
+            analyse_against_reference(&w, &out);
             let want = spec.expected();
             let cal = out.join("operating_calibration.yaml");
             let first = ((yaml(&cal, "first_sample_time_s") - record::T0_NS as f64 * 1e-9) * rate)

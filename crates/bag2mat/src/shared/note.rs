@@ -88,3 +88,13 @@ impl fmt::Display for Note {
         }
     }
 }
+
+/// Every note's text, one per line (no level prefix): what a message or a test that looks for
+/// one of them reads.
+pub fn texts(notes: &[Note]) -> String {
+    notes
+        .iter()
+        .map(|n| n.text.as_str())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
