@@ -126,30 +126,11 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if matches!(config.common.input, allan_kalibr::Input::Curves(_)) {
         return Ok(vec![run_curves(config, outputs)?.section]);
     }
-    let topics = run_topics(config, outputs)?;
-    let several = topics.len() > 1;
-    topics
-        .into_iter()
-        .map(|t| match t.result {
-            Ok(o) => Ok(o.section),
-            // one topic of several: said as its error, the others still written (the rule
-            // allan_kalibr follows too)
-            Err(e) if several => Ok(allan_kalibr::topic_failed(&t.topic, t.notes, &e)),
-            Err(e) => Err(e),
-        })
-        .collect()
+    allan_kalibr::topic_sections(run_topics(config, outputs)?, |o| o.section)
 }
 
 /// One topic's outcome in a run of several ([`run_topics`]).
-#[derive(Debug)]
-pub struct TopicRun {
-    /// The topic.
-    pub topic: String,
-    /// What its reader said (repeated for a topic that failed, whose section has no other).
-    pub notes: Vec<Note>,
-    /// Its analysis, or why it failed.
-    pub result: Result<Outcome, Error>,
-}
+pub type TopicRun = allan_kalibr::TopicOutcome<Outcome, Error>;
 
 impl allan_kalibr::Job for Config {
     type Error = Error;

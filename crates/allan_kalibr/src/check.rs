@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 use crate::consumers::read::{self, Entry, Kind};
 use crate::consumers::{Consumer, ConsumerId, Form, Key, Quantity, consumer, datasheet};
+use crate::ieee952::csv_back::OutputCsv;
 use crate::ieee952::files as terms;
 
 /// A value within this factor of the measured one agrees with it (the 95 % precision of K
@@ -127,28 +128,22 @@ impl Reference {
         curves: Option<&str>,
         what: &str,
     ) -> Result<Reference, String> {
-        let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-        let col = |name: &str| {
-            header
-                .iter()
-                .position(|h| *h == name)
-                .ok_or_else(|| format!("no column {name}: not an ieee952_terms.csv"))
-        };
-        let (cs, ca, ct, cv, clo, chi, cr) = (
-            col(terms::COL_SENSOR)?,
-            col(terms::COL_AXIS)?,
-            col(terms::COL_TERM)?,
-            col(terms::COL_VALUE)?,
-            col(terms::COL_CI95_LO)?,
-            col(terms::COL_CI95_HI)?,
-            col(terms::COL_RESOLVED)?,
-        );
+        let csv = OutputCsv::parse(text);
+        let [cs, ca, ct, cv, clo, chi, cr] = csv
+            .columns([
+                terms::COL_SENSOR,
+                terms::COL_AXIS,
+                terms::COL_TERM,
+                terms::COL_VALUE,
+                terms::COL_CI95_LO,
+                terms::COL_CI95_HI,
+                terms::COL_RESOLVED,
+            ])
+            .map_err(|name| format!("no column {name}: not an ieee952_terms.csv"))?;
         let mut axes = [[None; 3]; 4];
         let mut floors: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
-        for l in lines {
-            let f: Vec<&str> = l.split(',').collect();
-            if f.len() < header.len() {
+        for f in csv.rows() {
+            if f.len() < csv.width() {
                 continue;
             }
             let num = |i: usize| f[i].parse::<f64>().unwrap_or(f64::NAN);

@@ -363,6 +363,36 @@ pub fn topic_failed(topic: &str, notes: Vec<Note>, error: &dyn std::fmt::Display
     }
 }
 
+/// One topic's outcome in a run of several (both tools' `run_topics`): a topic that fails
+/// does not stop the others.
+#[derive(Debug)]
+pub struct TopicOutcome<O, E> {
+    /// The topic.
+    pub topic: String,
+    /// What its reader said (repeated for a topic that failed, whose section has no other).
+    pub notes: Vec<Note>,
+    /// Its analysis, or why it failed.
+    pub result: Result<O, E>,
+}
+
+/// The sections of a run's topics, `section` giving an analysis' own: of several topics,
+/// one that failed is said as its error ([`topic_failed`]) and the others are still written
+/// (both tools' rule); a single topic's error is the run's.
+pub fn topic_sections<O, E: std::fmt::Display>(
+    topics: Vec<TopicOutcome<O, E>>,
+    section: impl Fn(O) -> Section,
+) -> Result<Vec<Section>, E> {
+    let several = topics.len() > 1;
+    topics
+        .into_iter()
+        .map(|t| match t.result {
+            Ok(o) => Ok(section(o)),
+            Err(e) if several => Ok(topic_failed(&t.topic, t.notes, &e)),
+            Err(e) => Err(e),
+        })
+        .collect()
+}
+
 /// A tool's settings as the front end runs them: the shared part, and the job that turns
 /// them into sections.
 pub trait Job {
@@ -452,11 +482,10 @@ fn stale_files(out_dir: &Path, sections: &[Section], names: &[String]) -> Vec<Pa
     stale
 }
 
-/// "removed 2 files an earlier run left in DIR/ (this run does not write them): a, b", one
-/// line per folder.
-fn removed_lines(removed: &[PathBuf]) -> Vec<String> {
+/// `paths` grouped by folder, in the order each folder first appears: (folder, file names).
+fn by_folder(paths: &[PathBuf]) -> Vec<(&Path, Vec<String>)> {
     let mut folders: Vec<(&Path, Vec<String>)> = Vec::new();
-    for p in removed {
+    for p in paths {
         let dir = p.parent().unwrap_or(Path::new(""));
         let name = p.file_name().map_or_else(
             || p.display().to_string(),
@@ -468,6 +497,12 @@ fn removed_lines(removed: &[PathBuf]) -> Vec<String> {
         }
     }
     folders
+}
+
+/// "removed 2 files an earlier run left in DIR/ (this run does not write them): a, b", one
+/// line per folder.
+fn removed_lines(removed: &[PathBuf]) -> Vec<String> {
+    by_folder(removed)
         .into_iter()
         .map(|(dir, names)| {
             let files = if names.len() == 1 { "file" } else { "files" };
@@ -584,19 +619,7 @@ fn finish<E: std::fmt::Display>(
 /// "wrote N files to DIR/: a, b, …", one line per folder, in the order written; "(K of
 /// them replacing an earlier run's)" when files of these names were there before.
 fn wrote_lines(written: &[PathBuf], replaced: &[PathBuf]) -> Vec<String> {
-    let mut folders: Vec<(&Path, Vec<String>)> = Vec::new();
-    for p in written {
-        let dir = p.parent().unwrap_or(Path::new(""));
-        let name = p.file_name().map_or_else(
-            || p.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        match folders.iter_mut().find(|(d, _)| *d == dir) {
-            Some((_, names)) => names.push(name),
-            None => folders.push((dir, vec![name])),
-        }
-    }
-    folders
+    by_folder(written)
         .into_iter()
         .map(|(dir, names)| {
             let again = replaced

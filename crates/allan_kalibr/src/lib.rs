@@ -86,12 +86,13 @@ pub use consumers::SensorValue;
 pub use error::Error;
 pub use front::CurvesInput;
 pub use front::{
-    Common, CommonArgs, Input, Job, MAT_INPUT, Section, command_line, main as analyser_main,
-    rate_for_text, refusal_text, run_job, topic_failed,
+    Common, CommonArgs, Input, Job, MAT_INPUT, Section, TopicOutcome, command_line,
+    main as analyser_main, rate_for_text, refusal_text, run_job, topic_failed, topic_sections,
 };
 pub use ieee952::advisor::advise;
 pub use ieee952::advisor::{Advice, TermAdvice};
 pub use ieee952::ci::chi2_interval;
+pub use ieee952::csv_back::{OutputCsv, field as csv_field};
 pub use ieee952::curves_in::{Curves, Format as CurvesFormat, SensorCurves};
 pub use ieee952::curves_in::{
     CurvesError, ImuUtilsRaw, Options as CurvesOptions, read as read_curves,

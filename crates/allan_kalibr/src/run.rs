@@ -143,29 +143,11 @@ pub fn sections(config: &Config, outputs: &Outputs) -> Result<Vec<Section>, Erro
     if let Some(s) = &config.operating {
         return crate::operating::sections(TOOL, &config.common, &config.title, s, outputs);
     }
-    let topics = run_topics(config, outputs)?;
-    let several = topics.len() > 1;
-    topics
-        .into_iter()
-        .map(|t| match t.result {
-            Ok(out) => Ok(out.section),
-            // one topic of several: said as its error, the others still written
-            Err(e) if several => Ok(crate::front::topic_failed(&t.topic, t.notes, &e)),
-            Err(e) => Err(e),
-        })
-        .collect()
+    crate::front::topic_sections(run_topics(config, outputs)?, |out| out.section)
 }
 
 /// One topic's outcome in a run of several ([`run_topics`]).
-#[derive(Debug)]
-pub struct TopicRun {
-    /// The topic.
-    pub topic: String,
-    /// What its reader said (repeated for a topic that failed, whose section has no other).
-    pub notes: Vec<Note>,
-    /// Its analysis, or why it failed.
-    pub result: Result<RunOutput, Error>,
-}
+pub type TopicRun = crate::front::TopicOutcome<RunOutput, Error>;
 
 impl crate::front::Job for Config {
     type Error = Error;

@@ -249,29 +249,23 @@ pub fn read_kalibr_yaml(path: &Path) -> Result<BTreeMap<String, f64>> {
 /// The N and K rows of an `ieee952_terms.csv`, as intervals over the three axes.
 pub fn read_ieee_terms(path: &Path) -> Result<BTreeMap<(Sensor, Quantity), Interval>> {
     let text = read(path)?;
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
-    };
     use allan_kalibr::{COL_CI95_HI, COL_CI95_LO, COL_RESOLVED, COL_SENSOR, COL_TERM, COL_VALUE};
-    let (cs, ct, cv, cl, ch, cr) = (
-        col(COL_SENSOR)?,
-        col(COL_TERM)?,
-        col(COL_VALUE)?,
-        col(COL_CI95_LO)?,
-        col(COL_CI95_HI)?,
-        col(COL_RESOLVED)?,
-    );
+    let csv = allan_kalibr::OutputCsv::parse(&text);
+    let [cs, ct, cv, cl, ch, cr] = csv
+        .columns([
+            COL_SENSOR,
+            COL_TERM,
+            COL_VALUE,
+            COL_CI95_LO,
+            COL_CI95_HI,
+            COL_RESOLVED,
+        ])
+        .map_err(|name| SimError::Input(format!("{}: no column {name}", path.display())))?;
     // Per (sensor, term): (value, lo, hi, resolved) of each axis.
     type AxisRows = Vec<(f64, f64, f64, bool)>;
     let mut acc: BTreeMap<(Sensor, Quantity), AxisRows> = BTreeMap::new();
-    for line in lines {
-        let f: Vec<&str> = line.split(',').collect();
-        let get = |i: usize| f.get(i).copied().unwrap_or("");
+    for f in csv.rows() {
+        let get = |i: usize| allan_kalibr::csv_field(&f, i);
         let sensor = match get(cs) {
             "gyroscope" => Sensor::Gyro,
             "accelerometer" => Sensor::Acc,

@@ -35,17 +35,13 @@ fn read(path: &Path) -> Result<String> {
 /// kalibr_allan's averaged curve (`acc_avg` or `gyro_avg`) from `allan_curves.csv`.
 fn kalibr_curve(path: &Path, column: &str) -> Result<Vec<(f64, f64)>> {
     let text = read(path)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let c = header
-        .iter()
-        .position(|h| *h == column)
+    let csv = allan_kalibr::OutputCsv::parse(&text);
+    let c = csv
+        .column(column)
         .ok_or_else(|| SimError::Input(format!("{}: no {column}", path.display())))?;
-    Ok(lines
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            Some((f.first()?.parse().ok()?, f.get(c)?.parse().ok()?))
-        })
+    Ok(csv
+        .rows()
+        .filter_map(|f| Some((f.first()?.parse().ok()?, f.get(c)?.parse().ok()?)))
         .filter(|(t, v): &(f64, f64)| *t > 0.0 && v.is_finite() && *v > 0.0)
         .collect())
 }
@@ -54,24 +50,13 @@ fn kalibr_curve(path: &Path, column: &str) -> Result<Vec<(f64, f64)>> {
 fn ieee_curve(path: &Path, axes: [&str; 3]) -> Result<Vec<(f64, f64)>> {
     use allan_kalibr::{CURVE_ADEV, CURVE_AXIS, CURVE_M, CURVE_TAU};
     let text = read(path)?;
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| SimError::Input(format!("{}: no column {name}", path.display())))
-    };
-    let (ca, cm, ct, cd) = (
-        col(CURVE_AXIS)?,
-        col(CURVE_M)?,
-        col(CURVE_TAU)?,
-        col(CURVE_ADEV)?,
-    );
+    let csv = allan_kalibr::OutputCsv::parse(&text);
+    let [ca, cm, ct, cd] = csv
+        .columns([CURVE_AXIS, CURVE_M, CURVE_TAU, CURVE_ADEV])
+        .map_err(|name| SimError::Input(format!("{}: no column {name}", path.display())))?;
     let mut by_m: std::collections::BTreeMap<u64, (f64, f64, usize)> = Default::default();
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
-        let get = |i: usize| f.get(i).copied().unwrap_or("");
+    for f in csv.rows() {
+        let get = |i: usize| allan_kalibr::csv_field(&f, i);
         if !axes.contains(&get(ca)) {
             continue;
         }

@@ -105,6 +105,7 @@ mod analysed_curve;
 mod avar_cov;
 mod band;
 pub(crate) mod ci;
+pub(crate) mod csv_back;
 pub(crate) mod curves_in;
 pub(crate) mod edf;
 pub(crate) mod files;

@@ -48,9 +48,8 @@ pub fn find_truth(input: &Path, a: &ImuAnalysis) -> Option<Truth> {
 
 /// Parses a `sim` truth CSV for the axes of `a`.
 pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next()?.split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name);
+    let csv = super::csv_back::OutputCsv::parse(text);
+    let col = |name: &str| csv.column(name);
     let tau_c = col("tau_s")?;
     let cols: Vec<usize> = a
         .axes
@@ -64,8 +63,7 @@ pub(crate) fn read_truth(text: &str, a: &ImuAnalysis) -> Option<Truth> {
         })
         .collect::<Option<_>>()?;
     let mut out: Truth = vec![Vec::new(); cols.len()];
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
+    for f in csv.rows() {
         let tau: f64 = f.get(tau_c)?.parse().ok()?;
         for (k, &c) in cols.iter().enumerate() {
             let v: f64 = f.get(c)?.parse().ok()?;
