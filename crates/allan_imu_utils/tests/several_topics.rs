@@ -4,28 +4,11 @@
 
 use std::process::Command;
 
-/// A ROS 1 bag (Debian's python rosbag) with two 30 s topics at 100 Hz and one of `short`
-/// messages.
-pub fn rig_bag(dir: &std::path::Path, short: usize) -> std::path::PathBuf {
-    let bag = dir.join("rig.bag");
-    let topic = |t: &str, n: usize| {
-        format!(r#"{{"topic": "{t}", "n": {n}, "rate": 100, "gyro_n": 1e-4, "acc_n": 1e-3}}"#)
-    };
-    let spec = format!(
-        r#"{{"seed": 41, "topics": [{}, {}, {}]}}"#,
-        topic("/imu0", 3000),
-        topic("/imu1", 3000),
-        topic("/short", short)
-    );
-    bag2mat::test_tools::independent_log("ros1", &bag, &spec);
-    bag
-}
-
 #[test]
 fn a_topic_too_short_fails_alone_and_the_other_topics_are_written() {
     let dir = tempfile::tempdir().unwrap();
     // 5 messages: imu_utils' fit needs more Allan points than they give
-    let bag = rig_bag(dir.path(), 5);
+    let bag = bag2mat::test_tools::several_topics_bag(dir.path(), 5);
     let out = dir.path().join("out");
     let o = Command::new(env!("CARGO_BIN_EXE_allan_imu_utils"))
         .arg(&bag)

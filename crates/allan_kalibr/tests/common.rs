@@ -156,3 +156,31 @@ pub fn rel_err(a: f64, b: f64) -> f64 {
         ((a - b) / b).abs()
     }
 }
+
+/// `sim bag ARGS…` through sim's library as its binary runs it (its outputs written in
+/// place).
+pub fn sim_bag(args: &[&str]) {
+    let argv = ["sim", "bag"].iter().chain(args);
+    let cli = <sim::Cli as clap::Parser>::try_parse_from(argv).unwrap();
+    let sim::Command::Bag(a) = cli.command else {
+        unreachable!("a bag command")
+    };
+    let cfg = sim::BagConfig::try_from(*a).unwrap();
+    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
+}
+
+/// `sim bag` with a moving IMU (its ellipse, the medium preset) for `seconds`.
+pub fn sim_ellipse_bag(path: &std::path::Path, seconds: u32) {
+    let seconds = seconds.to_string();
+    sim_bag(&[
+        "-o",
+        path.to_str().unwrap(),
+        "--motion",
+        "ellipse",
+        "--duration",
+        &seconds,
+        "--preset",
+        "medium",
+        "-q",
+    ]);
+}

@@ -100,30 +100,6 @@ fn curves_input_files_carry_the_record_rate_not_the_curve_spacing() {
     assert!(yaml_number(&kalibr, "gyroscope_noise_density") > 0.0);
 }
 
-/// `sim bag` with a moving IMU (its ellipse), through sim's library as its binary runs it.
-fn sim_ellipse_bag(path: &Path) {
-    use clap::Parser;
-    let cli = sim::Cli::try_parse_from([
-        "sim",
-        "bag",
-        "-o",
-        path.to_str().unwrap(),
-        "--motion",
-        "ellipse",
-        "--duration",
-        "120",
-        "--preset",
-        "medium",
-        "-q",
-    ])
-    .unwrap();
-    let sim::Command::Bag(a) = cli.command else {
-        unreachable!()
-    };
-    let cfg = sim::BagConfig::try_from(*a).unwrap();
-    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
-}
-
 #[test]
 fn a_reused_output_folder_holds_only_the_last_runs_files() {
     let tmp = tempfile::tempdir().unwrap();
@@ -141,7 +117,7 @@ fn a_reused_output_folder_holds_only_the_last_runs_files() {
 
     // a moving record into the same folder: its section is not computed
     let moving = tmp.path().join("ellipse.bag");
-    sim_ellipse_bag(&moving);
+    crate::common::sim_ellipse_bag(&moving, 120);
     let err = ok(&run(&[moving.to_str().unwrap(), "-q", "-o", o]));
     // before: p3's kalibr_imu_ieee952.yaml (and every other section file) stayed, and
     // imu.yaml pointed to it "beside this file"

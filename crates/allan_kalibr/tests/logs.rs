@@ -16,9 +16,7 @@ fn values(yaml: &str) -> Vec<String> {
 fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("sim.bag");
-    let sim::Command::Bag(a) = sim::Cli::try_parse_from([
-        "sim",
-        "bag",
+    crate::common::sim_bag(&[
         "-o",
         bag.to_str().unwrap(),
         "--duration",
@@ -30,17 +28,7 @@ fn sim_bag_to_csv_to_euroc_gives_the_bags_terms() {
         "--seed",
         "20",
         "-q",
-    ])
-    .unwrap()
-    .command
-    else {
-        panic!("not a bag command")
-    };
-    sim::run_bag(
-        &sim::BagConfig::try_from(*a).unwrap(),
-        &bag2mat::shared::output::Outputs::direct(),
-    )
-    .unwrap();
+    ]);
     let root = bag2mat::test_tools::euroc_dataset_from_bag(
         &bag,
         "imu",

@@ -186,37 +186,13 @@ fn warm_up_is_flagged_on_every_axis_and_the_skip_outlasts_it() {
     );
 }
 
-/// `sim bag` with a moving IMU (its ellipse), through sim's library as its binary runs it.
-fn sim_ellipse_bag(path: &Path) {
-    use clap::Parser;
-    let cli = sim::Cli::try_parse_from([
-        "sim",
-        "bag",
-        "-o",
-        path.to_str().unwrap(),
-        "--motion",
-        "ellipse",
-        "--duration",
-        "300",
-        "--preset",
-        "medium",
-        "-q",
-    ])
-    .unwrap();
-    let sim::Command::Bag(a) = cli.command else {
-        unreachable!()
-    };
-    let cfg = sim::BagConfig::try_from(*a).unwrap();
-    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
-}
-
 #[test]
 fn a_moving_record_refuses_the_corrected_section() {
     let tmp = tempfile::tempdir().unwrap();
     let hand = tmp.path().join("hand.bag");
     odd_record(OddWriter::Rosbag, &hand, "handheld", 600.0, 100.0);
     let ellipse = tmp.path().join("ellipse.bag");
-    sim_ellipse_bag(&ellipse);
+    crate::common::sim_ellipse_bag(&ellipse, 300);
     for bag in [hand, ellipse] {
         let out = tmp.path().join(bag.file_stem().unwrap());
         let (text, err) = analyse(&bag, &out, &[]);

@@ -7,18 +7,8 @@ use std::process::Command;
 #[test]
 fn a_topic_too_short_fails_alone_and_the_other_topics_are_written() {
     let dir = tempfile::tempdir().unwrap();
-    let bag = dir.path().join("rig.bag");
-    let topic = |t: &str, n: usize| {
-        format!(r#"{{"topic": "{t}", "n": {n}, "rate": 100, "gyro_n": 1e-4, "acc_n": 1e-3}}"#)
-    };
     // 2 messages: no Allan variance at all
-    let spec = format!(
-        r#"{{"seed": 41, "topics": [{}, {}, {}]}}"#,
-        topic("/imu0", 3000),
-        topic("/imu1", 3000),
-        topic("/short", 2)
-    );
-    bag2mat::test_tools::independent_log("ros1", &bag, &spec);
+    let bag = bag2mat::test_tools::several_topics_bag(dir.path(), 2);
     let out = dir.path().join("out");
     let o = Command::new(env!("CARGO_BIN_EXE_allan_kalibr"))
         .arg(&bag)

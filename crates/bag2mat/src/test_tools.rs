@@ -798,3 +798,21 @@ pub fn assert_help_lists_every_input(stdout: &[u8], extra: &[&str]) {
         assert!(help.contains(phrase), "{phrase:?} missing from {help}");
     }
 }
+
+/// `dir/rig.bag`, a ROS 1 bag written by Debian's python rosbag ([`independent_log`]): two
+/// 30 s Imu topics at 100 Hz (`/imu0`, `/imu1`) and `/short` with `short` messages (the
+/// analysers' several-topics tests: one topic that cannot be analysed among good ones).
+pub fn several_topics_bag(dir: &Path, short: usize) -> PathBuf {
+    let bag = dir.join("rig.bag");
+    let topic = |t: &str, n: usize| {
+        format!(r#"{{"topic": "{t}", "n": {n}, "rate": 100, "gyro_n": 1e-4, "acc_n": 1e-3}}"#)
+    };
+    let spec = format!(
+        r#"{{"seed": 41, "topics": [{}, {}, {}]}}"#,
+        topic("/imu0", 3000),
+        topic("/imu1", 3000),
+        topic("/short", short)
+    );
+    independent_log("ros1", &bag, &spec);
+    bag
+}

@@ -530,9 +530,7 @@ fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
     .unwrap();
     let bag = d.path().join("hand.bag");
     let reference = d.path().join("hand.tum");
-    let cli = <sim::Cli as clap::Parser>::try_parse_from([
-        "sim",
-        "bag",
+    crate::common::sim_bag(&[
         "-o",
         bag.to_str().unwrap(),
         "--motion",
@@ -566,13 +564,7 @@ fn a_sim_bag_with_its_reference_is_analysed_to_its_truth() {
         "--g-sensitivity",
         "2e-4",
         "-q",
-    ])
-    .unwrap();
-    let sim::Command::Bag(a) = cli.command else {
-        unreachable!()
-    };
-    let cfg = sim::BagConfig::try_from(*a).unwrap();
-    sim::run_bag(&cfg, &bag2mat::shared::output::Outputs::direct()).unwrap();
+    ]);
     let truth = sim::reference_truth_path(&reference);
     let want: Vec<f64> = yaml_list(&truth, "gyroscope_operating_noise_density")
         .into_iter()
