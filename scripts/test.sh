@@ -61,7 +61,8 @@ cargo test --workspace "$@"
 # analysis' advice on four simulated sensors × 5 seeds (issue 43), and issue 42's coverage
 # count of the operating-noise interval (80 seeded hand-held records with a reference,
 # through the allan_kalibr binary: 249 s measured on two cores shared with other builds).
-cargo test -p allan_kalibr --test main -- --ignored --exact \
+# --nocapture: each study's counts (coverage numerators/denominators) go into the CI log.
+cargo test -p allan_kalibr --test main -- --ignored --exact --nocapture \
   studies::profiles::profiles_study studies::bandlimited::bandlimited_study \
   studies::lines::lines_study studies::coverage::coverage_study \
   studies::plan::plan_study studies::operating::operating_interval_coverage_study
